@@ -1,0 +1,27 @@
+// Compiled by nvcc in CUDA builds (throng_kernel_sources), by g++ otherwise.
+#include "core/array_ops.h"
+
+#include "core/error.h"
+#include "core/reduce.h"
+
+namespace throng {
+
+void saxpy(float a, Span<const float> x, Span<float> y) {
+  if (x.size() != y.size()) throw Error("saxpy: x and y differ in length");
+  parallel_for("core.saxpy", x.size(), THRONG_LAMBDA(Index i) { y[i] = a * x[i] + y[i]; });
+}
+
+float sum(Span<const float> x) { return deterministic_sum("core.sum_f32", x); }
+double sum(Span<const double> x) { return deterministic_sum("core.sum_f64", x); }
+
+template <class T>
+static T scan_checked(Span<const T> in, Span<T> out) {
+  if (in.size() != out.size()) throw Error("exclusive_scan: input and output differ in length");
+  return exclusive_scan("core.exclusive_scan", in, out);
+}
+
+std::int32_t exclusive_scan(Span<const std::int32_t> in, Span<std::int32_t> out) { return scan_checked(in, out); }
+std::int64_t exclusive_scan(Span<const std::int64_t> in, Span<std::int64_t> out) { return scan_checked(in, out); }
+float exclusive_scan(Span<const float> in, Span<float> out) { return scan_checked(in, out); }
+
+}  // namespace throng

@@ -1,0 +1,53 @@
+// Per-kernel timing, collected by the description given to parallel_for.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace throng {
+
+struct KernelStat {
+  std::string name;
+  std::int64_t count = 0;
+  double total_ms = 0;
+  double median_ms = 0;  // over the most recent samples (see KernelTimings)
+  double min_ms = 0;
+  double max_ms = 0;
+};
+
+class KernelTimings {
+ public:
+  // Samples kept per kernel for the median; count and total stay exact.
+  static constexpr std::size_t kMaxSamples = 1 << 14;
+
+  static KernelTimings& global();
+  void record(std::string_view name, double ms);
+  std::vector<KernelStat> stats() const;  // by total time, largest first
+  std::string table() const;              // aligned text, one row per kernel
+  std::string json() const;               // [{"name":..,"count":..,...}]
+  void reset();
+
+ private:
+  KernelTimings() = default;
+};
+
+// Times a scope and records it under `name` when it ends.
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(const char* name) : name_(name), start_(std::chrono::steady_clock::now()) {}
+  ~ScopedTimer() {
+    const auto d = std::chrono::steady_clock::now() - start_;
+    KernelTimings::global().record(name_, std::chrono::duration<double, std::milli>(d).count());
+  }
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  const char* name_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace throng

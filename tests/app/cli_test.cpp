@@ -1,0 +1,84 @@
+// Runs the real throng executable and checks its exit codes and output.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <sys/wait.h>
+
+namespace {
+
+struct Result {
+  int code;
+  std::string out;  // stdout and stderr together
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(THRONG_EXE) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return {-1, "popen failed"};
+  std::string out;
+  std::array<char, 4096> buf;
+  std::size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::size_t lines(const std::string& s) {
+  std::size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+}  // namespace
+
+TEST(Cli, VersionAndHelp) {
+  auto r = run("version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind("throng ", 0), 0u) << r.out;
+  for (const char* sub : {"run", "bench", "info", "version"}) {
+    r = run(std::string(sub) + " --help");
+    EXPECT_EQ(r.code, 0) << sub;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub << ": " << r.out;
+  }
+}
+
+TEST(Cli, BadArgumentsGiveOneLineErrorAndNonZeroExit) {
+  for (const char* args : {"frobnicate", "--backend gpu info", "--threads -3 info", "bench --no-such-flag", ""}) {
+    const auto r = run(args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_EQ(lines(r.out), 1u) << "'" << args << "' printed:\n" << r.out;
+    EXPECT_NE(r.out.find("error"), std::string::npos) << r.out;
+  }
+}
+
+TEST(Cli, InfoJson) {
+  const auto r = run("--backend cpu --log-level off info --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["backend"], "cpu");
+  EXPECT_GE(j["hardware_threads"].get<int>(), 1);
+}
+
+TEST(Cli, BenchQuickWritesJsonRows) {
+  const auto path = std::filesystem::temp_directory_path() / "throng_cli_bench.json";
+  const auto r = run("--backend cpu bench --quick --filter 'core/saxpy/cpu/n=1000/' --json " + path.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream in(path);
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_TRUE(j["benchmarks"].is_array());
+  ASSERT_GE(j["benchmarks"].size(), 1u);
+  for (const auto& row : j["benchmarks"]) {
+    EXPECT_EQ(row["name"], "core/saxpy");
+    EXPECT_EQ(row["N"], 1000);
+    EXPECT_GE(row["threads"].get<int>(), 1);
+    EXPECT_GT(row["median_ns"].get<double>(), 0);
+    EXPECT_GT(row["items_per_second"].get<double>(), 0);
+  }
+  std::filesystem::remove(path);
+}
