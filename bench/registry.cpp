@@ -19,6 +19,21 @@ struct CaseMeta {
   Index n;
   int threads;
 };
+std::vector<std::pair<std::string, SuiteFn>>& suites() {
+  static std::vector<std::pair<std::string, SuiteFn>> s;
+  return s;
+}
+
+// Every suite, once per process (Google Benchmark keeps registrations).
+void register_all(const Options& options) {
+  static bool done = false;
+  if (done) return;
+  done = true;
+  auto list = suites();
+  std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [name, fn] : list) fn(options);
+}
+
 std::map<std::string, CaseMeta>& metas() {
   static std::map<std::string, CaseMeta> m;
   return m;
@@ -65,6 +80,11 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
   }
 };
 }  // namespace
+
+bool register_suite(const char* name, SuiteFn fn) {
+  suites().emplace_back(name, fn);
+  return true;
+}
 
 void add(const Options& options, CaseSpec spec) {
   for (Index n : spec.sizes) {

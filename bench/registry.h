@@ -35,10 +35,11 @@ struct CaseSpec {
 };
 void add(const Options& options, CaseSpec spec);
 
-// Each family's suite (bench/<family>/...).
-void register_core(const Options& options);
-// Every suite; called once per process.
-void register_all(const Options& options);
+// A suite registers itself from its own file (bench/<family>/*_bench.cpp):
+//   static const bool registered = throng::bench::register_suite("core", &register_core);
+// The suites are linked as an object library, so no registration is dropped.
+using SuiteFn = void (*)(const Options& options);
+bool register_suite(const char* name, SuiteFn fn);
 
 struct Row {
   std::string name;

@@ -2,11 +2,12 @@
 #include <vector>
 
 #include "bench/registry.h"
-#include "core/array_ops.h"
+#include "core/array_kernels.h"
 #include "core/buffer.h"
 
 namespace throng::bench {
 
+namespace {
 void register_core(const Options& options) {
   const std::vector<Index> sizes = {1000, 100000, 1000000, 10000000};
   add(options, {"core/saxpy", sizes,
@@ -33,5 +34,9 @@ void register_core(const Options& options) {
                 },
                 true});
 }
+
+}  // namespace
+
+static const bool registered = register_suite("core", &register_core);
 
 }  // namespace throng::bench

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <random>
 
-#include "core/array_ops.h"
+#include "core/array_kernels.h"
 #include "core/buffer.h"
 #include "core/error.h"
 

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "core/array_ops.h"
+#include "core/array_kernels.h"
 
 namespace throng {
 

@@ -1,5 +1,5 @@
 // Compiled by nvcc in CUDA builds (throng_kernel_sources), by g++ otherwise.
-#include "core/array_ops.h"
+#include "core/array_kernels.h"
 
 #include "core/error.h"
 #include "core/reduce.h"

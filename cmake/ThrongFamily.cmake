@@ -1,0 +1,23 @@
+# throng_family(name DEPENDS lib...): the library throng_<name> from every
+# src/<name>/*.cpp, and the test executable <name>_tests from every
+# tests/<name>/*_test.cpp. Sources named *_kernels.cpp hold parallel_for
+# bodies that must also run on the GPU: CUDA builds compile them with nvcc.
+function(throng_family name)
+  cmake_parse_arguments(F "" "" "DEPENDS;TEST_DEPENDS" ${ARGN})
+  set(dir ${PROJECT_SOURCE_DIR}/src/${name})
+  file(GLOB sources CONFIGURE_DEPENDS ${dir}/*.cpp)
+  file(GLOB kernels CONFIGURE_DEPENDS ${dir}/*_kernels.cpp)
+  if(kernels)
+    throng_kernel_sources(${kernels})
+  endif()
+  add_library(throng_${name} ${sources})
+  target_include_directories(throng_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(throng_${name} PUBLIC ${F_DEPENDS})
+  throng_setup_target(throng_${name})
+
+  file(GLOB tests CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/tests/${name}/*_test.cpp)
+  if(tests AND THRONG_TESTS)
+    throng_test(${name}_tests ${tests} LIBS throng_${name} ${F_TEST_DEPENDS})
+    target_include_directories(${name}_tests PRIVATE ${PROJECT_SOURCE_DIR})
+  endif()
+endfunction()

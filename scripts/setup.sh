@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs throng's dependencies from Debian's packages (idempotent, quiet when
+# nothing is missing), then configures and builds a Release build.
+#   bash scripts/setup.sh            # deps + build/release
+#   bash scripts/setup.sh --deps     # deps only
+#   BUILD_DIR=build/x CMAKE_ARGS="-DTHRONG_SANITIZE=ON" bash scripts/setup.sh
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+
+mapfile -t wanted < <(grep -v '^\s*#' scripts/packages.txt | sed '/^\s*$/d')
+missing=()
+for p in "${wanted[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${#missing[@]} package(s): ${missing[*]}"
+  sudo_cmd=""
+  [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo_cmd apt-get update -qq
+  $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+[ "${1:-}" = "--deps" ] && exit 0
+
+build_dir=${BUILD_DIR:-build/release}
+jobs=${JOBS:-$(nproc)}
+extra=()
+[ "${CI:-}" = "true" ] && extra+=(-DTHRONG_WERROR=ON)
+# shellcheck disable=SC2206
+extra+=(${CMAKE_ARGS:-})
+if [ ! -f "$build_dir/build.ninja" ]; then
+  cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" "${extra[@]}" >/dev/null
+fi
+echo "setup: building $build_dir"
+cmake --build "$build_dir" -j "$jobs" -- --quiet
