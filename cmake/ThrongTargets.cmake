@@ -24,7 +24,7 @@ endfunction()
 # compiled by nvcc so the same lambda becomes a CUDA kernel.
 function(throng_kernel_sources)
   if(THRONG_CUDA)
-    set_source_files_properties(${ARGN} DIRECTORY ${CMAKE_SOURCE_DIR} PROPERTIES LANGUAGE CUDA)
+    set_source_files_properties(${ARGN} PROPERTIES LANGUAGE CUDA)
   endif()
 endfunction()
 
