@@ -33,6 +33,8 @@ int main(int argc, char** argv) {
   add_run_command(app, g);
   add_bench_command(app, g);
   add_info_command(app, g);
+  add_convert_command(app, g);
+  add_export_command(app, g);
   add_version_command(app);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,66 @@
+#include "motion/foot_skating.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+
+namespace throng::motion {
+
+FootSkatingReport measure_foot_skating(const ModelSpaceClip& m, const ContactReport& contacts, const FeetJoints& feet) {
+  const std::int32_t F = m.frame_count;
+  FootSkatingReport r;
+  for (int f = 0; f < 2; ++f) {
+    const FootContacts& fc = contacts.feet[static_cast<std::size_t>(f)];
+    const auto raw = foot_tracks(m, feet, f, 0);
+    const std::int32_t k = contacts.smoothing_frames;
+    for (const ContactInterval& c : fc.intervals) {
+      if (c.begin < 0 || c.end > F || c.begin >= c.end) throw Error("foot skating: contact interval outside the clip");
+      // Smoothed inside the contact only (mocap jitter would otherwise add up
+      // along the path, and the swing must not leak in).
+      auto smoothed = [&](std::size_t p, std::int32_t i) {
+        const std::int32_t half = std::min({k, i - c.begin, c.end - 1 - i});
+        glm::dvec3 sum(0.0);
+        for (std::int32_t d = -half; d <= half; ++d) sum += glm::dvec3(raw[p][static_cast<std::size_t>(i + d)]);
+        return sum / static_cast<double>(2 * half + 1);
+      };
+      double slide = 0.0;
+      for (std::int32_t i = c.begin; i + 1 < c.end; ++i) {
+        double low_min = std::numeric_limits<double>::infinity(), any_min = low_min;
+        for (std::size_t p = 0; p < 2; ++p) {
+          if (raw[p].empty()) continue;
+          const glm::dvec3 p0 = smoothed(p, i);
+          const glm::dvec3 p1 = smoothed(p, i + 1);
+          const double d = std::hypot(p1.x - p0.x, p1.z - p0.z);
+          any_min = std::min(any_min, d);
+          const double ground = fc.ground[p];
+          if (p0.y - ground < contacts.height_threshold && p1.y - ground < contacts.height_threshold) low_min = std::min(low_min, d);
+        }
+        slide += std::isfinite(low_min) ? low_min : (std::isfinite(any_min) ? any_min : 0.0);
+      }
+      r.slides_cm.push_back(100.0 * slide);
+    }
+  }
+  r.contacts = static_cast<std::int32_t>(r.slides_cm.size());
+  if (r.contacts == 0) return r;
+  std::vector<double> sorted = r.slides_cm;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0;
+  for (double s : sorted) sum += s;
+  r.mean_cm = sum / static_cast<double>(sorted.size());
+  const auto rank = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(sorted.size())));
+  r.p95_cm = sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
+  r.max_cm = sorted.back();
+  return r;
+}
+
+FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options) {
+  const FeetJoints feet = FeetJoints::from_roles(skeleton);
+  const ModelSpaceClip m = forward_kinematics(skeleton, clip);
+  const ContactReport contacts = detect_foot_contacts(skeleton, m, clip.frame_time, feet, options);
+  return measure_foot_skating(m, contacts, feet);
+}
+
+}  // namespace throng::motion

@@ -1,0 +1,173 @@
+// `throng info FILE.bvh --json` and `throng convert` run as a user runs them.
+// The executable is looked up next to this test's build folder; the tests
+// skip when it is absent (build the `throng` target) or ../shared is.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+#include "io/bvh_reader.h"
+#include "motion/fk.h"
+
+namespace throng::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::optional<fs::path> find_throng() {
+  std::error_code ec;
+  fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
+  for (int up = 0; up < 3 && !ec; ++up, dir = dir.parent_path())
+    if (fs::is_regular_file(dir / "throng")) return dir / "throng";
+  return std::nullopt;
+}
+
+struct Result {
+  int code;
+  std::string out;
+};
+Result run(const fs::path& exe, const std::string& args, bool with_stderr = true) {
+  const std::string cmd = exe.string() + " --backend cpu --log-level warn " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return {-1, "popen failed"};
+  std::string out;
+  std::array<char, 4096> buf;
+  std::size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::optional<fs::path> shared_bvh_dir() {
+  const char* dir = std::getenv("THRONG_SHARED_DIR");
+  if (dir == nullptr || !fs::is_directory(fs::path(dir) / "data" / "bvh")) return std::nullopt;
+  return fs::path(dir) / "data" / "bvh";
+}
+
+#define REQUIRE_EXE_AND_SHARED(exe, dir)                                                       \
+  const auto exe = find_throng();                                                              \
+  if (!exe) GTEST_SKIP() << "throng executable not found near this test (build target throng)"; \
+  const auto dir = shared_bvh_dir();                                                           \
+  if (!dir) GTEST_SKIP() << "../shared not found: THRONG_SHARED_DIR is unset or has no data/bvh"
+
+// Header facts read without the reader.
+struct Header {
+  int joints = 0;
+  long frames = -1;
+  double frame_time = -1;
+};
+Header read_header(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  Header h;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string first;
+    words >> first;
+    if (first == "ROOT" || first == "JOINT") ++h.joints;
+    if (first == "Frames:") words >> h.frames;
+    if (first == "Frame") {
+      std::string time;
+      words >> time >> h.frame_time;
+      break;
+    }
+  }
+  return h;
+}
+
+TEST(BvhCli, InfoJsonMatchesEveryHeader) {
+  REQUIRE_EXE_AND_SHARED(exe, dir);
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(*dir)) {
+    if (e.path().extension() != ".bvh") continue;
+    ++files;
+    const Result r = run(*exe, "info " + e.path().string() + " --json", false);
+    ASSERT_EQ(r.code, 0) << r.out;
+    const auto j = nlohmann::json::parse(r.out);
+    const Header h = read_header(e.path());
+    EXPECT_EQ(j["joints"].get<int>(), h.joints) << e.path();
+    EXPECT_EQ(j["frames"].get<long>(), h.frames) << e.path();
+    EXPECT_EQ(j["frame_time"].get<double>(), h.frame_time) << e.path();
+    EXPECT_NEAR(j["duration"].get<double>(), h.frames * h.frame_time, 1e-9);
+    EXPECT_TRUE(j["units"]["detected"].get<bool>());
+    EXPECT_EQ(j["skeleton"].size(), static_cast<std::size_t>(h.joints));
+    EXPECT_FALSE(j["roles"]["left_knee"].is_null());
+    ASSERT_TRUE(j.contains("cycle"));
+    if (e.path().filename().string().find("_walk_") != std::string::npos) {  // a walk has a gait cycle
+      ASSERT_TRUE(j["cycle"].is_object()) << e.path();
+      EXPECT_GT(j["cycle"].value("period_s", 0.0), 0.3) << j["cycle"];
+    }
+  }
+  EXPECT_GT(files, 0);
+}
+
+TEST(BvhCli, InfoTextAndOptions) {
+  REQUIRE_EXE_AND_SHARED(exe, dir);
+  const std::string file = (*dir / "cmu_02_01_walk_mb.bvh").string();
+  Result r = run(*exe, "info " + file);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("joints       31 (7 end sites), 96 channels"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cmu (detected)"), std::string::npos) << r.out;
+  r = run(*exe, "info " + file + " --json --units cm --role left_knee=LeftFoot", false);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["units"]["unit"], "cm");
+  EXPECT_FALSE(j["units"]["detected"].get<bool>());
+  EXPECT_EQ(j["roles"]["left_knee"], "LeftFoot");
+}
+
+TEST(BvhCli, ConvertRoundTripsAndNormalises) {
+  REQUIRE_EXE_AND_SHARED(exe, dir);
+  const fs::path in = *dir / "cmu_131_02_start_walk_stop_max.bvh";  // mixed orders, CMU units
+  const fs::path out = fs::temp_directory_path() / "throng_bvh_cli_convert.bvh";
+  const Result r = run(*exe, "convert " + in.string() + " " + out.string() + " --order YXZ --units m");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const BvhFile a = read_bvh(in.string());
+  BvhReadOptions metres;
+  metres.unit = motion::LengthUnit::Metre;
+  const BvhFile b = read_bvh(out.string(), metres);
+  fs::remove(out);
+  for (std::int32_t jn = 0; jn < b.skeleton.joint_count(); ++jn) EXPECT_EQ(b.rotation_order(jn), "YXZ");
+  EXPECT_EQ(b.frame_time, a.frame_time);
+  const auto ma = motion::forward_kinematics(a.skeleton, a.clip);
+  const auto mb = motion::forward_kinematics(b.skeleton, b.clip);
+  ASSERT_EQ(ma.positions.size(), mb.positions.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < ma.positions.size(); ++i) worst = std::max(worst, static_cast<double>(glm::length(ma.positions[i] - mb.positions[i])));
+  EXPECT_LT(worst, 1e-4);
+}
+
+std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+TEST(BvhCli, ErrorsAreOneLineWithNonZeroExit) {
+  const auto exe = find_throng();
+  if (!exe) GTEST_SKIP() << "throng executable not found near this test (build target throng)";
+  const fs::path bad = fs::path(__FILE__).parent_path().parent_path() / "data" / "bvh_bad" / "nan_value.bvh";
+  const fs::path tmp = fs::temp_directory_path() / "throng_bvh_cli_out.bvh";
+  const std::vector<std::string> cases = {"info /nonexistent/x.bvh", "info " + bad.string(), "info README.md",
+                                  "convert " + bad.string() + " " + tmp.string(), "convert a.bvh b.bvh --order QQQ",
+                                  "convert a.bvh b.bvh --units parsec", "info x.bvh --units furlong", "info x.bvh --role elbow=X",
+                                  "convert onlyone.bvh"};
+  for (const std::string& args : cases) {
+    const Result r = run(*exe, args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_EQ(lines(r.out), 1u) << args << " printed:\n" << r.out;
+    EXPECT_NE(r.out.find("error"), std::string::npos) << r.out;
+  }
+  const Result r = run(*exe, "info " + bad.string());
+  EXPECT_NE(r.out.find("nan_value.bvh:26:"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(tmp));
+}
+
+}  // namespace
+}  // namespace throng::io
