@@ -1,0 +1,191 @@
+// LOD kernels: compiled by nvcc in CUDA builds, by g++ otherwise.
+#include "anim/lod.h"
+#include "anim/motion_cache.h"
+#include "anim/sphere_projection.h"
+#include "core/error.h"
+#include "core/parallel.h"
+
+namespace throng::anim {
+
+namespace {
+
+// Plain arrays travel into kernels by value; std::array's members are host-only in CUDA.
+struct Anchors {
+  SphereAnchor a[kBodyPartCount];
+};
+struct Templates {
+  glm::vec4 s[kBodyPartCount];
+};
+
+// A joint's rotation between two clip frames: the evaluator of masked_pose.
+struct ClipBetweenFrames {
+  const glm::quat* a;
+  const glm::quat* b;
+  float t;
+  THRONG_HOST_DEVICE glm::quat operator()(std::int32_t joint) const { return glm::slerp(a[joint], b[joint], t); }
+};
+
+constexpr Index kHistogramBlock = 4096;
+
+}  // namespace
+
+void LodSpheresJob::run() const {
+  validate();
+  Anchors anchor_table{};
+  for (int p = 0; p < kBodyPartCount; ++p) anchor_table.a[p] = anchors[static_cast<std::size_t>(p)];
+  const std::int32_t J = joint_count;
+  const auto positions = joint_positions;
+  const auto scale = scales;
+  const auto out = spheres;
+  parallel_for(
+      "anim.lod_spheres", character_count(),
+      THRONG_LAMBDA(Index c) {
+        const glm::vec3* joints = positions.data() + c * J;
+        const float s = scale.empty() ? 1.0f : scale[c];
+        for (int p = 0; p < kBodyPartCount; ++p)
+          out[c * kBodyPartCount + p] = glm::vec4(anchor_centre(anchor_table.a[p], joints), s * anchor_table.a[p].radius);
+      },
+      256);
+}
+
+void LodJob::run() const {
+  validate();
+  Templates tmpl{};
+  for (int p = 0; p < kBodyPartCount; ++p) tmpl.s[p] = template_spheres[static_cast<std::size_t>(p)];
+  const CameraView cam = camera;
+  const bool from_roots = spheres.empty();
+  const bool cull = cull_outside_view;
+  const std::int32_t L = level_count;
+  const std::int32_t W = mask_words;
+  const auto given = spheres;
+  const auto positions = root_positions;
+  const auto headings = root_headings;
+  const auto scales = root_scales;
+  const auto thr = thresholds;
+  const auto masks = part_masks;
+  const auto out_levels = levels;
+  const auto out_masks = joint_masks;
+  const auto out_coverage = coverage;
+  parallel_for(
+      "anim.lod", character_count(),
+      THRONG_LAMBDA(Index c) {
+        float cos_h = 1.0f, sin_h = 0.0f, scale = 1.0f;
+        glm::vec3 root(0.0f);
+        if (from_roots) {
+          cos_h = glm::cos(headings[c]);
+          sin_h = glm::sin(headings[c]);
+          scale = scales.empty() ? 1.0f : scales[c];
+          root = positions[c];
+        }
+        int level_of[kBodyPartCount];
+        for (int p = 0; p < kBodyPartCount; ++p) {
+          glm::vec4 s;
+          if (from_roots) {
+            // Rotation about +Y by the heading, then scale, then translation.
+            const glm::vec4 t = tmpl.s[p];
+            const glm::vec3 turned(cos_h * t.x + sin_h * t.z, t.y, -sin_h * t.x + cos_h * t.z);
+            s = glm::vec4(root + scale * turned, scale * t.w);
+          } else {
+            s = given[c * kBodyPartCount + p];
+          }
+          const float area = sphere_pixel_coverage(to_camera_space(cam, glm::vec3(s)), s.w, cam, cull);
+          const float* part_thresholds = thr.data() + p * (L - 1);
+          int level = 0;
+          while (level < L - 1 && !(area >= part_thresholds[level])) ++level;
+          level_of[p] = level;
+          out_levels[c * kBodyPartCount + p] = static_cast<std::uint8_t>(level);
+          if (!out_coverage.empty()) out_coverage[c * kBodyPartCount + p] = area;
+        }
+        // Parts partition the joints, so the union is a plain OR.
+        for (std::int32_t w = 0; w < W; ++w) {
+          std::uint32_t bits = 0u;
+          for (int p = 0; p < kBodyPartCount; ++p) bits |= masks[(static_cast<Index>(p) * L + level_of[p]) * W + w];
+          out_masks[c * W + w] = bits;
+        }
+      },
+      256);
+}
+
+LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint32_t> joint_masks, std::int32_t level_count,
+                           std::int32_t joint_count) {
+  if (level_count < 1 || level_count > kMaxLodLevels)
+    throw Error("must be in [1, " + std::to_string(kMaxLodLevels) + "]", at_field("lod_histogram.level_count"));
+  if (joint_count < 1 || joint_count > kMaxLodJoints)
+    throw Error("must be in [1, " + std::to_string(kMaxLodJoints) + "]", at_field("lod_histogram.joint_count"));
+  if (levels.size() % kBodyPartCount != 0) throw Error("size must be a multiple of 5", at_field("lod_histogram.levels"));
+  const Index n = levels.size() / kBodyPartCount;
+  const std::int32_t W = mask_word_count(joint_count);
+  if (joint_masks.size() != n * W)
+    throw Error("has " + std::to_string(joint_masks.size()) + " words, expected " + std::to_string(n * W),
+                at_field("lod_histogram.joint_masks"));
+
+  LodHistogram h;
+  h.level_count = level_count;
+  h.joint_count = joint_count;
+  h.characters = n;
+  h.level_counts.assign(static_cast<std::size_t>(kBodyPartCount * level_count), 0);
+  h.joints_synthesised.assign(static_cast<std::size_t>(joint_count) + 1, 0);
+  if (n == 0) return h;
+
+  // Each block of characters counts into its own row; rows are summed in
+  // order on the host. Integer counts: the same for any thread count.
+  const Index row = static_cast<Index>(kBodyPartCount) * level_count + joint_count + 1;
+  const Index blocks = (n + kHistogramBlock - 1) / kHistogramBlock;
+  Buffer<Index> partial(blocks * row, current_memory());
+  const auto rows = partial.span();
+  const std::int32_t L = level_count;
+  const std::int32_t J = joint_count;
+  parallel_for(
+      "anim.lod_histogram", blocks,
+      THRONG_LAMBDA(Index b) {
+        Index* counts = rows.data() + b * row;
+        for (Index i = 0; i < row; ++i) counts[i] = 0;
+        const Index end = (b + 1) * kHistogramBlock < n ? (b + 1) * kHistogramBlock : n;
+        for (Index c = b * kHistogramBlock; c < end; ++c) {
+          for (int p = 0; p < kBodyPartCount; ++p) {
+            const int level = levels[c * kBodyPartCount + p];
+            ++counts[p * L + (level < L ? level : L - 1)];
+          }
+          std::int32_t k = 0;
+          for (std::int32_t w = 0; w < W; ++w) k += popcount32(joint_masks[c * W + w]);
+          ++counts[kBodyPartCount * L + (k < J ? k : J)];
+        }
+      },
+      1);
+  const std::vector<Index> all = partial.to_vector();
+  for (Index b = 0; b < blocks; ++b) {
+    const Index* counts = all.data() + b * row;
+    for (int i = 0; i < kBodyPartCount * L; ++i) h.level_counts[static_cast<std::size_t>(i)] += counts[i];
+    for (std::int32_t k = 0; k <= J; ++k) h.joints_synthesised[static_cast<std::size_t>(k)] += counts[kBodyPartCount * L + k];
+  }
+  for (std::int32_t k = 0; k <= J; ++k) h.total_joints_synthesised += k * h.joints_synthesised[static_cast<std::size_t>(k)];
+  return h;
+}
+
+void MaskedPoseJob::run() const {
+  validate();
+  const std::int32_t J = joint_count;
+  const std::int32_t W = mask_word_count(joint_count);
+  const std::int32_t F = frame_count;
+  const auto P = parents;
+  const auto O = offsets;
+  const auto clip = clip_rotations;
+  const auto held = held_rotations;
+  const auto phase = phases;
+  const auto roots = root_positions;
+  const auto masks = joint_masks;
+  const auto outP = out_positions;
+  const auto outR = out_rotations;
+  const auto count = evaluated;
+  parallel_for(
+      "anim.masked_pose", character_count(),
+      THRONG_LAMBDA(Index c) {
+        const CyclePoint at = cycle_point(F, phase[c]);
+        const ClipBetweenFrames evaluate{clip.data() + static_cast<Index>(at.f0) * J, clip.data() + static_cast<Index>(at.f1) * J, at.t};
+        count[c] = masked_pose(J, P.data(), O.data(), masks.data() + c * W, evaluate, held.empty() ? nullptr : held.data(),
+                               roots[c], outP.data() + c * J, outR.data() + c * J);
+      },
+      64);
+}
+
+}  // namespace throng::anim

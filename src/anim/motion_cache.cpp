@@ -1,0 +1,185 @@
+#include "anim/motion_cache.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+
+namespace throng::anim {
+
+void CachedCycle::validate() const {
+  if (frame_count <= 0) throw Error("must be positive", at_field("cycle.frame_count"));
+  if (joint_count <= 0) throw Error("must be positive", at_field("cycle.joint_count"));
+  const std::size_t want = static_cast<std::size_t>(frame_count) * static_cast<std::size_t>(joint_count);
+  if (rotations.size() != want)
+    throw Error("has " + std::to_string(rotations.size()) + " rotations, expected " + std::to_string(want),
+                at_field("cycle.rotations"));
+  if (!(std::isfinite(duration) && duration > 0.0f)) throw Error("must be positive and finite", at_field("cycle.duration"));
+}
+
+double rotation_angle_deg(const glm::quat& a, const glm::quat& b) {
+  // In double, from the relative rotation's vector and scalar parts: accurate
+  // near 0 degrees, where acos of a dot product loses every digit.
+  const glm::dquat r = glm::inverse(glm::dquat(a)) * glm::dquat(b);
+  const double v = std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z);
+  return 2.0 * std::atan2(v, std::abs(r.w)) * (180.0 / 3.14159265358979323846);
+}
+
+void MotionCacheConfig::validate() const {
+  if (!(std::isfinite(bucket_width) && bucket_width >= 1e-4f && bucket_width <= 1.0f))
+    throw Error("must be in [0.0001, 1], got " + std::to_string(bucket_width), at_field("motion_cache.bucket_width"));
+}
+
+MotionCache::MotionCache(MotionCacheConfig config) : config_(config) {
+  config_.validate();
+  // Guard against 1 / 0.05 = 20.000000000000004 making a 21st empty bucket.
+  bucket_count_ = std::max(1, static_cast<std::int32_t>(std::ceil(1.0 / static_cast<double>(config_.bucket_width) - 1e-6)));
+}
+
+std::int32_t MotionCache::bucket_of(float w) const {
+  if (!(w > 0.0f)) return 0;  // also NaN
+  const auto b = static_cast<std::int32_t>(std::floor(static_cast<double>(std::min(w, 1.0f)) / config_.bucket_width));
+  return std::min(b, bucket_count_ - 1);
+}
+
+float MotionCache::bucket_centre(std::int32_t bucket) const {
+  const double lo = static_cast<double>(bucket) * config_.bucket_width;
+  const double hi = std::min(1.0, static_cast<double>(bucket + 1) * config_.bucket_width);
+  return static_cast<float>(0.5 * (lo + hi));
+}
+
+const CachedCycle* MotionCache::find(float w, std::uint32_t state) {
+  const auto it = entries_.find(key(state, bucket_of(w)));
+  if (it == entries_.end()) {
+    ++stats_.misses;
+    return nullptr;
+  }
+  ++stats_.hits;
+  return it->second.get();
+}
+
+bool MotionCache::contains(std::int32_t bucket, std::uint32_t state) const { return entries_.count(key(state, bucket)) != 0; }
+
+void MotionCache::erase(std::uint64_t k) {
+  const auto it = entries_.find(k);
+  if (it == entries_.end()) return;
+  stats_.bytes -= it->second->bytes();
+  entries_.erase(it);
+  order_.erase(std::find(order_.begin(), order_.end(), k));
+  stats_.entries = entries_.size();
+}
+
+const CachedCycle* MotionCache::insert(std::int32_t bucket, CachedCycle cycle, std::uint32_t state) {
+  if (bucket < 0 || bucket >= bucket_count_)
+    throw Error("bucket " + std::to_string(bucket) + " is not in [0, " + std::to_string(bucket_count_) + ")",
+                at_field("motion_cache.bucket"));
+  cycle.validate();
+  const std::size_t size = cycle.bytes();
+  const std::uint64_t k = key(state, bucket);
+  erase(k);  // a replacement is a new entry, not an eviction
+  if (size > config_.capacity_bytes) {
+    ++stats_.rejected;
+    return nullptr;
+  }
+  while (stats_.bytes + size > config_.capacity_bytes) {
+    erase(order_.front());
+    ++stats_.evictions;
+  }
+  auto stored = std::make_unique<CachedCycle>(std::move(cycle));
+  const CachedCycle* out = stored.get();
+  entries_.emplace(k, std::move(stored));
+  order_.push_back(k);
+  stats_.bytes += size;
+  stats_.entries = entries_.size();
+  ++stats_.insertions;
+  return out;
+}
+
+const CachedCycle& MotionCache::get(float w, const Synthesise& synthesise, std::uint32_t state) {
+  if (const CachedCycle* hit = find(w, state)) return *hit;
+  const std::int32_t b = bucket_of(w);
+  CachedCycle cycle = synthesise(bucket_centre(b));
+  cycle.validate();
+  if (cycle.bytes() > config_.capacity_bytes) {
+    ++stats_.rejected;
+    uncached_ = std::move(cycle);
+    return uncached_;
+  }
+  return *insert(b, std::move(cycle), state);
+}
+
+void MotionCache::sample(float w, float phase, const Synthesise& synthesise, Span<glm::quat> out, std::uint32_t state) {
+  const CachedCycle& cycle = get(w, synthesise, state);
+  if (out.size() != cycle.joint_count)
+    throw Error("has " + std::to_string(out.size()) + " rotations, the cycle " + std::to_string(cycle.joint_count) + " joints",
+                at_field("motion_cache.sample.out"));
+  sample_cycle(cycle, phase, out.data());
+}
+
+void MotionCache::reset_counters() {
+  stats_.hits = stats_.misses = stats_.insertions = stats_.evictions = stats_.rejected = 0;
+}
+
+void MotionCache::clear() {
+  entries_.clear();
+  order_.clear();
+  stats_.bytes = 0;
+  stats_.entries = 0;
+}
+
+std::vector<std::pair<std::uint32_t, std::int32_t>> MotionCache::fifo_order() const {
+  std::vector<std::pair<std::uint32_t, std::int32_t>> out;
+  for (std::uint64_t k : order_) out.emplace_back(static_cast<std::uint32_t>(k >> 32), static_cast<std::int32_t>(k & 0xffffffffu));
+  return out;
+}
+
+QuantisationError measure_quantisation_error(const MotionCacheConfig& config, const MotionCache::Synthesise& synthesise,
+                                             std::int32_t w_samples, std::int32_t phase_samples) {
+  if (w_samples < 1 || w_samples > 100000) throw Error("must be in [1, 100000]", at_field("quantisation_error.w_samples"));
+  if (phase_samples < 1 || phase_samples > 100000)
+    throw Error("must be in [1, 100000]", at_field("quantisation_error.phase_samples"));
+  const MotionCache buckets(config);  // for the bucket arithmetic only
+  QuantisationError e;
+  double sum = 0.0;
+  Index terms = 0;
+  std::unordered_map<std::int32_t, CachedCycle> bucket_cycles;
+  std::vector<glm::quat> cached, exact;
+  for (std::int32_t i = 0; i < w_samples; ++i) {
+    const float w = w_samples == 1 ? 0.5f : static_cast<float>(i) / static_cast<float>(w_samples - 1);
+    const std::int32_t b = buckets.bucket_of(w);
+    auto it = bucket_cycles.find(b);
+    if (it == bucket_cycles.end()) {
+      it = bucket_cycles.emplace(b, synthesise(buckets.bucket_centre(b))).first;
+      it->second.validate();
+    }
+    const CachedCycle& from_bucket = it->second;
+    const CachedCycle at_w = synthesise(w);
+    at_w.validate();
+    if (at_w.joint_count != from_bucket.joint_count)
+      throw Error("synthesis gave cycles with different joint counts", at_field("quantisation_error.synthesise"));
+    cached.resize(static_cast<std::size_t>(at_w.joint_count));
+    exact.resize(static_cast<std::size_t>(at_w.joint_count));
+    for (std::int32_t k = 0; k < phase_samples; ++k) {
+      const float phase = static_cast<float>(k) / static_cast<float>(phase_samples);
+      sample_cycle(from_bucket, phase, cached.data());
+      sample_cycle(at_w, phase, exact.data());
+      for (std::int32_t j = 0; j < at_w.joint_count; ++j) {
+        const double a = rotation_angle_deg(cached[static_cast<std::size_t>(j)], exact[static_cast<std::size_t>(j)]);
+        sum += a;
+        ++terms;
+        if (a > e.max_deg) {
+          e.max_deg = a;
+          e.worst_w = w;
+          e.worst_phase = phase;
+          e.worst_joint = j;
+        }
+      }
+      ++e.samples;
+    }
+  }
+  e.mean_deg = terms > 0 ? sum / static_cast<double>(terms) : 0.0;
+  return e;
+}
+
+}  // namespace throng::anim
