@@ -1,0 +1,352 @@
+#include "sim/crowd.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numeric>
+#include <unordered_map>
+
+#include "core/error.h"
+#include "sim/random.h"
+
+namespace throng::sim {
+
+namespace {
+
+constexpr double kPi = 3.141592653589793;
+
+Aabb region_bounds(const Region& r) {
+  Aabb b;
+  switch (r.kind) {
+    case Region::Kind::rect:
+      b.add(r.min);
+      b.add(r.max);
+      break;
+    case Region::Kind::disc:
+    case Region::Kind::ring:
+      b.add(r.center - glm::vec2(r.radius));
+      b.add(r.center + glm::vec2(r.radius));
+      break;
+    case Region::Kind::polygon: b = bounds(r.polygon); break;
+  }
+  return b;
+}
+
+bool region_contains(const Region& r, glm::vec2 p) {
+  switch (r.kind) {
+    case Region::Kind::rect: return p.x >= r.min.x && p.x <= r.max.x && p.y >= r.min.y && p.y <= r.max.y;
+    case Region::Kind::disc: return length2(p - r.center) <= r.radius * r.radius;
+    case Region::Kind::ring: return false;
+    case Region::Kind::polygon: return point_in_polygon(p, r.polygon);
+  }
+  return false;
+}
+
+void check_region(const Region& r, const std::string& field, float max_extent) {
+  auto finite = [&](glm::vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::fabs(p.x) <= max_extent && std::fabs(p.y) <= max_extent; };
+  switch (r.kind) {
+    case Region::Kind::rect:
+      if (!finite(r.min) || !finite(r.max)) throw Error("rect corners must be finite numbers within the extent limit", at_field(field + ".rect"));
+      if (!(r.max.x > r.min.x && r.max.y > r.min.y)) throw Error("rect needs max > min in x and y", at_field(field + ".rect"));
+      break;
+    case Region::Kind::disc:
+    case Region::Kind::ring:
+      if (!finite(r.center)) throw Error("center must be finite numbers within the extent limit", at_field(field));
+      if (!std::isfinite(r.radius) || r.radius < 0 || r.radius > max_extent) throw Error("radius must be >= 0", at_field(field + ".radius"));
+      if (r.kind == Region::Kind::disc && !(r.radius > 0)) throw Error("disc radius must be > 0", at_field(field + ".radius"));
+      if (!std::isfinite(r.spacing) || r.spacing < 0 || r.spacing > max_extent) throw Error("spacing must be >= 0", at_field(field + ".spacing"));
+      break;
+    case Region::Kind::polygon:
+      if (r.polygon.outer.size() < 3) throw Error("polygon needs at least 3 vertices", at_field(field + ".polygon"));
+      for (glm::vec2 p : r.polygon.outer)
+        if (!finite(p)) throw Error("polygon vertices must be finite numbers within the extent limit", at_field(field + ".polygon"));
+      if (find_self_intersection(r.polygon.outer)) throw Error("spawn polygon is self-intersecting", at_field(field + ".polygon"));
+      break;
+  }
+}
+
+// Agents already placed, for overlap tests across groups.
+class Occupancy {
+ public:
+  explicit Occupancy(float cell) : cell_(cell) {}
+  bool overlaps(glm::vec2 p, float r, float gap) const {
+    const std::int32_t cx = cell_coord(p.x, cell_), cy = cell_coord(p.y, cell_);
+    for (std::int32_t dy = -1; dy <= 1; ++dy)
+      for (std::int32_t dx = -1; dx <= 1; ++dx) {
+        auto it = cells_.find(cell_key(cx + dx, cy + dy));
+        if (it == cells_.end()) continue;
+        for (const auto& [q, rq] : it->second)
+          if (length2(q - p) < (r + rq + gap) * (r + rq + gap)) return true;
+      }
+    return false;
+  }
+  void add(glm::vec2 p, float r) { cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r}); }
+
+ private:
+  float cell_;
+  std::unordered_map<std::uint64_t, std::vector<std::pair<glm::vec2, float>>> cells_;
+};
+
+std::string point_text(glm::vec2 p) { return fmt::format("({:.3g}, {:.3g})", p.x, p.y); }
+
+}  // namespace
+
+CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits) {
+  spec.model.validate();
+  if (!(spec.dt > 0) || !(spec.dt <= 10.0f)) throw Error(fmt::format("time step must be in (0, 10] s (got {})", spec.dt), at_field("dt"));
+  const float cell = world.cell_size();
+  const std::int64_t total = spec.total_agents();
+  if (total > limits.max_agents) throw Error(fmt::format("{} agents exceed the limit of {}", total, limits.max_agents), at_field("groups"));
+  if (spec.groups.empty()) throw Error("a scenario needs at least one group", at_field("groups"));
+
+  float max_radius = 0.0f;
+  for (std::size_t g = 0; g < spec.groups.size(); ++g) {
+    const GroupSpec& G = spec.groups[g];
+    const std::string field = fmt::format("groups[{}]", g);
+    if (G.count < 0) throw Error(fmt::format("count must be >= 0 (got {})", G.count), at_field(field + ".count"));
+    if (!std::isfinite(G.radius) || !(G.radius > 0))
+      throw Error(fmt::format("radius must be a positive number (got {})", G.radius), at_field(field + ".radius"));
+    const float step = spec.model.max_speed * spec.dt;
+    if (step > 0.9f * G.radius)
+      throw Error(fmt::format("dt * model.max_speed = {:.3g} m must stay below 0.9 * radius = {:.3g} m, else agents could step "
+                              "through walls: lower dt or max_speed",
+                              step, 0.9f * G.radius),
+                  at_field(field + ".radius"));
+    if (2.0f * G.radius + 2.0f * step > cell || G.radius > spec.model.pred_time * spec.model.max_speed)
+      throw Error(fmt::format("radius {} m is too large for the bins of side {} m (2 * model.pred_time * model.max_speed)", G.radius, cell),
+                  at_field(field + ".radius"));
+    const SpeedSpec& S = G.speed;
+    if (!std::isfinite(S.mean) || !(S.mean > 0)) throw Error(fmt::format("mean speed must be > 0 (got {})", S.mean), at_field(field + ".speed.mean"));
+    if (!std::isfinite(S.stddev) || S.stddev < 0) throw Error(fmt::format("stddev must be >= 0 (got {})", S.stddev), at_field(field + ".speed.stddev"));
+    if (!std::isfinite(S.min) || !(S.min > 0)) throw Error(fmt::format("min speed must be > 0 (got {})", S.min), at_field(field + ".speed.min"));
+    if (!std::isfinite(S.max) || S.max < S.min) throw Error("max speed must be >= min speed", at_field(field + ".speed.max"));
+    if (S.max > spec.model.max_speed)
+      throw Error(fmt::format("speed.max {} exceeds model.max_speed {}", S.max, spec.model.max_speed), at_field(field + ".speed.max"));
+    if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
+      throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius), at_field(field + ".arrival_radius"));
+    if (G.goals.empty()) throw Error("a group needs at least one goal", at_field(field + ".goals"));
+    if (static_cast<std::int64_t>(G.goals.size()) > limits.max_waypoints)
+      throw Error(fmt::format("more than {} goals", limits.max_waypoints), at_field(field + ".goals"));
+    check_region(G.spawn, field + ".spawn", limits.max_extent);
+    for (std::size_t w = 0; w < G.goals.size(); ++w) {
+      const GoalSpec& goal = G.goals[w];
+      const std::string gf = fmt::format("{}.goals[{}]", field, w);
+      if (!std::isfinite(goal.value.x) || !std::isfinite(goal.value.y) || std::fabs(goal.value.x) > limits.max_extent ||
+          std::fabs(goal.value.y) > limits.max_extent)
+        throw Error("goal coordinates must be finite numbers within the extent limit", at_field(gf));
+      if (goal.kind == GoalSpec::Kind::Random) {
+        check_region(goal.region, gf + ".random", limits.max_extent);
+        if (goal.region.kind == Region::Kind::ring) throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
+      }
+    }
+    max_radius = std::max(max_radius, G.radius);
+  }
+  std::int64_t total_waypoints = 0;
+  for (const GroupSpec& G : spec.groups)
+    total_waypoints += G.count * static_cast<std::int64_t>(G.goals.size() + (G.arrival == ArrivalBehaviour::Loop ? 1 : 0));
+  if (total_waypoints > 4 * limits.max_agents)
+    throw Error(fmt::format("{} waypoints in all (agents x goals) exceed the limit of {}", total_waypoints, 4 * limits.max_agents), at_field("groups"));
+
+  // Reachability raster over everything the agents could need.
+  std::unique_ptr<Reachability> reach;
+  if (world.has_walkable() || !world.polygons().empty() || !world.circles().empty()) {
+    Aabb extent = world.bounds();
+    if (!world.has_walkable()) {
+      for (const GroupSpec& G : spec.groups) {
+        const Aabb sb = region_bounds(G.spawn);
+        extent.add(sb);
+        for (const GoalSpec& goal : G.goals) {
+          switch (goal.kind) {
+            case GoalSpec::Kind::Point: extent.add(goal.value); break;
+            case GoalSpec::Kind::Offset:
+              extent.add(sb.min + goal.value);
+              extent.add(sb.max + goal.value);
+              break;
+            case GoalSpec::Kind::Mirror:
+              extent.add(2.0f * goal.value - sb.min);
+              extent.add(2.0f * goal.value - sb.max);
+              break;
+            case GoalSpec::Kind::Random: extent.add(region_bounds(goal.region)); break;
+          }
+        }
+      }
+      const glm::vec2 margin = extent.size() * 0.05f + glm::vec2(5.0f);
+      extent.min -= margin;
+      extent.max += margin;
+    }
+    reach = std::make_unique<Reachability>(world, extent, limits.raster_resolution);
+  }
+
+  CrowdHost out;
+  const auto n = static_cast<std::size_t>(total);
+  out.position.reserve(n);
+  Occupancy placed(std::max(2.0f * max_radius * 1.2f, 0.1f));
+  for (std::size_t g = 0; g < spec.groups.size(); ++g) {
+    const GroupSpec& G = spec.groups[g];
+    const std::string field = fmt::format("groups[{}]", g);
+    const float r = G.radius;
+    const float gap = 0.1f * r;
+    const float wall_clearance = 1.05f * r;
+    std::vector<glm::vec2> chosen;
+    if (G.count == 0) {
+      // nothing to place
+    } else if (G.spawn.kind == Region::Kind::ring) {
+      const double R = G.spawn.radius > 0 ? G.spawn.radius : static_cast<double>(G.count) * G.spawn.spacing / (2.0 * kPi);
+      if (!(R > 0)) throw Error("a ring needs radius > 0 or spacing > 0", at_field(field + ".spawn.ring"));
+      const double chord = G.count > 1 ? 2.0 * R * std::sin(kPi / static_cast<double>(G.count)) : 2.0 * R + 2.0 * r;
+      if (chord < 2.0 * r + gap)
+        throw Error(fmt::format("{} agents of radius {} do not fit on a ring of radius {:.3g} m (neighbours {:.3g} m apart)", G.count, r, R, chord),
+                    at_field(field + ".spawn"));
+      for (std::int64_t k = 0; k < G.count; ++k) {
+        const double a = 2.0 * kPi * static_cast<double>(k) / static_cast<double>(G.count);
+        const glm::vec2 p = G.spawn.center + glm::vec2(static_cast<float>(R * std::cos(a)), static_cast<float>(R * std::sin(a)));
+        if (!world.disc_fits(p, wall_clearance)) {
+          const std::string blocked = world.what_blocks(p);
+          throw Error(fmt::format("agent {} at {} does not fit: {}", k, point_text(p), blocked.empty() ? "too close to a wall" : blocked),
+                      at_field(field + ".spawn"));
+        }
+        if (placed.overlaps(p, r, gap)) throw Error(fmt::format("agent {} at {} overlaps an agent of an earlier group", k, point_text(p)), at_field(field + ".spawn"));
+        chosen.push_back(p);
+      }
+    } else {
+      // Jittered lattice: spacing d = 2r + gap keeps neighbours apart; a
+      // sparse spawn widens the lattice so it holds about 3 * count points.
+      const Aabb b = region_bounds(G.spawn);
+      const double d = 2.0 * r + gap;
+      const double area = static_cast<double>(b.size().x) * b.size().y;
+      const double s = std::max(d, std::sqrt(area / (3.0 * static_cast<double>(G.count))));
+      const double fnx = std::floor(b.size().x / s) + 1, fny = std::floor(b.size().y / s) + 1;
+      if (fnx * fny > 8.0 * static_cast<double>(G.count) + 4.0e6)
+        throw Error(fmt::format("the spawn region ({:.3g} x {:.3g} m) is too elongated for agents of radius {} m", b.size().x, b.size().y, r),
+                    at_field(field + ".spawn"));
+      const auto nx = static_cast<std::int64_t>(fnx), ny = static_cast<std::int64_t>(fny);
+      if (fnx * fny < static_cast<double>(G.count))
+        throw Error(fmt::format("{} agents of radius {} m cannot fit in the spawn region ({:.3g} x {:.3g} m)", G.count, r, b.size().x, b.size().y),
+                    at_field(field + ".spawn"));
+      const double jitter = (s - d) * 0.5;
+      Rng rng(spec.seed, 0x59a3000000ull + g);
+      std::vector<glm::vec2> candidates;
+      for (std::int64_t j = 0; j < ny; ++j)
+        for (std::int64_t i = 0; i < nx; ++i) {
+          const double ox = rng.uniform(-jitter, jitter), oy = rng.uniform(-jitter, jitter);
+          const glm::vec2 p(static_cast<float>(b.min.x + (static_cast<double>(i) + 0.5) * s + ox),
+                            static_cast<float>(b.min.y + (static_cast<double>(j) + 0.5) * s + oy));
+          if (!region_contains(G.spawn, p) || !world.disc_fits(p, wall_clearance) || placed.overlaps(p, r, gap)) continue;
+          candidates.push_back(p);
+        }
+      if (static_cast<std::int64_t>(candidates.size()) < G.count) {
+        const glm::vec2 centre = (b.min + b.max) * 0.5f;
+        const std::string blocked = world.what_blocks(centre);
+        if (candidates.empty() && !blocked.empty())
+          throw Error(fmt::format("the spawn region lies {}: no free place for an agent", blocked), at_field(field + ".spawn"));
+        throw Error(fmt::format("room for only {} of {} agents of radius {} m in the spawn region (obstacles, walls and other groups "
+                                "take the rest)",
+                                candidates.size(), G.count, r),
+                    at_field(field + ".spawn"));
+      }
+      // Choose count of them at random, then keep lattice order (neighbours
+      // in space get neighbouring indices: better memory locality).
+      std::vector<std::uint32_t> order(candidates.size());
+      std::iota(order.begin(), order.end(), 0u);
+      for (std::size_t k = 0; k < static_cast<std::size_t>(G.count); ++k) {
+        const std::size_t pick = k + static_cast<std::size_t>(rng.below(order.size() - k));
+        std::swap(order[k], order[pick]);
+      }
+      order.resize(static_cast<std::size_t>(G.count));
+      std::sort(order.begin(), order.end());
+      for (std::uint32_t k : order) chosen.push_back(candidates[k]);
+    }
+
+    GroupRuntime rt;
+    rt.arrival = G.arrival;
+    rt.arrival_radius = G.arrival_radius;
+    rt.final_waypoint = static_cast<std::int32_t>(G.goals.size()) - 1;
+    out.groups.push_back(rt);
+    const auto first_agent = static_cast<std::int64_t>(out.position.size());
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      const glm::vec2 p = chosen[k];
+      const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
+      placed.add(p, r);
+      Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
+      const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
+                                      static_cast<double>(G.speed.min), static_cast<double>(G.speed.max));
+      out.position.push_back(p);
+      out.radius.push_back(r);
+      out.pref_speed.push_back(static_cast<float>(speed));
+      out.group.push_back(static_cast<std::int32_t>(g));
+      out.waypoint_begin.push_back(static_cast<std::int32_t>(out.waypoints.size()));
+      glm::vec2 from = p;
+      for (std::size_t w = 0; w < G.goals.size(); ++w) {
+        const GoalSpec& goal = G.goals[w];
+        const std::string gf = fmt::format("{}.goals[{}]", field, w);
+        glm::vec2 q(0.0f);
+        switch (goal.kind) {
+          case GoalSpec::Kind::Point: q = goal.value; break;
+          case GoalSpec::Kind::Offset: q = p + goal.value; break;
+          case GoalSpec::Kind::Mirror: q = 2.0f * goal.value - p; break;
+          case GoalSpec::Kind::Random: {
+            const Aabb rb = region_bounds(goal.region);
+            bool found = false;
+            for (int attempt = 0; attempt < 200 && !found; ++attempt) {
+              q = glm::vec2(static_cast<float>(arng.uniform(rb.min.x, rb.max.x)), static_cast<float>(arng.uniform(rb.min.y, rb.max.y)));
+              found = region_contains(goal.region, q) && world.disc_fits(q, r) && (!reach || reach->connected(from, q));
+            }
+            if (!found)
+              throw Error(fmt::format("found no free place reachable from {} for agent {} in the goal region", point_text(from), agent),
+                          at_field(gf + ".random"));
+            break;
+          }
+        }
+        if (!std::isfinite(q.x) || !std::isfinite(q.y) || std::fabs(q.x) > limits.max_extent || std::fabs(q.y) > limits.max_extent)
+          throw Error(fmt::format("goal {} of agent {} is beyond the extent limit", point_text(q), agent), at_field(gf));
+        if (const std::string blocked = world.what_blocks(q); !blocked.empty())
+          throw Error(fmt::format("goal {} of agent {} lies {}", point_text(q), agent, blocked), at_field(gf));
+        if (reach && !reach->connected(from, q))
+          throw Error(fmt::format("goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
+                                  point_text(q), agent, point_text(from), reach->cell_size()),
+                      at_field(gf));
+        out.waypoints.push_back(q);
+        from = q;
+      }
+      // A loop walks the list and comes back to where the agent started.
+      if (G.arrival == ArrivalBehaviour::Loop) out.waypoints.push_back(p);
+      out.waypoint_count.push_back(static_cast<std::int32_t>(out.waypoints.size()) - out.waypoint_begin.back());
+      const glm::vec2 first_goal = out.waypoints[static_cast<std::size_t>(out.waypoint_begin.back())];
+      const glm::vec2 to = first_goal - p;
+      out.heading.push_back(length2(to) > 0 ? std::atan2(to.y, to.x) : 0.0f);
+    }
+  }
+  return out;
+}
+
+CrowdState upload_crowd(const CrowdHost& h, Memory m) {
+  CrowdState c;
+  const auto n = static_cast<Index>(h.position.size());
+  c.count = n;
+  auto up = [m](const auto& v) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    return Buffer<T>(std::span<const T>(v), m);
+  };
+  c.position = up(h.position);
+  c.velocity = Buffer<glm::vec2>::zeros(n, m);
+  c.heading = up(h.heading);
+  c.radius = up(h.radius);
+  c.pref_speed = up(h.pref_speed);
+  c.path_start = up(h.position);
+  std::vector<glm::vec2> goals(h.position.size());
+  for (std::size_t i = 0; i < goals.size(); ++i) goals[i] = h.waypoints[static_cast<std::size_t>(h.waypoint_begin[i])];
+  c.goal = up(goals);
+  c.waypoint_begin = up(h.waypoint_begin);
+  c.waypoint_count = up(h.waypoint_count);
+  c.waypoint_cursor = Buffer<std::int32_t>::zeros(n, m);
+  c.group = up(h.group);
+  c.flags = up(std::vector<std::uint8_t>(h.position.size(), kAgentActive));
+  c.arrival_time = up(std::vector<float>(h.position.size(), -1.0f));
+  c.waypoints = up(h.waypoints);
+  c.groups = up(h.groups);
+  return c;
+}
+
+}  // namespace throng::sim

@@ -1,0 +1,61 @@
+// The crowd as structure-of-arrays buffers in current_memory(), and spawning
+// it from a scenario's groups (on the host, then uploaded).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/buffer.h"
+#include "sim/scenario.h"
+#include "sim/world.h"
+
+namespace throng::sim {
+
+// Agent flags (bits of CrowdState::flags).
+inline constexpr std::uint8_t kAgentActive = 1;   // simulated and binned
+inline constexpr std::uint8_t kAgentArrived = 2;  // reached its final waypoint at least once
+inline constexpr std::uint8_t kAgentStopped = 4;  // arrived with behaviour `stop`: no more steering
+
+// Per-group constants the kernels need.
+struct GroupRuntime {
+  ArrivalBehaviour arrival = ArrivalBehaviour::Stop;
+  float arrival_radius = 0.5f;
+  std::int32_t final_waypoint = 0;  // cursor whose arrival counts as arriving
+};
+
+struct CrowdState {
+  Index count = 0;
+  Buffer<glm::vec2> position;
+  Buffer<glm::vec2> velocity;
+  Buffer<float> heading;      // radians, from +x
+  Buffer<float> radius;       // m
+  Buffer<float> pref_speed;   // m/s
+  Buffer<glm::vec2> path_start;  // start of the current leg
+  Buffer<glm::vec2> goal;        // end of the current leg (current waypoint)
+  Buffer<std::int32_t> waypoint_begin;   // into waypoints
+  Buffer<std::int32_t> waypoint_count;
+  Buffer<std::int32_t> waypoint_cursor;  // current waypoint, 0-based
+  Buffer<std::int32_t> group;
+  Buffer<std::uint8_t> flags;
+  Buffer<float> arrival_time;  // s, -1 until arrived
+  Buffer<glm::vec2> waypoints;    // every agent's waypoint list, flattened
+  Buffer<GroupRuntime> groups;
+};
+
+// Host copy of the per-agent spawn data (what spawn_crowd computed).
+struct CrowdHost {
+  std::vector<glm::vec2> position;
+  std::vector<float> heading, radius, pref_speed;
+  std::vector<std::int32_t> group, waypoint_begin, waypoint_count;
+  std::vector<glm::vec2> waypoints;
+  std::vector<GroupRuntime> groups;
+};
+
+// Places every group's agents without overlaps in free space, draws their
+// speeds and goals from the seed, and checks each goal lies in free space and
+// is reachable from where the agent starts. Errors name the group field
+// ("groups[1].spawn", "groups[0].goals[2]").
+CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits = {});
+CrowdState upload_crowd(const CrowdHost& host, Memory memory = current_memory());
+
+}  // namespace throng::sim

@@ -1,0 +1,161 @@
+// Sparse uniform grids: cell (cx, cy) -> a run of item indices.
+//
+// Only occupied cells are stored, in an open-addressing hash table keyed by
+// the packed cell coordinates, so memory grows with the items and the area
+// they occupy, never with the extent of the scene (a 10 km scene with a few
+// agents costs a few cells). Two builders share one view type:
+//   - StaticGrid: built once on the host from (cell, item) pairs (obstacles);
+//   - AgentGrid: rebuilt every step by a counting sort through parallel_for
+//     (histogram with atomics -> exclusive_scan -> scatter -> sort inside each
+//     cell by agent index, so the order inside a bin is deterministic).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <glm/vec2.hpp>
+#include <utility>
+#include <vector>
+
+#include "core/buffer.h"
+#include "core/span.h"
+
+namespace throng::sim {
+
+inline constexpr std::uint64_t kEmptyCell = ~std::uint64_t{0};
+// Cell coordinates are clamped to +-2^30 so keys never reach kEmptyCell.
+inline constexpr std::int32_t kCellCoordLimit = 1 << 30;
+
+THRONG_HOST_DEVICE inline std::int32_t cell_coord(float x, float cell_size) {
+  const float c = floorf(x / cell_size);
+  // NaN fails both comparisons and lands in cell 0 instead of being UB.
+  if (!(c > -static_cast<float>(kCellCoordLimit))) return c != c ? 0 : -kCellCoordLimit;
+  if (!(c < static_cast<float>(kCellCoordLimit - 1))) return kCellCoordLimit - 1;
+  return static_cast<std::int32_t>(c);
+}
+
+THRONG_HOST_DEVICE inline std::uint64_t cell_key(std::int32_t cx, std::int32_t cy) {
+  const auto ux = static_cast<std::uint32_t>(cx + kCellCoordLimit);
+  const auto uy = static_cast<std::uint32_t>(cy + kCellCoordLimit);
+  return (static_cast<std::uint64_t>(ux) << 32) | uy;
+}
+THRONG_HOST_DEVICE inline std::int32_t key_cx(std::uint64_t key) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(key >> 32)) - kCellCoordLimit;
+}
+THRONG_HOST_DEVICE inline std::int32_t key_cy(std::uint64_t key) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(key & 0xffffffffu)) - kCellCoordLimit;
+}
+// Colour of the four-colour batches: cells of one colour are two apart in x
+// or y, so their 3x3 neighbourhoods never include each other.
+THRONG_HOST_DEVICE inline int cell_colour(std::uint64_t key) {
+  return (key_cx(key) & 1) | ((key_cy(key) & 1) << 1);
+}
+
+THRONG_HOST_DEVICE inline std::uint64_t mix_key(std::uint64_t k) {
+  // splitmix64 finaliser: neighbouring cells land far apart in the table.
+  k ^= k >> 30;
+  k *= 0xbf58476d1ce4e5b9ull;
+  k ^= k >> 27;
+  k *= 0x94d049bb133111ebull;
+  k ^= k >> 31;
+  return k;
+}
+
+// What kernels see: the table (keys per slot, kEmptyCell when free), the run
+// of each slot in `items`, and the cell side.
+struct GridView {
+  float cell_size = 1.0f;
+  std::uint64_t mask = 0;  // capacity - 1 (capacity is a power of two)
+  Span<const std::uint64_t> keys;
+  Span<const std::int32_t> start;
+  Span<const std::int32_t> count;
+  Span<const std::int32_t> items;
+
+  THRONG_HOST_DEVICE Index capacity() const { return keys.size(); }
+  // Slot holding the cell, or -1.
+  THRONG_HOST_DEVICE Index find(std::int32_t cx, std::int32_t cy) const {
+    if (keys.size() == 0) return -1;
+    const std::uint64_t key = cell_key(cx, cy);
+    std::uint64_t s = mix_key(key) & mask;
+    for (;;) {
+      const std::uint64_t k = keys[static_cast<Index>(s)];
+      if (k == key) return static_cast<Index>(s);
+      if (k == kEmptyCell) return -1;
+      s = (s + 1) & mask;
+    }
+  }
+};
+
+// Calls fn(item) for every item of the 3x3 cells around cell (cx, cy), cells
+// in row-major order (dy, then dx), items in their stored order.
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_in_3x3(const GridView& g, std::int32_t cx, std::int32_t cy, Fn&& fn) {
+  for (std::int32_t dy = -1; dy <= 1; ++dy)
+    for (std::int32_t dx = -1; dx <= 1; ++dx) {
+      const Index s = g.find(cx + dx, cy + dy);
+      if (s < 0) continue;
+      const std::int32_t b = g.start[s], n = g.count[s];
+      for (std::int32_t k = 0; k < n; ++k) fn(g.items[b + k]);
+    }
+}
+// The same around the cell containing p.
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_in_3x3(const GridView& g, glm::vec2 p, Fn&& fn) {
+  for_each_in_3x3(g, cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size), fn);
+}
+// The same for the one cell containing p.
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_in_cell(const GridView& g, glm::vec2 p, Fn&& fn) {
+  const Index s = g.find(cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size));
+  if (s < 0) return;
+  const std::int32_t b = g.start[s], n = g.count[s];
+  for (std::int32_t k = 0; k < n; ++k) fn(g.items[b + k]);
+}
+
+// Smallest power of two >= 2 * n (load factor <= 1/2), at least 16.
+Index grid_capacity_for(Index n);
+
+// Host-built grid from (cell key, item) pairs; uploaded to `memory`.
+class StaticGrid {
+ public:
+  StaticGrid() = default;
+  StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std::int32_t>> pairs, Memory memory);
+  GridView view() const;
+  // The same tables in host memory (spawning and validation run on the host).
+  GridView host_view() const;
+  Index occupied_cells() const { return occupied_; }
+  Index item_count() const { return static_cast<Index>(host_items_.size()); }
+
+ private:
+  float cell_size_ = 1.0f;
+  std::uint64_t mask_ = 0;
+  Index occupied_ = 0;
+  std::vector<std::uint64_t> host_keys_;
+  std::vector<std::int32_t> host_start_, host_count_, host_items_;
+  Buffer<std::uint64_t> keys_;
+  Buffer<std::int32_t> start_, count_, items_;
+};
+
+// Agents binned by position, rebuilt each step (kernels in grid_kernels.cpp).
+class AgentGrid {
+ public:
+  AgentGrid() = default;
+  explicit AgentGrid(float cell_size) : cell_size_(cell_size) {}
+  // Bins every agent whose flags[i] has bit 0 (active) set, by positions[i].
+  // Spans in current_memory().
+  void rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags);
+  GridView view() const;
+  float cell_size() const { return cell_size_; }
+  Index binned_agents() const { return binned_; }
+  Index occupied_cells() const;  // counts on the host (for tests and stats)
+  // Memory held by the tables, bytes.
+  std::size_t bytes() const;
+
+ private:
+  float cell_size_ = 1.0f;
+  std::uint64_t mask_ = 0;
+  Index binned_ = 0;
+  Buffer<std::uint64_t> keys_;
+  Buffer<std::int32_t> start_, count_, cursor_, items_, slot_of_agent_;
+};
+
+}  // namespace throng::sim

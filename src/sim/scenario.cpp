@@ -1,0 +1,81 @@
+#include "sim/scenario.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace throng::sim {
+
+namespace {
+void check_range(float v, float lo, float hi, bool lo_inclusive, const char* field, const char* what) {
+  const bool above = lo_inclusive ? v >= lo : v > lo;
+  if (!std::isfinite(v) || !above || v > hi)
+    throw Error(fmt::format("{} must be {} {} and at most {} (got {})", what, lo_inclusive ? ">=" : ">", lo, hi, v), at_field(field));
+}
+}  // namespace
+
+void ModelParams::validate() const {
+  check_range(pred_time, 0.0f, 100.0f, false, "model.pred_time", "prediction time (s)");
+  check_range(max_speed, 0.0f, 100.0f, false, "model.max_speed", "maximum speed (m/s)");
+  check_range(max_force, 0.0f, 1000.0f, false, "model.max_force", "maximum steering acceleration (m/s^2)");
+  check_range(personal_space, 0.0f, 100.0f, true, "model.personal_space", "personal space (m)");
+  check_range(lane_half_width, 0.0f, 1000.0f, false, "model.lane_half_width", "lane half-width (m)");
+  check_range(relaxation_time, 0.0f, 100.0f, false, "model.relaxation_time", "relaxation time (s)");
+  check_range(probe_margin, 0.0f, 100.0f, true, "model.probe_margin", "probe margin (m)");
+  if (contact_iterations < 0 || contact_iterations > 64)
+    throw Error(fmt::format("contact iterations must be in [0, 64] (got {})", contact_iterations), at_field("model.contact_iterations"));
+}
+
+const char* to_string(ArrivalBehaviour a) {
+  switch (a) {
+    case ArrivalBehaviour::Stop: return "stop";
+    case ArrivalBehaviour::Despawn: return "despawn";
+    case ArrivalBehaviour::Loop: return "loop";
+  }
+  return "?";
+}
+
+const char* to_string(SchedulerKind s) { return s == SchedulerKind::FourColour ? "four_colour" : "double_buffer"; }
+
+SchedulerKind parse_scheduler(const std::string& text, const std::string& field) {
+  if (text == "double_buffer") return SchedulerKind::DoubleBuffer;
+  if (text == "four_colour" || text == "four_color") return SchedulerKind::FourColour;
+  throw Error("unknown scheduler '" + text + "' (double_buffer or four_colour)", at_field(field));
+}
+
+std::int64_t ScenarioSpec::total_agents() const {
+  std::int64_t n = 0;
+  for (const GroupSpec& g : groups) n += g.count;
+  return n;
+}
+
+std::int64_t ScenarioSpec::step_count() const {
+  if (steps > 0) return steps;
+  return static_cast<std::int64_t>(std::ceil(static_cast<double>(duration) / static_cast<double>(dt) - 1e-9));
+}
+
+void scale_agent_counts(ScenarioSpec& spec, std::int64_t total) {
+  const auto groups = static_cast<std::int64_t>(spec.groups.size());
+  if (groups == 0) throw Error("the scenario has no groups to resize", at_field("--agents"));
+  if (total < groups) throw Error(fmt::format("need at least one agent per group ({} groups)", groups), at_field("--agents"));
+  const std::int64_t old_total = spec.total_agents();
+  std::vector<std::int64_t> counts(spec.groups.size(), 1);
+  std::vector<std::pair<double, std::size_t>> remainders;
+  std::int64_t assigned = 0;
+  for (std::size_t g = 0; g < spec.groups.size(); ++g) {
+    // Equal shares when the scenario has no agents to take proportions from.
+    const double share = old_total > 0 ? static_cast<double>(spec.groups[g].count) / static_cast<double>(old_total) : 1.0 / static_cast<double>(groups);
+    const double exact = share * static_cast<double>(total - groups);
+    counts[g] += static_cast<std::int64_t>(std::floor(exact));
+    assigned += counts[g];
+    remainders.push_back({exact - std::floor(exact), g});
+  }
+  std::stable_sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (std::size_t k = 0; assigned < total; k = (k + 1) % remainders.size(), ++assigned) ++counts[remainders[k].second];
+  for (std::size_t g = 0; g < spec.groups.size(); ++g) spec.groups[g].count = counts[g];
+}
+
+}  // namespace throng::sim

@@ -1,0 +1,150 @@
+// A scenario as plain host data: world geometry, agent groups, model
+// parameters, time stepping, camera and outputs. io/scenario_yaml reads it
+// from YAML (the schema is docs/scenarios.md); sim builds a World and a crowd
+// from it. Field paths used in errors ("groups[1].spawn") follow the YAML keys.
+#pragma once
+
+#include <cstdint>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "sim/geometry.h"
+
+namespace throng::sim {
+
+// Parameters of the paper's priority-force model and of the move stage.
+struct ModelParams {
+  float pred_time = 1.0f;          // s: prediction horizon (predTime)
+  float max_speed = 2.0f;          // m/s: maxVelocity; query radius = 2 * pred_time * max_speed
+  float max_force = 4.0f;          // m/s^2: largest steering acceleration
+  float personal_space = 0.15f;    // m: observation radius = radius + personal_space
+  float lane_half_width = 0.5f;    // m: path following steers back beyond this
+  float relaxation_time = 0.5f;    // s: path following reaches the desired velocity in about this
+  float probe_margin = 0.1f;       // m: probe half-width = radius + probe_margin
+  std::int32_t contact_iterations = 4;  // contact/obstacle projection passes per step (the added constraint)
+  float query_radius() const { return 2.0f * pred_time * max_speed; }
+  // Throws Error naming the field ("model.pred_time") for NaN, negative or
+  // out-of-range values.
+  void validate() const;
+};
+
+enum class ArrivalBehaviour : std::uint8_t { Stop, Despawn, Loop };
+enum class SchedulerKind : std::uint8_t { DoubleBuffer, FourColour };
+const char* to_string(ArrivalBehaviour a);
+const char* to_string(SchedulerKind s);
+// "double_buffer" | "four_colour"; throws Error on anything else.
+SchedulerKind parse_scheduler(const std::string& text, const std::string& field);
+
+// A region of the plane: rect, disc, ring (points on a circle) or polygon.
+struct Region {
+  enum class Kind : std::uint8_t { rect, disc, ring, polygon };  // named as in YAML
+  Kind kind = Kind::rect;
+  glm::vec2 min{0.0f}, max{0.0f};  // Rect
+  glm::vec2 center{0.0f};          // Disc, Ring
+  float radius = 0.0f;             // Disc, Ring (Ring: 0 = from spacing)
+  float spacing = 0.0f;            // Ring: arc length between agents when radius is 0
+  Polygon polygon;                 // Polygon
+};
+
+// One waypoint of a group: the same for every agent, or per agent.
+struct GoalSpec {
+  enum class Kind : std::uint8_t {
+    Point,   // value
+    Offset,  // spawn position + value
+    Mirror,  // 2 * value - spawn position (the antipode through value)
+    Random,  // a random free point of `region` per agent
+  };
+  Kind kind = Kind::Point;
+  glm::vec2 value{0.0f};
+  Region region;  // Random
+};
+
+struct SpeedSpec {
+  float mean = 1.3f;    // m/s
+  float stddev = 0.0f;  // normal distribution, clamped to [min, max]
+  float min = 0.5f;
+  float max = 2.0f;
+};
+
+struct GroupSpec {
+  std::string name;
+  std::int64_t count = 0;
+  float radius = 0.25f;
+  SpeedSpec speed;
+  Region spawn;
+  std::vector<GoalSpec> goals;  // visited in order
+  ArrivalBehaviour arrival = ArrivalBehaviour::Stop;
+  float arrival_radius = 0.5f;
+};
+
+struct CameraSpec {
+  glm::vec3 position{0.0f, -40.0f, 60.0f};
+  glm::vec3 target{0.0f};
+  float fov_degrees = 60.0f;
+};
+
+struct OutputSpec {
+  std::string dir;          // empty = out/<name>
+  std::int64_t every = 0;   // trajectory frame stride; 0 = about one frame per simulated second
+  bool trajectories = true;
+  bool stats = true;
+};
+
+// A generated obstacle field: `count` shapes placed at random in `region`.
+struct ScatterSpec {
+  std::int64_t count = 0;
+  Region region;              // Rect
+  float min_size = 1.0f;      // m: circle diameter or rectangle side
+  float max_size = 4.0f;
+  float clearance = 2.0f;     // m: free gap kept between scattered shapes
+  std::uint64_t seed = 1;
+};
+
+struct WorldSpec {
+  bool has_walkable = false;
+  Polygon walkable;                       // outer boundary and holes
+  std::vector<Polygon> polygons;          // obstacle polygons
+  std::vector<std::string> polygon_fields;  // "world.obstacles[3]" per polygon
+  std::vector<Circle> circles;
+  std::vector<std::string> circle_fields;
+  std::vector<ScatterSpec> scatters;
+  std::vector<std::string> scatter_fields;
+};
+
+struct ScenarioSpec {
+  std::string name = "scenario";
+  std::string description;
+  float dt = 0.1f;            // s
+  std::int64_t steps = 0;     // derived from duration when 0
+  float duration = 60.0f;     // s
+  std::uint64_t seed = 1;
+  SchedulerKind scheduler = SchedulerKind::DoubleBuffer;
+  ModelParams model;
+  WorldSpec world;
+  std::vector<GroupSpec> groups;
+  CameraSpec camera;
+  OutputSpec outputs;
+  std::int64_t total_agents() const;
+  std::int64_t step_count() const;  // steps, or ceil(duration / dt)
+};
+
+// Limits checked before anything is allocated (bad or hostile input).
+struct ScenarioLimits {
+  std::int64_t max_agents = 20'000'000;
+  std::int64_t max_steps = 100'000'000;
+  std::int64_t max_vertices = 1'000'000;   // all polygons together
+  std::int64_t max_obstacles = 1'000'000;  // polygons + circles + scattered
+  std::int64_t max_waypoints = 1'000;      // per group
+  std::int64_t max_grid_items = 64'000'000;  // obstacle cell registrations
+  std::int32_t raster_resolution = 1024;   // cells per side of the reachability raster
+  float max_extent = 1.0e6f;               // m: coordinates beyond +-this are rejected
+};
+
+// Resizes group counts so they add up to `total` (largest remainder), keeping
+// their proportions; throws Error when total < number of groups or <= 0.
+void scale_agent_counts(ScenarioSpec& spec, std::int64_t total);
+
+}  // namespace throng::sim

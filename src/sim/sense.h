@@ -1,0 +1,109 @@
+// The sense stage for one agent: candidates from the 3x3 bins, reduced to
+// what the steering forces need (the nearest obstacle hit, the most urgent
+// neighbour threat), plus the projections of the move stage. Host+device.
+#pragma once
+
+#include "sim/crowd.h"
+#include "sim/grid.h"
+#include "sim/steering.h"
+#include "sim/world.h"
+
+namespace throng::sim {
+
+// Nearest probe hit whose force is non-zero, and that force.
+struct ObstacleSense {
+  ProbeHit hit;
+  glm::vec2 force{0.0f};
+};
+THRONG_HOST_DEVICE inline ObstacleSense sense_obstacles(const WorldView& w, const Probe& pr, float max_force) {
+  ObstacleSense best;
+  auto consider = [&](const ProbeHit& h) {
+    if (!h.hit || h.distance >= best.hit.distance) return;
+    const glm::vec2 f = obstacle_force(pr, h, max_force);
+    if (length2(f) <= 0.0f) return;
+    best.hit = h;
+    best.force = f;
+  };
+  for_each_in_3x3(w.segment_grid, pr.origin, [&](std::int32_t k) { consider(probe_segment(pr, w.segments[k].a, w.segments[k].b)); });
+  for_each_in_3x3(w.circle_grid, pr.origin, [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
+  return best;
+}
+
+// Read-only view of the neighbours' state.
+struct NeighbourArrays {
+  Span<const glm::vec2> position;
+  Span<const glm::vec2> velocity;
+  Span<const float> radius;
+  Span<const std::uint8_t> flags;
+};
+
+// Most urgent threat among active neighbours within the query radius,
+// visited in bin order (deterministic).
+THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self, glm::vec2 p,
+                                                  glm::vec2 v, glm::vec2 forward, float radius, const NeighbourArrays& n,
+                                                  const ModelParams& m) {
+  Threat best;
+  const float query2 = m.query_radius() * m.query_radius();
+  for_each_in_3x3(bins, cx, cy, [&](std::int32_t j) {
+    if (j == self || (n.flags[j] & kAgentActive) == 0) return;
+    const glm::vec2 q = n.position[j];
+    if (length2(q - p) >= query2) return;
+    const Threat t = predict_threat(p, v, forward, radius + m.personal_space, q, n.velocity[j], n.radius[j] + m.personal_space, m.pred_time);
+    if (more_urgent(t, best)) best = t;
+  });
+  return best;
+}
+
+// Deterministic unit direction for two agents at exactly the same point.
+THRONG_HOST_DEVICE inline glm::vec2 tie_direction(Index i, Index j) {
+  const Index lo = i < j ? i : j, hi = i < j ? j : i;
+  const std::uint64_t h = mix_key(static_cast<std::uint64_t>(lo) * 0x9e3779b97f4a7c15ull + static_cast<std::uint64_t>(hi));
+  const float a = static_cast<float>(h >> 40) * (6.2831853f / 16777216.0f);
+  const glm::vec2 u(cosf(a), sinf(a));
+  return i < j ? u : -u;
+}
+
+// Contact constraint (the addition to the paper's model): each overlapping
+// pair is pushed apart, this agent taking half of the overlap.
+THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self, glm::vec2 p, float radius,
+                                                 Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags) {
+  glm::vec2 push(0.0f);
+  for_each_in_3x3(bins, cx, cy, [&](std::int32_t j) {
+    if (j == self || (flags[j] & kAgentActive) == 0) return;
+    const glm::vec2 d = p - positions[j];
+    const float reach = radius + radii[j];
+    const float d2 = length2(d);
+    if (d2 >= reach * reach) return;
+    const float dist = sqrtf(d2);
+    const glm::vec2 dir = dist > 1e-6f ? d * (1.0f / dist) : tie_direction(self, j);
+    push += dir * (0.5f * (reach - dist));
+  });
+  return push;
+}
+
+// Moves a disc out of every wall and circle it overlaps (two passes for
+// corners). `anchor` (the last valid position) breaks ties when the centre
+// lies on a wall.
+THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w, glm::vec2 p, float r, glm::vec2 anchor) {
+  for (int pass = 0; pass < 2; ++pass) {
+    for_each_in_3x3(w.segment_grid, p, [&](std::int32_t k) {
+      const Segment s = w.segments[k];
+      const glm::vec2 q = closest_point_on_segment(p, s.a, s.b);
+      const float d = length_of(p - q);
+      if (d >= r) return;
+      glm::vec2 n = normalize_or(perp_left(s.b - s.a), glm::vec2(1.0f, 0.0f));
+      if (dot2(n, anchor - s.a) < 0.0f) n = -n;
+      const glm::vec2 dir = d > 1e-6f ? (p - q) * (1.0f / d) : n;
+      p = q + dir * r;
+    });
+    for_each_in_3x3(w.circle_grid, p, [&](std::int32_t k) {
+      const Circle c = w.circles[k];
+      const glm::vec2 d = p - c.center;
+      if (length2(d) >= (c.radius + r) * (c.radius + r)) return;
+      p = c.center + normalize_or(d, normalize_or(anchor - c.center, glm::vec2(1.0f, 0.0f))) * (c.radius + r);
+    });
+  }
+  return p;
+}
+
+}  // namespace throng::sim

@@ -1,0 +1,114 @@
+// One crowd simulation: world, crowd state, bins and the per-step stages
+//   bin -> sense + steer -> move (contacts, obstacle projection) -> finalize
+// under one of two schedulers:
+//   DoubleBuffer: every agent reads the previous step and writes the next;
+//                 fully parallel, bitwise the same for any thread count.
+//   FourColour:   the paper's batches: bins of one colour (cx & 1, cy & 1) in
+//                 parallel, agents inside a bin in sequence, updated in place.
+//
+// The move stage adds to the paper's forces a contact constraint: after
+// integration, `model.contact_iterations` passes push overlapping pairs
+// apart (each takes half the overlap) and project agents out of walls; a
+// position still closer than its radius to a wall is rejected (the agent
+// stays put), so agents never penetrate obstacles. Velocity is the actual
+// displacement / dt, so blocked agents slow down.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sim/crowd.h"
+#include "sim/grid.h"
+#include "sim/scenario.h"
+#include "sim/world.h"
+
+namespace throng::sim {
+
+// Device-side views of the state the stages update (kernels in
+// simulation_kernels.cpp).
+struct AgentArrays {
+  Span<glm::vec2> position;
+  Span<glm::vec2> velocity;
+  Span<float> heading;
+  Span<const float> radius;
+  Span<const float> pref_speed;
+  Span<glm::vec2> path_start;
+  Span<glm::vec2> goal;
+  Span<const std::int32_t> waypoint_begin;
+  Span<const std::int32_t> waypoint_count;
+  Span<std::int32_t> waypoint_cursor;
+  Span<const std::int32_t> group;
+  Span<std::uint8_t> flags;
+  Span<float> arrival_time;
+  Span<const glm::vec2> waypoints;
+  Span<const GroupRuntime> groups;
+};
+AgentArrays arrays_of(CrowdState& c);
+
+struct StepContext {
+  WorldView world;
+  GridView bins;          // side query_radius: steering neighbours
+  GridView contact_bins;  // side contact_cell: contact pairs
+  ModelParams model;
+  float dt = 0.1f;
+  float time_after = 0.0f;  // simulated time at the end of this step
+};
+
+// Stages (each one or more parallel_for launches).
+// Double buffer: reads a.position/velocity/heading, writes candidate positions.
+void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> out_position);
+// Double buffer: one contact pass from `in` to `out` (anchor = last valid positions).
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> in,
+                            Span<glm::vec2> out);
+// Four colour: steering and then each contact pass, in place on a.position
+// and a.velocity, colour by colour.
+void steer_four_colour(const StepContext& ctx, const AgentArrays& a);
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor);
+// Both: accepts or rejects each moved position, sets velocity, heading,
+// arrivals and waypoints. `moved` may alias nothing in a except by index.
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> moved);
+void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to);
+
+class Simulation {
+ public:
+  // Builds the world and spawns the crowd in current_memory().
+  explicit Simulation(const ScenarioSpec& spec, const ScenarioLimits& limits = {});
+
+  void step();
+  void run(std::int64_t steps);
+
+  const ScenarioSpec& spec() const { return spec_; }
+  const World& world() const { return world_; }
+  CrowdState& crowd() { return crowd_; }
+  const CrowdState& crowd() const { return crowd_; }
+  const AgentGrid& bins() const { return bins_; }
+  // Side of the contact bins: 4 * the largest radius covers every pair that
+  // can touch during a step (each moves at most 0.9 radius).
+  float contact_cell() const { return contact_bins_.cell_size(); }
+  SchedulerKind scheduler() const { return scheduler_; }
+  void set_scheduler(SchedulerKind s) { scheduler_ = s; }
+  std::int64_t steps_done() const { return steps_done_; }
+  double time() const { return static_cast<double>(steps_done_) * spec_.dt; }
+  Index agent_count() const { return crowd_.count; }
+
+  // Host snapshots.
+  std::vector<glm::vec2> positions() const { return crowd_.position.to_vector(); }
+  std::vector<glm::vec2> velocities() const { return crowd_.velocity.to_vector(); }
+  std::vector<float> headings() const { return crowd_.heading.to_vector(); }
+  std::vector<std::uint8_t> flags() const { return crowd_.flags.to_vector(); }
+  std::vector<float> arrival_times() const { return crowd_.arrival_time.to_vector(); }
+  Index active_count() const;
+  Index arrived_count() const;
+
+ private:
+  ScenarioSpec spec_;
+  World world_;
+  CrowdState crowd_;
+  AgentGrid bins_;
+  AgentGrid contact_bins_;
+  SchedulerKind scheduler_ = SchedulerKind::DoubleBuffer;
+  std::int64_t steps_done_ = 0;
+  Buffer<glm::vec2> anchor_, candidate_, scratch_;
+};
+
+}  // namespace throng::sim

@@ -1,0 +1,191 @@
+// The per-step stages of the crowd simulation. Compiled by nvcc in CUDA
+// builds: bodies touch only spans and values.
+#include "core/parallel.h"
+#include "sim/sense.h"
+#include "sim/simulation.h"
+
+namespace throng::sim {
+
+namespace {
+
+constexpr float kWallTolerance = 1e-4f;   // m: accepted float error against walls
+constexpr float kMaxStepFraction = 0.9f;  // of the radius: displacement cap in a contact pass
+constexpr float kAcceptFraction = 0.95f;  // of the radius: largest accepted displacement per step
+
+// Steering + integration of one agent; neighbours from the 3x3 bins around
+// (cx, cy) (the agent's cell when binned).
+THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy,
+                                           glm::vec2& out_p, glm::vec2& out_v) {
+  const glm::vec2 p = a.position[i], v = a.velocity[i];
+  const std::uint8_t flags = a.flags[i];
+  if ((flags & kAgentActive) == 0 || (flags & kAgentStopped) != 0) {
+    out_p = p;
+    out_v = glm::vec2(0.0f);
+    return;
+  }
+  const ModelParams& m = ctx.model;
+  const float r = a.radius[i];
+  const Probe probe = make_probe(p, v, a.heading[i], r, m);
+  // Priority: a lower force is only computed when the higher ones are zero.
+  glm::vec2 force = sense_obstacles(ctx.world, probe, m.max_force).force;
+  if (length2(force) <= 1e-12f) {
+    const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+    force = avoidance_force(probe.forward, sense_neighbours(ctx.bins, cx, cy, i, p, v, probe.forward, r, n, m), m.max_force);
+    if (length2(force) <= 1e-12f) force = path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
+  }
+  out_v = clamp_length(v + force * ctx.dt, m.max_speed);
+  out_p = p + out_v * ctx.dt;
+}
+
+// One contact pass for one agent reading positions P.
+THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy,
+                                                  glm::vec2 anchor, Span<const glm::vec2> P) {
+  glm::vec2 p = P[i];
+  if ((a.flags[i] & kAgentActive) == 0) return p;
+  const float r = a.radius[i];
+  p += clamp_length(contact_push(ctx.contact_bins, cx, cy, i, p, r, P, a.radius, a.flags), 0.5f * r);
+  p = anchor + clamp_length(p - anchor, kMaxStepFraction * r);
+  return project_out_of_obstacles(ctx.world, p, r, anchor);
+}
+
+struct SteerDoubleBuffer {
+  StepContext ctx;
+  AgentArrays a;
+  Span<glm::vec2> out_p;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    const glm::vec2 p = a.position[i];
+    glm::vec2 np, nv;
+    steer_agent(ctx, a, i, cell_coord(p.x, ctx.bins.cell_size), cell_coord(p.y, ctx.bins.cell_size), np, nv);
+    out_p[i] = np;
+  }
+};
+
+struct ContactsDoubleBuffer {
+  StepContext ctx;
+  AgentArrays a;
+  Span<const glm::vec2> anchor, in;
+  Span<glm::vec2> out;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    const glm::vec2 b = anchor[i];
+    out[i] = contact_agent(ctx, a, i, cell_coord(b.x, ctx.contact_bins.cell_size), cell_coord(b.y, ctx.contact_bins.cell_size), b, in);
+  }
+};
+
+// Four colour: one launch per colour over the table slots; a slot of that
+// colour updates its agents one after another, in place.
+struct SteerColour {
+  StepContext ctx;
+  AgentArrays a;
+  int colour;
+  THRONG_HOST_DEVICE void operator()(Index s) const {
+    const std::uint64_t key = ctx.bins.keys[s];
+    if (key == kEmptyCell || cell_colour(key) != colour) return;
+    const std::int32_t cx = key_cx(key), cy = key_cy(key);
+    const std::int32_t b = ctx.bins.start[s], n = ctx.bins.count[s];
+    for (std::int32_t k = 0; k < n; ++k) {
+      const Index i = ctx.bins.items[b + k];
+      glm::vec2 np, nv;
+      steer_agent(ctx, a, i, cx, cy, np, nv);
+      a.position[i] = np;
+      a.velocity[i] = nv;
+    }
+  }
+};
+
+struct ContactsColour {
+  StepContext ctx;
+  AgentArrays a;
+  Span<const glm::vec2> anchor;
+  int colour;
+  THRONG_HOST_DEVICE void operator()(Index s) const {
+    const std::uint64_t key = ctx.contact_bins.keys[s];
+    if (key == kEmptyCell || cell_colour(key) != colour) return;
+    const std::int32_t cx = key_cx(key), cy = key_cy(key);
+    const std::int32_t b = ctx.contact_bins.start[s], n = ctx.contact_bins.count[s];
+    for (std::int32_t k = 0; k < n; ++k) {
+      const Index i = ctx.contact_bins.items[b + k];
+      a.position[i] = contact_agent(ctx, a, i, cx, cy, anchor[i], a.position);
+    }
+  }
+};
+
+struct Finalize {
+  StepContext ctx;
+  AgentArrays a;
+  Span<const glm::vec2> anchor, moved;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    std::uint8_t flags = a.flags[i];
+    if ((flags & kAgentActive) == 0) return;
+    const glm::vec2 from = anchor[i];
+    glm::vec2 p = moved[i];
+    const float r = a.radius[i];
+    // Accept the move only if it keeps the disc off every wall and is short
+    // enough that it cannot have crossed one (see the header).
+    const bool short_enough = length2(p - from) <= (kAcceptFraction * r) * (kAcceptFraction * r);
+    if (!(short_enough && wall_clearance(ctx.world, p, r) >= r - kWallTolerance)) p = from;
+    glm::vec2 v = clamp_length((p - from) * (1.0f / ctx.dt), ctx.model.max_speed);
+    if ((flags & kAgentStopped) != 0) v = glm::vec2(0.0f);
+    a.position[i] = p;
+    if (length2(v) > 0.05f * 0.05f) a.heading[i] = atan2f(v.y, v.x);
+    if ((flags & kAgentStopped) == 0) {
+      const GroupRuntime g = a.groups[a.group[i]];
+      const glm::vec2 goal = a.goal[i];
+      if (length2(goal - p) <= g.arrival_radius * g.arrival_radius) {
+        const std::int32_t cursor = a.waypoint_cursor[i];
+        const std::int32_t begin = a.waypoint_begin[i], count = a.waypoint_count[i];
+        if (cursor == g.final_waypoint && a.arrival_time[i] < 0.0f) {
+          a.arrival_time[i] = ctx.time_after;
+          flags |= kAgentArrived;
+        }
+        if (cursor + 1 < count) {
+          a.path_start[i] = goal;
+          a.waypoint_cursor[i] = cursor + 1;
+          a.goal[i] = a.waypoints[begin + cursor + 1];
+        } else if (g.arrival == ArrivalBehaviour::Stop) {
+          flags |= kAgentStopped;
+          v = glm::vec2(0.0f);
+        } else if (g.arrival == ArrivalBehaviour::Despawn) {
+          flags = static_cast<std::uint8_t>(flags & ~kAgentActive);
+          v = glm::vec2(0.0f);
+        } else {
+          a.path_start[i] = goal;
+          a.waypoint_cursor[i] = 0;
+          a.goal[i] = a.waypoints[begin];
+        }
+      }
+    }
+    a.velocity[i] = v;
+    a.flags[i] = flags;
+  }
+};
+
+constexpr Index kSlotGrain = 256;
+
+}  // namespace
+
+void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> out_position) {
+  parallel_for("sim.steer", a.position.size(), SteerDoubleBuffer{ctx, a, out_position}, 256);
+}
+
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> in,
+                            Span<glm::vec2> out) {
+  parallel_for("sim.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, out}, 256);
+}
+
+void steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
+  for (int c = 0; c < 4; ++c) parallel_for("sim.steer_colour", ctx.bins.capacity(), SteerColour{ctx, a, c}, kSlotGrain);
+}
+
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor) {
+  for (int c = 0; c < 4; ++c) parallel_for("sim.contacts_colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, c}, kSlotGrain);
+}
+
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> moved) {
+  parallel_for("sim.finalize", a.position.size(), Finalize{ctx, a, anchor, moved});
+}
+
+void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to) {
+  parallel_for("sim.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
+}
+
+}  // namespace throng::sim

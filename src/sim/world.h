@@ -1,0 +1,188 @@
+// The geometric layer: walkable region and obstacles, indexed for queries
+// near a point. Built once on the host from a WorldSpec; the flattened arrays
+// and grids live in current_memory() so kernels read them through WorldView.
+//
+// Obstacles are polygons (with holes) and circles. Walls are the edges of
+// every obstacle polygon and of the walkable boundary; holes of the walkable
+// region become obstacle polygons. Three sparse grids of side cell_size:
+//   segments: every cell an edge passes through (probe, projection);
+//   circles:  every cell a disc overlaps;
+//   polygons: every cell of a polygon's bounding box (point containment).
+// An agent's 3x3 cells reach every wall within one cell side of it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/buffer.h"
+#include "sim/geometry.h"
+#include "sim/grid.h"
+#include "sim/scenario.h"
+
+namespace throng::sim {
+
+struct RingRef {
+  std::int32_t begin = 0;  // into vertices
+  std::int32_t count = 0;
+};
+struct PolygonRef {
+  std::int32_t ring_begin = 0;  // into rings; the first is the outer ring
+  std::int32_t ring_count = 0;
+};
+
+// Device-readable view of the world.
+struct WorldView {
+  float cell_size = 4.0f;
+  bool has_walkable = false;
+  RingRef walkable_outer;
+  Span<const glm::vec2> vertices;
+  Span<const RingRef> rings;
+  Span<const PolygonRef> polygons;
+  Span<const Segment> segments;
+  Span<const Circle> circles;
+  GridView segment_grid;
+  GridView circle_grid;
+  GridView polygon_grid;
+};
+
+THRONG_HOST_DEVICE inline bool point_in_polygon_ref(const WorldView& w, glm::vec2 p, PolygonRef poly) {
+  const RingRef outer = w.rings[poly.ring_begin];
+  if (!point_in_ring(p, w.vertices.data() + outer.begin, outer.count)) return false;
+  for (std::int32_t r = 1; r < poly.ring_count; ++r) {
+    const RingRef hole = w.rings[poly.ring_begin + r];
+    if (point_in_ring(p, w.vertices.data() + hole.begin, hole.count)) return false;
+  }
+  return true;
+}
+
+// Index of an obstacle polygon containing p, or -1 (own cell only).
+THRONG_HOST_DEVICE inline std::int32_t polygon_containing(const WorldView& w, glm::vec2 p) {
+  std::int32_t found = -1;
+  for_each_in_cell(w.polygon_grid, p, [&](std::int32_t k) {
+    if (found < 0 && point_in_polygon_ref(w, p, w.polygons[k])) found = k;
+  });
+  return found;
+}
+THRONG_HOST_DEVICE inline std::int32_t circle_containing(const WorldView& w, glm::vec2 p) {
+  std::int32_t found = -1;
+  for_each_in_cell(w.circle_grid, p, [&](std::int32_t k) {
+    const Circle c = w.circles[k];
+    if (found < 0 && length2(p - c.center) < c.radius * c.radius) found = k;
+  });
+  return found;
+}
+
+// p is in free space: inside the walkable region (when there is one) and in
+// no obstacle.
+THRONG_HOST_DEVICE inline bool in_free_space(const WorldView& w, glm::vec2 p) {
+  if (w.has_walkable && !point_in_ring(p, w.vertices.data() + w.walkable_outer.begin, w.walkable_outer.count)) return false;
+  return polygon_containing(w, p) < 0 && circle_containing(w, p) < 0;
+}
+
+// Distance from p to the nearest wall or circle boundary within the 3x3 cells
+// (beyond that: `far`).
+THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, glm::vec2 p, float far) {
+  float best = far;
+  for_each_in_3x3(w.segment_grid, p, [&](std::int32_t k) {
+    const float d = distance_to_segment(p, w.segments[k].a, w.segments[k].b);
+    if (d < best) best = d;
+  });
+  for_each_in_3x3(w.circle_grid, p, [&](std::int32_t k) {
+    const Circle c = w.circles[k];
+    const float d = fabsf(length_of(p - c.center) - c.radius);
+    if (d < best) best = d;
+  });
+  return best;
+}
+
+// A disc of radius r at p penetrates no obstacle by more than `tolerance`:
+// walls and circle boundaries at least r - tolerance away, centre in free space.
+THRONG_HOST_DEVICE inline bool disc_is_clear(const WorldView& w, glm::vec2 p, float r, float tolerance) {
+  return wall_clearance(w, p, r) >= r - tolerance && in_free_space(w, p);
+}
+
+class World {
+ public:
+  World() = default;
+  // Validates and indexes the geometry. Errors name the field path of the
+  // offending shape ("world.obstacles[2]: polygon edges 3 and 7 cross").
+  static World build(const WorldSpec& spec, float cell_size, const ScenarioLimits& limits = {}, Memory memory = current_memory());
+
+  WorldView view() const;       // in the memory the world was built for
+  WorldView host_view() const;  // host mirror, for spawning and validation
+
+  float cell_size() const { return cell_size_; }
+  bool has_walkable() const { return has_walkable_; }
+  const Polygon& walkable() const { return walkable_; }
+  // All obstacle polygons (spec polygons, walkable holes, scattered shapes).
+  const std::vector<Polygon>& polygons() const { return polygons_; }
+  const std::vector<Circle>& circles() const { return circles_; }
+  const std::vector<Segment>& segments() const { return segments_; }
+  // Field path of obstacle polygon / circle k, for messages.
+  const std::string& polygon_field(std::int32_t k) const { return polygon_fields_[static_cast<std::size_t>(k)]; }
+  const std::string& circle_field(std::int32_t k) const { return circle_fields_[static_cast<std::size_t>(k)]; }
+  // Bounding box of the walkable region, or of all obstacles when unbounded.
+  Aabb bounds() const { return bounds_; }
+
+  // Host queries.
+  bool in_free_space(glm::vec2 p) const;
+  // Field path of an obstacle containing p, or "" when none does; "outside
+  // the walkable region" when p is outside it.
+  std::string what_blocks(glm::vec2 p) const;
+  // Disc of radius r at p fits without touching any wall (exact within one
+  // cell side; r must be below cell_size).
+  bool disc_fits(glm::vec2 p, float r) const;
+
+ private:
+  void index(const ScenarioLimits& limits, Memory memory);
+
+  float cell_size_ = 4.0f;
+  bool has_walkable_ = false;
+  Polygon walkable_;
+  std::vector<Polygon> polygons_;
+  std::vector<std::string> polygon_fields_;
+  std::vector<Circle> circles_;
+  std::vector<std::string> circle_fields_;
+  std::vector<Segment> segments_;
+  Aabb bounds_;
+
+  // Flattened host arrays and their device copies.
+  RingRef walkable_outer_;
+  std::vector<glm::vec2> vertices_;
+  std::vector<RingRef> rings_;
+  std::vector<PolygonRef> polygon_refs_;
+  Buffer<glm::vec2> d_vertices_;
+  Buffer<RingRef> d_rings_;
+  Buffer<PolygonRef> d_polygons_;
+  Buffer<Segment> d_segments_;
+  Buffer<Circle> d_circles_;
+  StaticGrid segment_grid_, circle_grid_, polygon_grid_;
+};
+
+// Connected parts of free space on a raster (for "unreachable goal"): cell
+// centres in free space are joined 4-way. Conservative: only reports two
+// points apart when no path exists at raster resolution.
+class Reachability {
+ public:
+  Reachability(const World& world, Aabb extent, std::int32_t resolution);
+  // Component labels of p: its raster cell's, or when that cell's centre is
+  // blocked (p close to an obstacle), those of the free cells around it.
+  struct Labels {
+    std::int32_t label[9];
+    int count = 0;
+  };
+  Labels components(glm::vec2 p) const;
+  // False only when both points have known labels and share none.
+  bool connected(glm::vec2 a, glm::vec2 b) const;
+  float cell_size() const { return h_; }
+
+ private:
+  std::int32_t label_at(std::int64_t x, std::int64_t y) const;
+  Aabb extent_;
+  float h_ = 1.0f;
+  std::int64_t nx_ = 0, ny_ = 0;
+  std::vector<std::int32_t> labels_;
+};
+
+}  // namespace throng::sim
