@@ -93,31 +93,41 @@ ResampledPath resample_path(std::span<const glm::vec2> polyline, const ResampleO
   ResampledPath out;
   out.spacing = options.spacing;
   out.spline_length = static_cast<float>(arc);
-  const auto count = static_cast<std::size_t>(std::floor(arc / options.spacing + 1e-6)) + 1;
-  std::size_t cursor = 0;
-  for (std::size_t j = 0; j < count; ++j) {
-    const double s = std::min(arc, static_cast<double>(j) * options.spacing);
-    while (cursor + 1 < table.size() && table[cursor + 1].arc < s) ++cursor;
-    const Sample& a = table[cursor];
-    const Sample& b = table[std::min(cursor + 1, table.size() - 1)];
-    std::int32_t piece = b.piece;
-    float u;
-    if (b.arc > a.arc) {
-      const float f = static_cast<float>((s - a.arc) / (b.arc - a.arc));
-      const float ua = a.piece == b.piece ? a.u : 0.0f;  // a sample at the previous piece's end is u = 0 here
-      u = ua + f * (b.u - ua);
-    } else {
-      piece = a.piece;
-      u = a.u;
-    }
+  // Each point lies at distance `spacing` (Euclidean) from the previous one,
+  // the first such point along the curve: the table brackets it (its
+  // sub-steps are at most half the spacing), bisection places it. Where the
+  // curve bends, the arc between points is a little longer than the chord.
+  const double s2 = static_cast<double>(options.spacing) * options.spacing;
+  auto emit = [&](std::int32_t piece, float u, double at_arc) {
     out.points.push_back(spline.position(piece, u));
     out.tangents.push_back(sim::normalize_or(spline.derivative(piece, u), glm::vec2(1.0f, 0.0f)));
-    out.arc.push_back(static_cast<float>(s));
+    out.arc.push_back(static_cast<float>(at_arc));
     // Deviation from the (densified) polyline near this piece.
     float dev = INFINITY;
     for (std::int32_t k = std::max(0, piece - 1); k <= std::min(spline.piece_count() - 1, piece + 1); ++k)
       dev = std::min(dev, sim::distance_to_segment(out.points.back(), knots[static_cast<std::size_t>(k)], knots[static_cast<std::size_t>(k) + 1]));
     out.max_polyline_deviation = std::max(out.max_polyline_deviation, dev);
+  };
+  auto sample_pos = [&](const Sample& x) { return spline.position(x.piece, x.u); };
+  auto far_enough = [&](glm::vec2 p) {
+    const glm::dvec2 d = glm::dvec2(p) - glm::dvec2(out.points.back());
+    return d.x * d.x + d.y * d.y >= s2;
+  };
+  emit(0, 0.0f, 0.0);
+  std::size_t cursor = 0;
+  for (;;) {
+    while (cursor + 1 < table.size() && !far_enough(sample_pos(table[cursor + 1]))) ++cursor;
+    if (cursor + 1 >= table.size()) break;
+    const Sample& a = table[cursor];
+    const Sample& b = table[cursor + 1];
+    const float ua = a.piece == b.piece ? a.u : 0.0f;  // a sample at the previous piece's end is u = 0 here
+    float lo = 0.0f, hi = 1.0f;
+    for (int it = 0; it < 40; ++it) {
+      const float mid = 0.5f * (lo + hi);
+      (far_enough(spline.position(b.piece, ua + mid * (b.u - ua))) ? hi : lo) = mid;
+    }
+    emit(b.piece, ua + hi * (b.u - ua), a.arc + hi * (b.arc - a.arc));
+    if (out.points.size() > 50'000'000) throw Error("path needs more than 50,000,000 points: raise the spacing", at_field("resample.spacing"));
   }
 
   // Marks: polyline arc length equals the chord-length knot parameter, so
