@@ -31,6 +31,7 @@ void PlanOptions::validate() const {
     throw Error("clearance weight must be >= 0", at_field("plan.clearance_weight"));
   if (!std::isfinite(shortcut_clearance) || (shortcut_clearance >= 0 && shortcut_clearance < radius))
     throw Error("shortcut clearance must be >= radius (or negative for the default)", at_field("plan.shortcut_clearance"));
+  if (!(std::isfinite(corner_radius) && corner_radius >= 0)) throw Error("corner radius must be >= 0", at_field("plan.corner_radius"));
   if (attach_candidates < 1) throw Error("attach candidates must be >= 1", at_field("plan.attach_candidates"));
   free_space.validate();
 }
@@ -224,6 +225,7 @@ PlannedPath Planner::plan(const PathQuery& q) const {
   out.status = PlanStatus::Found;
   out.roadmap_points = raw;
   out.points = options_.smooth ? shortcut(raw, options_.kept_clearance()) : raw;
+  if (options_.smooth && options_.corner_radius > 0) out.points = round_corners(out.points, options_.corner_radius);
   out.length = polyline_length(out.points);
   out.min_clearance = INFINITY;
   for (std::size_t i = 1; i < out.points.size(); ++i)
@@ -253,6 +255,45 @@ std::vector<glm::vec2> Planner::shortcut(std::span<const glm::vec2> poly, float 
     out.push_back(pass[j]);
     i = j;
   }
+  return out;
+}
+
+std::vector<glm::vec2> Planner::round_corners(std::span<const glm::vec2> poly, float radius) const {
+  if (poly.size() <= 2) return {poly.begin(), poly.end()};
+  std::vector<glm::vec2> out = {poly[0]};
+  for (std::size_t i = 1; i + 1 < poly.size(); ++i) {
+    const glm::vec2 p = poly[i];
+    const float len_in = sim::length_of(p - poly[i - 1]), len_out = sim::length_of(poly[i + 1] - p);
+    const glm::vec2 a = (p - poly[i - 1]) / len_in, b = (poly[i + 1] - p) / len_out;
+    const float turn = std::acos(std::clamp(sim::dot2(a, b), -1.0f, 1.0f));
+    std::vector<glm::vec2> arc;
+    if (turn > 1e-3f && turn < 3.1f) {
+      const float half = std::tan(0.5f * turn);
+      // Tangent length L = rho tan(turn / 2), at most 45 % of either edge.
+      float rho = std::min(radius, 0.45f * std::min(len_in, len_out) / half);
+      const float side = sim::cross2(a, b) > 0 ? 1.0f : -1.0f;
+      for (int attempt = 0; attempt < 5 && arc.empty(); ++attempt, rho *= 0.5f) {
+        const float L = rho * half;
+        const glm::vec2 t1 = p - a * L, centre = t1 + sim::perp_left(a) * (side * rho);
+        const int steps = std::max(2, static_cast<int>(std::ceil(turn / 0.1f)));
+        std::vector<glm::vec2> pts;
+        for (int k = 0; k <= steps; ++k) {
+          const float ang = side * turn * static_cast<float>(k) / static_cast<float>(steps);
+          const glm::vec2 r0 = t1 - centre;
+          pts.push_back(centre + glm::vec2(r0.x * std::cos(ang) - r0.y * std::sin(ang), r0.x * std::sin(ang) + r0.y * std::cos(ang)));
+        }
+        bool clear = true;
+        for (std::size_t k = 1; k < pts.size() && clear; ++k) clear = space_.segment_clear(pts[k - 1], pts[k], options_.radius);
+        if (clear) arc = std::move(pts);
+      }
+    }
+    if (arc.empty()) {
+      push_point(out, p);
+    } else {
+      for (glm::vec2 q : arc) push_point(out, q);
+    }
+  }
+  push_point(out, poly.back());
   return out;
 }
 

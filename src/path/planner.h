@@ -29,6 +29,10 @@ struct PlanOptions {
   // spline's rounding of corners).
   float shortcut_clearance = -1.0f;
   bool smooth = true;
+  // Corners of the smoothed path become circular arcs of this radius (less
+  // where the neighbouring edges are short or the arc would leave the
+  // clearance); 0 keeps sharp corners. Walking turns need about 1-2 m.
+  float corner_radius = 1.0f;
   std::int32_t attach_candidates = 32;  // nearest roadmap edges tried first when attaching a point
   FreeSpaceOptions free_space;
   RoadmapOptions roadmap_options() const;  // the roadmap for `radius`
@@ -71,6 +75,10 @@ class Planner {
   // Shortcut pass on its own: drops points while the segment that replaces
   // them keeps `clearance` (first a greedy sweep, then farthest-visible).
   std::vector<glm::vec2> shortcut(std::span<const glm::vec2> polyline, float clearance) const;
+  // Replaces each corner by a circular arc of at most `radius` whose chords
+  // keep the planner's radius (halving the arc's radius up to 4 times, else
+  // the corner stays).
+  std::vector<glm::vec2> round_corners(std::span<const glm::vec2> polyline, float radius) const;
 
  private:
   // Where a point joins the roadmap; edge < 0 when it cannot.
