@@ -97,7 +97,7 @@ struct BestMotionJob {
 };
 
 struct MatchOptions {
-  float speed_weight = 0.05f;  // s: cost per point of 1 m/s speed mismatch, in metres
+  float speed_weight = 0.2f;  // s: cost per point of 1 m/s speed mismatch, in metres
   void validate() const;
 };
 
