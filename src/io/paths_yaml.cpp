@@ -1,11 +1,11 @@
 #include "io/paths_yaml.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "io/yaml_fields.h"
 
 namespace throng::io {
 
@@ -14,36 +14,7 @@ namespace {
 constexpr double kMaxCoordinate = 1.0e6;  // m
 constexpr std::size_t kMaxPoints = 1'000'000;
 
-struct Reader {
-  std::string file;
-  Location where(const YAML::Node& n) const {
-    const YAML::Mark m = n.Mark();
-    return at_line(file, m.line + 1, m.column + 1);
-  }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& what) const { throw Error(what, where(n)); }
-  void only_keys(const YAML::Node& n, std::initializer_list<const char*> keys) const {
-    if (!n.IsMap()) fail(n, "expected a mapping");
-    for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
-      bool known = false;
-      std::string list;
-      for (const char* k : keys) {
-        known |= key == k;
-        list += list.empty() ? k : std::string(", ") + k;
-      }
-      if (!known) fail(kv.first, "unknown key '" + key + "' (expected one of: " + list + ")");
-    }
-  }
-  double number(const YAML::Node& n, double lo, double hi) const {
-    double v = 0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v)) fail(n, "expected a finite number");
-    if (v < lo || v > hi) {
-      std::ostringstream s;
-      s << "value " << v << " is out of range [" << lo << ", " << hi << "]";
-      fail(n, s.str());
-    }
-    return v;
-  }
+struct Reader : YamlFields {
   glm::vec2 point(const YAML::Node& n) const {
     if (!n.IsSequence() || n.size() != 2) fail(n, "a point is [x, y]");
     return {static_cast<float>(number(n[0], -kMaxCoordinate, kMaxCoordinate)), static_cast<float>(number(n[1], -kMaxCoordinate, kMaxCoordinate))};
@@ -61,13 +32,9 @@ struct Reader {
 }  // namespace
 
 PathsFile parse_paths(std::string_view text, const std::string& name) {
-  const Reader r{name};
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw Error(e.msg, at_line(name, e.mark.line + 1, e.mark.column + 1));
-  }
+  Reader r;
+  r.file = name;
+  const YAML::Node root = load_yaml(std::string(text), name);
   PathsFile out;
   try {
     if (!root.IsMap()) r.fail(root, "a paths file must be a mapping");

@@ -1,7 +1,5 @@
 #include "io/state_machine_yaml.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -9,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "io/yaml_fields.h"
 #include "motion/default_set.h"
 
 namespace throng::io {
@@ -17,46 +16,11 @@ extern const char* const kDefaultMachineYaml;  // generated from data/motion/def
 
 namespace {
 
-struct Reader {
-  std::string file;
-
-  Location where(const YAML::Node& n) const {
-    const YAML::Mark m = n.Mark();
-    return at_line(file, m.line + 1, m.column + 1);
-  }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& what) const { throw Error(what, where(n)); }
-
+struct Reader : YamlFields {
   void expect_map(const YAML::Node& n, const std::string& what) const {
     if (!n.IsMap()) fail(n, what + " must be a mapping");
   }
-  // Every key of `n` must be one of `keys`.
-  void only_keys(const YAML::Node& n, std::initializer_list<const char*> keys) const {
-    for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
-      bool known = false;
-      std::string list;
-      for (const char* k : keys) {
-        known |= key == k;
-        list += list.empty() ? k : std::string(", ") + k;
-      }
-      if (!known) fail(kv.first, "unknown key '" + key + "' (expected one of: " + list + ")");
-    }
-  }
-  std::string string(const YAML::Node& n) const {
-    if (!n.IsScalar()) fail(n, "expected a name");
-    return n.as<std::string>();
-  }
-  double number(const YAML::Node& n, double lo, double hi) const {
-    if (!n.IsScalar()) fail(n, "expected a number");
-    double v = 0;
-    if (!YAML::convert<double>::decode(n, v) || !std::isfinite(v)) fail(n, "'" + n.Scalar() + "' is not a finite number");
-    if (v < lo || v > hi) {
-      std::ostringstream s;
-      s << "value " << v << " is out of range [" << lo << ", " << hi << "]";
-      fail(n, s.str());
-    }
-    return v;
-  }
+  std::string string(const YAML::Node& n) const { return scalar(n); }
   std::int32_t integer(const YAML::Node& n, std::int32_t lo, std::int32_t hi) const {
     const double v = number(n, lo, hi);
     if (v != std::floor(v)) fail(n, "expected a whole number");
@@ -197,14 +161,11 @@ struct Reader {
 }  // namespace
 
 path::StateMachineSpec parse_state_machine(std::string_view text, const std::string& name) {
-  YAML::Node root;
+  const YAML::Node root = load_yaml(std::string(text), name);
   try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw Error(e.msg, at_line(name, e.mark.line + 1, e.mark.column + 1));
-  }
-  try {
-    return Reader{name}.machine(root);
+    Reader r;
+    r.file = name;
+    return r.machine(root);
   } catch (const YAML::Exception& e) {  // conversions of odd scalars
     throw Error(e.msg, at_line(name, e.mark.line + 1, e.mark.column + 1));
   }

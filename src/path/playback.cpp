@@ -12,11 +12,6 @@ namespace throng::path {
 
 namespace {
 
-glm::vec2 rotate(glm::vec2 v, float a) {
-  const float c = std::cos(a), s = std::sin(a);
-  return {c * v.x - s * v.y, s * v.x + c * v.y};
-}
-
 struct Item {
   std::int32_t segment;
   glm::vec2 place;     // where the segment's origin goes
@@ -52,7 +47,7 @@ Playback play(const StateMachine& machine, const ResampledPath& path, const Sequ
     const float theta = heading_of(path.tangents[i]);
     const MotionSegment& m = seg_of(sequence.segments[static_cast<std::size_t>(c)]);
     add(sequence.segments[static_cast<std::size_t>(c)], path.points[i], theta, c);
-    end_place = path.points[i] + rotate(m.end_point, theta);
+    end_place = path.points[i] + rotate_ccw(m.end_point, theta);
     end_heading = theta + m.end_heading;
   }
   if (sequence.end_segment >= 0) add(sequence.end_segment, end_place, end_heading, -1);
@@ -72,7 +67,7 @@ Playback play(const StateMachine& machine, const ResampledPath& path, const Sequ
   auto placed = [&](const Item& it, double u, std::vector<glm::quat>& rot, glm::vec3& root) {
     machine.pose(it.segment, u, rot, root);
     const MotionSegment& m = seg_of(it.segment);
-    const glm::vec2 g = it.place + rotate(ground_from_world(root) - m.origin, it.turn);
+    const glm::vec2 g = it.place + rotate_ccw(ground_from_world(root) - m.origin, it.turn);
     root = world_from_ground(g, root.y);
     rot[0] = glm::angleAxis(it.turn, glm::vec3(0, 1, 0)) * rot[0];
   };

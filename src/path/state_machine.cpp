@@ -17,11 +17,6 @@ namespace throng::path {
 
 namespace {
 
-glm::vec2 rotate(glm::vec2 v, float a) {
-  const float c = std::cos(a), s = std::sin(a);
-  return {c * v.x - s * v.y, s * v.x + c * v.y};
-}
-
 // Sampled frame position of clip time t (seconds, t0 = time of frame 0).
 struct FramePos {
   std::int32_t f0, f1;
@@ -186,7 +181,7 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
         const FramePos fp = frame_pos(mc.clip, mc.time_of_first_frame, fps, ms.start_time);
         ms.origin = mc.raw_root(ms.start_time);
         ms.heading = static_cast<float>(heading_from_yaw(static_cast<float>(motion::heading_of(mc.clip.rotation(fp.f0, 0)))));
-        ms.end_point = rotate(mc.raw_root(ms.start_time + ms.duration) - ms.origin, -ms.heading);
+        ms.end_point = rotate_ccw(mc.raw_root(ms.start_time + ms.duration) - ms.origin, -ms.heading);
       } else {
         // March along the smoothed root in quarter frames, recording the
         // times at arc length j * s (j = 0..k); linear inside a step.
@@ -220,8 +215,8 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
         };
         ms.origin = mc.smoothed_root(ms.start_time);
         ms.heading = static_cast<float>(heading_at(ms.start_time));
-        for (double tt : ms.times) ms.trajectory.push_back(rotate(mc.smoothed_root(tt) - ms.origin, -ms.heading));
-        ms.end_point = rotate(mc.smoothed_root(t_end) - ms.origin, -ms.heading);
+        for (double tt : ms.times) ms.trajectory.push_back(rotate_ccw(mc.smoothed_root(tt) - ms.origin, -ms.heading));
+        ms.end_point = rotate_ccw(mc.smoothed_root(t_end) - ms.origin, -ms.heading);
         ms.end_heading = static_cast<float>(std::remainder(heading_at(t_end) - ms.heading, 2.0 * std::numbers::pi));
         m.locomotion_.push_back(static_cast<std::int32_t>(m.segments_.size()));
       }

@@ -18,6 +18,7 @@
 // set plus a few generated clips (running turns, sharper walking turns).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <glm/vec2.hpp>
 #include <memory>
@@ -31,6 +32,12 @@
 #include "motion/skeleton.h"
 
 namespace throng::path {
+
+// v turned counter-clockwise by `angle` radians (map coordinates).
+inline glm::vec2 rotate_ccw(glm::vec2 v, float angle) {
+  const float c = std::cos(angle), s = std::sin(angle);
+  return {c * v.x - s * v.y, s * v.x + c * v.y};
+}
 
 // ---- the data file, as plain data (io/state_machine_yaml fills it) ----------
 

@@ -4,18 +4,16 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <sstream>
-#include <sys/wait.h>
 
 #include "core/error.h"
 #include "io/paths_yaml.h"
 #include "motion/default_set.h"
 #include "path/state_machine.h"
+#include "tests/io/throng_exe.h"
 
 namespace throng::io {
 namespace {
@@ -95,25 +93,15 @@ TEST(PathsYaml, ReadsPathsAndRejectsBadOnes) {
 
 // ---- the command ------------------------------------------------------------------
 
-std::optional<fs::path> find_throng() {
-  std::error_code ec;
-  fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
-  for (int up = 0; up < 3 && !ec; ++up, dir = dir.parent_path())
-    if (fs::is_regular_file(dir / "throng")) return dir / "throng";
-  return std::nullopt;
-}
-
+// The command's output, appended to `out`; returns the exit code.
 int run(const fs::path& exe, const std::string& args, std::string& out) {
-  const std::string cmd = exe.string() + " --backend cpu --log-level warn " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (pipe != nullptr && fgets(buf, sizeof buf, pipe) != nullptr) out += buf;
-  const int status = pipe != nullptr ? pclose(pipe) : -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const testing::Result r = testing::run(exe, args);
+  out += r.out;
+  return r.code;
 }
 
 TEST(MatchCommand, RandomPathsAndAPathsFile) {
-  const auto exe = find_throng();
+  const auto exe = testing::find_throng();
   if (!exe) GTEST_SKIP() << "build the throng target to run this test";
   const fs::path dir = fs::temp_directory_path() / ("throng_match_" + std::to_string(::getpid()));
   fs::create_directories(dir);
