@@ -272,6 +272,23 @@ TEST(Sequences, DpIsLegalOptimalAndBeatsRepairedGreedy) {
   EXPECT_GT(greedy_illegal, 0) << "these S-bends should trip the greedy choice";
 }
 
+TEST(Sequences, SameSequencesForAnyThreadCount) {
+  const StateMachine& m = small_machine();
+  const CurveSet cs = random_curves(20, 8);
+  MatchGrid grid(m, cs);
+  grid.match();
+  const std::vector<float> cost = grid.cost();
+  std::vector<std::vector<Sequence>> runs;
+  for (int threads : {1, 3}) {
+    ScopedExecution scope(Backend::Cpu, threads);
+    runs.push_back(dp_sequences(m, cs, cost));
+  }
+  for (std::size_t p = 0; p < runs[0].size(); ++p) {
+    EXPECT_EQ(runs[0][p].segments, runs[1][p].segments);
+    EXPECT_EQ(runs[0][p].total(), runs[1][p].total());
+  }
+}
+
 TEST(Sequences, DpEqualsBruteForceOnShortPaths) {
   const StateMachine& m = small_machine();
   const auto& loco = m.locomotion_segments();
