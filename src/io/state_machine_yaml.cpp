@@ -91,10 +91,10 @@ struct Reader : YamlFields {
       sp.where = where(seg);
       if (!seg["clip"]) fail(seg, "a segment needs 'clip'");
       sp.clip = string(seg["clip"]);
-      if (seg["start"]) sp.start_frame = number(seg["start"], 0, 1e6);
+      if (seg["start"]) sp.start_frame = number(seg["start"], 0, 36000);
       if (seg["frames"]) {
         if (s.locomotion) fail(seg["frames"], "a locomotion segment's length is the machine's segment length (points_per_segment x spacing), not frames");
-        sp.frames = number(seg["frames"], 1, 1e6);
+        sp.frames = number(seg["frames"], 1, 36000);
       }
       s.segments.push_back(sp);
     }

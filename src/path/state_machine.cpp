@@ -70,6 +70,11 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
   if (spec.transition_frames < 0 || spec.transition_frames > 240) fail("transition_frames must be in [0, 240]", at_field("transition_frames"));
   if (!(spec.pose_weight >= 0 && std::isfinite(spec.pose_weight))) fail("pose_weight must be >= 0", at_field("pose_weight"));
   if (spec.states.empty()) fail("a machine needs at least one state", at_field("states"));
+  std::size_t segment_total = 0;
+  for (const StateSpec& s : spec.states) segment_total += s.segments.size();
+  // The transition table has segments^2 entries.
+  if (segment_total > 4096) fail("a machine may have at most 4096 segments", at_field("states"));
+  if (spec.clips.size() > 1024) fail("a machine may have at most 1024 clips", at_field("clips"));
 
   StateMachine m;
   m.spec_ = spec;
@@ -121,8 +126,8 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
     for (const SegmentSpec& seg : s.segments) {
       auto it = clip_of.find(seg.clip);
       if (it == clip_of.end()) fail("unknown clip '" + seg.clip + "'", seg.where);
-      if (!(seg.start_frame >= 0 && seg.start_frame <= 1e6)) fail("start frame must be in [0, 1e6]", seg.where);
-      if (!(seg.frames >= 0 && seg.frames <= 1e6)) fail("frames must be in [0, 1e6]", seg.where);
+      if (!(seg.start_frame >= 0 && seg.start_frame <= 36000)) fail("start frame must be in [0, 36000]", seg.where);
+      if (!(seg.frames >= 0 && seg.frames <= 36000)) fail("frames must be in [0, 36000]", seg.where);
       const motion::LocomotionSpec& ls = spec.clips[static_cast<std::size_t>(it->second)].spec;
       if (s.locomotion && !(ls.speed > 0)) fail("a locomotion segment needs a moving clip ('" + seg.clip + "' stands)", seg.where);
       // Generous: the smoothed root may be a little slower than the clip's speed.
@@ -151,7 +156,7 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
     const double pad = (mc.period_frames + 2.0 * spec.transition_frames + 4.0) / fps;
     mc.time_of_first_frame = -pad;
     const auto frames = static_cast<std::int32_t>(std::ceil((clip_end[i] + 2.0 * pad) * fps)) + 1;
-    if (frames > 2'000'000) fail("clip would need more than 2,000,000 frames", c.where);
+    if (frames > 100'000) fail("clip would need more than 100,000 frames (lower the start frames or raise the speed)", c.where);
     mc.clip.resize(frames, skeleton.joint_count());
     mc.clip.frame_time = static_cast<float>(1.0 / fps);
     std::vector<glm::quat> rot(static_cast<std::size_t>(skeleton.joint_count()));
