@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -19,6 +21,27 @@ struct HeadlessContext::State {
 };
 
 namespace {
+
+// EGL displays are per process: eglTerminate would end every context on
+// one, so each is terminated only when its last HeadlessContext goes.
+std::mutex display_mutex;
+std::map<EGLDisplay, int>& display_users() {
+  static std::map<EGLDisplay, int> users;
+  return users;
+}
+void acquire_display(EGLDisplay d) {
+  const std::lock_guard<std::mutex> lock(display_mutex);
+  ++display_users()[d];
+}
+// Terminates `d` unless another context still uses it.
+void release_display(EGLDisplay d) {
+  const std::lock_guard<std::mutex> lock(display_mutex);
+  auto& users = display_users();
+  const auto it = users.find(d);
+  if (it != users.end() && --it->second > 0) return;
+  if (it != users.end()) users.erase(it);
+  eglTerminate(d);
+}
 
 bool has_extension(const char* list, const char* name) {
   if (list == nullptr) return false;
@@ -40,6 +63,7 @@ EGLContext try_context(EGLDisplay display, const HeadlessOptions& o, const std::
     why += fmt::format("{}: no display; ", label);
     return EGL_NO_CONTEXT;
   }
+  acquire_display(display);
   EGLint major = 0, minor = 0;
   if (eglInitialize(display, &major, &minor) != EGL_TRUE) {
     why += fmt::format("{}: eglInitialize failed ({}); ", label, egl_error_text());
@@ -47,7 +71,7 @@ EGLContext try_context(EGLDisplay display, const HeadlessOptions& o, const std::
   }
   if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) {
     why += fmt::format("{}: no desktop OpenGL API ({}); ", label, egl_error_text());
-    eglTerminate(display);
+    release_display(display);
     return EGL_NO_CONTEXT;
   }
   const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
@@ -65,20 +89,20 @@ EGLContext try_context(EGLDisplay display, const HeadlessOptions& o, const std::
     EGLint count = 0;
     if (eglChooseConfig(display, wanted, &config, 1, &count) != EGL_TRUE || count < 1) {
       why += fmt::format("{}: no desktop OpenGL config; ", label);
-      eglTerminate(display);
+      release_display(display);
       return EGL_NO_CONTEXT;
     }
   }
   EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, attributes);
   if (context == EGL_NO_CONTEXT) {
     why += fmt::format("{}: no OpenGL {}.{} core context ({}); ", label, o.gl_major, o.gl_minor, egl_error_text());
-    eglTerminate(display);
+    release_display(display);
     return EGL_NO_CONTEXT;
   }
   if (eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context) != EGL_TRUE) {
     why += fmt::format("{}: cannot make the context current without a surface ({}); ", label, egl_error_text());
     eglDestroyContext(display, context);
-    eglTerminate(display);
+    release_display(display);
     return EGL_NO_CONTEXT;
   }
   return context;
@@ -141,9 +165,9 @@ HeadlessContext::HeadlessContext(const HeadlessOptions& o) : state_(std::make_un
 
 HeadlessContext::~HeadlessContext() {
   if (state_ && state_->display != EGL_NO_DISPLAY) {
-    eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (eglGetCurrentContext() == state_->context) eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(state_->display, state_->context);
-    eglTerminate(state_->display);
+    release_display(state_->display);
   }
 }
 
