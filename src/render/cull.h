@@ -21,19 +21,26 @@
 
 namespace throng::render {
 
+// How a visible character is drawn, by the image radius of its bounding
+// sphere: near ones with the finer sphere mesh, mid ones with the coarse
+// mesh, the smallest (a few pixels tall) as one line per bone.
+enum class DrawTier : std::uint8_t { Fine, Coarse, Lines };
+inline constexpr int kDrawTiers = 3;
+
 struct CullJob {
   CameraView camera;
   std::int32_t joint_count = 0;
   float bounding_radius = 1.0f;  // about the root joint (JointRig::bounding_radius)
-  // Characters whose bounding sphere's image radius is at least this many
-  // pixels get the fine mesh; the rest the coarse one.
-  float fine_min_pixels = 40.0f;
+  float fine_min_pixels = 40.0f;  // image radius from which the fine mesh is used
+  float lines_max_pixels = 4.0f;  // image radius below which bones are lines
   bool cull = true;  // false: every character is visible
   Span<const glm::vec3> joint_positions;  // characters * joint_count
-  Span<std::uint32_t> fine;               // out, characters: 1 = visible, fine mesh
-  Span<std::uint32_t> coarse;             // out, characters: 1 = visible, coarse mesh
+  // out, kDrawTiers * characters, tier-major: [t * characters + c] is 1
+  // when character c is visible and drawn in tier t. One exclusive scan
+  // over it gives every visible character its slot, tier after tier.
+  Span<std::uint32_t> tier_flags;
 
-  Index character_count() const { return fine.size(); }
+  Index character_count() const { return tier_flags.size() / kDrawTiers; }
   void validate() const;  // Error naming the span or parameter
   void run() const;       // parallel_for "render.cull"
 };
@@ -50,12 +57,11 @@ struct PackJob {
   Span<const glm::vec3> joint_positions;  // characters * joint_count, world
   Span<const glm::quat> joint_rotations;  // characters * joint_count, world
   Span<const std::uint8_t> lod_levels;    // empty, characters, or characters * 5
-  Span<const std::uint32_t> fine, coarse;             // CullJob's flags
-  Span<const std::uint32_t> fine_slot, coarse_slot;   // their exclusive scans
-  Index fine_total = 0;                   // visible characters with the fine mesh
+  Span<const std::uint32_t> tier_flags;   // CullJob's
+  Span<const std::uint32_t> slots;        // its exclusive scan
   Span<glm::vec4> out_points;             // (visible characters) * points.size()
 
-  Index character_count() const { return fine.size(); }
+  Index character_count() const { return tier_flags.size() / kDrawTiers; }
   void validate() const;
   void run() const;  // parallel_for "render.pack"
 };

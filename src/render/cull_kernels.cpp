@@ -10,13 +10,14 @@ namespace throng::render {
 
 void CullJob::validate() const {
   if (joint_count <= 0) throw Error("must be positive", at_field("cull.joint_count"));
+  if (tier_flags.size() % kDrawTiers != 0) throw Error("not a whole number of characters", at_field("cull.tier_flags"));
   const Index n = character_count();
-  if (coarse.size() != n) throw Error(fmt::format("{} flags for {} characters", coarse.size(), n), at_field("cull.coarse"));
   if (joint_positions.size() != n * joint_count)
     throw Error(fmt::format("{} positions for {} characters of {} joints", joint_positions.size(), n, joint_count),
                 at_field("cull.joint_positions"));
   if (!(bounding_radius > 0.0f)) throw Error("must be positive", at_field("cull.bounding_radius"));
   if (!(fine_min_pixels >= 0.0f)) throw Error("must be >= 0", at_field("cull.fine_min_pixels"));
+  if (!(lines_max_pixels >= 0.0f)) throw Error("must be >= 0", at_field("cull.lines_max_pixels"));
 }
 
 void CullJob::run() const {
@@ -24,19 +25,25 @@ void CullJob::run() const {
   const CameraView cam = camera;
   const std::int32_t J = joint_count;
   const float radius = bounding_radius;
-  const float fine_px = fine_min_pixels;
+  const float fine_px = fine_min_pixels, lines_px = lines_max_pixels;
   const bool do_cull = cull;
+  const Index n = character_count();
   const Span<const glm::vec3> pos = joint_positions;
-  const Span<std::uint32_t> fine_out = fine, coarse_out = coarse;
-  parallel_for("render.cull", character_count(), THRONG_LAMBDA(Index c) {
+  const Span<std::uint32_t> flags = tier_flags;
+  parallel_for("render.cull", n, THRONG_LAMBDA(Index c) {
     const glm::vec3 centre = to_camera_space(cam, pos[c * J]);
     const bool visible = !do_cull || !anim::sphere_outside_view(centre, radius, cam);
-    // Image radius of the bounding sphere, pixels (whole viewport when the
-    // camera is inside it or it straddles the camera plane).
+    // Image radius of the bounding sphere against the tiers' limits (the
+    // whole viewport when the camera is inside it or it straddles the
+    // camera plane): focal * radius / depth >= limit, without dividing.
     const float depth = -centre.z;
-    const bool near = depth <= radius || cam.focal_px * radius >= fine_px * depth;
-    fine_out[c] = visible && near ? 1u : 0u;
-    coarse_out[c] = visible && !near ? 1u : 0u;
+    const float size = cam.focal_px * radius;
+    const bool close = depth <= radius;
+    const bool fine = close || size >= fine_px * depth;
+    const bool lines = !close && size < lines_px * depth;
+    flags[c] = visible && fine ? 1u : 0u;
+    flags[n + c] = visible && !fine && !lines ? 1u : 0u;
+    flags[2 * n + c] = visible && !fine && lines ? 1u : 0u;
   });
 }
 
@@ -47,14 +54,13 @@ void PackJob::validate() const {
   };
   if (joint_count <= 0) throw Error("must be positive", at_field("pack.joint_count"));
   if (points.size() < joint_count) throw Error("fewer points than joints", at_field("pack.points"));
+  if (tier_flags.size() % kDrawTiers != 0) throw Error("not a whole number of characters", at_field("pack.tier_flags"));
   check(joint_positions.size(), n * joint_count, "pack.joint_positions");
   check(joint_rotations.size(), n * joint_count, "pack.joint_rotations");
-  check(coarse.size(), n, "pack.coarse");
-  check(fine_slot.size(), n, "pack.fine_slot");
-  check(coarse_slot.size(), n, "pack.coarse_slot");
+  check(slots.size(), tier_flags.size(), "pack.slots");
   if (!lod_levels.empty() && lod_levels.size() != n && lod_levels.size() != n * anim::kBodyPartCount)
     throw Error(fmt::format("{} levels for {} characters", lod_levels.size(), n), at_field("pack.lod_levels"));
-  if (out_points.size() % points.size() != 0 || out_points.size() / points.size() < fine_total)
+  if (out_points.size() % points.size() != 0)
     throw Error(fmt::format("{} packed points is not a whole number of {}-point slots", out_points.size(), points.size()),
                 at_field("pack.out_points"));
 }
@@ -63,21 +69,21 @@ void PackJob::run() const {
   validate();
   const std::int32_t J = joint_count;
   const Index P = points.size();
-  const Index slots = out_points.size() / P;
-  const Index level_stride = lod_levels.empty() ? 0 : lod_levels.size() / character_count();
-  const Index fine_count = fine_total;
+  const Index n = character_count();
+  const Index slot_count = out_points.size() / P;
+  const Index level_stride = lod_levels.empty() || n == 0 ? 0 : lod_levels.size() / n;
   const Span<const RigPoint> rig = points;
   const Span<const glm::vec3> pos = joint_positions;
   const Span<const glm::quat> rot = joint_rotations;
   const Span<const std::uint8_t> levels = lod_levels;
-  const Span<const std::uint32_t> is_fine = fine, is_coarse = coarse, fine_at = fine_slot, coarse_at = coarse_slot;
+  const Span<const std::uint32_t> flags = tier_flags, slot_of = slots;
   const Span<glm::vec4> out = out_points;
   parallel_for(
-      "render.pack", character_count(), THRONG_LAMBDA(Index c) {
+      "render.pack", n, THRONG_LAMBDA(Index c) {
         Index slot = -1;
-        if (is_fine[c] != 0u) slot = fine_at[c];
-        if (is_coarse[c] != 0u) slot = fine_count + coarse_at[c];
-        if (slot < 0 || slot >= slots) return;
+        for (int t = 0; t < kDrawTiers; ++t)
+          if (flags[t * n + c] != 0u) slot = slot_of[t * n + c];
+        if (slot < 0 || slot >= slot_count) return;
         for (Index k = 0; k < P; ++k) {
           const RigPoint p = rig[k];
           const Index joint = c * J + p.joint;

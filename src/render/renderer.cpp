@@ -84,6 +84,8 @@ void RenderOptions::validate() const {
     throw Error("skinned mode needs the mannequin mesh, which is not built yet; use joints", at_field("render.mode"));
   if (!(fine_min_pixels >= 0.0f) || !std::isfinite(fine_min_pixels))
     throw Error("must be finite and >= 0", at_field("render.fine_min_pixels"));
+  if (!(lines_max_pixels >= 0.0f) || !std::isfinite(lines_max_pixels))
+    throw Error("must be finite and >= 0", at_field("render.lines_max_pixels"));
   if (!(fog_distance >= 0.0f) || !std::isfinite(fog_distance)) throw Error("must be finite and >= 0", at_field("render.fog_distance"));
   for (int c = 0; c < 3; ++c)
     if (!(background[c] >= 0.0f && background[c] <= 1.0f)) throw Error("channels must be within 0..1", at_field("render.background"));
@@ -91,14 +93,14 @@ void RenderOptions::validate() const {
 
 struct Renderer::State {
   JointRig rig;
-  GlProgram joints, walls, ground, bins, flat;
+  GlProgram joints, joint_lines, walls, ground, bins, flat;
   GpuMesh fine_sphere, coarse_sphere;
   GlBuffer bones_ssbo, points_ssbo;
   std::size_t points_capacity = 0;
   GlVertexArray empty_vao;  // attribute-less draws (ground, bins)
   Buffer<RigPoint> rig_points;
   Memory rig_memory = Memory::Host;
-  Buffer<std::uint32_t> fine, coarse, fine_slot, coarse_slot;
+  Buffer<std::uint32_t> tier_flags, slots;
   Buffer<glm::vec4> device_points;  // packing target when kernels run on the GPU
   std::vector<glm::vec4> staging;
 
@@ -123,6 +125,7 @@ Renderer::Renderer(const JointRig& rig) : s_(std::make_unique<State>()) {
   check_gl_version();
   s_->rig = rig;
   s_->joints = make_program("render.joints", shaders::kJointsVertex, shaders::kLitFragment);
+  s_->joint_lines = make_program("render.joint_lines", shaders::kJointLinesVertex, shaders::kLitFragment);
   s_->walls = make_program("render.obstacles", shaders::kStaticVertex, shaders::kLitFragment);
   s_->ground = make_program("render.ground", shaders::kGroundVertex, shaders::kGroundFragment);
   s_->bins = make_program("render.bins", shaders::kGroundVertex, shaders::kBinsFragment);
@@ -223,29 +226,32 @@ RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, 
   // Cull, give every visible character a slot, pack its points.
   const Index n = stats.characters;
   const Index P = rig.point_count();
-  Index fine_total = 0, coarse_total = 0;
+  Index tier_count[kDrawTiers] = {0, 0, 0};
   if (n > 0) {
     const Memory memory = current_memory();
     if (s.rig_points.size() == 0 || s.rig_memory != memory) {
       s.rig_points = Buffer<RigPoint>(std::span<const RigPoint>(rig.points), memory);
       s.rig_memory = memory;
     }
-    for (Buffer<std::uint32_t>* b : {&s.fine, &s.coarse, &s.fine_slot, &s.coarse_slot})
-      if (b->size() != n || b->memory() != memory) *b = Buffer<std::uint32_t>(n, memory);
+    for (Buffer<std::uint32_t>* b : {&s.tier_flags, &s.slots})
+      if (b->size() != kDrawTiers * n || b->memory() != memory) *b = Buffer<std::uint32_t>(kDrawTiers * n, memory);
     CullJob cull;
     cull.camera = make_camera_view(camera);
     cull.joint_count = rig.joint_count;
     cull.bounding_radius = rig.bounding_radius;
     cull.fine_min_pixels = options.fine_min_pixels;
+    cull.lines_max_pixels = options.lines_max_pixels;
     cull.cull = options.cull;
     cull.joint_positions = poses.joint_positions;
-    cull.fine = s.fine.span();
-    cull.coarse = s.coarse.span();
+    cull.tier_flags = s.tier_flags.span();
     cull.run();
-    fine_total = exclusive_scan<std::uint32_t>("render.slots", s.fine.span(), s.fine_slot.span());
-    coarse_total = exclusive_scan<std::uint32_t>("render.slots", s.coarse.span(), s.coarse_slot.span());
+    const Index visible = exclusive_scan<std::uint32_t>("render.slots", s.tier_flags.span(), s.slots.span());
+    // Where each tier's slots begin: the scan at the tier's first entry.
+    std::uint32_t starts[kDrawTiers] = {0, 0, 0};
+    for (int t = 1; t < kDrawTiers; ++t)
+      throng::detail::copy_bytes(&starts[t], Memory::Host, s.slots.data() + t * n, memory, sizeof(std::uint32_t));
+    for (int t = 0; t < kDrawTiers; ++t) tier_count[t] = (t + 1 < kDrawTiers ? starts[t + 1] : visible) - starts[t];
 
-    const Index visible = fine_total + coarse_total;
     if (visible > 0) {
       PackJob pack;
       pack.joint_count = rig.joint_count;
@@ -253,11 +259,8 @@ RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, 
       pack.joint_positions = poses.joint_positions;
       pack.joint_rotations = poses.joint_rotations;
       pack.lod_levels = poses.lod_levels;
-      pack.fine = s.fine.span();
-      pack.coarse = s.coarse.span();
-      pack.fine_slot = s.fine_slot.span();
-      pack.coarse_slot = s.coarse_slot.span();
-      pack.fine_total = fine_total;
+      pack.tier_flags = s.tier_flags.span();
+      pack.slots = s.slots.span();
       const std::size_t bytes = static_cast<std::size_t>(visible * P) * sizeof(glm::vec4);
       reserve_buffer(GL_SHADER_STORAGE_BUFFER, s.points_ssbo, bytes, s.points_capacity);
       glBindBuffer(GL_SHADER_STORAGE_BUFFER, s.points_ssbo.get());
@@ -284,8 +287,10 @@ RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, 
       }
     }
   }
-  stats.visible = fine_total + coarse_total;
+  const Index fine_total = tier_count[0], coarse_total = tier_count[1], lines_total = tier_count[2];
+  stats.visible = fine_total + coarse_total + lines_total;
   stats.fine = fine_total;
+  stats.lines = lines_total;
   stats.instances = stats.visible * rig.bone_count();
   stats.prepare_ms = ms_since(t0);
 
@@ -377,6 +382,18 @@ RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, 
     draw(s.fine_sphere, 0, fine_total);
     draw(s.coarse_sphere, fine_total, coarse_total);
     glDisable(GL_CULL_FACE);
+    if (lines_total > 0) {
+      // The smallest: one line per bone, two vertices, no instancing.
+      set_lighting(s.joint_lines);
+      glUniform1i(uniform(s.joint_lines, "u_bone_count"), rig.bone_count());
+      glUniform1i(uniform(s.joint_lines, "u_point_count"), static_cast<GLint>(P));
+      glUniform1i(uniform(s.joint_lines, "u_colour_by_lod"), options.lod_colours ? 1 : 0);
+      glUniform3fv(uniform(s.joint_lines, "u_lod_palette"), 16, &kLodPalette[0][0]);
+      glUniform3fv(uniform(s.joint_lines, "u_clothes"), 8, &kClothes[0][0]);
+      glUniform1i(uniform(s.joint_lines, "u_slot_base"), static_cast<GLint>(fine_total + coarse_total));
+      glBindVertexArray(s.empty_vao.get());
+      glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines_total * rig.bone_count() * 2));
+    }
   }
 
   if (options.obstacles && s.has_obstacles) {

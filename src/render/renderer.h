@@ -37,7 +37,10 @@ struct RenderOptions {
   bool cull = true;   // skip characters whose bounding sphere is outside the view
   // Characters whose bounding sphere is at least this many pixels in
   // radius get the finer sphere mesh.
-  float fine_min_pixels = 40.0f;
+  float fine_min_pixels = 24.0f;
+  // Characters whose bounding sphere is below this many pixels in radius
+  // (a person under about 6 pixels tall) are drawn as one line per bone.
+  float lines_max_pixels = 3.0f;
   glm::vec3 background{0.70f, 0.78f, 0.86f};
   // Distance (metres) at which everything has faded into the background;
   // 0 = the camera's far plane.
@@ -49,8 +52,9 @@ struct RenderStats {
   Index characters = 0;
   Index visible = 0;       // after culling
   Index fine = 0;          // of them with the fine mesh
+  Index lines = 0;         // of them as lines
   Index instances = 0;     // ellipsoids drawn
-  Index triangles = 0;     // character triangles submitted
+  Index triangles = 0;     // character triangles submitted (lines not counted)
   double prepare_ms = 0;   // cull + pack + upload (CPU)
   double submit_ms = 0;    // issuing draws (the GPU may still be working)
 };

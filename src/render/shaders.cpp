@@ -61,6 +61,39 @@ void main() {
 }
 )";
 
+const char* const kJointLinesVertex = R"(#version 430 core
+layout(std430, binding = 0) readonly buffer Points { vec4 points[]; };
+struct Bone { int from_point; int to_point; float radius; float pad; };
+layout(std430, binding = 1) readonly buffer Bones { Bone bones[]; };
+uniform mat4 u_view_projection;
+uniform int u_bone_count;
+uniform int u_point_count;
+uniform int u_slot_base;
+uniform int u_colour_by_lod;
+uniform vec3 u_lod_palette[16];
+uniform vec3 u_clothes[8];
+out vec3 v_world;
+out vec3 v_normal;
+flat out vec3 v_albedo;
+void main() {
+  int segment = gl_VertexID / 2;
+  int slot = u_slot_base + segment / u_bone_count;
+  Bone bone = bones[segment % u_bone_count];
+  vec4 a = points[slot * u_point_count + bone.from_point];
+  vec4 b = points[slot * u_point_count + bone.to_point];
+  v_world = (gl_VertexID & 1) == 0 ? a.xyz : b.xyz;
+  v_normal = vec3(0.0, 1.0, 0.0);
+  int tag = int(b.w);
+  if (u_colour_by_lod != 0) {
+    v_albedo = u_lod_palette[tag & 15];
+  } else {
+    int id = tag >> 4;
+    v_albedo = u_clothes[(id * 5 + (id >> 3)) & 7];
+  }
+  gl_Position = u_view_projection * vec4(v_world, 1.0);
+}
+)";
+
 const char* const kLitFragment = "#version 430 core\n"
                                   "in vec3 v_world;\n"
                                   "in vec3 v_normal;\n"

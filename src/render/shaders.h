@@ -7,6 +7,9 @@ namespace throng::render::shaders {
 // packed points read from a shader storage buffer.
 extern const char* const kJointsVertex;
 extern const char* const kLitFragment;
+// Joint mode for the smallest characters: one line per (slot, bone) from
+// gl_VertexID alone, no vertex attributes.
+extern const char* const kJointLinesVertex;
 // Obstacle walls: positions and normals from vertex attributes.
 extern const char* const kStaticVertex;
 // Ground plane with a metre grid (analytic, antialiased lines).
