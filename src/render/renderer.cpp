@@ -21,8 +21,8 @@ namespace throng::render {
 
 namespace {
 
-constexpr std::int32_t kFineSlices = 14, kFineStacks = 9;
-constexpr std::int32_t kCoarseSlices = 6, kCoarseStacks = 4;
+constexpr std::int32_t kFineSlices = 10, kFineStacks = 6;
+constexpr std::int32_t kCoarseSlices = 4, kCoarseStacks = 2;
 
 // Colours of joint-LOD levels 0.. (finest first), after the spirit of the
 // 2019 paper's Figure 8: warm near, cool far.

@@ -37,7 +37,7 @@ struct RenderOptions {
   bool cull = true;   // skip characters whose bounding sphere is outside the view
   // Characters whose bounding sphere is at least this many pixels in
   // radius get the finer sphere mesh.
-  float fine_min_pixels = 24.0f;
+  float fine_min_pixels = 16.0f;
   // Characters whose bounding sphere is below this many pixels in radius
   // (a person under about 6 pixels tall) are drawn as one line per bone.
   float lines_max_pixels = 3.0f;
