@@ -29,6 +29,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--speed", o.speed, "Animation speed factor");
   cmd->add_flag("--paused", o.paused, "Start paused (space toggles, period steps)");
   cmd->add_flag("!--no-panel", o.panel, "Hide the ImGui panel");
+  cmd->add_flag("--bins", o.bins, "Show agents per 4 m cell as a heat map");
   cmd->add_option("--lod-thresholds", o.lod_thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")
       ->delimiter(',');
   cmd->callback([&g] {

@@ -243,7 +243,7 @@ ViewerResult run_viewer(const ViewerOptions& options) {
   });
 
   RenderOptions render_options;
-  render_options.fog_distance = 0.0f;
+  render_options.bins = options.bins;
   int mode_index = 0;
   bool show_lod = true;
   double t = 0.0;
@@ -251,6 +251,7 @@ ViewerResult run_viewer(const ViewerOptions& options) {
   double frame_ms = 0.0;
   RenderStats stats;
   anim::LodHistogram histogram;
+  std::vector<std::int32_t> bin_counts;
   const bool scripted = options.frames > 0;
 
   while (!glfwWindowShouldClose(window.get())) {
@@ -284,6 +285,28 @@ ViewerResult run_viewer(const ViewerOptions& options) {
     histogram = anim::lod_histogram(levels.span(), masks.span(), lod_config.level_count, lod_config.joint_count);
     crowd.update(t, masks.span());
 
+    if (render_options.bins) {
+      // Agents per 4 m cell over the crowd's square: the bins overlay.
+      const float cell = 4.0f;
+      const auto side = static_cast<std::int32_t>(std::ceil(2.0f * extent / cell));
+      std::vector<glm::vec3> ground(static_cast<std::size_t>(n));
+      if (n > 0)
+        throng::detail::copy_bytes(ground.data(), Memory::Host, crowd.ground_positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
+      bin_counts.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side), 0);
+      for (const glm::vec3& p : ground) {
+        const glm::vec2 m = (ground_from_world(p) + glm::vec2(extent)) / cell;
+        const auto x = static_cast<std::int32_t>(std::floor(m.x)), y = static_cast<std::int32_t>(std::floor(m.y));
+        if (x >= 0 && x < side && y >= 0 && y < side) ++bin_counts[static_cast<std::size_t>(y * side + x)];
+      }
+      BinsOverlay bins;
+      bins.min = glm::vec2(-extent);
+      bins.cell_size = cell;
+      bins.columns = side;
+      bins.rows = side;
+      bins.counts = bin_counts;
+      bins.saturate_at = 12;
+      renderer.set_bins(bins);
+    }
     CharacterPoses poses = crowd.poses();
     poses.lod_levels = levels.span();
     render_options.lod_colours = input.lod_colours && show_lod;
@@ -315,6 +338,8 @@ ViewerResult run_viewer(const ViewerOptions& options) {
       ImGui::Checkbox("obstacles", &render_options.obstacles);
       ImGui::SameLine();
       ImGui::Checkbox("paths", &render_options.paths);
+      ImGui::SameLine();
+      ImGui::Checkbox("bins", &render_options.bins);
       if (ImGui::CollapsingHeader("Joint LOD", ImGuiTreeNodeFlags_DefaultOpen)) {
         bool changed = false;
         for (std::size_t l = 0; l < thresholds.size(); ++l) {

@@ -30,6 +30,7 @@ struct ViewerOptions {
   double speed = 1.0;
   bool vsync = true;
   bool panel = true;
+  bool bins = false;  // start with the agents-per-cell overlay on
   std::vector<float> lod_thresholds;  // empty = anim::default_lod_thresholds()
   void validate() const;  // Error naming the option ("--width")
 };

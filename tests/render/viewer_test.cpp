@@ -88,7 +88,7 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
   std::filesystem::remove(shot);
   std::string out;
   const int code = run("DISPLAY=" + x.display() + " " + THRONG_EXE +
-                           " --threads 2 view --agents 150 --layout grid --frames 12 --width 480 --height 270 --screenshot " + shot,
+                           " --threads 2 view --agents 150 --layout grid --bins --frames 12 --width 480 --height 270 --screenshot " + shot,
                        out);
   ASSERT_EQ(code, 0) << out;
   EXPECT_NE(out.find("12 frames"), std::string::npos) << out;
