@@ -361,13 +361,17 @@ RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, 
   }
 
   // Characters: one instance per (visible character, bone); fine slots first.
+  // Both joint programs read the same storage buffers and colour uniforms.
+  const auto use_joint_program = [&](const GlProgram& p) {
+    set_lighting(p);
+    glUniform1i(uniform(p, "u_bone_count"), rig.bone_count());
+    glUniform1i(uniform(p, "u_point_count"), static_cast<GLint>(P));
+    glUniform1i(uniform(p, "u_colour_by_lod"), options.lod_colours ? 1 : 0);
+    glUniform3fv(uniform(p, "u_lod_palette"), 16, &kLodPalette[0][0]);
+    glUniform3fv(uniform(p, "u_clothes"), 8, &kClothes[0][0]);
+  };
   if (stats.visible > 0) {
-    set_lighting(s.joints);
-    glUniform1i(uniform(s.joints, "u_bone_count"), rig.bone_count());
-    glUniform1i(uniform(s.joints, "u_point_count"), static_cast<GLint>(P));
-    glUniform1i(uniform(s.joints, "u_colour_by_lod"), options.lod_colours ? 1 : 0);
-    glUniform3fv(uniform(s.joints, "u_lod_palette"), 16, &kLodPalette[0][0]);
-    glUniform3fv(uniform(s.joints, "u_clothes"), 8, &kClothes[0][0]);
+    use_joint_program(s.joints);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.points_ssbo.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.bones_ssbo.get());
     glEnable(GL_CULL_FACE);
@@ -384,12 +388,7 @@ RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, 
     glDisable(GL_CULL_FACE);
     if (lines_total > 0) {
       // The smallest: one line per bone, two vertices, no instancing.
-      set_lighting(s.joint_lines);
-      glUniform1i(uniform(s.joint_lines, "u_bone_count"), rig.bone_count());
-      glUniform1i(uniform(s.joint_lines, "u_point_count"), static_cast<GLint>(P));
-      glUniform1i(uniform(s.joint_lines, "u_colour_by_lod"), options.lod_colours ? 1 : 0);
-      glUniform3fv(uniform(s.joint_lines, "u_lod_palette"), 16, &kLodPalette[0][0]);
-      glUniform3fv(uniform(s.joint_lines, "u_clothes"), 8, &kClothes[0][0]);
+      use_joint_program(s.joint_lines);
       glUniform1i(uniform(s.joint_lines, "u_slot_base"), static_cast<GLint>(fine_total + coarse_total));
       glBindVertexArray(s.empty_vao.get());
       glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines_total * rig.bone_count() * 2));

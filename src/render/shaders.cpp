@@ -17,21 +17,31 @@ namespace throng::render::shaders {
   "  return mix(c, u_background, clamp(d * d, 0.0, 1.0));\n"                    \
   "}\n"
 
-const char* const kJointsVertex = R"(#version 430 core
-layout(location = 0) in vec3 a_position;  // unit sphere
-layout(std430, binding = 0) readonly buffer Points { vec4 points[]; };
-struct Bone { int from_point; int to_point; float radius; float pad; };
-layout(std430, binding = 1) readonly buffer Bones { Bone bones[]; };
-uniform mat4 u_view_projection;
-uniform int u_bone_count;
-uniform int u_point_count;
-uniform int u_slot_base;
-uniform int u_colour_by_lod;
-uniform vec3 u_lod_palette[16];
-uniform vec3 u_clothes[8];
-out vec3 v_world;
-out vec3 v_normal;
-flat out vec3 v_albedo;
+// What both joint programs read: packed points, the bone table, colours.
+#define THRONG_JOINT_INPUTS                                                                 \
+  "layout(std430, binding = 0) readonly buffer Points { vec4 points[]; };\n"               \
+  "struct Bone { int from_point; int to_point; float radius; float pad; };\n"             \
+  "layout(std430, binding = 1) readonly buffer Bones { Bone bones[]; };\n"                 \
+  "uniform mat4 u_view_projection;\n"                                                      \
+  "uniform int u_bone_count;\n"                                                            \
+  "uniform int u_point_count;\n"                                                           \
+  "uniform int u_slot_base;\n"                                                             \
+  "uniform int u_colour_by_lod;\n"                                                         \
+  "uniform vec3 u_lod_palette[16];\n"                                                      \
+  "uniform vec3 u_clothes[8];\n"                                                           \
+  "out vec3 v_world;\n"                                                                    \
+  "out vec3 v_normal;\n"                                                                   \
+  "flat out vec3 v_albedo;\n"                                                              \
+  "// A packed point's w: LOD level in the low 4 bits, character id above.\n"             \
+  "vec3 albedo_of(float tag_w) {\n"                                                        \
+  "  int tag = int(tag_w);\n"                                                              \
+  "  if (u_colour_by_lod != 0) return u_lod_palette[tag & 15];\n"                          \
+  "  int id = tag >> 4;\n"                                                                 \
+  "  return u_clothes[(id * 5 + (id >> 3)) & 7];\n"                                        \
+  "}\n"
+
+const char* const kJointsVertex = "#version 430 core\n"
+                                   "layout(location = 0) in vec3 a_position;  // unit sphere\n" THRONG_JOINT_INPUTS R"(
 void main() {
   int slot = u_slot_base + gl_InstanceID / u_bone_count;
   Bone bone = bones[gl_InstanceID % u_bone_count];
@@ -50,31 +60,12 @@ void main() {
   vec3 centre = 0.5 * (a.xyz + b.xyz);
   v_world = centre + u * (a_position.y * along) + v * (a_position.x * across) + w * (a_position.z * across);
   v_normal = normalize(u * (a_position.y / along) + v * (a_position.x / across) + w * (a_position.z / across));
-  int tag = int(b.w);
-  if (u_colour_by_lod != 0) {
-    v_albedo = u_lod_palette[tag & 15];
-  } else {
-    int id = tag >> 4;
-    v_albedo = u_clothes[(id * 5 + (id >> 3)) & 7];
-  }
+  v_albedo = albedo_of(b.w);
   gl_Position = u_view_projection * vec4(v_world, 1.0);
 }
 )";
 
-const char* const kJointLinesVertex = R"(#version 430 core
-layout(std430, binding = 0) readonly buffer Points { vec4 points[]; };
-struct Bone { int from_point; int to_point; float radius; float pad; };
-layout(std430, binding = 1) readonly buffer Bones { Bone bones[]; };
-uniform mat4 u_view_projection;
-uniform int u_bone_count;
-uniform int u_point_count;
-uniform int u_slot_base;
-uniform int u_colour_by_lod;
-uniform vec3 u_lod_palette[16];
-uniform vec3 u_clothes[8];
-out vec3 v_world;
-out vec3 v_normal;
-flat out vec3 v_albedo;
+const char* const kJointLinesVertex = "#version 430 core\n" THRONG_JOINT_INPUTS R"(
 void main() {
   int segment = gl_VertexID / 2;
   int slot = u_slot_base + segment / u_bone_count;
@@ -83,13 +74,7 @@ void main() {
   vec4 b = points[slot * u_point_count + bone.to_point];
   v_world = (gl_VertexID & 1) == 0 ? a.xyz : b.xyz;
   v_normal = vec3(0.0, 1.0, 0.0);
-  int tag = int(b.w);
-  if (u_colour_by_lod != 0) {
-    v_albedo = u_lod_palette[tag & 15];
-  } else {
-    int id = tag >> 4;
-    v_albedo = u_clothes[(id * 5 + (id >> 3)) & 7];
-  }
+  v_albedo = albedo_of(b.w);
   gl_Position = u_view_projection * vec4(v_world, 1.0);
 }
 )";
@@ -195,5 +180,6 @@ void main() { o_colour = u_colour; }
 )";
 
 #undef THRONG_LIGHTING
+#undef THRONG_JOINT_INPUTS
 
 }  // namespace throng::render::shaders

@@ -126,6 +126,26 @@ TEST_F(RendererTest, CullingCanBeTurnedOff) {
   EXPECT_EQ(stats.visible, 4);
 }
 
+TEST_F(RendererTest, EveryTierDrawsTheCharacters) {
+  TPoseCrowd c = crowd();
+  Renderer r(make_joint_rig(c.skeleton));
+  TPoseCrowd none;
+  const Image empty = draw(r, camera(), none.poses());
+  for (int tier = 0; tier < 3; ++tier) {
+    RenderOptions o;
+    o.fine_min_pixels = tier == 0 ? 0.0f : 1e6f;  // all fine, or none
+    o.lines_max_pixels = tier == 2 ? 1e6f : 0.0f; // all lines, or none
+    RenderStats stats;
+    const Image im = draw(r, camera(), c.poses(), o, &stats);
+    EXPECT_EQ(stats.visible, 3);
+    EXPECT_EQ(stats.fine, tier == 0 ? 3 : 0);
+    EXPECT_EQ(stats.lines, tier == 2 ? 3 : 0);
+    const ImageDifference d = compare_images(im, empty, 20);
+    // Three people of about a hundred pixels each at this distance; lines fewer.
+    EXPECT_GT(d.fraction_differing * im.width * im.height, tier == 2 ? 30.0 : 150.0) << "tier " << tier;
+  }
+}
+
 TEST_F(RendererTest, ObstacleTopsFollowTheEvenOddRule) {
   TPoseCrowd none;
   Renderer r(make_joint_rig(none.skeleton));
