@@ -5,8 +5,11 @@
 # -DTHRONG_RENDER=OFF builds everything else without the renderer.
 option(THRONG_RENDER "Build the OpenGL renderer, headless video and viewer (src/render)" ON)
 set(THRONG_RENDER_LIBS "")
+if(THRONG_FUZZ)
+  set(THRONG_RENDER OFF)  # fuzz targets parse input; they need no renderer
+endif()
 if(NOT THRONG_RENDER)
-  message(STATUS "throng: renderer disabled (THRONG_RENDER=OFF): no `throng view`, no video")
+  message(STATUS "throng: renderer off: no `throng view`, no video")
   return()
 endif()
 
