@@ -126,3 +126,35 @@ void reserve_buffer(GLenum target, const GlBuffer& buffer, std::size_t bytes, st
 }
 
 }  // namespace throng::render
+
+// ---- sanitizer builds ---------------------------------------------------------
+// OpenGL drivers (Mesa's EGL/GLX/DRI libraries and the LLVM they JIT with)
+// keep a few allocations for the life of the process and are unloaded
+// before LeakSanitizer looks, so it can no longer name them. In sanitizer
+// builds, pin_gl_libraries() keeps every loaded library mapped (the
+// renderer calls it once a context exists), and these suppressions name
+// the drivers; leaks in throng's own code are still reported.
+#if defined(__SANITIZE_ADDRESS__)
+#include <dlfcn.h>
+#include <link.h>
+
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libEGL_mesa.so\nleak:libGLX_mesa.so\nleak:libGLdispatch.so\nleak:_dri.so\nleak:libLLVM\n"
+         "leak:libglfw.so\nleak:libX11.so\nleak:libxcb\nleak:libdrm\nleak:libglapi.so\nleak:libubsan.so\n";
+}
+
+namespace throng::render {
+void pin_gl_libraries() {
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t, void*) {
+        if (info->dlpi_name != nullptr && info->dlpi_name[0] != '\0') dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+        return 0;
+      },
+      nullptr);
+}
+}  // namespace throng::render
+#else
+namespace throng::render {
+void pin_gl_libraries() {}
+}  // namespace throng::render
+#endif

@@ -24,6 +24,10 @@ void check_gl_version();
 // Throws Error naming `what` when glGetError() reports an error.
 void check_gl(std::string_view what);
 
+// Sanitizer builds only (a no-op otherwise): keeps the GL driver libraries
+// loaded until exit so LeakSanitizer can name, and suppress, what they keep.
+void pin_gl_libraries();
+
 // An owned GL name, deleted with `Delete` when it goes.
 template <void (*Delete)(GLuint)>
 class GlHandle {

@@ -161,6 +161,7 @@ HeadlessContext::HeadlessContext(const HeadlessOptions& o) : state_(std::make_un
                             o.gl_major, o.gl_minor, why));
   software_ = software_renderer();
   check_gl_version();
+  pin_gl_libraries();
 }
 
 HeadlessContext::~HeadlessContext() {

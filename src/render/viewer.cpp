@@ -165,6 +165,7 @@ ViewerResult run_viewer(const ViewerOptions& options) {
   glfwMakeContextCurrent(window.get());
   glfwSwapInterval(options.vsync && options.frames == 0 ? 1 : 0);
   check_gl_version();
+  pin_gl_libraries();
   ViewerResult result;
   result.gl = gl_description();
   spdlog::info("viewer: {}", result.gl);
