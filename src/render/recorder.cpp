@@ -1,0 +1,107 @@
+#include "render/recorder.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+
+#include "core/error.h"
+#include "render/framebuffer.h"
+#include "render/video.h"
+
+namespace throng::render {
+
+const char* to_string(RecordOutput o) { return o == RecordOutput::Video ? "video" : "frames"; }
+
+RecordOutput parse_record_output(const std::string& text, const std::string& field) {
+  if (text == "video") return RecordOutput::Video;
+  if (text == "frames") return RecordOutput::Frames;
+  throw Error(fmt::format("unknown render output '{}' (video or frames)", text), at_field(field));
+}
+
+void RecordSpec::validate() const {
+  if (folder.empty()) throw Error("no output folder", at_field("render.folder"));
+  if (output == RecordOutput::Video) {
+    VideoSpec v;
+    v.path = folder + "/" + video_name;
+    v.width = width;
+    v.height = height;
+    v.fps = fps;
+    v.crf = crf;
+    try {
+      v.validate();
+    } catch (const Error& e) {
+      // Same checks, named after the recorder's fields.
+      std::string field = e.location().field;
+      if (field.rfind("video.", 0) == 0) field = "render." + field.substr(6);
+      throw Error(e.message(), at_field(field));
+    }
+  } else if (width < 1 || width > 16384 || height < 1 || height > 16384) {
+    throw Error(fmt::format("{}x{} is outside 1..16384", width, height), at_field("render.width"));
+  }
+  if (samples < 0 || samples > 16) throw Error("must be within 0..16", at_field("render.samples"));
+}
+
+struct Recorder::State {
+  RecordSpec spec;
+  HeadlessContext context;
+  OffscreenTarget target;
+  Renderer renderer;
+  std::unique_ptr<VideoWriter> video;
+  Image frame;
+  Index frames = 0;
+  State(const RecordSpec& s, const JointRig& rig)
+      : spec(s), context(s.context), target(s.width, s.height, s.samples), renderer(rig) {}
+};
+
+Recorder::Recorder(const RecordSpec& spec, const JointRig& rig) {
+  spec.validate();
+  std::error_code ec;
+  std::filesystem::create_directories(spec.folder, ec);
+  if (ec) throw Error(fmt::format("cannot create the folder: {}", ec.message()), at_field(spec.folder));
+  s_ = std::make_unique<State>(spec, rig);
+  if (spec.output == RecordOutput::Video) {
+    VideoSpec v;
+    v.path = (std::filesystem::path(spec.folder) / spec.video_name).string();
+    v.width = spec.width;
+    v.height = spec.height;
+    v.fps = spec.fps;
+    v.crf = spec.crf;
+    s_->video = std::make_unique<VideoWriter>(v);
+  }
+}
+
+Recorder::~Recorder() = default;
+
+Renderer& Recorder::renderer() { return s_->renderer; }
+const HeadlessContext& Recorder::context() const { return s_->context; }
+const Image& Recorder::last_frame() const { return s_->frame; }
+Index Recorder::frames() const { return s_->frames; }
+
+RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options) {
+  State& s = *s_;
+  s.context.make_current();
+  Camera c = camera;
+  c.width = s.spec.width;
+  c.height = s.spec.height;
+  s.target.bind();
+  const RenderStats stats = s.renderer.render(c, poses, options);
+  s.target.read_into(s.frame);
+  if (s.video) {
+    s.video->write(s.frame);
+  } else {
+    const auto path = std::filesystem::path(s.spec.folder) / fmt::format("{}{:05d}.png", s.spec.frame_prefix, s.frames);
+    write_png(path.string(), s.frame);
+  }
+  ++s.frames;
+  return stats;
+}
+
+std::string Recorder::finish() {
+  if (s_->video) {
+    s_->video->finish();
+    return s_->video->spec().path;
+  }
+  return s_->spec.folder;
+}
+
+}  // namespace throng::render

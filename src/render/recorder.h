@@ -1,0 +1,60 @@
+// Headless output in one object: an EGL context, an offscreen target, the
+// renderer, and either an MP4 (ffmpeg) or numbered PNG frames in a folder.
+// What `throng run ... --render video|frames` drives once per frame.
+//
+//   Recorder rec({.output = RecordOutput::Video, .folder = "out"}, rig);
+//   rec.renderer().set_obstacles(...);
+//   for (...) rec.add_frame(path.at(t), poses, options);
+//   std::string file = rec.finish();   // "out/crowd.mp4"
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "render/headless.h"
+#include "render/image.h"
+#include "render/renderer.h"
+
+namespace throng::render {
+
+enum class RecordOutput : std::uint8_t { Video, Frames };
+const char* to_string(RecordOutput o);
+RecordOutput parse_record_output(const std::string& text, const std::string& field);  // video | frames
+
+struct RecordSpec {
+  RecordOutput output = RecordOutput::Video;
+  std::string folder = ".";               // created when missing
+  std::string video_name = "crowd.mp4";   // Video
+  std::string frame_prefix = "frame_";    // Frames: frame_00000.png, ...
+  std::int32_t width = 960;
+  std::int32_t height = 540;
+  double fps = 30.0;
+  std::int32_t samples = 4;  // multisampling
+  std::int32_t crf = 23;
+  HeadlessOptions context;
+  void validate() const;  // Error naming the field ("render.width")
+};
+
+class Recorder {
+ public:
+  Recorder(const RecordSpec& spec, const JointRig& rig);
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  Renderer& renderer();
+  const HeadlessContext& context() const;
+  // Renders one frame with `camera` (its viewport is set to the spec's
+  // size) and appends it. The picture stays available in last_frame().
+  RenderStats add_frame(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options);
+  const Image& last_frame() const;
+  Index frames() const;
+  // Ends the video (or nothing for frames) and returns the file or folder.
+  std::string finish();
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+}  // namespace throng::render

@@ -1,0 +1,92 @@
+// The crowd renderer (OpenGL 4.3 core): instanced joint ellipsoids fed from
+// shader storage buffers, the ground with a metre grid, extruded obstacles,
+// and optional overlays (planned paths, simulation bins as a heat map).
+//
+// It draws into whatever framebuffer is bound (an OffscreenTarget or the
+// viewer's window) with the viewport camera.width x camera.height; the
+// camera is core/camera.h's, the same one that drives the joint LOD.
+//
+//   HeadlessContext gl;                          // or a window's context
+//   OffscreenTarget target(640, 360);
+//   Renderer renderer(make_joint_rig(skeleton));
+//   renderer.set_obstacles(world.polygons(), world.circles());
+//   target.bind();
+//   RenderStats s = renderer.render(camera, poses, options);
+//   write_png("frame.png", target.read());
+#pragma once
+
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <memory>
+#include <vector>
+
+#include "core/camera.h"
+#include "render/scene.h"
+#include "sim/geometry.h"
+
+namespace throng::render {
+
+struct RenderOptions {
+  RenderMode mode = RenderMode::Joints;
+  bool lod_colours = true;  // colour by joint-LOD level (paper Fig. 8); else by character
+  bool ground = true;
+  bool grid = true;
+  bool obstacles = true;
+  bool paths = true;  // when set_paths gave any
+  bool bins = false;  // when set_bins gave any
+  bool cull = true;   // skip characters whose bounding sphere is outside the view
+  // Characters whose bounding sphere is at least this many pixels in
+  // radius get the finer sphere mesh.
+  float fine_min_pixels = 16.0f;
+  // Characters whose bounding sphere is below this many pixels in radius
+  // (a person under about 6 pixels tall) are drawn as one line per bone.
+  float lines_max_pixels = 3.0f;
+  glm::vec3 background{0.70f, 0.78f, 0.86f};
+  // Distance (metres) at which everything has faded into the background;
+  // 0 = the camera's far plane.
+  float fog_distance = 0.0f;
+  void validate() const;  // Error naming the field
+};
+
+struct RenderStats {
+  Index characters = 0;
+  Index visible = 0;       // after culling
+  Index fine = 0;          // of them with the fine mesh
+  Index lines = 0;         // of them as lines
+  Index instances = 0;     // ellipsoids drawn
+  Index triangles = 0;     // character triangles submitted (lines not counted)
+  double prepare_ms = 0;   // cull + pack + upload (CPU)
+  double submit_ms = 0;    // issuing draws (the GPU may still be working)
+};
+
+// Colour of joint-LOD level `level` (0 = finest), shared with the viewer's legend.
+glm::vec3 lod_level_colour(std::int32_t level);
+
+class Renderer {
+ public:
+  // Needs a current OpenGL 4.3 context (throws Error otherwise); compiles
+  // the programs and uploads the rig and meshes.
+  explicit Renderer(const JointRig& rig);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  const JointRig& rig() const;
+  // Static scene: obstacles of the simulation's map, uploaded once.
+  void set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles, const ObstacleStyle& style = {});
+  // Paths drawn when options.paths; an empty list clears them.
+  void set_paths(const std::vector<MapPolyline>& paths);
+  // Bins drawn when options.bins (counts copied; call again to update).
+  void set_bins(const BinsOverlay& bins);
+
+  // Draws one frame into the bound framebuffer. The pose spans are in
+  // current_memory(): culling and packing run as parallel_for stages there
+  // ("render.cull", "render.pack") and only visible characters are uploaded.
+  RenderStats render(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+}  // namespace throng::render

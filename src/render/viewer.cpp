@@ -1,0 +1,389 @@
+#include "render/viewer.h"
+
+// GL entry points from render/gl.h; GLFW must not pull in its own GL header.
+#include "render/gl.h"
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <fmt/format.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "anim/lod.h"
+#include "core/buffer.h"
+#include "core/error.h"
+#include "core/ground.h"
+#include "core/timing.h"
+#include "render/gl.h"
+#include "render/image.h"
+#include "render/renderer.h"
+
+namespace throng::render {
+
+void ViewerOptions::validate() const {
+  crowd.validate();
+  if (width < 64 || width > 8192) throw Error(fmt::format("{} is outside 64..8192", width), at_field("--width"));
+  if (height < 64 || height > 8192) throw Error(fmt::format("{} is outside 64..8192", height), at_field("--height"));
+  if (frames < 0) throw Error("must be >= 0", at_field("--frames"));
+  if (!(speed >= 0.0 && speed <= 100.0)) throw Error("must be within 0..100", at_field("--speed"));
+  for (std::size_t i = 0; i < lod_thresholds.size(); ++i)
+    if (!(lod_thresholds[i] > 0.0f) || !std::isfinite(lod_thresholds[i]) || (i > 0 && !(lod_thresholds[i] < lod_thresholds[i - 1])))
+      throw Error("thresholds must be positive and decreasing", at_field("--lod-thresholds"));
+}
+
+namespace {
+
+struct GlfwSession {
+  GlfwSession() {
+    glfwSetErrorCallback([](int code, const char* text) { spdlog::debug("glfw {}: {}", code, text); });
+    if (glfwInit() != GLFW_TRUE) {
+      const char* why = nullptr;
+      glfwGetError(&why);
+      throw Error(fmt::format("cannot open a window ({}): run it on a desktop, or under xvfb-run", why != nullptr ? why : "no display"));
+    }
+  }
+  ~GlfwSession() { glfwTerminate(); }
+};
+
+// Mouse-driven orbit about a target on the ground.
+struct OrbitControl {
+  glm::vec3 target{0.0f, 1.0f, 0.0f};
+  float distance = 30.0f;
+  float yaw = 0.6f;    // about +Y
+  float pitch = 0.55f; // above the horizon
+  Camera camera(const Camera& lens) const {
+    Camera c = lens;
+    c.target = target;
+    c.position = target + distance * glm::vec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return c;
+  }
+};
+
+struct InputState {
+  OrbitControl* orbit = nullptr;
+  bool paused = false;
+  bool step = false;
+  double speed = 1.0;
+  bool lod_colours = true;
+  double last_x = 0.0, last_y = 0.0;
+  bool dragging_orbit = false, dragging_pan = false;
+};
+
+InputState* input_of(GLFWwindow* w) { return static_cast<InputState*>(glfwGetWindowUserPointer(w)); }
+
+void on_key(GLFWwindow* w, int key, int, int action, int) {
+  if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+  if (ImGui::GetIO().WantCaptureKeyboard) return;
+  InputState& in = *input_of(w);
+  switch (key) {
+    case GLFW_KEY_ESCAPE:
+    case GLFW_KEY_Q: glfwSetWindowShouldClose(w, GLFW_TRUE); break;
+    case GLFW_KEY_SPACE: in.paused = !in.paused; break;
+    case GLFW_KEY_PERIOD: in.step = true; break;
+    case GLFW_KEY_EQUAL:
+    case GLFW_KEY_KP_ADD: in.speed = std::min(in.speed * 1.5, 100.0); break;
+    case GLFW_KEY_MINUS:
+    case GLFW_KEY_KP_SUBTRACT: in.speed = std::max(in.speed / 1.5, 0.01); break;
+    case GLFW_KEY_L: in.lod_colours = !in.lod_colours; break;
+    default: break;
+  }
+}
+
+void on_mouse_button(GLFWwindow* w, int button, int action, int) {
+  InputState& in = *input_of(w);
+  const bool down = action == GLFW_PRESS && !ImGui::GetIO().WantCaptureMouse;
+  glfwGetCursorPos(w, &in.last_x, &in.last_y);
+  if (button == GLFW_MOUSE_BUTTON_LEFT) in.dragging_orbit = down;
+  if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE) in.dragging_pan = down;
+}
+
+void on_cursor(GLFWwindow* w, double x, double y) {
+  InputState& in = *input_of(w);
+  const auto dx = static_cast<float>(x - in.last_x), dy = static_cast<float>(y - in.last_y);
+  in.last_x = x;
+  in.last_y = y;
+  OrbitControl& o = *in.orbit;
+  if (in.dragging_orbit) {
+    o.yaw -= 0.006f * dx;
+    o.pitch = std::clamp(o.pitch + 0.006f * dy, 0.05f, 1.5f);
+  } else if (in.dragging_pan) {
+    // Move the target in the ground plane, along the view's right and forward.
+    const glm::vec3 right(std::cos(o.yaw), 0.0f, -std::sin(o.yaw));
+    const glm::vec3 forward(-std::sin(o.yaw), 0.0f, -std::cos(o.yaw));
+    const float scale = 0.0015f * o.distance;
+    o.target += scale * (-dx * right + dy * forward);
+  }
+}
+
+void on_scroll(GLFWwindow* w, double, double dy) {
+  if (ImGui::GetIO().WantCaptureMouse) return;
+  OrbitControl& o = *input_of(w)->orbit;
+  o.distance = std::clamp(o.distance * std::pow(0.88f, static_cast<float>(dy)), 1.5f, 5000.0f);
+}
+
+Image read_window(std::int32_t width, std::int32_t height) {
+  Image image(width, height);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  const std::size_t row = static_cast<std::size_t>(width) * 4u;
+  std::vector<std::uint8_t> flipped(image.rgba.size());
+  for (std::int32_t y = 0; y < height; ++y)
+    std::copy_n(image.rgba.data() + static_cast<std::size_t>(height - 1 - y) * row, row, flipped.data() + static_cast<std::size_t>(y) * row);
+  image.rgba.swap(flipped);
+  for (std::size_t i = 3; i < image.rgba.size(); i += 4) image.rgba[i] = 255;
+  return image;
+}
+
+}  // namespace
+
+ViewerResult run_viewer(const ViewerOptions& options) {
+  options.validate();
+  GlfwSession glfw;
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_SAMPLES, 4);
+  glfwWindowHint(GLFW_DEPTH_BITS, 24);
+  glfwWindowHint(GLFW_STENCIL_BITS, 8);
+  std::unique_ptr<GLFWwindow, void (*)(GLFWwindow*)> window(
+      glfwCreateWindow(options.width, options.height, "throng", nullptr, nullptr), glfwDestroyWindow);
+  if (!window) {
+    const char* why = nullptr;
+    glfwGetError(&why);
+    throw Error(fmt::format("cannot open an OpenGL 4.3 core window: {}", why != nullptr ? why : "unknown reason"));
+  }
+  glfwMakeContextCurrent(window.get());
+  glfwSwapInterval(options.vsync && options.frames == 0 ? 1 : 0);
+  check_gl_version();
+  pin_gl_libraries();
+  ViewerResult result;
+  result.gl = gl_description();
+  spdlog::info("viewer: {}", result.gl);
+
+  DemoCrowd crowd(options.crowd);
+  Renderer renderer(make_joint_rig(crowd.skeleton()));
+  // Pillars outside the crowd and the rings it walks, to show obstacles and paths.
+  const float extent = crowd.extent();
+  std::vector<sim::Circle> pillars;
+  for (int k = 0; k < 8; ++k) {
+    const float a = 6.2831853f * static_cast<float>(k) / 8.0f;
+    pillars.push_back({(extent + 4.0f) * glm::vec2(std::cos(a), std::sin(a)), 1.2f});
+  }
+  renderer.set_obstacles({}, pillars, ObstacleStyle{});
+  if (options.crowd.layout == DemoLayout::Ring) {
+    std::vector<MapPolyline> rings;
+    for (float r = 1.5f * options.crowd.spacing; r <= extent; r += 1.5f * options.crowd.spacing) {
+      MapPolyline ring;
+      for (int k = 0; k <= 96; ++k) {
+        const float a = 6.2831853f * static_cast<float>(k) / 96.0f;
+        ring.push_back(r * glm::vec2(std::cos(a), std::sin(a)));
+      }
+      rings.push_back(ring);
+    }
+    renderer.set_paths(rings);
+  }
+
+  // Joint LOD, driven by the rendering camera.
+  const anim::BodyParts parts = anim::make_body_parts(crowd.skeleton());
+  std::vector<float> thresholds = options.lod_thresholds.empty() ? anim::default_lod_thresholds() : options.lod_thresholds;
+  anim::LodConfig lod_config = anim::make_lod_config(parts, thresholds);
+  anim::LodTables lod_tables(lod_config);
+  const Index n = crowd.character_count();
+  const std::int32_t words = anim::mask_word_count(crowd.joint_count());
+  Buffer<std::uint8_t> levels(n * anim::kBodyPartCount, current_memory());
+  Buffer<std::uint32_t> masks(n * words, current_memory());
+
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window.get(), true);
+  ImGui_ImplOpenGL3_Init("#version 430");
+  struct ImGuiShutdown {
+    ~ImGuiShutdown() {
+      ImGui_ImplOpenGL3_Shutdown();
+      ImGui_ImplGlfw_Shutdown();
+      ImGui::DestroyContext();
+    }
+  } imgui_shutdown;
+
+  OrbitControl orbit;
+  orbit.target = crowd.centre() + glm::vec3(0.0f, 1.0f, 0.0f);
+  orbit.distance = std::max(8.0f, 1.05f * extent / std::tan(0.5f * Camera{}.fov_y));
+  InputState input;
+  input.orbit = &orbit;
+  input.paused = options.paused;
+  input.speed = options.speed;
+  glfwSetWindowUserPointer(window.get(), &input);
+  // ImGui's GLFW backend chains to callbacks installed before it; ours
+  // are installed after, so they call it themselves via ImGui's handlers.
+  glfwSetKeyCallback(window.get(), [](GLFWwindow* w, int k, int s, int a, int m) {
+    ImGui_ImplGlfw_KeyCallback(w, k, s, a, m);
+    on_key(w, k, s, a, m);
+  });
+  glfwSetMouseButtonCallback(window.get(), [](GLFWwindow* w, int b, int a, int m) {
+    ImGui_ImplGlfw_MouseButtonCallback(w, b, a, m);
+    on_mouse_button(w, b, a, m);
+  });
+  glfwSetCursorPosCallback(window.get(), [](GLFWwindow* w, double x, double y) {
+    // ImGui 1.86 polls the cursor position itself in NewFrame.
+    on_cursor(w, x, y);
+  });
+  glfwSetScrollCallback(window.get(), [](GLFWwindow* w, double x, double y) {
+    ImGui_ImplGlfw_ScrollCallback(w, x, y);
+    on_scroll(w, x, y);
+  });
+
+  RenderOptions render_options;
+  render_options.bins = options.bins;
+  int mode_index = 0;
+  bool show_lod = true;
+  double t = 0.0;
+  auto last = std::chrono::steady_clock::now();
+  double frame_ms = 0.0;
+  RenderStats stats;
+  anim::LodHistogram histogram;
+  std::vector<std::int32_t> bin_counts;
+  const bool scripted = options.frames > 0;
+
+  while (!glfwWindowShouldClose(window.get())) {
+    glfwPollEvents();
+    const auto now = std::chrono::steady_clock::now();
+    const double wall = std::chrono::duration<double>(now - last).count();
+    last = now;
+    frame_ms = 0.9 * frame_ms + 0.1 * wall * 1000.0;
+    if (!input.paused || input.step) t += (scripted ? 1.0 / 30.0 : std::min(wall, 0.1)) * input.speed;
+    input.step = false;
+
+    std::int32_t fb_width = 0, fb_height = 0;
+    glfwGetFramebufferSize(window.get(), &fb_width, &fb_height);
+    if (fb_width <= 0 || fb_height <= 0) continue;  // minimised
+    Camera lens;
+    lens.width = fb_width;
+    lens.height = fb_height;
+    lens.far_plane = std::max(1000.0f, 4.0f * orbit.distance);
+    const Camera camera = orbit.camera(lens);
+
+    // LOD from last frame's root transforms (the pose does not move them).
+    anim::LodJob lod;
+    lod.camera = make_camera_view(camera);
+    lod.set_tables(lod_tables);
+    lod.root_positions = crowd.ground_positions();
+    lod.root_headings = crowd.yaws();
+    lod.template_spheres = parts.rest_spheres;
+    lod.levels = levels.span();
+    lod.joint_masks = masks.span();
+    lod.run();
+    histogram = anim::lod_histogram(levels.span(), masks.span(), lod_config.level_count, lod_config.joint_count);
+    crowd.update(t, masks.span());
+
+    if (render_options.bins) {
+      // Agents per 4 m cell over the crowd's square: the bins overlay.
+      const float cell = 4.0f;
+      const auto side = static_cast<std::int32_t>(std::ceil(2.0f * extent / cell));
+      std::vector<glm::vec3> ground(static_cast<std::size_t>(n));
+      if (n > 0)
+        throng::detail::copy_bytes(ground.data(), Memory::Host, crowd.ground_positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
+      bin_counts.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side), 0);
+      for (const glm::vec3& p : ground) {
+        const glm::vec2 m = (ground_from_world(p) + glm::vec2(extent)) / cell;
+        const auto x = static_cast<std::int32_t>(std::floor(m.x)), y = static_cast<std::int32_t>(std::floor(m.y));
+        if (x >= 0 && x < side && y >= 0 && y < side) ++bin_counts[static_cast<std::size_t>(y * side + x)];
+      }
+      BinsOverlay bins;
+      bins.min = glm::vec2(-extent);
+      bins.cell_size = cell;
+      bins.columns = side;
+      bins.rows = side;
+      bins.counts = bin_counts;
+      bins.saturate_at = 12;
+      renderer.set_bins(bins);
+    }
+    CharacterPoses poses = crowd.poses();
+    poses.lod_levels = levels.span();
+    render_options.lod_colours = input.lod_colours && show_lod;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    stats = renderer.render(camera, poses, render_options);
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    if (options.panel) {
+      ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+      ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+      ImGui::Begin("throng");
+      ImGui::Text("agents %lld, visible %lld (%lld near)", static_cast<long long>(stats.characters), static_cast<long long>(stats.visible),
+                  static_cast<long long>(stats.fine));
+      ImGui::Text("frame %.1f ms, time %.1f s, %.1fM triangles", frame_ms, t, static_cast<double>(stats.triangles) / 1e6);
+      ImGui::Checkbox("paused", &input.paused);
+      ImGui::SameLine();
+      if (ImGui::Button("step")) input.step = true;
+      float speed = static_cast<float>(input.speed);
+      if (ImGui::SliderFloat("speed", &speed, 0.0f, 4.0f, "%.2fx")) input.speed = speed;
+      const char* modes[] = {"joints", "skinned (not built yet)"};
+      ImGui::Combo("mode", &mode_index, modes, 1);
+      ImGui::Checkbox("LOD colours", &input.lod_colours);
+      ImGui::SameLine();
+      ImGui::Checkbox("grid", &render_options.grid);
+      ImGui::SameLine();
+      ImGui::Checkbox("cull", &render_options.cull);
+      ImGui::Checkbox("obstacles", &render_options.obstacles);
+      ImGui::SameLine();
+      ImGui::Checkbox("paths", &render_options.paths);
+      ImGui::SameLine();
+      ImGui::Checkbox("bins", &render_options.bins);
+      if (ImGui::CollapsingHeader("Joint LOD", ImGuiTreeNodeFlags_DefaultOpen)) {
+        bool changed = false;
+        for (std::size_t l = 0; l < thresholds.size(); ++l) {
+          const float lo = l + 1 < thresholds.size() ? thresholds[l + 1] + 1.0f : 1.0f;
+          const float hi = l > 0 ? thresholds[l - 1] - 1.0f : 50000.0f;
+          changed |= ImGui::SliderFloat(fmt::format("L{} from px^2", l).c_str(), &thresholds[l], lo, std::max(lo, hi), "%.0f",
+                                        ImGuiSliderFlags_Logarithmic);
+        }
+        if (changed) {
+          lod_config = anim::make_lod_config(parts, thresholds);
+          lod_tables = anim::LodTables(lod_config);
+        }
+        for (std::int32_t l = 0; l < histogram.level_count; ++l) {
+          Index count = 0;
+          for (int p = 0; p < anim::kBodyPartCount; ++p) count += histogram.at_level(static_cast<anim::BodyPart>(p), l);
+          const glm::vec3 c = lod_level_colour(l);
+          ImGui::ColorButton(fmt::format("##level{}", l).c_str(), ImVec4(c.r, c.g, c.b, 1.0f), 0, ImVec2(12, 12));
+          ImGui::SameLine();
+          const float share = n > 0 ? static_cast<float>(count) / static_cast<float>(n * anim::kBodyPartCount) : 0.0f;
+          ImGui::ProgressBar(share, ImVec2(-1, 0), fmt::format("level {}: {:.0f}% of body parts", l, 100.0f * share).c_str());
+        }
+        ImGui::Text("joints synthesised: %.1f of %d per agent", histogram.mean_joints_synthesised(), crowd.joint_count());
+        ImGui::TextDisabled("cache hit rate: when locomotion lands");
+      }
+      if (ImGui::CollapsingHeader("Stages (median ms)", ImGuiTreeNodeFlags_DefaultOpen)) {
+        const std::vector<KernelStat> kernels = KernelTimings::global().stats();  // largest total first
+        for (std::size_t k = 0; k < std::min<std::size_t>(kernels.size(), 10); ++k)
+          ImGui::Text("%-20s %8.3f", kernels[k].name.c_str(), kernels[k].median_ms);
+      }
+      ImGui::TextDisabled("drag: orbit, right drag: pan, wheel: zoom");
+      ImGui::End();
+    }
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+    ++result.frames;
+    const bool last_frame = scripted && result.frames >= options.frames;
+    if (last_frame && !options.screenshot.empty()) write_png(options.screenshot, read_window(fb_width, fb_height));
+    glfwSwapBuffers(window.get());
+    if (last_frame) glfwSetWindowShouldClose(window.get(), GLFW_TRUE);
+  }
+  result.seconds_shown = t;
+  return result;
+}
+
+}  // namespace throng::render

@@ -1,0 +1,175 @@
+#include "render/video.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "core/error.h"
+#include "render/camera_path.h"
+#include "render/demo_crowd.h"
+#include "render/recorder.h"
+
+namespace throng::render {
+namespace {
+
+std::string temp_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("throng_video_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+// ffprobe's answer for the first video stream: "width,height,nb_read_frames,duration".
+std::string probe(const std::string& path) {
+  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                          "stream=width,height,nb_read_frames,codec_name,pix_fmt:format=duration -of default=noprint_wrappers=1 '" +
+                          path + "' 2>&1";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  char buf[256];
+  while (pipe && fgets(buf, sizeof buf, pipe.get()) != nullptr) out += buf;
+  return out;
+}
+
+std::string field(const std::string& text, const std::string& key) {
+  const auto at = text.find(key + "=");
+  if (at == std::string::npos) return "";
+  const auto end = text.find('\n', at);
+  return text.substr(at + key.size() + 1, end - at - key.size() - 1);
+}
+
+Image solid(std::int32_t w, std::int32_t h, std::uint8_t shade) {
+  Image im(w, h);
+  for (std::size_t i = 0; i < im.rgba.size(); ++i) im.rgba[i] = (i % 4 == 3) ? 255 : static_cast<std::uint8_t>(shade + i % 7);
+  return im;
+}
+
+class VideoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!ffmpeg_available()) GTEST_FAIL() << "ffmpeg is missing: bash scripts/setup.sh --deps installs it";
+  }
+};
+
+TEST_F(VideoTest, WritesAPlayableMp4) {
+  const std::string dir = temp_dir("plain");
+  VideoSpec spec;
+  spec.path = dir + "/clip.mp4";
+  spec.width = 64;
+  spec.height = 48;
+  spec.fps = 25.0;
+  {
+    VideoWriter w(spec);
+    for (int f = 0; f < 50; ++f) w.write(solid(64, 48, static_cast<std::uint8_t>(f * 4)));
+    EXPECT_EQ(w.frames_written(), 50);
+    w.finish();
+  }
+  const std::string p = probe(spec.path);
+  EXPECT_EQ(field(p, "codec_name"), "h264") << p;
+  EXPECT_EQ(field(p, "pix_fmt"), "yuv420p") << p;
+  EXPECT_EQ(field(p, "width"), "64") << p;
+  EXPECT_EQ(field(p, "height"), "48") << p;
+  EXPECT_EQ(field(p, "nb_read_frames"), "50") << p;
+  EXPECT_NEAR(std::stod(field(p, "duration")), 2.0, 0.05) << p;
+}
+
+TEST_F(VideoTest, BadSpecsAndFramesAreErrors) {
+  VideoSpec spec;
+  spec.path = temp_dir("bad") + "/x.mp4";
+  spec.width = 63;
+  EXPECT_THROW(spec.validate(), Error);
+  spec.width = 64;
+  spec.fps = 0.0;
+  EXPECT_THROW(spec.validate(), Error);
+  spec.fps = 30.0;
+  spec.ffmpeg = "/nonexistent/ffmpeg";
+  try {
+    VideoWriter w(spec);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.location().field, "video.ffmpeg");
+  }
+  spec.ffmpeg = "ffmpeg";
+  VideoWriter w(spec);
+  EXPECT_THROW(w.write(solid(32, 32, 0)), Error);  // wrong size
+}
+
+TEST_F(VideoTest, FfmpegFailureIsReportedNotFatal) {
+  VideoSpec spec;
+  spec.path = "/nonexistent-folder/x.mp4";  // ffmpeg cannot open it
+  spec.width = 320;
+  spec.height = 240;
+  VideoWriter w(spec);
+  bool failed = false;
+  try {
+    // ffmpeg exits at once; writing into the closed pipe must not kill us.
+    for (int f = 0; f < 200 && !failed; ++f) w.write(solid(320, 240, 0));
+    w.finish();
+  } catch (const Error& e) {
+    failed = true;
+    EXPECT_NE(std::string(e.what()).find("ffmpeg"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(failed);
+}
+
+TEST_F(VideoTest, RecorderWritesVideoOfADemoCrowd) {
+  DemoCrowdSpec crowd_spec;
+  crowd_spec.characters = 40;
+  DemoCrowd crowd(crowd_spec);
+  RecordSpec spec;
+  spec.folder = temp_dir("recorder");
+  spec.width = 160;
+  spec.height = 90;
+  spec.fps = 10.0;
+  Recorder rec(spec, make_joint_rig(crowd.skeleton()));
+  const CameraPath path = framing_orbit(crowd.centre(), crowd.extent(), Camera{});
+  for (int f = 0; f < 15; ++f) {
+    crowd.update(f / spec.fps);
+    const RenderStats s = rec.add_frame(path.at(f / spec.fps), crowd.poses(), {});
+    EXPECT_EQ(s.characters, 40);
+    EXPECT_GT(s.visible, 30);
+  }
+  const std::string file = rec.finish();
+  EXPECT_EQ(file, spec.folder + "/crowd.mp4");
+  const std::string p = probe(file);
+  EXPECT_EQ(field(p, "width"), "160") << p;
+  EXPECT_EQ(field(p, "height"), "90") << p;
+  EXPECT_EQ(field(p, "nb_read_frames"), "15") << p;
+  EXPECT_NEAR(std::stod(field(p, "duration")), 1.5, 0.05) << p;
+}
+
+TEST_F(VideoTest, RecorderWritesNumberedPngFrames) {
+  DemoCrowdSpec crowd_spec;
+  crowd_spec.characters = 5;
+  crowd_spec.layout = DemoLayout::Grid;
+  DemoCrowd crowd(crowd_spec);
+  RecordSpec spec;
+  spec.output = RecordOutput::Frames;
+  spec.folder = temp_dir("frames") + "/nested";
+  spec.width = 81;  // odd sizes are fine for PNG
+  spec.height = 45;
+  Recorder rec(spec, make_joint_rig(crowd.skeleton()));
+  const CameraPath path = framing_flyover(crowd.centre(), crowd.extent(), Camera{}, 1.0f);
+  for (int f = 0; f < 3; ++f) rec.add_frame(path.at(0.5 * f), crowd.poses(), {});
+  EXPECT_EQ(rec.finish(), spec.folder);
+  for (int f = 0; f < 3; ++f) {
+    const Image im = read_png(spec.folder + "/frame_0000" + std::to_string(f) + ".png");
+    EXPECT_EQ(im.width, 81);
+    EXPECT_EQ(im.height, 45);
+  }
+  EXPECT_FALSE(std::filesystem::exists(spec.folder + "/frame_00003.png"));
+  RecordSpec bad = spec;
+  bad.output = RecordOutput::Video;
+  try {
+    bad.validate();
+    FAIL() << "odd video width accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.location().field, "render.width");
+  }
+}
+
+}  // namespace
+}  // namespace throng::render

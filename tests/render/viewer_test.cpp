@@ -1,0 +1,123 @@
+// `throng view` in a real window on a virtual X server (Xvfb, started here
+// on a free display), quitting by itself after N frames with a screenshot.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "render/image.h"
+
+extern char** environ;
+
+namespace throng::render {
+namespace {
+
+// An Xvfb server on a display it picks (-displayfd), ended with the object.
+class VirtualDisplay {
+ public:
+  VirtualDisplay() {
+    int fds[2];
+    if (pipe(fds) != 0) return;
+    const std::string fd = std::to_string(fds[1]);
+    std::vector<std::string> args = {"Xvfb", "-displayfd", fd, "-screen", "0", "1024x768x24", "-nolisten", "tcp", "-noreset"};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addclose(&actions, fds[0]);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+    pid_t pid = -1;
+    const int rc = posix_spawnp(&pid, "Xvfb", &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    close(fds[1]);
+    if (rc != 0) {
+      close(fds[0]);
+      return;
+    }
+    pid_ = pid;
+    // Xvfb writes the display number once it accepts connections.
+    pollfd p{fds[0], POLLIN, 0};
+    std::string number;
+    while (poll(&p, 1, 30000) > 0) {
+      char c = 0;
+      if (read(fds[0], &c, 1) != 1 || c == '\n') break;
+      number += c;
+    }
+    close(fds[0]);
+    if (!number.empty()) display_ = ":" + number;
+  }
+  ~VirtualDisplay() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      int status = 0;
+      waitpid(pid_, &status, 0);
+    }
+  }
+  const std::string& display() const { return display_; }
+
+ private:
+  pid_t pid_ = -1;
+  std::string display_;
+};
+
+int run(const std::string& command, std::string& output) {
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return -1;
+  char buf[512];
+  while (fgets(buf, sizeof buf, pipe) != nullptr) output += buf;
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
+  VirtualDisplay x;
+  ASSERT_FALSE(x.display().empty()) << "Xvfb did not start: install it (package xvfb, bash scripts/setup.sh --deps)";
+  const std::string shot = (std::filesystem::temp_directory_path() / "throng_viewer_test.png").string();
+  std::filesystem::remove(shot);
+  std::string out;
+  const int code = run("DISPLAY=" + x.display() + " " + THRONG_EXE +
+                           " --threads 2 view --agents 150 --layout grid --bins --frames 12 --width 480 --height 270 --screenshot " + shot,
+                       out);
+  ASSERT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("12 frames"), std::string::npos) << out;
+  ASSERT_TRUE(std::filesystem::exists(shot)) << out;
+  const Image im = read_png(shot);
+  EXPECT_EQ(im.width, 480);
+  EXPECT_EQ(im.height, 270);
+  // A real picture: the panel, the ground, characters in LOD colours.
+  std::set<std::uint32_t> colours;
+  for (std::size_t i = 0; i < im.rgba.size(); i += 4)
+    colours.insert(static_cast<std::uint32_t>(im.rgba[i]) << 16 | static_cast<std::uint32_t>(im.rgba[i + 1]) << 8 | im.rgba[i + 2]);
+  EXPECT_GT(colours.size(), 200u);
+}
+
+TEST(Viewer, NoDisplayIsAClearError) {
+  std::string out;
+  const int code = run(std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + THRONG_EXE + " view --frames 1", out);
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_NE(out.find("throng: error: cannot open a window"), std::string::npos) << out;
+}
+
+TEST(Viewer, BadOptionsAreErrors) {
+  std::string out;
+  EXPECT_NE(run(std::string(THRONG_EXE) + " view --screenshot x.png", out), 0);
+  EXPECT_NE(out.find("--frames"), std::string::npos) << out;
+  out.clear();
+  EXPECT_NE(run(std::string(THRONG_EXE) + " view --lod-thresholds 10,100 --frames 1", out), 0);
+  EXPECT_NE(out.find("--lod-thresholds"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace throng::render
