@@ -66,9 +66,15 @@ AnimStream::AnimStream(const Rig& rig, std::int32_t rig_index, StreamSpec spec, 
     upload(rotations_, k * joints_, rest.local.data(), joints_);
     upload(roots_, k, &rest.root, 1);
   }
+  head_ = spec_.history - 1;  // the first pose written lands in slot 0
 }
 
-std::int32_t AnimStream::max_offset() const { return static_cast<std::int32_t>(std::floor(dilation_)); }
+double AnimStream::dilation() const {
+  return std::min(dilation_from_ + static_cast<double>(dilation_steps_) * change_rate_, dilation_target_);
+}
+
+// The epsilon keeps k * rate that is an integer in exact arithmetic from flooring one below.
+std::int32_t AnimStream::max_offset() const { return static_cast<std::int32_t>(std::floor(dilation() + 1e-9)); }
 
 std::size_t AnimStream::pose_bytes() const {
   return static_cast<std::size_t>(rotations_.size()) * sizeof(glm::quat) + static_cast<std::size_t>(roots_.size()) * sizeof(glm::vec3);
@@ -107,7 +113,8 @@ void AnimStream::start(float frame_rate) {
   state_ = StreamState::Running;
   controller_->reset();
   written_ = 0;
-  dilation_ = 0.0;
+  dilation_from_ = 0.0;
+  dilation_steps_ = 0;
   dilation_target_ = spec_.history - 1;
   change_rate_ = static_cast<double>(spec_.history) / (static_cast<double>(spec_.time_to_dilate) * frame_rate);
 }
@@ -118,7 +125,7 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
   const std::int32_t old_m = spec_.history;
   // Offsets may reach current_length - 1 now; the growth beyond must take
   // at least one frame per slot.
-  const double current_length = std::floor(dilation_) + 1.0;
+  const double current_length = max_offset() + 1.0;
   const double growth = std::max(0.0, history - current_length);
   if (!std::isfinite(time_to_dilate) || !(static_cast<double>(time_to_dilate) * frame_rate >= growth - 1e-6) || time_to_dilate < 0.0f)
     throw Error("must be at least " + std::to_string(growth / frame_rate) + " s to grow the history from " + std::to_string(old_m) + " to " +
@@ -151,7 +158,8 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
   events_ = std::move(events);
   head_ = 0;
   written_ = std::min(written_, history);
-  dilation_ = std::min(dilation_, static_cast<double>(history - 1));
+  dilation_from_ = std::min(dilation(), static_cast<double>(history - 1));
+  dilation_steps_ = 0;
   dilation_target_ = history - 1;
   change_rate_ = growth > 0.0 ? growth / (static_cast<double>(time_to_dilate) * frame_rate) : 0.0;
   spec_.history = history;
@@ -166,7 +174,7 @@ void AnimStream::write(const Pose& pose, EventMask events, std::int32_t frame) {
   upload(events_, head_, &events, 1);
   newest_ = frame;
   // D grows only from the second written frame on, so D <= written - 1.
-  if (written_ > 0) dilation_ = std::min(dilation_ + change_rate_, dilation_target_);
+  if (written_ > 0) ++dilation_steps_;
   written_ = std::min(written_ + 1, spec_.history);
 }
 

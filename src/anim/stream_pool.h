@@ -98,7 +98,7 @@ class AnimStream {
   std::int32_t head() const { return head_; }
   std::int32_t newest_frame() const { return newest_; }
   std::int32_t written() const { return written_; }  // slots written since the last start, <= M
-  double dilation() const { return dilation_; }       // D
+  double dilation() const;                            // D
   double change_rate() const { return change_rate_; } // slots per frame while dilating
   std::int32_t max_offset() const;
 
@@ -126,7 +126,10 @@ class AnimStream {
   std::int32_t head_ = 0;
   std::int32_t newest_ = -1;
   std::int32_t written_ = 0;
-  double dilation_ = 0.0;
+  // D = min(dilation_from_ + dilation_steps_ * change_rate_, dilation_target_):
+  // counted, not accumulated, so floor(D) has no drift.
+  double dilation_from_ = 0.0;
+  std::int64_t dilation_steps_ = 0;
   double dilation_target_ = 0.0;
   double change_rate_ = 0.0;
 };
