@@ -40,6 +40,7 @@ void StreamSpec::validate(std::int32_t rig_count, float frame_rate) const {
   if (rig < 0 || rig >= rig_count) throw Error("no such rig", at_field(at + ".rig"));
   if (history < 1 || history > 65536) throw Error("must be in [1, 65536] slots", at_field(at + ".history"));
   const double least = static_cast<double>(history) / frame_rate;
+  if (time_to_dilate == 0.0f) return;  // automatic
   if (!(time_to_dilate >= least - 1e-6) || !std::isfinite(time_to_dilate))
     throw Error("must be at least history / frame_rate = " + std::to_string(least) +
                     " s, so that offsets never outrun the history (it grows one slot per frame)",
@@ -127,6 +128,7 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
   // at least one frame per slot.
   const double current_length = max_offset() + 1.0;
   const double growth = std::max(0.0, history - current_length);
+  if (time_to_dilate == 0.0f) time_to_dilate = static_cast<float>(2.0 * growth / frame_rate);
   if (!std::isfinite(time_to_dilate) || !(static_cast<double>(time_to_dilate) * frame_rate >= growth - 1e-6) || time_to_dilate < 0.0f)
     throw Error("must be at least " + std::to_string(growth / frame_rate) + " s to grow the history from " + std::to_string(old_m) + " to " +
                     std::to_string(history) + " slots at no more than one slot per frame",
@@ -163,7 +165,8 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
   dilation_target_ = history - 1;
   change_rate_ = growth > 0.0 ? growth / (static_cast<double>(time_to_dilate) * frame_rate) : 0.0;
   spec_.history = history;
-  spec_.time_to_dilate = time_to_dilate;
+  // A later restart dilates over the new history: keep its time if it still suffices.
+  if (static_cast<double>(spec_.time_to_dilate) * frame_rate < history) spec_.time_to_dilate = 2.0f * static_cast<float>(history) / frame_rate;
 }
 
 void AnimStream::write(const Pose& pose, EventMask events, std::int32_t frame) {
@@ -187,6 +190,7 @@ StreamPool::StreamPool(float frame_rate, Memory memory) : frame_rate_(frame_rate
 std::int32_t StreamPool::add(const Rig& rig, std::int32_t rig_index, StreamSpec spec, std::unique_ptr<Controller> controller) {
   spec.rig = rig_index;
   spec.validate(rig_index + 1, frame_rate_);
+  if (spec.time_to_dilate == 0.0f) spec.time_to_dilate = 2.0f * static_cast<float>(spec.history) / frame_rate_;
   if (find(spec.name) >= 0) throw Error("stream name used twice", at_field("streams." + spec.name));
   const bool running = spec.running;
   streams_.push_back(std::make_unique<AnimStream>(rig, rig_index, std::move(spec), std::move(controller), memory_));

@@ -75,7 +75,9 @@ struct StreamSpec {
   std::int32_t rig = 0;
   std::int32_t history = 64;      // M, slots
   RootMotion root = RootMotion::InPlace;
-  float time_to_dilate = 2.5f;    // seconds for offsets to spread after a start
+  // Seconds for offsets to spread after a start; 0 picks 2 * history /
+  // frame_rate (agents play at half speed while their offsets spread).
+  float time_to_dilate = 0.0f;
   bool running = true;            // started when added
   void validate(std::int32_t rig_count, float frame_rate) const;  // Error naming "streams.<name>.<field>"
 };
@@ -151,7 +153,8 @@ class StreamPool {
   void start(std::int32_t stream);
   void stop(std::int32_t stream);
   // Changes M at run time: kept slots keep their offsets; growing dilates
-  // from the current D at (M_new - M) / (time_to_dilate * frame_rate).
+  // from the current D at (M_new - M) / (time_to_dilate * frame_rate)
+  // (time_to_dilate 0: two frames per slot).
   void set_history(std::int32_t stream, std::int32_t history, float time_to_dilate);
 
   // One animation frame: every running stream's controller advances by
