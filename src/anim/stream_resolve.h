@@ -164,6 +164,7 @@ struct ClipPaletteJob {
   Span<const glm::vec3> clip_roots;
   bool in_place = true;                  // drop the root's horizontal motion, as streams do
   Span<const float> times;               // per agent, seconds
+  float time_offset = 0.0f;              // added to every agent's time (the clock)
   Span<const glm::vec3> positions;       // agents, or empty
   Span<const float> yaws;                // agents, or empty
   Span<Mat3x4> palettes;                 // agents * joint_count

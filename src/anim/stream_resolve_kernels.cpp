@@ -299,13 +299,14 @@ void ClipPaletteJob::run() const {
   const auto CP = clip_roots;
   const bool drop_xz = in_place;
   const auto TI = times;
+  const float clock = time_offset;
   const auto pos = positions;
   const auto yaw = yaws;
   const auto out = palettes;
   parallel_for(
       "anim.clip_palette", agent_count(),
       THRONG_LAMBDA(Index a) {
-        const float phase = TI[a] / period;
+        const float phase = (TI[a] + clock) / period;
         const CyclePoint cp = cycle_point(N, phase);
         const glm::quat* q0 = CR.data() + static_cast<Index>(cp.f0) * J;
         const glm::quat* q1 = CR.data() + static_cast<Index>(cp.f1) * J;
