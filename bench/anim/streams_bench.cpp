@@ -79,7 +79,7 @@ struct StreamsFixture {
     }
     crowd->add_agents(rig, n);
     crowd->assign_random(0, n, {{all, all, all}, true}, 7);
-    for (int f = 0; f < 130; ++f) crowd->streams().step(f);  // dilation done: offsets spread over all 64 slots
+    for (int f = 0; f < 130; ++f) crowd->step();  // dilation done: offsets spread over all 64 slots
     placement = std::make_unique<Placement>(n);
     palettes = Buffer<Mat3x4>(crowd->palette_size(), current_memory());
   }

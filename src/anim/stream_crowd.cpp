@@ -189,12 +189,7 @@ void StreamCrowd::assign(Index first, Index count, std::int32_t cluster, std::in
     check_agent_cluster(a, cluster);
     if (host_agent_rig_[static_cast<std::size_t>(a)] != s.rig())
       throw Error("stream '" + s.name() + "' is of another rig than agent " + std::to_string(a), at_field("assign.stream"));
-    ClusterCommand c;
-    c.agent = a;
-    c.cluster = cluster;
-    c.source = stream;
-    c.offset = offset;
-    cmds.push_back(c);
+    cmds.push_back({a, cluster, stream, offset});
   }
   apply(std::move(cmds));
 }
@@ -229,12 +224,7 @@ void StreamCrowd::assign_random(Index first, Index count, const VarietySpec& spe
           if (picked[d] == s) offset = offsets[d];
       picked[c] = s;
       offsets[c] = offset;
-      ClusterCommand cmd;
-      cmd.agent = a;
-      cmd.cluster = c;
-      cmd.source = s;
-      cmd.offset = offset;
-      cmds.push_back(cmd);
+      cmds.push_back({a, c, s, offset});
     }
   }
   apply(std::move(cmds));

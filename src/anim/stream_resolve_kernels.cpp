@@ -16,13 +16,18 @@ struct SlotRead {
   std::int32_t offset = -1;              // effective offset read, -1 for none
 };
 
+// The view of a source id, or null for none (or an id out of range).
+THRONG_HOST_DEVICE inline const SourceView* find_source(Span<const SourceView> streams, Span<const SourceView> uniques, std::int32_t source) {
+  if (source >= 0 && source < streams.size()) return &streams[source];
+  if (is_unique_source(source) && unique_instance(source) < uniques.size()) return &uniques[unique_instance(source)];
+  return nullptr;
+}
+
 THRONG_HOST_DEVICE inline SlotRead read_source(Span<const SourceView> streams, Span<const SourceView> uniques, std::int32_t source,
                                                std::int32_t offset, std::int32_t joints, glm::vec3 rest_root) {
   SlotRead r;
   r.root = rest_root;
-  const SourceView* v = nullptr;
-  if (source >= 0 && source < streams.size()) v = &streams[source];
-  if (is_unique_source(source) && unique_instance(source) < uniques.size()) v = &uniques[unique_instance(source)];
+  const SourceView* v = find_source(streams, uniques, source);
   if (v == nullptr || v->joints != joints || v->rotations == nullptr) return r;
   const std::int32_t slot = history_slot(*v, offset);
   r.rotations = v->rotations + static_cast<Index>(slot) * joints;
@@ -100,9 +105,7 @@ void StreamEventsJob::run() const {
         EventMask mask = 0;
         for (std::int32_t c = 0; c < count && c < stride; ++c) {
           ClusterRef& ref = refs[a * stride + c];
-          const SourceView* v = nullptr;
-          if (ref.source >= 0 && ref.source < S.size()) v = &S[ref.source];
-          if (is_unique_source(ref.source) && unique_instance(ref.source) < U.size()) v = &U[unique_instance(ref.source)];
+          const SourceView* v = find_source(S, U, ref.source);
           if (v == nullptr || v->newest < 0) continue;
           const std::int32_t read = v->newest - effective_offset(*v, ref.offset);
           if (ref.last_read != kNeverRead && read > ref.last_read) {

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/error.h"
+#include "anim/skin.h"
 #include "core/exec.h"
 #include "stream_reference.h"
 
@@ -359,6 +360,29 @@ TEST(StreamCrowd, BoneOverridesReplaceRotationsAndAimLookAt) {
   BoneOverride bad;
   bad.joint = 40;
   EXPECT_THROW(crowd.set_override(a, bad), Error);
+}
+
+TEST(StreamCrowd, MannequinsAtRestPoseSkinToTheirBindPose) {
+  // Fresh agents read no source: the rest pose. Resolved by the kernel and
+  // skinned by the CPU reference, every vertex is where the mesh has it.
+  StreamCrowd crowd({kFps, 1});
+  crowd.add_rig(humanoid_rig());
+  crowd.add_rig(make_rig("fingered", fingered_skeleton()));
+  crowd.add_agents(0, 2);
+  crowd.add_agents(1, 2);
+  crowd.step();
+  std::vector<Mat3x4> palettes(static_cast<std::size_t>(crowd.palette_size()));
+  crowd.resolve({}, {}, palettes);
+  for (Index a = 0; a < 4; ++a) {
+    const Rig& rig = crowd.rig(crowd.agent_rig(a));
+    const auto J = static_cast<std::size_t>(rig.joint_count());
+    std::vector<glm::vec3> p(rig.mesh.positions.size()), n(p.size());
+    skin_reference(rig.mesh, std::span<const Mat3x4>(palettes).subspan(static_cast<std::size_t>(crowd.palette_offsets()[a]), J), p, n);
+    for (std::size_t v = 0; v < p.size(); ++v) {
+      ASSERT_LT(glm::length(p[v] - rig.mesh.positions[v]), 1e-5f) << a << " " << v;
+      ASSERT_LT(glm::length(n[v] - rig.mesh.normals[v]), 1e-5f) << a << " " << v;
+    }
+  }
 }
 
 TEST(StreamCrowd, CulledClusterCollapsesOntoItsHook) {
