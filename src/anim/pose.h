@@ -56,15 +56,15 @@ THRONG_HOST_DEVICE inline glm::vec3 transform_vector(const Mat3x4& m, const glm:
 }
 
 // a * b as affine maps (b first).
+THRONG_HOST_DEVICE inline glm::vec4 row_times(const glm::vec4& x, const Mat3x4& b) {
+  return glm::vec4(x.x * b.r0.x + x.y * b.r1.x + x.z * b.r2.x, x.x * b.r0.y + x.y * b.r1.y + x.z * b.r2.y,
+                   x.x * b.r0.z + x.y * b.r1.z + x.z * b.r2.z, x.x * b.r0.w + x.y * b.r1.w + x.z * b.r2.w + x.w);
+}
 THRONG_HOST_DEVICE inline Mat3x4 operator*(const Mat3x4& a, const Mat3x4& b) {
   Mat3x4 m;
-  const glm::vec4* ar[3] = {&a.r0, &a.r1, &a.r2};
-  glm::vec4* mr[3] = {&m.r0, &m.r1, &m.r2};
-  for (int r = 0; r < 3; ++r) {
-    const glm::vec4 x = *ar[r];
-    *mr[r] = glm::vec4(x.x * b.r0.x + x.y * b.r1.x + x.z * b.r2.x, x.x * b.r0.y + x.y * b.r1.y + x.z * b.r2.y,
-                       x.x * b.r0.z + x.y * b.r1.z + x.z * b.r2.z, x.x * b.r0.w + x.y * b.r1.w + x.z * b.r2.w + x.w);
-  }
+  m.r0 = row_times(a.r0, b);
+  m.r1 = row_times(a.r1, b);
+  m.r2 = row_times(a.r2, b);
   return m;
 }
 
@@ -72,6 +72,20 @@ THRONG_HOST_DEVICE inline Mat3x4 operator*(const Mat3x4& a, const Mat3x4& b) {
 THRONG_HOST_DEVICE inline Mat3x4 inverse_rigid(const glm::quat& q, const glm::vec3& t) {
   const glm::quat qi = glm::conjugate(q);
   return mat3x4_from(qi, -(qi * t));
+}
+
+// The inverse of a rigid Mat3x4 (orthonormal rotation part): [R^T | -R^T t].
+THRONG_HOST_DEVICE inline Mat3x4 inverse_rigid(const Mat3x4& m) {
+  const glm::vec3 t(m.r0.w, m.r1.w, m.r2.w);
+  Mat3x4 out;
+  out.r0 = glm::vec4(m.r0.x, m.r1.x, m.r2.x, 0.0f);
+  out.r1 = glm::vec4(m.r0.y, m.r1.y, m.r2.y, 0.0f);
+  out.r2 = glm::vec4(m.r0.z, m.r1.z, m.r2.z, 0.0f);
+  const glm::vec3 it = -transform_vector(out, t);
+  out.r0.w = it.x;
+  out.r1.w = it.y;
+  out.r2.w = it.z;
+  return out;
 }
 
 // Every vertex skinned by it collapses onto point p: how a culled cluster's

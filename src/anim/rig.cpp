@@ -67,6 +67,18 @@ ClusterLayout make_cluster_layout(const motion::Skeleton& skeleton, std::vector<
       throw Error("cluster '" + clusters[c].name + "' owns no joint (its roots lie inside other clusters' roots only)",
                   at_field("clusters[" + std::to_string(c) + "]"));
   }
+  for (std::int32_t j = 0; j < J; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    const std::int32_t p = skeleton.parents[ju];
+    if (p < 0 || out.cluster_of_joint[static_cast<std::size_t>(p)] != out.cluster_of_joint[ju]) {
+      if (static_cast<std::int32_t>(out.segment_roots.size()) >= kMaxSegments)
+        throw Error("at most " + std::to_string(kMaxSegments) + " cluster roots per rig", at_field("clusters"));
+      out.segment_of_joint.push_back(static_cast<std::uint8_t>(out.segment_roots.size()));
+      out.segment_roots.push_back(j);
+    } else {
+      out.segment_of_joint.push_back(out.segment_of_joint[static_cast<std::size_t>(p)]);
+    }
+  }
   out.clusters = std::move(clusters);
   return out;
 }
@@ -92,6 +104,17 @@ Pose Rig::rest_pose() const {
   p.root = skeleton.offsets.empty() ? glm::vec3(0.0f) : skeleton.offsets[0];
   return p;
 }
+
+void PoseKinematics::palette(const Pose& pose, Mat3x4* out) const {
+  const auto J = static_cast<std::int32_t>(parents.size());
+  if (J > kMaxRigJoints || pose.joint_count() != J) throw Error("pose and skeleton differ in joint count", at_field("pose"));
+  glm::vec3 positions[kMaxRigJoints];
+  glm::quat rotations[kMaxRigJoints];
+  motion::fk_pose(J, parents.data(), offsets.data(), pose.local.data(), nullptr, pose.root, positions, rotations);
+  for (std::int32_t j = 0; j < J; ++j) out[j] = mat3x4_from(rotations[j], positions[j]) * inverse_bind[static_cast<std::size_t>(j)];
+}
+
+PoseKinematics Rig::kinematics() const { return {skeleton.parents, skeleton.offsets, inverse_bind}; }
 
 Rig make_rig(std::string name, motion::Skeleton skeleton, std::vector<ClusterDef> clusters) {
   SkinnedMesh mesh = make_mannequin(skeleton);

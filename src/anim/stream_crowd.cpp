@@ -40,10 +40,14 @@ struct StreamCrowd::RigTables {
   Buffer<glm::quat> hook_rotations;
   Buffer<glm::vec3> hook_translations;
   Buffer<std::int32_t> hook_joints;
+  Buffer<std::uint8_t> joint_segment;
+  Buffer<Mat3x4> segment_hooks;
+  Buffer<glm::vec3> bind_positions;
 
   RigTablesView view() const {
     return {rigs.span(),        parents.span(),        offsets.span(),           joint_cluster.span(),
-            inverse_bind.span(), hook_rotations.span(), hook_translations.span(), hook_joints.span()};
+            inverse_bind.span(), hook_rotations.span(), hook_translations.span(), hook_joints.span(),
+            joint_segment.span(), segment_hooks.span(), bind_positions.span()};
   }
 };
 
@@ -87,18 +91,37 @@ void StreamCrowd::rebuild_rig_tables() {
   std::vector<std::uint8_t> joint_cluster;
   std::vector<Mat3x4> inverse_bind;
   std::vector<glm::quat> hook_q;
+  std::vector<std::uint8_t> joint_segment;
+  std::vector<Mat3x4> segment_hooks;
+  std::vector<glm::vec3> bind_positions;
   for (const Rig& r : rigs_) {
     RigView v;
     v.joint_base = static_cast<Index>(parents.size());
     v.joint_count = r.joint_count();
     v.cluster_base = static_cast<std::int32_t>(hook_q.size());
     v.cluster_count = r.clusters.count();
+    v.segment_base = static_cast<std::int32_t>(segment_hooks.size());
+    v.segment_count = static_cast<std::int32_t>(r.clusters.segment_roots.size());
     v.rest_root = r.rest_pose().root;
     views.push_back(v);
     parents.insert(parents.end(), r.skeleton.parents.begin(), r.skeleton.parents.end());
     offsets.insert(offsets.end(), r.skeleton.offsets.begin(), r.skeleton.offsets.end());
     joint_cluster.insert(joint_cluster.end(), r.clusters.cluster_of_joint.begin(), r.clusters.cluster_of_joint.end());
     inverse_bind.insert(inverse_bind.end(), r.inverse_bind.begin(), r.inverse_bind.end());
+    joint_segment.insert(joint_segment.end(), r.clusters.segment_of_joint.begin(), r.clusters.segment_of_joint.end());
+    bind_positions.insert(bind_positions.end(), r.bind_positions.begin(), r.bind_positions.end());
+    for (const std::int32_t root : r.clusters.segment_roots) {
+      // B_p * hook * B_p^-1 with p the root's parent: the hook moved into model space.
+      const std::int32_t p = r.skeleton.parents[static_cast<std::size_t>(root)];
+      const ClusterDef& d = r.clusters.clusters[r.clusters.cluster_of_joint[static_cast<std::size_t>(root)]];
+      const bool identity = d.hook_rotation == glm::quat(1, 0, 0, 0) && d.hook_translation == glm::vec3(0.0f);
+      if (p < 0 || identity) {
+        segment_hooks.emplace_back();
+      } else {
+        const auto pu = static_cast<std::size_t>(p);
+        segment_hooks.push_back(inverse_rigid(r.inverse_bind[pu]) * mat3x4_from(d.hook_rotation, d.hook_translation) * r.inverse_bind[pu]);
+      }
+    }
     for (std::int32_t c = 0; c < r.clusters.count(); ++c) {
       hook_q.push_back(r.clusters.clusters[static_cast<std::size_t>(c)].hook_rotation);
       hook_t.push_back(r.clusters.clusters[static_cast<std::size_t>(c)].hook_translation);
@@ -113,6 +136,9 @@ void StreamCrowd::rebuild_rig_tables() {
   tables_->hook_rotations = to_buffer(hook_q, memory_);
   tables_->hook_translations = to_buffer(hook_t, memory_);
   tables_->hook_joints = to_buffer(hook_joints, memory_);
+  tables_->joint_segment = to_buffer(joint_segment, memory_);
+  tables_->segment_hooks = to_buffer(segment_hooks, memory_);
+  tables_->bind_positions = to_buffer(bind_positions, memory_);
 }
 
 // ---- agents -----------------------------------------------------------------------------

@@ -50,7 +50,7 @@ void StreamSpec::validate(std::int32_t rig_count, float frame_rate) const {
 // ---- AnimStream ------------------------------------------------------------------
 
 AnimStream::AnimStream(const Rig& rig, std::int32_t rig_index, StreamSpec spec, std::unique_ptr<Controller> controller, Memory memory)
-    : spec_(std::move(spec)), joints_(rig.joint_count()), controller_(std::move(controller)) {
+    : spec_(std::move(spec)), joints_(rig.joint_count()), controller_(std::move(controller)), kinematics_(rig.kinematics()) {
   spec_.rig = rig_index;
   if (!controller_) throw Error("a stream needs a controller", at_field("streams." + spec_.name + ".controller"));
   if (controller_->joint_count() != joints_)
@@ -58,13 +58,17 @@ AnimStream::AnimStream(const Rig& rig, std::int32_t rig_index, StreamSpec spec, 
                 at_field("streams." + spec_.name + ".controller"));
   const Index M = spec_.history;
   rotations_ = Buffer<glm::quat>(M * joints_, memory);
+  skinning_ = Buffer<Mat3x4>(M * joints_, memory);
   roots_ = Buffer<glm::vec3>(M, memory);
   events_ = Buffer<std::uint32_t>::zeros(M, memory);
   // Every slot starts as the rest pose, so even a read that dilation should
   // have prevented sees a valid pose.
   const Pose rest = rig.rest_pose();
+  std::vector<Mat3x4> palette(static_cast<std::size_t>(joints_));
+  kinematics_.palette(rest, palette.data());
   for (Index k = 0; k < M; ++k) {
     upload(rotations_, k * joints_, rest.local.data(), joints_);
+    upload(skinning_, k * joints_, palette.data(), joints_);
     upload(roots_, k, &rest.root, 1);
   }
   head_ = spec_.history - 1;  // the first pose written lands in slot 0
@@ -78,12 +82,14 @@ double AnimStream::dilation() const {
 std::int32_t AnimStream::max_offset() const { return static_cast<std::int32_t>(std::floor(dilation() + 1e-9)); }
 
 std::size_t AnimStream::pose_bytes() const {
-  return static_cast<std::size_t>(rotations_.size()) * sizeof(glm::quat) + static_cast<std::size_t>(roots_.size()) * sizeof(glm::vec3);
+  return static_cast<std::size_t>(rotations_.size()) * sizeof(glm::quat) + static_cast<std::size_t>(skinning_.size()) * sizeof(Mat3x4) +
+         static_cast<std::size_t>(roots_.size()) * sizeof(glm::vec3);
 }
 
 SourceView AnimStream::view() const {
   SourceView v;
   v.rotations = rotations_.data();
+  v.skinning = skinning_.data();
   v.roots = roots_.data();
   v.events = events_.data();
   v.joints = joints_;
@@ -135,27 +141,32 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
                 at_field(at + ".time_to_dilate"));
   const Memory memory = rotations_.memory();
   Buffer<glm::quat> rotations(static_cast<Index>(history) * joints_, memory);
+  Buffer<Mat3x4> skinning(static_cast<Index>(history) * joints_, memory);
   Buffer<glm::vec3> roots(history, memory);
   Buffer<std::uint32_t> events = Buffer<std::uint32_t>::zeros(history, memory);
   // The new ring's head is slot 0; offset o goes to slot (-o mod M_new).
   // Slots beyond what is kept get a copy of the oldest kept pose.
   const std::int32_t kept = std::max(1, std::min(std::max(written_, 1), history));
   std::vector<glm::quat> q(static_cast<std::size_t>(joints_));
+  std::vector<Mat3x4> m(static_cast<std::size_t>(joints_));
   glm::vec3 r;
   std::uint32_t e = 0;
   for (std::int32_t o = 0; o < history; ++o) {
     const std::int32_t from_o = std::min(o, kept - 1);
     const std::int32_t from = (head_ - from_o + old_m * 2) % old_m;
     download(rotations_, static_cast<Index>(from) * joints_, q.data(), joints_);
+    download(skinning_, static_cast<Index>(from) * joints_, m.data(), joints_);
     download(roots_, from, &r, 1);
     download(events_, from, &e, 1);
     if (o >= kept) e = 0;
     const std::int32_t to = (history - o) % history;
     upload(rotations, static_cast<Index>(to) * joints_, q.data(), joints_);
+    upload(skinning, static_cast<Index>(to) * joints_, m.data(), joints_);
     upload(roots, to, &r, 1);
     upload(events, to, &e, 1);
   }
   rotations_ = std::move(rotations);
+  skinning_ = std::move(skinning);
   roots_ = std::move(roots);
   events_ = std::move(events);
   head_ = 0;
@@ -169,10 +180,13 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
   if (static_cast<double>(spec_.time_to_dilate) * frame_rate < history) spec_.time_to_dilate = 2.0f * static_cast<float>(history) / frame_rate;
 }
 
-void AnimStream::write(const Pose& pose, EventMask events, std::int32_t frame) {
+void AnimStream::write(const Pose& pose, EventMask events, std::int32_t frame, std::vector<Mat3x4>& palette) {
   check_pose(pose, joints_, "streams." + spec_.name + ".controller");
   head_ = (head_ + 1) % spec_.history;
+  palette.resize(static_cast<std::size_t>(joints_));
+  kinematics_.palette(pose, palette.data());
   upload(rotations_, static_cast<Index>(head_) * joints_, pose.local.data(), joints_);
+  upload(skinning_, static_cast<Index>(head_) * joints_, palette.data(), joints_);
   upload(roots_, head_, &pose.root, 1);
   upload(events_, head_, &events, 1);
   newest_ = frame;
@@ -233,7 +247,7 @@ void StreamPool::step(std::int32_t frame) {
     if (s.written_ > 0) s.controller_->advance(dt, s.parameters_, events);
     s.controller_->evaluate(scratch_);
     apply_root_motion(s.spec_.root, scratch_);
-    s.write(scratch_, events, frame);
+    s.write(scratch_, events, frame, palette_scratch_);
   }
   refresh_views();
 }
@@ -268,12 +282,17 @@ void UniquePool::set_capacity(const Rig& rig, std::int32_t rig_index, std::int32
   slab.joints = rig.joint_count();
   slab.first_instance = instance_count();
   slab.capacity = capacity;
+  slab.kinematics = rig.kinematics();
   slab.rotations = Buffer<glm::quat>(static_cast<Index>(capacity) * slab.joints, memory_);
+  slab.skinning = Buffer<Mat3x4>(static_cast<Index>(capacity) * slab.joints, memory_);
   slab.roots = Buffer<glm::vec3>(capacity, memory_);
   slab.events = Buffer<std::uint32_t>::zeros(capacity, memory_);
   const Pose rest = rig.rest_pose();
+  std::vector<Mat3x4> palette(static_cast<std::size_t>(slab.joints));
+  slab.kinematics.palette(rest, palette.data());
   for (std::int32_t k = 0; k < capacity; ++k) {
     upload(slab.rotations, static_cast<Index>(k) * slab.joints, rest.local.data(), slab.joints);
+    upload(slab.skinning, static_cast<Index>(k) * slab.joints, palette.data(), slab.joints);
     upload(slab.roots, k, &rest.root, 1);
     Instance inst;
     inst.slab = static_cast<std::int32_t>(slabs_.size());
@@ -368,7 +387,10 @@ void UniquePool::step(std::int32_t frame) {
     inst.controller->evaluate(scratch_);
     check_pose(scratch_, slab.joints, "unique.animations." + animations_[static_cast<std::size_t>(inst.animation)].name);
     apply_root_motion(animations_[static_cast<std::size_t>(inst.animation)].root, scratch_);
+    palette_scratch_.resize(static_cast<std::size_t>(slab.joints));
+    slab.kinematics.palette(scratch_, palette_scratch_.data());
     upload(slab.rotations, static_cast<Index>(inst.slot) * slab.joints, scratch_.local.data(), slab.joints);
+    upload(slab.skinning, static_cast<Index>(inst.slot) * slab.joints, palette_scratch_.data(), slab.joints);
     upload(slab.roots, inst.slot, &scratch_.root, 1);
     upload(slab.events, inst.slot, &events, 1);
     inst.newest = frame;
@@ -379,7 +401,7 @@ void UniquePool::step(std::int32_t frame) {
 std::size_t UniquePool::pose_bytes() const {
   std::size_t total = 0;
   for (const Slab& s : slabs_)
-    total += static_cast<std::size_t>(s.rotations.size()) * sizeof(glm::quat) + static_cast<std::size_t>(s.roots.size()) * sizeof(glm::vec3);
+    total += static_cast<std::size_t>(s.capacity) * pose_slot_bytes(s.joints);
   return total;
 }
 
@@ -390,6 +412,7 @@ void UniquePool::refresh_views() {
     const Slab& s = slabs_[static_cast<std::size_t>(inst.slab)];
     SourceView& w = v[i];
     w.rotations = s.rotations.data() + static_cast<Index>(inst.slot) * s.joints;
+    w.skinning = s.skinning.data() + static_cast<Index>(inst.slot) * s.joints;
     w.roots = s.roots.data() + inst.slot;
     w.events = s.events.data() + inst.slot;
     w.joints = s.joints;

@@ -34,10 +34,13 @@
 namespace throng::anim {
 
 // What kernels read of one pose source (a stream or a unique instance).
-// Slot k holds joints rotations at rotations[k * joints], the root at
-// roots[k] and the events fired when it was written at events[k].
+// Slot k holds joints local rotations at rotations[k * joints], the root at
+// roots[k], the events fired when it was written at events[k], and the
+// pose's model-space skinning palette (model_j * inverse_bind_j, computed
+// once when the slot is written) at skinning[k * joints].
 struct SourceView {
   const glm::quat* rotations = nullptr;
+  const Mat3x4* skinning = nullptr;
   const glm::vec3* roots = nullptr;
   const std::uint32_t* events = nullptr;
   std::int32_t joints = 0;
@@ -104,7 +107,8 @@ class AnimStream {
   double change_rate() const { return change_rate_; } // slots per frame while dilating
   std::int32_t max_offset() const;
 
-  // Bytes of pose history (rotations and roots): M * (J * 16 + 12).
+  // Bytes of pose history (local rotations, skinning palettes and roots):
+  // M * (J * (16 + 48) + 12).
   std::size_t pose_bytes() const;
   // A copy of the pose at an offset (0 = P) from the history, for tests and tools.
   Pose pose_at(std::int32_t offset) const;
@@ -115,14 +119,16 @@ class AnimStream {
   friend class StreamPool;
   void start(float frame_rate);
   void resize_history(std::int32_t history, float time_to_dilate, float frame_rate);
-  void write(const Pose& pose, EventMask events, std::int32_t frame);
+  void write(const Pose& pose, EventMask events, std::int32_t frame, std::vector<Mat3x4>& palette_scratch);
 
   StreamSpec spec_;
   std::int32_t joints_ = 0;
   std::unique_ptr<Controller> controller_;
   ParameterSet parameters_;
   StreamState state_ = StreamState::Stopped;
+  PoseKinematics kinematics_;
   Buffer<glm::quat> rotations_;   // M * J
+  Buffer<Mat3x4> skinning_;       // M * J
   Buffer<glm::vec3> roots_;       // M
   Buffer<std::uint32_t> events_;  // M
   std::int32_t head_ = 0;
@@ -172,7 +178,13 @@ class StreamPool {
   std::vector<std::unique_ptr<AnimStream>> streams_;
   Buffer<SourceView> views_;
   Pose scratch_;
+  std::vector<Mat3x4> palette_scratch_;
 };
+
+// Bytes a source of J joints keeps per history slot.
+inline std::size_t pose_slot_bytes(std::int32_t joints) {
+  return static_cast<std::size_t>(joints) * (sizeof(glm::quat) + sizeof(Mat3x4)) + sizeof(glm::vec3);
+}
 
 // A per-agent animation: a template controller cloned for every instance.
 struct UniqueAnimation {
@@ -215,7 +227,9 @@ class UniquePool {
     std::int32_t joints = 0;
     std::int32_t first_instance = 0;
     std::int32_t capacity = 0;
+    PoseKinematics kinematics;
     Buffer<glm::quat> rotations;
+    Buffer<Mat3x4> skinning;
     Buffer<glm::vec3> roots;
     Buffer<std::uint32_t> events;
   };
@@ -234,6 +248,7 @@ class UniquePool {
   std::vector<UniqueAnimation> animations_;
   Buffer<SourceView> views_;
   Pose scratch_;
+  std::vector<Mat3x4> palette_scratch_;
 };
 
 }  // namespace throng::anim

@@ -71,6 +71,8 @@ struct RigView {
   std::int32_t joint_count = 0;
   std::int32_t cluster_base = 0;
   std::int32_t cluster_count = 0;
+  std::int32_t segment_base = 0;
+  std::int32_t segment_count = 0;
   glm::vec3 rest_root{0.0f};
 };
 
@@ -83,6 +85,9 @@ struct RigTablesView {
   Span<const glm::quat> hook_rotations;   // per rig cluster
   Span<const glm::vec3> hook_translations;
   Span<const std::int32_t> hook_joints;   // per rig cluster, rig-local, -1 for the root's cluster
+  Span<const std::uint8_t> joint_segment; // segment of each joint (rig-local, ClusterLayout::segment_of_joint)
+  Span<const Mat3x4> segment_hooks;       // per rig segment: B_p * hook * B_p^-1, p its root's parent, B = bind
+  Span<const glm::vec3> bind_positions;   // per joint, model space
 };
 
 // One transition or assignment for one (agent, cluster).
@@ -124,11 +129,17 @@ struct StreamEventsJob {
   void run() const;
 };
 
-// Every agent's palette ("anim.stream_resolve"): per joint, the local
-// rotation of its cluster's (source, offset) slot, SLERPed from the
-// transition source by alpha, custom overrides applied; forward kinematics
-// through the cluster hooks; times the agent's world transform and the
-// inverse bind matrix. Culled clusters' joints collapse onto their hook.
+// Every agent's palette ("anim.stream_resolve"). An agent with no
+// transition running and no override takes the fast path: per joint one
+// 3x4 product of its segment's transform with the skinning matrix its
+// source slot already holds (W_seg = world for the root's segment, and
+// palette_p * B_p * hook * B_p^-1 * S_p^-1 where a cluster root hangs from
+// joint p). Otherwise, per joint: the local rotation of its cluster's
+// (source, offset) slot, SLERPed from the transition source by alpha,
+// custom overrides applied; forward kinematics through the cluster hooks;
+// times the agent's world transform and the inverse bind matrix. Both give
+// world(a) * model_j * inverse_bind_j. Culled clusters' joints then collapse
+// onto their hook.
 struct StreamResolveJob {
   RigTablesView tables;
   Span<const SourceView> streams;

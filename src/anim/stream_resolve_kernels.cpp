@@ -12,6 +12,7 @@ namespace {
 // Where one cluster's joints come from this frame.
 struct SlotRead {
   const glm::quat* rotations = nullptr;  // null: the rest pose (identity rotations)
+  const Mat3x4* skinning = nullptr;      // null: the rest pose (identity matrices)
   glm::vec3 root{0.0f};
   std::int32_t offset = -1;              // effective offset read, -1 for none
 };
@@ -31,6 +32,7 @@ THRONG_HOST_DEVICE inline SlotRead read_source(Span<const SourceView> streams, S
   if (v == nullptr || v->joints != joints || v->rotations == nullptr) return r;
   const std::int32_t slot = history_slot(*v, offset);
   r.rotations = v->rotations + static_cast<Index>(slot) * joints;
+  if (v->skinning != nullptr) r.skinning = v->skinning + static_cast<Index>(slot) * joints;
   r.root = v->roots[slot];
   r.offset = effective_offset(*v, offset);
   return r;
@@ -146,6 +148,8 @@ void StreamResolveJob::validate() const {
   check("tables.offsets", tables.offsets.size(), tables.parents.size());
   check("tables.joint_cluster", tables.joint_cluster.size(), tables.parents.size());
   check("tables.inverse_bind", tables.inverse_bind.size(), tables.parents.size());
+  check("tables.joint_segment", tables.joint_segment.size(), tables.parents.size());
+  check("tables.bind_positions", tables.bind_positions.size(), tables.parents.size());
 }
 
 void StreamResolveJob::run() const {
@@ -201,68 +205,94 @@ void StreamResolveJob::run() const {
           ov_end = OB[a + 1];
         }
 
-        glm::quat R[kMaxRigJoints];
-        glm::vec3 P[kMaxRigJoints];
-        for (std::int32_t j = 0; j < J; ++j) {
-          const Index tj = rig.joint_base + j;
-          std::int32_t c = T.joint_cluster[tj];
-          c = c < clusters_here ? c : 0;
-          glm::quat local = to[c].rotations != nullptr ? to[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-          if (alpha[c] < 1.0f) {
-            const glm::quat src = from[c].rotations != nullptr ? from[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-            local = glm::slerp(src, local, alpha[c]);
-          }
-          while (ov < ov_end && OV[ov].joint < j) ++ov;
-          const BoneOverride* o = ov < ov_end && OV[ov].joint == j ? &OV[ov] : nullptr;
-          if (o != nullptr && o->kind == OverrideKind::Rotation) local = glm::slerp(local, o->rotation, o->weight);
-
-          const std::int32_t p = T.parents[tj];
-          if (p < 0) {
-            glm::vec3 root = to[c].root;
-            if (alpha[c] < 1.0f) root = glm::mix(from[c].root, root, alpha[c]);
-            R[j] = world_q * local;
-            P[j] = world_t + world_q * root;
-          } else {
-            glm::quat pq = R[p];
-            glm::vec3 pt = P[p];
-            if (T.joint_cluster[rig.joint_base + p] != T.joint_cluster[tj]) {
-              // Entering another cluster: hang it from its hook.
-              const Index h = rig.cluster_base + c;
-              pt = pt + pq * T.hook_translations[h];
-              pq = pq * T.hook_rotations[h];
+        bool fast = ov == ov_end;
+        for (std::int32_t c = 0; c < clusters_here; ++c) fast = fast && alpha[c] >= 1.0f;
+        if (fast) {
+          // Each joint: its segment's transform times the skinning matrix of its source slot.
+          Mat3x4 W[kMaxSegments];
+          for (std::int32_t j = 0; j < J; ++j) {
+            const Index tj = rig.joint_base + j;
+            std::int32_t c = T.joint_cluster[tj];
+            c = c < clusters_here ? c : 0;
+            const std::int32_t seg = T.joint_segment[tj];
+            const Mat3x4* slot = to[c].skinning;
+            const std::int32_t p = T.parents[tj];
+            if (p < 0) {
+              W[seg] = mat3x4_from(world_q, world_t);
+            } else if (T.joint_cluster[rig.joint_base + p] != T.joint_cluster[tj]) {
+              const Mat3x4 hooked = out[base + p] * T.segment_hooks[rig.segment_base + seg];
+              W[seg] = slot != nullptr ? hooked * inverse_rigid(slot[p]) : hooked;
             }
-            R[j] = pq * local;
-            P[j] = pt + pq * T.offsets[tj];
+            out[base + j] = slot != nullptr ? W[seg] * slot[j] : W[seg];
           }
+        } else {
+          glm::quat R[kMaxRigJoints];
+          glm::vec3 P[kMaxRigJoints];
+          for (std::int32_t j = 0; j < J; ++j) {
+            const Index tj = rig.joint_base + j;
+            std::int32_t c = T.joint_cluster[tj];
+            c = c < clusters_here ? c : 0;
+            glm::quat local = to[c].rotations != nullptr ? to[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+            if (alpha[c] < 1.0f) {
+              const glm::quat src = from[c].rotations != nullptr ? from[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+              local = glm::slerp(src, local, alpha[c]);
+            }
+            while (ov < ov_end && OV[ov].joint < j) ++ov;
+            const BoneOverride* o = ov < ov_end && OV[ov].joint == j ? &OV[ov] : nullptr;
+            if (o != nullptr && o->kind == OverrideKind::Rotation) local = glm::slerp(local, o->rotation, o->weight);
 
-          if (o != nullptr && o->kind == OverrideKind::LookAt) {
-            const glm::vec3 f = glm::normalize(R[j] * o->aim_axis);
-            glm::vec3 d = o->target - P[j];
-            const float dl = glm::length(d);
-            if (dl > 1e-6f) {
-              d = d / dl;
-              glm::vec3 axis = glm::cross(f, d);
-              const float s = glm::length(axis);
-              if (s > 1e-6f) {
-                float cosang = glm::dot(f, d);
-                cosang = cosang < -1.0f ? -1.0f : (cosang > 1.0f ? 1.0f : cosang);
-                float angle = glm::acos(cosang);
-                angle = (angle < o->max_angle ? angle : o->max_angle) * o->weight;
-                R[j] = glm::normalize(glm::angleAxis(angle, axis / s) * R[j]);
+            const std::int32_t p = T.parents[tj];
+            if (p < 0) {
+              glm::vec3 root = to[c].root;
+              if (alpha[c] < 1.0f) root = glm::mix(from[c].root, root, alpha[c]);
+              R[j] = world_q * local;
+              P[j] = world_t + world_q * root;
+            } else {
+              glm::quat pq = R[p];
+              glm::vec3 pt = P[p];
+              if (T.joint_cluster[rig.joint_base + p] != T.joint_cluster[tj]) {
+                // Entering another cluster: hang it from its hook.
+                const Index h = rig.cluster_base + c;
+                pt = pt + pq * T.hook_translations[h];
+                pq = pq * T.hook_rotations[h];
+              }
+              R[j] = pq * local;
+              P[j] = pt + pq * T.offsets[tj];
+            }
+
+            if (o != nullptr && o->kind == OverrideKind::LookAt) {
+              const glm::vec3 f = glm::normalize(R[j] * o->aim_axis);
+              glm::vec3 d = o->target - P[j];
+              const float dl = glm::length(d);
+              if (dl > 1e-6f) {
+                d = d / dl;
+                glm::vec3 axis = glm::cross(f, d);
+                const float s = glm::length(axis);
+                if (s > 1e-6f) {
+                  float cosang = glm::dot(f, d);
+                  cosang = cosang < -1.0f ? -1.0f : (cosang > 1.0f ? 1.0f : cosang);
+                  float angle = glm::acos(cosang);
+                  angle = (angle < o->max_angle ? angle : o->max_angle) * o->weight;
+                  R[j] = glm::normalize(glm::angleAxis(angle, axis / s) * R[j]);
+                }
               }
             }
+            out[base + j] = mat3x4_from(R[j], P[j]) * T.inverse_bind[tj];
           }
         }
 
-        for (std::int32_t j = 0; j < J; ++j) {
-          const Index tj = rig.joint_base + j;
-          std::int32_t c = T.joint_cluster[tj];
-          c = c < clusters_here ? c : 0;
-          if (culled[c]) {
-            const std::int32_t hook = T.hook_joints[rig.cluster_base + c];
-            out[base + j] = collapse_to(P[hook >= 0 ? hook : 0]);
-          } else {
-            out[base + j] = mat3x4_from(R[j], P[j]) * T.inverse_bind[tj];
+        // Culled clusters, children first so that every hook read is still posed.
+        bool any_culled = false;
+        for (std::int32_t c = 0; c < clusters_here; ++c) any_culled = any_culled || culled[c];
+        if (any_culled) {
+          for (std::int32_t j = J - 1; j >= 0; --j) {
+            const Index tj = rig.joint_base + j;
+            std::int32_t c = T.joint_cluster[tj];
+            c = c < clusters_here ? c : 0;
+            if (!culled[c]) continue;
+            std::int32_t hook = T.hook_joints[rig.cluster_base + c];
+            hook = hook >= 0 ? hook : 0;
+            out[base + j] = collapse_to(transform_point(out[base + hook], T.bind_positions[rig.joint_base + hook]));
           }
         }
       },

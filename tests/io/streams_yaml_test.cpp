@@ -38,7 +38,7 @@ TEST(StreamsYaml, ExampleBuildsAndItsStateMachineFollowsTheParameters) {
   ASSERT_GE(run_event, 0);
   const std::int32_t loco = crowd->streams().find("locomotion");
   ASSERT_GE(loco, 0);
-  EXPECT_EQ(crowd->memory().stream_poses, 4u * 64u * (22u * 16u + 12u));
+  EXPECT_EQ(crowd->memory().stream_poses, 4u * 64u * (22u * 64u + 12u));
 
   crowd->add_agents(0, 300);
   crowd->assign_random(0, 300, {{{0, 1, 3}, {0, 1, 2, 3}, {0, 1, 2, 3}}, true}, 3);
@@ -131,7 +131,7 @@ TEST(StreamsYaml, MixedCrowdWithARealCmuSkeleton) {
   crowd->add_agents(1, 500);
   crowd->assign_random(0, 500, {{{0, 1}, {0, 1}, {0}}, true}, 1);
   crowd->assign_random(500, 500, {{{2, 3}, {2, 3}, {2, 3}}, true}, 2);
-  const std::size_t want = 64u * (22u * 16u + 12u) + 32u * (22u * 16u + 12u) + 64u * (31u * 16u + 12u) + 48u * (31u * 16u + 12u);
+  const std::size_t want = 64u * (22u * 64u + 12u) + 32u * (22u * 64u + 12u) + 64u * (31u * 64u + 12u) + 48u * (31u * 64u + 12u);
   EXPECT_EQ(crowd->memory().stream_poses, want);
   EXPECT_EQ(crowd->palette_size(), 500 * 22 + 500 * 31);
 
