@@ -18,13 +18,16 @@ struct SlotRead {
 };
 
 // The view of a source id, or null for none (or an id out of range).
-THRONG_HOST_DEVICE inline const SourceView* find_source(Span<const SourceView> streams, Span<const SourceView> uniques, std::int32_t source) {
+// Spans by reference: copying a non-const Span lvalue would pick Span's
+// host-only container constructor under nvcc.
+THRONG_HOST_DEVICE inline const SourceView* find_source(const Span<const SourceView>& streams, const Span<const SourceView>& uniques,
+                                                        std::int32_t source) {
   if (source >= 0 && source < streams.size()) return &streams[source];
   if (is_unique_source(source) && unique_instance(source) < uniques.size()) return &uniques[unique_instance(source)];
   return nullptr;
 }
 
-THRONG_HOST_DEVICE inline SlotRead read_source(Span<const SourceView> streams, Span<const SourceView> uniques, std::int32_t source,
+THRONG_HOST_DEVICE inline SlotRead read_source(const Span<const SourceView>& streams, const Span<const SourceView>& uniques, std::int32_t source,
                                                std::int32_t offset, std::int32_t joints, glm::vec3 rest_root) {
   SlotRead r;
   r.root = rest_root;
