@@ -43,24 +43,25 @@ const std::vector<motion::DefaultMotion>& default_motions() {
   return m;
 }
 
-// The crowd of one size, kept between repetitions and thread counts (its
-// set-up at 10^6 agents takes seconds); one fixture lives at a time.
+// A fixture of one size, kept between repetitions and thread counts (its
+// set-up at 10^6 agents takes seconds); one of each kind lives at a time.
+template <class Fixture>
+Fixture& cached(Index n) {
+  static std::unique_ptr<Fixture> f;
+  if (!f || f->n != n || f->backend != current_backend()) {
+    f.reset();  // free the previous one's palettes first
+    f = std::make_unique<Fixture>();
+    f->build(n);
+  }
+  return *f;
+}
+
 struct StreamsFixture {
   Index n = 0;
   Backend backend = Backend::Cpu;
   std::unique_ptr<StreamCrowd> crowd;
   std::unique_ptr<Placement> placement;
   Buffer<Mat3x4> palettes;
-
-  static StreamsFixture& get(Index n) {
-    static std::unique_ptr<StreamsFixture> f;
-    if (!f || f->n != n || f->backend != current_backend()) {
-      f.reset();  // free the previous palettes first
-      f = std::make_unique<StreamsFixture>();
-      f->build(n);
-    }
-    return *f;
-  }
 
   void build(Index count) {
     n = count;
@@ -105,16 +106,6 @@ struct ExactFixture {
   Buffer<Mat3x4> palettes;
   ClipPaletteJob job;
 
-  static ExactFixture& get(Index n) {
-    static std::unique_ptr<ExactFixture> f;
-    if (!f || f->n != n || f->backend != current_backend()) {
-      f.reset();
-      f = std::make_unique<ExactFixture>();
-      f->build(n);
-    }
-    return *f;
-  }
-
   void build(Index count) {
     n = count;
     backend = current_backend();
@@ -154,7 +145,7 @@ void register_streams(const Options& options) {
   // histories), then every agent's palette is resolved.
   add(options, {"anim/streams_frame", sizes,
                 [](benchmark::State& state, Index n) {
-                  StreamsFixture& f = StreamsFixture::get(n);
+                  StreamsFixture& f = cached<StreamsFixture>(n);
                   for (auto _ : state) {
                     f.crowd->step();
                     f.crowd->resolve(f.placement->positions.span(), f.placement->yaws.span(), f.palettes.span());
@@ -164,10 +155,20 @@ void register_streams(const Options& options) {
                 },
                 true});
 
-  // The per-agent part alone.
+  // The step alone: 8 controllers write their poses, events reach every agent.
+  add(options, {"anim/streams_step", sizes,
+                [](benchmark::State& state, Index n) {
+                  StreamsFixture& f = cached<StreamsFixture>(n);
+                  for (auto _ : state) f.crowd->step();
+                  state.SetItemsProcessed(state.iterations() * n);
+                  f.counters(state);
+                },
+                true});
+
+  // The palettes alone.
   add(options, {"anim/streams_resolve", sizes,
                 [](benchmark::State& state, Index n) {
-                  StreamsFixture& f = StreamsFixture::get(n);
+                  StreamsFixture& f = cached<StreamsFixture>(n);
                   for (auto _ : state) f.crowd->resolve(f.placement->positions.span(), f.placement->yaws.span(), f.palettes.span());
                   state.SetItemsProcessed(state.iterations() * n);
                   f.counters(state);
@@ -177,7 +178,7 @@ void register_streams(const Options& options) {
   // Exact per-agent evaluation of a clip at each agent's own time.
   add(options, {"anim/exact_clip_palette", sizes,
                 [](benchmark::State& state, Index n) {
-                  ExactFixture& f = ExactFixture::get(n);
+                  ExactFixture& f = cached<ExactFixture>(n);
                   for (auto _ : state) {
                     f.job.run();
                     f.job.time_offset += 1.0f / kFrameRate;
