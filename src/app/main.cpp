@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add_info_command(app, g);
   add_convert_command(app, g);
   add_export_command(app, g);
+  add_match_command(app, g);
   add_version_command(app);
   try {
     app.parse(argc, argv);

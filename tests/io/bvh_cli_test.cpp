@@ -18,35 +18,16 @@
 
 #include "io/bvh_reader.h"
 #include "motion/fk.h"
+#include "tests/io/throng_exe.h"
 
 namespace throng::io {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::optional<fs::path> find_throng() {
-  std::error_code ec;
-  fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
-  for (int up = 0; up < 3 && !ec; ++up, dir = dir.parent_path())
-    if (fs::is_regular_file(dir / "throng")) return dir / "throng";
-  return std::nullopt;
-}
-
-struct Result {
-  int code;
-  std::string out;
-};
-Result run(const fs::path& exe, const std::string& args, bool with_stderr = true) {
-  const std::string cmd = exe.string() + " --backend cpu --log-level warn " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return {-1, "popen failed"};
-  std::string out;
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using testing::find_throng;
+using testing::Result;
+using testing::run;
 
 std::optional<fs::path> shared_bvh_dir() {
   const char* dir = std::getenv("THRONG_SHARED_DIR");

@@ -1,0 +1,308 @@
+#include "path/planner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+#include "core/error.h"
+#include "path/host_parallel.h"
+
+namespace throng::path {
+
+const char* to_string(PlanStatus s) {
+  switch (s) {
+    case PlanStatus::Found: return "found";
+    case PlanStatus::StartBlocked: return "start_blocked";
+    case PlanStatus::GoalBlocked: return "goal_blocked";
+    case PlanStatus::Unreachable: return "unreachable";
+  }
+  return "?";
+}
+
+RoadmapOptions PlanOptions::roadmap_options() const {
+  RoadmapOptions r;
+  r.radius = radius;
+  return r;
+}
+
+void PlanOptions::validate() const {
+  if (!(std::isfinite(radius) && radius >= 0)) throw Error("radius must be >= 0", at_field("plan.radius"));
+  if (!(std::isfinite(clearance_weight) && clearance_weight >= 0))
+    throw Error("clearance weight must be >= 0", at_field("plan.clearance_weight"));
+  if (!std::isfinite(shortcut_clearance) || (shortcut_clearance >= 0 && shortcut_clearance < radius))
+    throw Error("shortcut clearance must be >= radius (or negative for the default)", at_field("plan.shortcut_clearance"));
+  if (!(std::isfinite(corner_radius) && corner_radius >= 0)) throw Error("corner radius must be >= 0", at_field("plan.corner_radius"));
+  if (attach_candidates < 1) throw Error("attach candidates must be >= 1", at_field("plan.attach_candidates"));
+  free_space.validate();
+}
+
+float polyline_length(std::span<const glm::vec2> points) {
+  float len = 0;
+  for (std::size_t i = 1; i < points.size(); ++i) len += sim::length_of(points[i] - points[i - 1]);
+  return len;
+}
+
+Planner Planner::build(const sim::World& world, const PlanOptions& options) {
+  options.validate();
+  return build(FreeSpace::build(world, options.free_space), options);
+}
+
+Planner Planner::build(FreeSpace space, const PlanOptions& options) {
+  options.validate();
+  Planner p;
+  p.options_ = options;
+  p.space_ = std::move(space);
+  p.roadmap_ = build_roadmap(p.space_, options.roadmap_options());
+  const Roadmap& m = p.roadmap_;
+  p.cumulative_cost_.assign(m.points.size(), 0.0f);
+  for (const RoadmapEdge& e : m.edges) {
+    float acc = 0;
+    for (std::int32_t i = 1; i < e.point_count; ++i) {
+      const auto k = static_cast<std::size_t>(e.point_begin + i);
+      const float len = sim::length_of(m.points[k] - m.points[k - 1]);
+      const float c = std::max(0.5f * (m.point_clearance[k] + m.point_clearance[k - 1]), 1e-6f);
+      acc += len * (1.0f + options.clearance_weight * options.radius / c);
+      p.cumulative_cost_[k] = acc;
+    }
+  }
+  return p;
+}
+
+EdgePoint Planner::attach(glm::vec2 p) const {
+  const float r = options_.radius;
+  for (std::int32_t limit : {options_.attach_candidates, roadmap_.edge_count()}) {
+    for (const EdgePoint& e : roadmap_.nearest_points(p, limit))
+      if (space_.segment_clear(p, e.point, r)) return e;
+    if (limit >= roadmap_.edge_count()) break;
+  }
+  return {};
+}
+
+float Planner::cost_to_edge_start(const EdgePoint& e) const {
+  const RoadmapEdge& edge = roadmap_.edges[static_cast<std::size_t>(e.edge)];
+  const auto k = static_cast<std::size_t>(edge.point_begin + e.piece);
+  return cumulative_cost_[k] + e.t * (cumulative_cost_[k + 1] - cumulative_cost_[k]);
+}
+
+namespace {
+
+void push_point(std::vector<glm::vec2>& out, glm::vec2 p) {
+  if (out.empty() || sim::length2(out.back() - p) > 1e-12f) out.push_back(p);
+}
+
+// Polyline points of `edge` strictly between the attach point and its end
+// at node side `to_b` (true: towards b).
+void append_partial(const Roadmap& m, const EdgePoint& at, bool to_b, std::vector<glm::vec2>& out) {
+  const RoadmapEdge& e = m.edges[static_cast<std::size_t>(at.edge)];
+  if (to_b)
+    for (std::int32_t i = at.piece + 1; i < e.point_count; ++i) push_point(out, m.edge_point(at.edge, i));
+  else
+    for (std::int32_t i = at.piece; i >= 0; --i) push_point(out, m.edge_point(at.edge, i));
+}
+
+}  // namespace
+
+PlannedPath Planner::plan(const PathQuery& q) const {
+  PlannedPath out;
+  const float r = options_.radius;
+  if (!space_.contains(q.start) || space_.boundary_distance(q.start) < r) {
+    out.status = PlanStatus::StartBlocked;
+    return out;
+  }
+  if (!space_.contains(q.goal) || space_.boundary_distance(q.goal) < r) {
+    out.status = PlanStatus::GoalBlocked;
+    return out;
+  }
+  std::vector<glm::vec2> raw;
+  if (space_.segment_clear(q.start, q.goal, r)) {
+    raw = {q.start, q.goal};
+  } else {
+    const EdgePoint s = attach(q.start), g = attach(q.goal);
+    if (s.edge < 0 || g.edge < 0) {
+      out.status = PlanStatus::Unreachable;
+      return out;
+    }
+    const Roadmap& m = roadmap_;
+    const std::int32_t n = m.node_count();
+    const std::int32_t S = n, G = n + 1;
+    const RoadmapEdge& se = m.edges[static_cast<std::size_t>(s.edge)];
+    const RoadmapEdge& ge = m.edges[static_cast<std::size_t>(g.edge)];
+    if (m.node_component[static_cast<std::size_t>(se.a)] != m.node_component[static_cast<std::size_t>(ge.a)]) {
+      out.status = PlanStatus::Unreachable;
+      return out;
+    }
+    const float s_from_a = cost_to_edge_start(s), g_from_a = cost_to_edge_start(g);
+    const float s_total = cumulative_cost_[static_cast<std::size_t>(se.point_begin + se.point_count - 1)];
+    const float g_total = cumulative_cost_[static_cast<std::size_t>(ge.point_begin + ge.point_count - 1)];
+    const float s_attach = sim::length_of(s.point - q.start), g_attach = sim::length_of(g.point - q.goal);
+
+    std::vector<float> cost(static_cast<std::size_t>(n + 2), INFINITY);
+    std::vector<std::int32_t> parent(static_cast<std::size_t>(n + 2), -1);
+    auto h = [&](std::int32_t v) { return v == G ? 0.0f : sim::length_of((v == S ? q.start : m.nodes[static_cast<std::size_t>(v)]) - q.goal); };
+    using Entry = std::pair<float, std::int32_t>;  // (f, node): ties broken by node index
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+    auto relax = [&](std::int32_t from, std::int32_t to, float c) {
+      const float g2 = cost[static_cast<std::size_t>(from)] + c;
+      if (g2 < cost[static_cast<std::size_t>(to)]) {
+        cost[static_cast<std::size_t>(to)] = g2;
+        parent[static_cast<std::size_t>(to)] = from;
+        open.push({g2 + h(to), to});
+      }
+    };
+    cost[static_cast<std::size_t>(S)] = 0;
+    open.push({h(S), S});
+    while (!open.empty()) {
+      const auto [f, v] = open.top();
+      open.pop();
+      if (f > cost[static_cast<std::size_t>(v)] + h(v) + 1e-6f * std::max(1.0f, f)) continue;  // stale
+      if (v == G) break;
+      if (v == S) {
+        relax(S, se.a, s_attach + s_from_a);
+        relax(S, se.b, s_attach + s_total - s_from_a);
+        if (s.edge == g.edge) relax(S, G, s_attach + std::fabs(g_from_a - s_from_a) + g_attach);
+        continue;
+      }
+      if (v == ge.a) relax(v, G, g_from_a + g_attach);
+      if (v == ge.b) relax(v, G, g_total - g_from_a + g_attach);
+      for (std::int32_t k = m.adjacency_begin[static_cast<std::size_t>(v)]; k < m.adjacency_begin[static_cast<std::size_t>(v) + 1]; ++k) {
+        const std::int32_t e = m.adjacency[static_cast<std::size_t>(k)];
+        const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
+        const float c = cumulative_cost_[static_cast<std::size_t>(edge.point_begin + edge.point_count - 1)];
+        relax(v, edge.a == v ? edge.b : edge.a, c);
+      }
+    }
+    if (!(cost[static_cast<std::size_t>(G)] < INFINITY)) {
+      out.status = PlanStatus::Unreachable;
+      return out;
+    }
+    // Nodes from S to G; the edge between two consecutive nodes is the
+    // cheapest one joining them (what the search relaxed).
+    std::vector<std::int32_t> chain;
+    for (std::int32_t v = G; v >= 0; v = parent[static_cast<std::size_t>(v)]) chain.push_back(v);
+    std::reverse(chain.begin(), chain.end());
+    push_point(raw, q.start);
+    push_point(raw, s.point);
+    if (chain.size() == 2) {  // S -> G along the shared edge
+      const bool forward = s.piece < g.piece || (s.piece == g.piece && s.t <= g.t);
+      if (forward)
+        for (std::int32_t i = s.piece + 1; i <= g.piece; ++i) push_point(raw, m.edge_point(s.edge, i));
+      else
+        for (std::int32_t i = s.piece; i > g.piece; --i) push_point(raw, m.edge_point(s.edge, i));
+    } else {
+      append_partial(m, s, chain[1] == se.b && !(chain[1] == se.a && s_from_a <= s_total - s_from_a), raw);
+      for (std::size_t k = 1; k + 2 < chain.size(); ++k) {
+        const std::int32_t u = chain[k], v = chain[k + 1];
+        // The cheapest edge u-v.
+        std::int32_t best = -1;
+        float best_cost = INFINITY;
+        for (std::int32_t a = m.adjacency_begin[static_cast<std::size_t>(u)]; a < m.adjacency_begin[static_cast<std::size_t>(u) + 1]; ++a) {
+          const std::int32_t e = m.adjacency[static_cast<std::size_t>(a)];
+          const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
+          if (!((edge.a == u && edge.b == v) || (edge.a == v && edge.b == u))) continue;
+          const float c = cumulative_cost_[static_cast<std::size_t>(edge.point_begin + edge.point_count - 1)];
+          if (c < best_cost) {
+            best_cost = c;
+            best = e;
+          }
+        }
+        const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(best)];
+        if (edge.a == u)
+          for (std::int32_t i = 0; i < edge.point_count; ++i) push_point(raw, m.edge_point(best, i));
+        else
+          for (std::int32_t i = edge.point_count - 1; i >= 0; --i) push_point(raw, m.edge_point(best, i));
+      }
+      // From the last node along the goal's edge to its attach point.
+      const std::int32_t last = chain[chain.size() - 2];
+      const bool from_a = last == ge.a && !(last == ge.b && g_total - g_from_a < g_from_a);
+      if (from_a)
+        for (std::int32_t i = 0; i <= g.piece; ++i) push_point(raw, m.edge_point(g.edge, i));
+      else
+        for (std::int32_t i = ge.point_count - 1; i > g.piece; --i) push_point(raw, m.edge_point(g.edge, i));
+    }
+    push_point(raw, g.point);
+    push_point(raw, q.goal);
+  }
+  out.status = PlanStatus::Found;
+  out.roadmap_points = raw;
+  out.points = options_.smooth ? shortcut(raw, options_.kept_clearance()) : raw;
+  if (options_.smooth && options_.corner_radius > 0) out.points = round_corners(out.points, options_.corner_radius);
+  out.length = polyline_length(out.points);
+  out.min_clearance = INFINITY;
+  for (std::size_t i = 1; i < out.points.size(); ++i)
+    out.min_clearance = std::min(out.min_clearance, space_.segment_clearance(out.points[i - 1], out.points[i]));
+  return out;
+}
+
+std::vector<glm::vec2> Planner::shortcut(std::span<const glm::vec2> poly, float clearance) const {
+  if (poly.size() <= 2) return {poly.begin(), poly.end()};
+  // Greedy sweep: from each kept point extend while the line of sight holds.
+  std::vector<glm::vec2> pass;
+  std::size_t i = 0;
+  pass.push_back(poly[0]);
+  while (i + 1 < poly.size()) {
+    std::size_t j = i + 1;
+    while (j + 1 < poly.size() && space_.segment_clear(poly[i], poly[j + 1], clearance)) ++j;
+    pass.push_back(poly[j]);
+    i = j;
+  }
+  if (pass.size() > 256) return pass;
+  // Farthest visible point from each kept point.
+  std::vector<glm::vec2> out = {pass[0]};
+  i = 0;
+  while (i + 1 < pass.size()) {
+    std::size_t j = pass.size() - 1;
+    while (j > i + 1 && !space_.segment_clear(pass[i], pass[j], clearance)) --j;
+    out.push_back(pass[j]);
+    i = j;
+  }
+  return out;
+}
+
+std::vector<glm::vec2> Planner::round_corners(std::span<const glm::vec2> poly, float radius) const {
+  if (poly.size() <= 2) return {poly.begin(), poly.end()};
+  std::vector<glm::vec2> out = {poly[0]};
+  for (std::size_t i = 1; i + 1 < poly.size(); ++i) {
+    const glm::vec2 p = poly[i];
+    const float len_in = sim::length_of(p - poly[i - 1]), len_out = sim::length_of(poly[i + 1] - p);
+    const glm::vec2 a = (p - poly[i - 1]) / len_in, b = (poly[i + 1] - p) / len_out;
+    const float turn = std::acos(std::clamp(sim::dot2(a, b), -1.0f, 1.0f));
+    std::vector<glm::vec2> arc;
+    if (turn > 1e-3f && turn < 3.1f) {
+      const float half = std::tan(0.5f * turn);
+      // Tangent length L = rho tan(turn / 2), at most 45 % of either edge.
+      float rho = std::min(radius, 0.45f * std::min(len_in, len_out) / half);
+      const float side = sim::cross2(a, b) > 0 ? 1.0f : -1.0f;
+      for (int attempt = 0; attempt < 5 && arc.empty(); ++attempt, rho *= 0.5f) {
+        const float L = rho * half;
+        const glm::vec2 t1 = p - a * L, centre = t1 + sim::perp_left(a) * (side * rho);
+        const int steps = std::max(2, static_cast<int>(std::ceil(turn / 0.1f)));
+        std::vector<glm::vec2> pts;
+        for (int k = 0; k <= steps; ++k) {
+          const float ang = side * turn * static_cast<float>(k) / static_cast<float>(steps);
+          const glm::vec2 r0 = t1 - centre;
+          pts.push_back(centre + glm::vec2(r0.x * std::cos(ang) - r0.y * std::sin(ang), r0.x * std::sin(ang) + r0.y * std::cos(ang)));
+        }
+        bool clear = true;
+        for (std::size_t k = 1; k < pts.size() && clear; ++k) clear = space_.segment_clear(pts[k - 1], pts[k], options_.radius);
+        if (clear) arc = std::move(pts);
+      }
+    }
+    if (arc.empty()) {
+      push_point(out, p);
+    } else {
+      for (glm::vec2 q : arc) push_point(out, q);
+    }
+  }
+  push_point(out, poly.back());
+  return out;
+}
+
+std::vector<PlannedPath> Planner::plan_all(std::span<const PathQuery> queries) const {
+  std::vector<PlannedPath> out(queries.size());
+  host_parallel_for("path.plan", static_cast<Index>(queries.size()), [&](Index i) {
+    out[static_cast<std::size_t>(i)] = plan(queries[static_cast<std::size_t>(i)]);
+  });
+  return out;
+}
+
+}  // namespace throng::path

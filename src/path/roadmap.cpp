@@ -1,0 +1,292 @@
+#include "path/roadmap.h"
+
+#include <algorithm>
+#include <boost/polygon/segment_data.hpp>
+#include <boost/polygon/voronoi.hpp>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+#include "core/error.h"
+
+namespace throng::path {
+
+namespace bp = boost::polygon;
+using VoronoiDiagram = bp::voronoi_diagram<double>;
+
+namespace {
+
+struct DVec {
+  double x = 0, y = 0;
+};
+DVec operator-(DVec a, DVec b) { return {a.x - b.x, a.y - b.y}; }
+DVec operator+(DVec a, DVec b) { return {a.x + b.x, a.y + b.y}; }
+DVec operator*(DVec a, double s) { return {a.x * s, a.y * s}; }
+double dot(DVec a, DVec b) { return a.x * b.x + a.y * b.y; }
+double norm(DVec a) { return std::sqrt(dot(a, a)); }
+
+// A Voronoi site in integer units: a segment's interior or one endpoint.
+struct Site {
+  bool point = false;
+  DVec a, b;  // a only for a point
+  double distance(DVec p) const {
+    if (point) return norm(p - a);
+    const DVec ab = b - a;
+    const double l2 = dot(ab, ab);
+    const double t = l2 > 0 ? std::clamp(dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+    return norm(p - (a + ab * t));
+  }
+};
+
+Site site_of(const VoronoiDiagram::cell_type& cell, const std::vector<bp::segment_data<int>>& segments) {
+  const auto& s = segments[cell.source_index()];
+  const DVec lo{static_cast<double>(bp::low(s).x()), static_cast<double>(bp::low(s).y())};
+  const DVec hi{static_cast<double>(bp::high(s).x()), static_cast<double>(bp::high(s).y())};
+  switch (cell.source_category()) {
+    case bp::SOURCE_CATEGORY_SEGMENT_START_POINT: return {true, lo, lo};
+    case bp::SOURCE_CATEGORY_SEGMENT_END_POINT: return {true, hi, hi};
+    default: return {false, lo, hi};
+  }
+}
+
+// Points of the edge from v0 to v1 (integer units), dense enough that the
+// polyline stays within `tol` of a parabolic arc and no piece exceeds `step`.
+std::vector<DVec> discretize(DVec v0, DVec v1, const Site& s0, const Site& s1, bool curved, double tol, double step) {
+  std::vector<DVec> pts;
+  if (!curved) {
+    // Straight: a line bisector. Add where the clearance to a point site is
+    // smallest (the foot of the point), so the minimum is sampled exactly.
+    std::vector<double> ts = {0.0, 1.0};
+    const DVec d = v1 - v0;
+    const double l2 = dot(d, d);
+    for (const Site* s : {&s0, &s1})
+      if (s->point && l2 > 0) {
+        const double t = dot(s->a - v0, d) / l2;
+        if (t > 0 && t < 1) ts.push_back(t);
+      }
+    std::sort(ts.begin(), ts.end());
+    for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
+      const double len = (ts[i + 1] - ts[i]) * std::sqrt(l2);
+      const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
+      for (int k = 0; k < n; ++k) pts.push_back(v0 + d * (ts[i] + (ts[i + 1] - ts[i]) * k / n));
+    }
+    pts.push_back(v1);
+    return pts;
+  }
+  // Parabola: the points equidistant from a point P and a segment's line.
+  // Local frame: origin at the segment's start, x along it, y towards P;
+  // a point (x, y) of the arc has y = ((x - px)^2 + py^2) / (2 py).
+  const Site& P = s0.point ? s0 : s1;
+  const Site& S = s0.point ? s1 : s0;
+  const DVec u = (S.b - S.a) * (1.0 / norm(S.b - S.a));
+  DVec n{-u.y, u.x};
+  double py = dot(P.a - S.a, n);
+  if (py < 0) {
+    n = n * -1.0;
+    py = -py;
+  }
+  if (py < 1e-9) return discretize(v0, v1, s0, s1, false, tol, step);  // degenerate: the point on the line
+  const double px = dot(P.a - S.a, u);
+  const double x0 = dot(v0 - S.a, u), x1 = dot(v1 - S.a, u);
+  auto at = [&](double x) { return S.a + u * x + n * (((x - px) * (x - px) + py * py) / (2 * py)); };
+  // The arc's curvature is at most 1 / py (at its apex); a chord of length L
+  // strays about L^2 kappa / 8 from it.
+  const double chord = std::min(step, std::sqrt(8.0 * tol * py));
+  std::vector<double> xs = {x0, x1};
+  if ((px - x0) * (px - x1) < 0) xs.push_back(px);  // the apex: smallest clearance
+  std::sort(xs.begin(), xs.end());
+  if (x0 > x1) std::reverse(xs.begin(), xs.end());
+  for (std::size_t i = 0; i + 1 < xs.size(); ++i) {
+    // Arc length over [xs[i], xs[i+1]] is at least the x span; sample by it,
+    // refined where the arc is steep.
+    const double dx = xs[i + 1] - xs[i];
+    const double slope = std::max(std::fabs(xs[i] - px), std::fabs(xs[i + 1] - px)) / py;
+    const double len = std::fabs(dx) * std::sqrt(1 + slope * slope);
+    const int k = std::max(1, static_cast<int>(std::ceil(len / std::max(chord, 1e-9))));
+    for (int j = 0; j < k; ++j) pts.push_back(at(xs[i] + dx * j / k));
+  }
+  pts.front() = v0;
+  pts.push_back(v1);
+  return pts;
+}
+
+struct UnionFind {
+  std::vector<std::int32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  std::int32_t find(std::int32_t x) {
+    while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    return x;
+  }
+  void join(std::int32_t a, std::int32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+  }
+};
+
+}  // namespace
+
+void RoadmapOptions::validate() const {
+  if (!(std::isfinite(radius) && radius >= 0)) throw Error("radius must be >= 0", at_field("roadmap.radius"));
+  if (!(std::isfinite(arc_tolerance) && arc_tolerance > 0 && arc_tolerance <= 1))
+    throw Error("arc tolerance must be in (0, 1] m", at_field("roadmap.arc_tolerance"));
+  if (!(std::isfinite(max_step) && max_step > 0)) throw Error("max step must be > 0", at_field("roadmap.max_step"));
+}
+
+Roadmap build_roadmap(const FreeSpace& space, const RoadmapOptions& options) {
+  options.validate();
+  Roadmap map;
+  map.options = options;
+  const double res = space.resolution();
+  const double keep = options.kept_clearance(space.resolution()) / res;  // in units
+  const double tol = options.arc_tolerance / res, step = options.max_step / res;
+
+  std::vector<bp::segment_data<int>> segments;
+  segments.reserve(space.boundary_units().size());
+  for (const auto& s : space.boundary_units())
+    segments.emplace_back(bp::point_data<int>(s.x0, s.y0), bp::point_data<int>(s.x1, s.y1));
+  VoronoiDiagram vd;
+  bp::construct_voronoi(segments.begin(), segments.end(), &vd);
+
+  std::unordered_map<const VoronoiDiagram::vertex_type*, std::int32_t> vertex_node;
+  auto to_map = [res](DVec p) { return glm::vec2(static_cast<float>(p.x * res), static_cast<float>(p.y * res)); };
+  auto add_node = [&](DVec p, double clearance) {
+    map.nodes.push_back(to_map(p));
+    map.node_clearance.push_back(static_cast<float>(clearance * res));
+    return static_cast<std::int32_t>(map.nodes.size() - 1);
+  };
+  auto node_of_vertex = [&](const VoronoiDiagram::vertex_type* v, double clearance) {
+    auto it = vertex_node.find(v);
+    if (it != vertex_node.end()) return it->second;
+    const std::int32_t id = add_node({v->x(), v->y()}, clearance);
+    vertex_node.emplace(v, id);
+    return id;
+  };
+
+  for (const auto& edge : vd.edges()) {
+    if (!edge.is_primary() || edge.is_infinite() || edge.twin() < &edge) continue;
+    ++map.voronoi_edges;
+    const Site s0 = site_of(*edge.cell(), segments), s1 = site_of(*edge.twin()->cell(), segments);
+    const DVec v0{edge.vertex0()->x(), edge.vertex0()->y()}, v1{edge.vertex1()->x(), edge.vertex1()->y()};
+    const std::vector<DVec> pts = discretize(v0, v1, s0, s1, edge.is_curved(), tol, step);
+    // Wholly inside or outside free space (an edge never crosses a site):
+    // test a point away from the ends.
+    const DVec mid = pts.size() > 2 ? pts[pts.size() / 2] : (pts.front() + pts.back()) * 0.5;
+    if (!space.contains(to_map(mid))) continue;
+    ++map.inside_edges;
+    auto clearance = [&](DVec p) { return std::min(s0.distance(p), s1.distance(p)); };
+    std::vector<double> c(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) c[i] = clearance(pts[i]);
+
+    // Cut the polyline where the clearance crosses `keep`; keep the runs above.
+    std::size_t i = 0;
+    while (i < pts.size()) {
+      if (c[i] < keep) {
+        ++i;
+        continue;
+      }
+      std::size_t j = i;
+      while (j + 1 < pts.size() && c[j + 1] >= keep) ++j;
+      std::vector<DVec> run;
+      std::vector<double> run_c;
+      // Where the clearance rises through `keep` on the piece before i (bisection, good side kept).
+      auto crossing = [&](DVec bad, DVec good) {
+        for (int it = 0; it < 40; ++it) {
+          const DVec m = (bad + good) * 0.5;
+          (clearance(m) >= keep ? good : bad) = m;
+        }
+        return good;
+      };
+      if (i > 0) {
+        const DVec p = crossing(pts[i - 1], pts[i]);
+        run.push_back(p);
+        run_c.push_back(clearance(p));
+      }
+      for (std::size_t k = i; k <= j; ++k) {
+        run.push_back(pts[k]);
+        run_c.push_back(c[k]);
+      }
+      if (j + 1 < pts.size()) {
+        const DVec p = crossing(pts[j + 1], pts[j]);
+        run.push_back(p);
+        run_c.push_back(clearance(p));
+      }
+      i = j + 1;
+      // Drop repeated points (a cut at a sample point).
+      std::vector<DVec> poly;
+      std::vector<double> poly_c;
+      for (std::size_t k = 0; k < run.size(); ++k)
+        if (poly.empty() || norm(run[k] - poly.back()) > 1e-9) {
+          poly.push_back(run[k]);
+          poly_c.push_back(run_c[k]);
+        }
+      if (poly.size() < 2) continue;
+      const bool starts_at_vertex = norm(poly.front() - v0) <= 1e-9, ends_at_vertex = norm(poly.back() - v1) <= 1e-9;
+      RoadmapEdge e;
+      e.a = starts_at_vertex ? node_of_vertex(edge.vertex0(), poly_c.front()) : add_node(poly.front(), poly_c.front());
+      e.b = ends_at_vertex ? node_of_vertex(edge.vertex1(), poly_c.back()) : add_node(poly.back(), poly_c.back());
+      e.point_begin = static_cast<std::int32_t>(map.points.size());
+      e.point_count = static_cast<std::int32_t>(poly.size());
+      e.min_clearance = INFINITY;
+      for (std::size_t k = 0; k < poly.size(); ++k) {
+        map.points.push_back(to_map(poly[k]));
+        map.point_clearance.push_back(static_cast<float>(poly_c[k] * res));
+        e.min_clearance = std::min(e.min_clearance, static_cast<float>(poly_c[k] * res));
+        if (k > 0) e.length += static_cast<float>(norm(poly[k] - poly[k - 1]) * res);
+      }
+      if (e.a == e.b && e.length <= 0) continue;
+      map.edges.push_back(e);
+    }
+  }
+
+  // Adjacency and components.
+  const std::size_t n = map.nodes.size();
+  map.adjacency_begin.assign(n + 1, 0);
+  for (const RoadmapEdge& e : map.edges) {
+    ++map.adjacency_begin[static_cast<std::size_t>(e.a) + 1];
+    if (e.b != e.a) ++map.adjacency_begin[static_cast<std::size_t>(e.b) + 1];
+  }
+  std::partial_sum(map.adjacency_begin.begin(), map.adjacency_begin.end(), map.adjacency_begin.begin());
+  map.adjacency.assign(static_cast<std::size_t>(map.adjacency_begin.back()), 0);
+  std::vector<std::int32_t> cursor(map.adjacency_begin.begin(), map.adjacency_begin.end() - 1);
+  UnionFind uf(n);
+  for (std::size_t k = 0; k < map.edges.size(); ++k) {
+    const RoadmapEdge& e = map.edges[k];
+    map.adjacency[static_cast<std::size_t>(cursor[static_cast<std::size_t>(e.a)]++)] = static_cast<std::int32_t>(k);
+    if (e.b != e.a) map.adjacency[static_cast<std::size_t>(cursor[static_cast<std::size_t>(e.b)]++)] = static_cast<std::int32_t>(k);
+    uf.join(e.a, e.b);
+  }
+  map.node_component.resize(n);
+  for (std::size_t k = 0; k < n; ++k) map.node_component[k] = uf.find(static_cast<std::int32_t>(k));
+  return map;
+}
+
+std::vector<EdgePoint> Roadmap::nearest_points(glm::vec2 p, std::int32_t limit) const {
+  std::vector<EdgePoint> best;
+  best.reserve(edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const RoadmapEdge& edge = edges[e];
+    EdgePoint ep;
+    ep.edge = static_cast<std::int32_t>(e);
+    for (std::int32_t i = 0; i + 1 < edge.point_count; ++i) {
+      const glm::vec2 a = points[static_cast<std::size_t>(edge.point_begin + i)], b = points[static_cast<std::size_t>(edge.point_begin + i + 1)];
+      float t = 0;
+      const glm::vec2 q = sim::closest_point_on_segment(p, a, b, &t);
+      const float d = sim::length_of(p - q);
+      if (d < ep.distance) {
+        ep.piece = i;
+        ep.t = t;
+        ep.point = q;
+        ep.distance = d;
+      }
+    }
+    if (ep.distance < INFINITY) best.push_back(ep);
+  }
+  auto closer = [](const EdgePoint& x, const EdgePoint& y) { return x.distance < y.distance || (x.distance == y.distance && x.edge < y.edge); };
+  const std::size_t k = std::min(best.size(), static_cast<std::size_t>(std::max(0, limit)));
+  std::partial_sort(best.begin(), best.begin() + static_cast<std::ptrdiff_t>(k), best.end(), closer);
+  best.resize(k);
+  return best;
+}
+
+}  // namespace throng::path
