@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "io/bvh_reader.h"
+#include "io/yaml_fields.h"
 #include "motion/default_set.h"
 
 namespace throng::io {
@@ -25,7 +26,7 @@ using anim::Controller;
 // Builds a crowd while walking the YAML tree; every error names the node.
 class Reader {
  public:
-  Reader(std::string name, const StreamsYamlOptions& options) : name_(std::move(name)), options_(options) {}
+  Reader(std::string name, const StreamsYamlOptions& options) : fields_{std::move(name)}, options_(options) {}
 
   std::unique_ptr<anim::StreamCrowd> read(const YAML::Node& root) {
     if (!root.IsMap()) fail(root, "expected a mapping with 'rigs', 'clips', 'streams' (see docs/streams.md)");
@@ -54,13 +55,8 @@ class Reader {
     std::int32_t rig = 0;
   };
 
-  // ---- errors and scalars
-  Location at(const YAML::Node& n) const {
-    const YAML::Mark m = n.Mark();
-    if (m.is_null()) return at_line(name_, 0, 0);
-    return at_line(name_, m.line + 1, m.column + 1);
-  }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& message) const { throw Error(message, at(n)); }
+  // ---- errors and scalars (io/yaml_fields.h, plus what this format needs)
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& message) const { fields_.fail(n, message); }
 
   // Runs f; an Error from the library (which names a field) is reported at n.
   template <class F>
@@ -75,18 +71,7 @@ class Reader {
     }
   }
 
-  void keys(const YAML::Node& map, std::initializer_list<const char*> allowed) const {
-    for (auto it = map.begin(); it != map.end(); ++it) {
-      const std::string k = it->first.IsScalar() ? it->first.Scalar() : std::string();
-      bool ok = false;
-      for (const char* a : allowed) ok = ok || k == a;
-      if (!ok) {
-        std::string list;
-        for (const char* a : allowed) list.append(list.empty() ? "" : ", ").append(a);
-        fail(it->first, "unknown key '" + k + "' (expected one of: " + list + ")");
-      }
-    }
-  }
+  void keys(const YAML::Node& map, std::initializer_list<const char*> allowed) const { fields_.only_keys(map, allowed); }
   YAML::Node need(const YAML::Node& map, const char* key) const {
     const YAML::Node n = map[key];
     if (!n) fail(map, std::string("missing key '") + key + "'");
@@ -98,29 +83,13 @@ class Reader {
       fail(n, "more than " + std::to_string(options_.limits.max_items) + " items");
     return std::vector<YAML::Node>(n.begin(), n.end());
   }
-  std::string text(const YAML::Node& n) const {
-    if (!n.IsScalar()) fail(n, "expected a string");
-    return n.Scalar();
-  }
+  std::string text(const YAML::Node& n) const { return fields_.scalar(n); }
   std::string name_of(const YAML::Node& n) const {
     const std::string s = text(n);
     if (s.empty()) fail(n, "a name must not be empty");
     return s;
   }
-  double number(const YAML::Node& n, double lo, double hi) const {
-    if (!n.IsScalar()) fail(n, "expected a number");
-    const std::string& s = n.Scalar();
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(s, &used);
-    } catch (const std::exception&) {
-      fail(n, "expected a number, found '" + s + "'");
-    }
-    if (used != s.size()) fail(n, "expected a number, found '" + s + "'");
-    if (!std::isfinite(v) || v < lo || v > hi) fail(n, "must be in [" + fmt(lo) + ", " + fmt(hi) + "], found " + s);
-    return v;
-  }
+  double number(const YAML::Node& n, double lo, double hi) const { return fields_.number(n, lo, hi); }
   std::int64_t integer(const YAML::Node& n, std::int64_t lo, std::int64_t hi) const {
     const double v = number(n, static_cast<double>(lo), static_cast<double>(hi));
     if (v != std::floor(v)) fail(n, "expected a whole number, found '" + n.Scalar() + "'");
@@ -131,11 +100,6 @@ class Reader {
     if (s == "true" || s == "yes" || s == "on") return true;
     if (s == "false" || s == "no" || s == "off") return false;
     fail(n, "expected true or false, found '" + s + "'");
-  }
-  static std::string fmt(double v) {
-    std::ostringstream o;
-    o << v;
-    return o.str();
   }
   std::string path_of(const YAML::Node& n) const {
     const std::filesystem::path p(text(n));
@@ -496,7 +460,7 @@ class Reader {
     wrap(u, [&] { crowd_->uniques().add_animation(std::move(a)); });
   }
 
-  std::string name_;
+  YamlFields fields_;
   StreamsYamlOptions options_;
   std::unique_ptr<anim::StreamCrowd> crowd_;
   std::map<std::string, NamedClip> clips_;
@@ -508,12 +472,7 @@ class Reader {
 std::unique_ptr<anim::StreamCrowd> parse_stream_crowd(std::string_view text, const std::string& name, const StreamsYamlOptions& options) {
   if (text.size() > options.limits.max_file_bytes)
     throw Error("file is larger than " + std::to_string(options.limits.max_file_bytes) + " bytes", at_line(name, 0, 0));
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw Error(e.msg, at_line(name, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1));
-  }
+  const YAML::Node root = load_yaml(std::string(text), name);
   try {
     return Reader(name, options).read(root);
   } catch (const YAML::Exception& e) {
