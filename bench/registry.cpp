@@ -72,8 +72,13 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
       auto it = metas().find(r.run_name.function_name);
       if (it == metas().end()) continue;
       Row row{it->second.name, to_string(it->second.backend), it->second.n, it->second.threads, r.GetAdjustedRealTime(), 0,
-              static_cast<int>(r.repetitions)};
-      if (auto c = r.counters.find("items_per_second"); c != r.counters.end()) row.items_per_second = c->second.value;
+              static_cast<int>(r.repetitions), {}};
+      for (const auto& [key, counter] : r.counters) {
+        if (key == "items_per_second")
+          row.items_per_second = counter.value;
+        else
+          row.counters.emplace_back(key, counter.value);
+      }
       std::fprintf(stderr, "  %-60s %14.0f ns\n", r.run_name.function_name.c_str(), row.median_ns);
       rows.push_back(row);
     }
@@ -118,9 +123,12 @@ std::string table(const std::vector<Row>& rows) {
   for (const auto& r : rows) width = std::max(width, r.name.size());
   std::string s = fmt::format("{:<{}}  {:>7}  {:>10}  {:>7}  {:>14}  {:>14}\n", "benchmark", width, "backend", "N", "threads",
                               "median ns", "items/s");
-  for (const auto& r : rows)
-    s += fmt::format("{:<{}}  {:>7}  {:>10}  {:>7}  {:>14.0f}  {:>14.4g}\n", r.name, width, r.backend, r.n, r.threads, r.median_ns,
+  for (const auto& r : rows) {
+    s += fmt::format("{:<{}}  {:>7}  {:>10}  {:>7}  {:>14.0f}  {:>14.4g}", r.name, width, r.backend, r.n, r.threads, r.median_ns,
                      r.items_per_second);
+    for (const auto& [key, value] : r.counters) s += fmt::format("  {}={:.4g}", key, value);
+    s += "\n";
+  }
   return s;
 }
 
@@ -128,14 +136,18 @@ std::string json(const std::vector<Row>& rows) {
   nlohmann::json j;
   j["machine"] = {{"hardware_threads", hardware_threads()}, {"cuda", cuda_status()}};
   j["benchmarks"] = nlohmann::json::array();
-  for (const auto& r : rows)
+  for (const auto& r : rows) {
+    nlohmann::json counters = nlohmann::json::object();
+    for (const auto& [key, value] : r.counters) counters[key] = value;
     j["benchmarks"].push_back({{"name", r.name},
                                {"backend", r.backend},
                                {"N", r.n},
                                {"threads", r.threads},
                                {"median_ns", r.median_ns},
                                {"items_per_second", r.items_per_second},
-                               {"repetitions", r.repetitions}});
+                               {"repetitions", r.repetitions},
+                               {"counters", counters}});
+  }
   return j.dump(2) + "\n";
 }
 

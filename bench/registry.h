@@ -49,6 +49,8 @@ struct Row {
   double median_ns = 0;        // per iteration, wall clock
   double items_per_second = 0; // median over repetitions
   int repetitions = 0;
+  // A case's other counters (state.counters, e.g. bytes of pose data), medians.
+  std::vector<std::pair<std::string, double>> counters;
 };
 
 // Registers every suite, runs what matches options.filter, returns rows.
