@@ -101,7 +101,40 @@ void LocomotionOptions::validate() const {
   contacts.validate();
   if (!(std::isfinite(stationary_below_m) && stationary_below_m >= 0.0 && stationary_below_m < 10.0))
     throw Error("must be in [0, 10) m", at_field("locomotion.stationary_below_m"));
+  if (!(std::isfinite(contact_ramp_s) && contact_ramp_s >= 0.0 && contact_ramp_s <= 1.0))
+    throw Error("must be in [0, 1] s", at_field("locomotion.contact_ramp_s"));
+  if (!(std::isfinite(cleanup_speed_factor) && cleanup_speed_factor >= 1.0 && cleanup_speed_factor <= 20.0))
+    throw Error("must be in [1, 20]", at_field("locomotion.cleanup_speed_factor"));
+  if (!(std::isfinite(max_cleanup_m) && max_cleanup_m > 0.0 && max_cleanup_m <= 1.0))
+    throw Error("must be in (0, 1] m", at_field("locomotion.max_cleanup_m"));
 }
+
+namespace {
+
+// The cycle repeated `copies` times in its own motion: the root on its path
+// (a line, or an arc when the clip turns) at stride_m per cycle.
+Clip cycle_in_world(const LocomotionClip& c, std::int32_t copies) {
+  const std::int32_t F = c.cycle.frame_count, J = c.cycle.joint_count;
+  Clip w;
+  w.resize(F * copies, J);
+  w.frame_time = c.cycle.frame_time;
+  for (std::int32_t i = 0; i < F * copies; ++i) {
+    const double phi = static_cast<double>(i) / F;
+    const double yaw = c.turn_rad * phi;
+    glm::dvec3 path(0.0, 0.0, c.stride_m * phi);
+    if (std::abs(c.turn_rad) > 1e-9) {
+      const double r = c.stride_m / c.turn_rad;
+      path = glm::dvec3(r * (1.0 - std::cos(yaw)), 0.0, r * std::sin(yaw));
+    }
+    const std::int32_t k = i % F;
+    w.root_positions[at(i)] = glm::vec3(path + yaw_rotation(yaw) * glm::dvec3(c.cycle.root_positions[at(k)]));
+    w.rotation(i, 0) = glm::quat(glm::normalize(yaw_rotation(yaw) * glm::dquat(c.cycle.rotation(k, 0))));
+    for (std::int32_t j = 1; j < J; ++j) w.rotation(i, j) = c.cycle.rotation(k, j);
+  }
+  return w;
+}
+
+}  // namespace
 
 LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cycle, std::string name, const LocomotionOptions& o) {
   o.validate();
@@ -174,14 +207,30 @@ LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cy
 
   LocomotionClip out;
   out.name = std::move(name);
-
-  // Foot events from contacts over the middle copy.
-  std::array<std::int32_t, kFootEvents> event_frame{-1, -1, -1, -1};
+  out.cycle.resize(F, J);
+  out.cycle.frame_time = cycle.frame_time;
+  for (std::int32_t i = 0; i < F; ++i) {
+    for (std::int32_t j = 1; j < J; ++j) out.cycle.rotation(i, j) = cycle.rotation(i, j);
+    out.cycle.rotation(i, 0) = root_rotation[at(i)];
+    out.cycle.root_positions[at(i)] = glm::vec3(offset[at(i)]);
+  }
+  out.period_s = static_cast<double>(F) * cycle.frame_time;
+  out.stride_m = stride;
+  out.turn_rad = turn;
+  if (o.straighten) {
+    out.turn_removed_rad = turn;
+    out.turn_rad = 0.0;
+  }
+  out.speed = stride / out.period_s;
   const bool have_feet = skeleton.role(Role::LeftAnkle) >= 0 && skeleton.role(Role::RightAnkle) >= 0;
+  if (o.clean_contacts && have_feet && !stationary) out.contact_cleanup_m = clean_foot_contacts(skeleton, out, o);
+
+  // Foot events: contacts of the (cleaned) cycle in its own motion, over
+  // the middle of three copies.
+  std::array<std::int32_t, kFootEvents> event_frame{-1, -1, -1, -1};
   if (have_feet) {
-    const ModelSpaceClip model = forward_kinematics(skeleton, ext);
-    const ContactReport contacts =
-        detect_foot_contacts(skeleton, model, cycle.frame_time, FeetJoints::from_roles(skeleton), o.contacts);
+    const ModelSpaceClip model = forward_kinematics(skeleton, cycle_in_world(out, 3));
+    const ContactReport contacts = detect_foot_contacts(skeleton, model, cycle.frame_time, FeetJoints::from_roles(skeleton), o.contacts);
     for (int f = 0; f < 2; ++f) {
       std::int32_t downs = 0, ups = 0, down = -1, up = -1;
       for (const ContactInterval& c : contacts.feet[at(f)].intervals) {
@@ -201,23 +250,15 @@ LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cy
 
   // Re-phase: frame 0 at the left touchdown. The offsets are periodic, so
   // rotating the frame order is exact.
-  out.cycle.resize(F, J);
-  out.cycle.frame_time = cycle.frame_time;
-  for (std::int32_t i = 0; i < F; ++i) {
-    const std::int32_t src = (i + k0) % F;
-    for (std::int32_t j = 1; j < J; ++j) out.cycle.rotation(i, j) = cycle.rotation(src, j);
-    out.cycle.rotation(i, 0) = root_rotation[at(src)];
-    out.cycle.root_positions[at(i)] = glm::vec3(offset[at(src)]);
+  if (k0 != 0) {
+    const Clip before = out.cycle;
+    for (std::int32_t i = 0; i < F; ++i) {
+      const std::int32_t src = (i + k0) % F;
+      for (std::int32_t j = 0; j < J; ++j) out.cycle.rotation(i, j) = before.rotation(src, j);
+      out.cycle.root_positions[at(i)] = before.root_positions[at(src)];
+    }
   }
   out.source_start_frame = k0;
-  out.period_s = static_cast<double>(F) * cycle.frame_time;
-  out.stride_m = stride;
-  out.turn_rad = turn;
-  if (o.straighten) {
-    out.turn_removed_rad = turn;
-    out.turn_rad = 0.0;
-  }
-  out.speed = stride / out.period_s;
   out.mean_rotations.resize(at(J));
   for (std::int32_t j = 0; j < J; ++j) out.mean_rotations[at(j)] = mean_rotation(out.cycle.rotations, F, J, j);
   if (have_feet) {
@@ -230,6 +271,119 @@ LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cy
     }
   }
   return out;
+}
+
+double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& c, const LocomotionOptions& o) {
+  o.validate();
+  const std::int32_t F = c.cycle.frame_count, J = c.cycle.joint_count;
+  if (J != skeleton.joint_count() || F < 4) throw Error("clip and skeleton disagree", clip_field(c.name, "cycle"));
+  if (skeleton.role(Role::LeftAnkle) < 0 || skeleton.role(Role::RightAnkle) < 0) return 0.0;
+  const std::array<LegChain, 2> legs = leg_chains(skeleton);
+  const Clip world = cycle_in_world(c, 3);
+  const ModelSpaceClip model = forward_kinematics(skeleton, world);
+  const ContactReport contacts = detect_foot_contacts(skeleton, model, c.cycle.frame_time, FeetJoints::from_roles(skeleton), o.contacts);
+  const std::int32_t ramp = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::lround(o.contact_ramp_s / c.cycle.frame_time)));
+  const std::size_t frames = at(3 * F);
+  const auto index = [&](std::int32_t i, std::int32_t j) { return at(static_cast<std::int64_t>(i) * J + j); };
+  double largest = 0.0;
+  for (std::size_t leg = 0; leg < 2; ++leg) {
+    const LegChain& chain = legs[leg];
+    if (chain.count < 4) continue;
+    const std::int32_t thigh = chain.joints[chain.count - 3], knee = chain.joints[chain.count - 2], ankle = chain.joints[chain.count - 1];
+    const glm::vec3 ball(chain.ball[0], chain.ball[1], chain.ball[2]);
+    const FootContacts& fc = contacts.feet[leg];
+    const double ground = fc.ground[0];
+    // The ankle's correction on every contact frame.
+    std::vector<glm::dvec3> correction(frames, glm::dvec3(0.0));
+    std::vector<std::uint8_t> pinned(frames, 0);
+    // A contact goes on while the ball stays low and rolls (mocap feet roll
+    // about toes the skeleton lacks, so the ball moves faster than the
+    // strict speed limit allows) until the foot leaves.
+    std::vector<ContactInterval> intervals = fc.intervals;
+    const double ball_ground = fc.ground[1];
+    for (std::size_t k = 0; k < intervals.size() && chain.has_ball; ++k) {
+      const std::int32_t limit = k + 1 < intervals.size() ? intervals[k + 1].begin : 3 * F;
+      std::int32_t& e = intervals[k].end;
+      while (e < limit) {
+        const glm::dvec3 b = glm::dvec3(model.positions[index(e, ankle)] + model.rotations[index(e, ankle)] * ball);
+        const glm::dvec3 b0 = glm::dvec3(model.positions[index(e - 1, ankle)] + model.rotations[index(e - 1, ankle)] * ball);
+        const double speed = std::hypot(b.x - b0.x, b.z - b0.z) / c.cycle.frame_time;
+        if (!(b.y - ball_ground < contacts.height_threshold && speed < o.cleanup_speed_factor * contacts.speed_threshold)) break;
+        ++e;
+      }
+    }
+    for (const ContactInterval& in : intervals) {
+      // Heel down while the ankle is within half kHeelLift of its ground (from
+      // its first such frame until it rises): the ankle is pinned at its mean
+      // position there; from then on the ball, where it was with the foot as
+      // on the last heel-down frame. No heel-down frame (forefoot contact):
+      // the ball at its mean position.
+      glm::dvec3 anchor(0.0);
+      std::int32_t down = 0, rise = in.end;
+      for (std::int32_t i = in.begin; i < in.end && rise == in.end; ++i) {
+        const glm::dvec3 a(model.positions[index(i, ankle)]);
+        if (a.y - ground < 0.5 * kHeelLift) {
+          anchor += a;
+          ++down;
+        } else if (down > 0) {
+          rise = i;
+        }
+      }
+      glm::dvec3 ball_anchor(0.0);
+      if (down > 0) {
+        anchor /= static_cast<double>(down);
+        ball_anchor = anchor + glm::dvec3(model.rotations[index(rise - 1, ankle)] * ball);
+      } else {
+        for (std::int32_t i = in.begin; i < in.end; ++i)
+          ball_anchor += glm::dvec3(model.positions[index(i, ankle)] + model.rotations[index(i, ankle)] * ball);
+        ball_anchor /= static_cast<double>(in.end - in.begin);
+      }
+      for (std::int32_t i = in.begin; i < in.end; ++i) {
+        const bool on_heel = down > 0 && (i < rise || !chain.has_ball);
+        const glm::dvec3 target = on_heel ? anchor : ball_anchor - glm::dvec3(model.rotations[index(i, ankle)] * ball);
+        const glm::dvec3 corr = target - glm::dvec3(model.positions[index(i, ankle)]);
+        // The foot has left (or the data disagrees with a plant): stop here.
+        if (glm::length(corr) > o.max_cleanup_m) {
+          if (i > in.begin + (in.end - in.begin) / 2) break;
+          continue;
+        }
+        correction[at(i)] = corr;
+        pinned[at(i)] = 1;
+      }
+    }
+    // Fade in and out: a free frame takes the nearest pinned frame's
+    // correction, scaled down with the distance.
+    std::vector<glm::dvec3> faded = correction;
+    for (std::int32_t i = 0; i < 3 * F; ++i) {
+      if (pinned[at(i)]) continue;
+      for (std::int32_t d = 1; d <= ramp; ++d) {
+        const std::int32_t before = i - d, after = i + d;
+        const bool b = before >= 0 && pinned[at(before)], a = after < 3 * F && pinned[at(after)];
+        if (!a && !b) continue;
+        const glm::dvec3 near = b && a ? 0.5 * (correction[at(before)] + correction[at(after)]) : correction[at(b ? before : after)];
+        faded[at(i)] = near * (1.0 - static_cast<double>(d) / (ramp + 1));
+        break;
+      }
+    }
+    // IK on the middle copy's frames, which are the cycle's.
+    const std::int32_t hip_parent = skeleton.parents[at(thigh)];
+    for (std::int32_t k = 0; k < F; ++k) {
+      const std::int32_t i = F + k;
+      const glm::dvec3& corr = faded[at(i)];
+      if (glm::length(corr) < 1e-7) continue;
+      largest = std::max(largest, glm::length(corr));
+      const glm::vec3 target = model.positions[index(i, ankle)] + glm::vec3(corr);
+      glm::quat r_thigh = model.rotations[index(i, thigh)];
+      glm::quat r_knee = model.rotations[index(i, knee)];
+      const glm::quat r_foot = model.rotations[index(i, ankle)];
+      if (!two_bone_ik(model.positions[index(i, thigh)], skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], target, r_thigh, r_knee))
+        continue;
+      c.cycle.rotation(k, thigh) = glm::normalize(glm::inverse(model.rotations[index(i, hip_parent)]) * r_thigh);
+      c.cycle.rotation(k, knee) = glm::normalize(glm::inverse(r_thigh) * r_knee);
+      c.cycle.rotation(k, ankle) = glm::normalize(glm::inverse(r_knee) * r_foot);
+    }
+  }
+  return largest;
 }
 
 LocomotionClip prepare_locomotion_clip(const Skeleton& skeleton, const Clip& clip, std::string name, const LocomotionOptions& o) {
@@ -426,7 +580,9 @@ BlendSpace1D make_default_blend_space() {
   std::vector<LocomotionClip> clips;
   for (const DefaultMotion& m : make_default_motions(skeleton)) {
     if (m.spec.turn_rate != 0.0) continue;  // a speed blend space goes straight
-    clips.push_back(prepare_locomotion_cycle(skeleton, m.clip, m.spec.name));
+    LocomotionOptions options;
+    options.clean_contacts = false;  // planted by construction
+    clips.push_back(prepare_locomotion_cycle(skeleton, m.clip, m.spec.name, options));
   }
   return BlendSpace1D(std::move(skeleton), std::move(clips));
 }

@@ -59,6 +59,13 @@ struct LocomotionOptions {
   // Clips whose root moves less than this per cycle (m) are stationary
   // (idle): no stride, the path point is the root's mean ground position.
   double stationary_below_m = 0.05;
+  // Pin the feet during contacts in the cycle's own motion (clean_foot_contacts).
+  bool clean_contacts = true;
+  double contact_ramp_s = 0.1;  // corrections fade in and out over this before and after a contact
+  // A contact goes on after the strict test while the ball stays low and
+  // moves slower than contacts.speed_fraction times this (the push-off roll).
+  double cleanup_speed_factor = 3.0;
+  double max_cleanup_m = 0.04;  // frames that would need a larger correction are left free
   void validate() const;  // Error naming the field
 };
 
@@ -86,6 +93,7 @@ struct LocomotionClip {
   std::array<float, 2> ankle_ground{0.0f, 0.0f};
   // Input frame that became frame 0 (within the input cycle).
   std::int32_t source_start_frame = 0;
+  double contact_cleanup_m = 0.0;  // largest ankle correction of clean_foot_contacts
 
   std::int32_t frame_count() const { return cycle.frame_count; }
   float event(FootEvent e) const { return events[static_cast<std::size_t>(e)]; }
@@ -95,6 +103,15 @@ struct LocomotionClip {
 // by the cycle's rigid root motion), e.g. the default set's.
 LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cycle, std::string name,
                                         const LocomotionOptions& options = {});
+// Foot-skate cleanup of a prepared cycle, as motion capture slides (heel
+// rocker, marker drift, rescaled skeletons): in the cycle's own motion (its
+// path at stride_m per cycle), each contact (motion/cycle.h) pins the ankle
+// while the heel is down and the ball of the foot once it is up (the ball
+// where it stands when the heel rises); two-bone IK moves thigh and knee to
+// reach it and keeps the foot's world rotation. Corrections fade in and out
+// over contact_ramp_s around each contact. Returns the largest correction (m).
+double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& clip, const LocomotionOptions& options = {});
+
 // Any locomotion clip: finds the best loop (analyze_cycle), closes it
 // (make_cyclic), then prepare_locomotion_cycle. Error when no cycle is found.
 LocomotionClip prepare_locomotion_clip(const Skeleton& skeleton, const Clip& clip, std::string name,
@@ -499,6 +516,37 @@ THRONG_HOST_DEVICE inline glm::quat rotation_between(const glm::vec3& a, const g
   return glm::normalize(glm::quat(1.0f + d, c.x, c.y, c.z));
 }
 
+// Two-bone IK: turns the world rotations of a thigh and its knee so that the
+// ankle (knee_offset, ankle_offset: rest offsets of knee and ankle) reaches
+// `target` from the hip, or as near as the leg reaches. The knee bends about
+// its current hinge axis (law of cosines), then the leg swings about the hip
+// by the shortest arc. False (nothing changed) for a degenerate leg.
+THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3& knee_offset, const glm::vec3& ankle_offset,
+                                           const glm::vec3& target, glm::quat& r_thigh, glm::quat& r_knee) {
+  const glm::vec3 upper = r_thigh * knee_offset;
+  const glm::vec3 lower = r_knee * ankle_offset;
+  const float l1 = glm::length(upper), l2 = glm::length(lower);
+  if (!(l1 > 1e-6f && l2 > 1e-6f)) return false;
+  const glm::vec3 to_target = target - hip;
+  float d = glm::length(to_target);
+  const float d_min = glm::abs(l1 - l2) + 1e-4f, d_max = 0.9999f * (l1 + l2);
+  d = d < d_min ? d_min : (d > d_max ? d_max : d);
+  glm::vec3 axis = glm::cross(upper, lower);
+  if (glm::dot(axis, axis) < 1e-10f) axis = r_thigh * glm::vec3(1.0f, 0.0f, 0.0f);  // straight leg: the thigh's x axis
+  axis = glm::normalize(axis);
+  const float cos_now = glm::dot(upper, lower) / (l1 * l2);
+  const float cos_want = (d * d - l1 * l1 - l2 * l2) / (2.0f * l1 * l2);
+  const float bend = glm::acos(glm::clamp(cos_want, -1.0f, 1.0f)) - glm::acos(glm::clamp(cos_now, -1.0f, 1.0f));
+  r_knee = glm::angleAxis(bend, axis) * r_knee;
+  const glm::vec3 ankle_now = upper + r_knee * ankle_offset;
+  if (glm::dot(ankle_now, ankle_now) > 1e-12f && glm::dot(to_target, to_target) > 1e-12f) {
+    const glm::quat swing = rotation_between(glm::normalize(ankle_now), glm::normalize(to_target));
+    r_thigh = swing * r_thigh;
+    r_knee = swing * r_knee;
+  }
+  return true;
+}
+
 // Planted feet in a blend (past the paper). SLERP of joint rotations does
 // not lerp joint positions, so a foot planted in both clips drifts a little
 // in the blend. Eq. 10's root is exactly the lerp of the clips' roots, so a
@@ -570,6 +618,7 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
     glm::quat r_knee = r_thigh * joint_rotation(v, f, knee);
     const bool has_ankle = mask_bit(mask, ankle);
     const glm::quat r_foot = has_ankle ? r_knee * joint_rotation(v, f, ankle) : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    // The pivot: the ankle while the blended heel is down, then the ball.
     glm::vec3 target = ankle_target;
     if (chain.has_ball && has_ankle) {
       const float heel = glm::clamp((ankle_target.y - ground) / kHeelLift, 0.0f, 1.0f);
@@ -579,29 +628,7 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
       const float ramp = p.w < kLiftRamp ? p.w / kLiftRamp : 1.0f;
       target.y += ramp * (1.0f - p.w) * (lift[1] - lift[0]);
     }
-    const glm::vec3 upper = r_thigh * v.offsets[knee];
-    const glm::vec3 lower = r_knee * v.offsets[ankle];
-    const float l1 = glm::length(upper), l2 = glm::length(lower);
-    if (!(l1 > 1e-6f && l2 > 1e-6f)) continue;
-    // Knee: bend so that the hip-ankle distance is the hip-target distance.
-    const glm::vec3 to_target = target - hip;
-    float d = glm::length(to_target);
-    const float d_min = glm::abs(l1 - l2) + 1e-4f, d_max = 0.9999f * (l1 + l2);
-    d = d < d_min ? d_min : (d > d_max ? d_max : d);
-    glm::vec3 axis = glm::cross(upper, lower);
-    if (glm::dot(axis, axis) < 1e-10f) axis = r_thigh * glm::vec3(1.0f, 0.0f, 0.0f);  // straight leg: the thigh's x axis
-    axis = glm::normalize(axis);
-    const float cos_now = glm::dot(upper, lower) / (l1 * l2);
-    const float cos_want = (d * d - l1 * l1 - l2 * l2) / (2.0f * l1 * l2);
-    const float bend = glm::acos(glm::clamp(cos_want, -1.0f, 1.0f)) - glm::acos(glm::clamp(cos_now, -1.0f, 1.0f));
-    r_knee = glm::angleAxis(bend, axis) * r_knee;
-    // Hip: swing the leg so the ankle points at the target.
-    const glm::vec3 ankle_now = upper + r_knee * v.offsets[ankle];
-    if (glm::dot(ankle_now, ankle_now) > 1e-12f && glm::dot(to_target, to_target) > 1e-12f) {
-      const glm::quat swing = rotation_between(glm::normalize(ankle_now), glm::normalize(to_target));
-      r_thigh = swing * r_thigh;
-      r_knee = swing * r_knee;
-    }
+    if (!two_bone_ik(hip, v.offsets[knee], v.offsets[ankle], target, r_thigh, r_knee)) continue;
     out.active[leg] = true;
     out.ankle[leg] = has_ankle;
     out.corrected[leg][0] = glm::inverse(hip_parent) * r_thigh;
