@@ -169,60 +169,6 @@ void register_anim(const Options& options) {
                 },
                 true});
 
-  // Per-character pose (a SLERP per synthesised joint, then forward
-  // kinematics): every joint, then only the joints the LOD masks keep.
-  for (const bool lod : {false, true}) {
-    add(options, {lod ? "anim/masked_pose_lod" : "anim/masked_pose_full", {1000, 10000, 100000},
-                  [lod](benchmark::State& state, Index n) {
-                    const motion::Skeleton skeleton = bench_skeleton();
-                    const BodyParts parts = make_body_parts(skeleton);
-                    const LodConfig config = make_lod_config(parts, default_lod_thresholds());
-                    const LodTables tables(config, current_memory());
-                    const std::int32_t J = skeleton.joint_count();
-                    const std::int32_t F = 30;
-                    GridCrowd crowd(n);
-                    Buffer<std::uint8_t> levels(n * kBodyPartCount, current_memory());
-                    Buffer<std::uint32_t> masks(n * config.mask_words, current_memory());
-                    LodJob job;
-                    job.set_tables(tables);
-                    job.camera = make_camera_view(orbit_at(crowd.half_extent, 0.0f));
-                    job.root_positions = crowd.positions.span();
-                    job.root_headings = crowd.headings.span();
-                    job.template_spheres = parts.rest_spheres;
-                    job.levels = levels.span();
-                    job.joint_masks = masks.span();
-                    job.run();
-                    if (!lod) masks = Buffer<std::uint32_t>(std::vector<std::uint32_t>(static_cast<std::size_t>(n), (1u << J) - 1u), current_memory());
-                    std::vector<glm::quat> clip;
-                    for (std::int32_t i = 0; i < F * J; ++i)
-                      clip.push_back(glm::angleAxis(0.05f * static_cast<float>(i % 37), glm::normalize(glm::vec3(1.0f, 0.2f * static_cast<float>(i % 5), 0.5f))));
-                    std::vector<float> phases;
-                    for (Index i = 0; i < n; ++i) phases.push_back(static_cast<float>(i % 97) / 97.0f);
-                    const Buffer<std::int32_t> parents(std::span<const std::int32_t>(skeleton.parents), current_memory());
-                    const Buffer<glm::vec3> offsets(std::span<const glm::vec3>(skeleton.offsets), current_memory());
-                    const Buffer<glm::quat> clip_buf(std::span<const glm::quat>(clip), current_memory());
-                    const Buffer<float> phase_buf(std::span<const float>(phases), current_memory());
-                    Buffer<glm::vec3> out_p(n * J, current_memory());
-                    Buffer<glm::quat> out_r(n * J, current_memory());
-                    Buffer<std::int32_t> evaluated(n, current_memory());
-                    MaskedPoseJob pose;
-                    pose.joint_count = J;
-                    pose.frame_count = F;
-                    pose.parents = parents.span();
-                    pose.offsets = offsets.span();
-                    pose.clip_rotations = clip_buf.span();
-                    pose.phases = phase_buf.span();
-                    pose.root_positions = crowd.positions.span();
-                    pose.joint_masks = masks.span();
-                    pose.out_positions = out_p.span();
-                    pose.out_rotations = out_r.span();
-                    pose.evaluated = evaluated.span();
-                    for (auto _ : state) pose.run();
-                    state.SetItemsProcessed(state.iterations() * n);
-                  },
-                  true});
-  }
-
   // Cache reads: a bucket lookup plus a SLERP pose at the character's phase.
   add(options, {"anim/motion_cache_sample", {1000, 100000},
                 [](benchmark::State& state, Index n) {

@@ -484,10 +484,10 @@ struct CharacterFrame {
   glm::quat frame{1.0f, 0.0f, 0.0f, 0.0f};
   float scale = 1.0f;
 };
-THRONG_HOST_DEVICE inline CharacterFrame character_frame(const BlendSpaceView& v, float blend_speed, float phase,
-                                                         glm::vec3 position, float yaw, float scale) {
+THRONG_HOST_DEVICE inline CharacterFrame character_frame_at(const BlendSpaceView& v, const BlendPoint& point, float phase,
+                                                            glm::vec3 position, float yaw, float scale) {
   CharacterFrame f;
-  f.point = blend_point(v, blend_coordinate(v, blend_speed));
+  f.point = point;
   f.phase = wrap_phase(phase);
   const SegmentSync& sync = v.sync[f.point.segment];
   for (int g = 0; g < kSyncGroups; ++g) f.phases[g] = warp_phase(sync.group[g], f.point.w, f.phase);
@@ -497,6 +497,10 @@ THRONG_HOST_DEVICE inline CharacterFrame character_frame(const BlendSpaceView& v
   f.root_position = position + heading * (f.scale * f.root.position);
   f.frame = f.root.yaw != 0.0f ? heading * yaw_quat(f.root.yaw) : heading;
   return f;
+}
+THRONG_HOST_DEVICE inline CharacterFrame character_frame(const BlendSpaceView& v, float blend_speed, float phase,
+                                                         glm::vec3 position, float yaw, float scale) {
+  return character_frame_at(v, blend_point(v, blend_coordinate(v, blend_speed)), phase, position, yaw, scale);
 }
 
 // A joint's blended local rotation at its sync group's phases.
