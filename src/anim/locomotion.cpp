@@ -73,6 +73,7 @@ void PoseJob::validate() const {
     if (cache_cycles.size() % (static_cast<Index>(cache_frames) * J) != 0)
       throw Error("size must be a multiple of cache_frames * joints", at_field("PoseJob.cache_cycles"));
     const Index slots = cache_cycles.size() / (static_cast<Index>(cache_frames) * J);
+    check_size("PoseJob", "cache_drops", cache_drops.size(), slots * cache_frames);
     // Every slot a key names must exist (a bad table must not read past the arena).
     if (current_memory() == Memory::Host)
       for (Index k = 0; k < cache_slots.size(); ++k)
@@ -137,9 +138,10 @@ CycleCacheTable::CycleCacheTable(const motion::BlendSpace1D& space, MotionCacheC
   for (std::int32_t s = slot_count_ - 1; s >= 0; --s) free_slots_.push_back(s);
   slots_ = Buffer<std::int32_t>(std::span<const std::int32_t>(host_slots_), current_memory());
   cycles_ = Buffer<glm::quat>(static_cast<Index>(slot_count_) * frames_ * J, current_memory());
+  drops_ = Buffer<float>(static_cast<Index>(slot_count_) * frames_, current_memory());
 }
 
-CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w) const {
+CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w, std::vector<float>* drops) const {
   if (segment < 0 || segment >= space_->segment_count()) throw Error("no such segment", at_field("motion_cache.segment"));
   const motion::BlendSpaceView view = space_->view();
   const std::int32_t J = view.joint_count;
@@ -155,11 +157,13 @@ CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w) const {
   const float rate = motion::cycle_rate(view, point, speed);
   cycle.duration = rate > 0.0f ? 1.0f / rate : motion::blended_period(view, point);
   cycle.rotations.resize(static_cast<std::size_t>(frames_) * static_cast<std::size_t>(J));
+  if (drops != nullptr) drops->assign(static_cast<std::size_t>(frames_), 0.0f);
   for (std::int32_t k = 0; k < frames_; ++k) {
     const float phase = static_cast<float>(k) / static_cast<float>(frames_);
     const motion::CharacterFrame f = motion::character_frame_at(view, point, phase, glm::vec3(0.0f), 0.0f, 1.0f);
     const motion::PlantedLegs legs = motion::plant_legs(view, f, nullptr);
     for (std::int32_t j = 0; j < J; ++j) cycle.rotations[at(static_cast<Index>(k) * J + j)] = motion::synthesised_rotation(view, f, legs, j);
+    if (drops != nullptr) (*drops)[at(k)] = legs.pelvis_drop;
   }
   return cycle;
 }
@@ -178,7 +182,8 @@ std::int32_t CycleCacheTable::update(const std::vector<Index>& counts, std::int3
     const float w = cache_.bucket_centre(bucket);
     if (cache_.find(w, static_cast<std::uint32_t>(segment), n) != nullptr) continue;
     if (stored >= max_new) continue;
-    const CachedCycle* held = cache_.insert(bucket, synthesise(segment, w), static_cast<std::uint32_t>(segment));
+    std::vector<float> drops;
+    const CachedCycle* held = cache_.insert(bucket, synthesise(segment, w, &drops), static_cast<std::uint32_t>(segment));
     ++stored;
     // FIFO evictions free their slots.
     for (std::int32_t k = 0; k < key_count_; ++k) {
@@ -194,6 +199,8 @@ std::int32_t CycleCacheTable::update(const std::vector<Index>& counts, std::int3
     const std::size_t bytes = held->rotations.size() * sizeof(glm::quat);
     detail::copy_bytes(cycles_.data() + static_cast<Index>(slot) * frames_ * J, cycles_.memory(), held->rotations.data(), Memory::Host,
                        bytes);
+    detail::copy_bytes(drops_.data() + static_cast<Index>(slot) * frames_, drops_.memory(), drops.data(), Memory::Host,
+                       drops.size() * sizeof(float));
     host_slots_[at(key)] = slot;
     changed = true;
   }
@@ -320,7 +327,11 @@ void CrowdAnimator::drive_from_map(Span<const glm::vec2> positions, Span<const g
 
 const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
   if (!(std::isfinite(input.dt) && input.dt >= 0.0f && input.dt <= 10.0f)) throw Error("must be in [0, 10] s", at_field("frame.dt"));
-  const motion::BlendSpaceView view = tables_.view();
+  motion::BlendSpaceView view = tables_.view();
+  if (cache_) {  // every character shows its bucket's blend: a cached cycle is exactly its pose
+    view.quantum = cache_->bucket_width();
+    view.quantum_buckets = cache_->bucket_count();
+  }
   LocomoteJob locomote;
   locomote.blend = view;
   locomote.step.dt = input.dt;
@@ -370,6 +381,7 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
   if (cache_) {
     pose.cache_slots = cache_->slots();
     pose.cache_cycles = cache_->cycles();
+    pose.cache_drops = cache_->drops();
     pose.cache_frames = cache_->frames();
     pose.bucket_width = cache_->bucket_width();
     pose.bucket_count = cache_->bucket_count();

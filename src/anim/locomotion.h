@@ -86,6 +86,7 @@ struct PoseJob {
   // The motion cache's device side (CycleCacheTable); empty slots = no cache.
   Span<const std::int32_t> cache_slots;   // per key (segment * bucket_count + bucket): slot or -1
   Span<const glm::quat> cache_cycles;     // slots * cache_frames * J local rotations
+  Span<const float> cache_drops;          // slots * cache_frames pelvis drops (m, scale 1)
   std::int32_t cache_frames = 0;
   float bucket_width = 0.05f;
   std::int32_t bucket_count = 20;
@@ -153,13 +154,15 @@ class CycleCacheTable {
   float bucket_width() const { return cache_.config().bucket_width; }
   Span<const std::int32_t> slots() const { return slots_.span(); }
   Span<const glm::quat> cycles() const { return cycles_.span(); }
+  Span<const float> drops() const { return drops_.span(); }
 
   // One frame: counts[key] characters look their key up (hits and misses
   // count characters); up to max_new missing cycles are synthesised and
   // stored (FIFO evictions free their slots). Returns how many were stored.
   std::int32_t update(const std::vector<Index>& counts, std::int32_t max_new);
-  // The cycle of a key, synthesised (host), for tests and the table.
-  CachedCycle synthesise(std::int32_t segment, float w) const;
+  // The cycle of a key, synthesised (host), for tests and the table; with
+  // drops, also the pelvis drop of each frame (motion::PlantedLegs).
+  CachedCycle synthesise(std::int32_t segment, float w, std::vector<float>* drops = nullptr) const;
   // Angle between a cached read and per-character synthesis over a grid of
   // w and phases in every segment: what caching costs.
   QuantisationError quantisation_error(std::int32_t w_samples = 41, std::int32_t phase_samples = 48) const;
@@ -175,6 +178,7 @@ class CycleCacheTable {
   std::vector<std::int32_t> free_slots_;
   Buffer<std::int32_t> slots_;
   Buffer<glm::quat> cycles_;
+  Buffer<float> drops_;
 };
 
 struct CrowdAnimatorConfig {

@@ -98,6 +98,7 @@ void PoseJob::run() const {
   const auto masks = joint_masks;
   const auto slots = cache_slots;
   const auto cycles = cache_cycles;
+  const auto drops = cache_drops;
   const auto shapes = joint_shapes;
   const auto out_p = joint_positions;
   const auto out_r = joint_rotations;
@@ -119,11 +120,15 @@ void PoseJob::run() const {
           const motion::CyclePoint cp = motion::cycle_point(frames, f.phase);
           const glm::quat* cycle = cycles.data() + static_cast<Index>(slot) * frames * J;
           const CachedJoint e{cycle + static_cast<Index>(cp.f0) * J, cycle + static_cast<Index>(cp.f1) * J, cp.t, f.frame};
-          n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position, joints_p, joints_r, f.scale);
+          const float* drop = drops.data() + static_cast<Index>(slot) * frames;
+          const float lowered = f.scale * (drop[cp.f0] + cp.t * (drop[cp.f1] - drop[cp.f0]));
+          n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, lowered, 0.0f), joints_p,
+                          joints_r, f.scale);
         } else {
           const motion::PlantedLegs legs = motion::plant_legs(view, f, mask);
           const SynthesisedJoint e{&view, &f, &legs};
-          n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position, joints_p, joints_r, f.scale);
+          n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f),
+                          joints_p, joints_r, f.scale);
         }
         if (!out_count.empty()) out_count[c] = n;
         if (!out_cache.empty()) out_cache[c] = slot >= 0 ? 1 : 0;

@@ -33,17 +33,12 @@ void MotionCacheConfig::validate() const {
 
 MotionCache::MotionCache(MotionCacheConfig config) : config_(config) {
   config_.validate();
-  // Guard against 1 / 0.05 = 20.000000000000004 making a 21st empty bucket.
-  bucket_count_ = std::max(1, static_cast<std::int32_t>(std::ceil(1.0 / static_cast<double>(config_.bucket_width) - 1e-6)));
+  bucket_count_ = motion::weight_bucket_count(config_.bucket_width);
 }
 
 std::int32_t MotionCache::bucket_of(float w) const { return cache_bucket(w, config_.bucket_width, bucket_count_); }
 
-float MotionCache::bucket_centre(std::int32_t bucket) const {
-  const double lo = static_cast<double>(bucket) * config_.bucket_width;
-  const double hi = std::min(1.0, static_cast<double>(bucket + 1) * config_.bucket_width);
-  return static_cast<float>(0.5 * (lo + hi));
-}
+float MotionCache::bucket_centre(std::int32_t bucket) const { return motion::weight_bucket_centre(bucket, config_.bucket_width); }
 
 const CachedCycle* MotionCache::find(float w, std::uint32_t state, std::int64_t lookups) {
   const auto it = entries_.find(key(state, bucket_of(w)));

@@ -23,6 +23,7 @@
 
 #include "core/config.h"
 #include "core/span.h"
+#include "motion/locomotion.h"
 #include "motion/phase.h"
 
 namespace throng::anim {
@@ -52,10 +53,7 @@ inline void sample_cycle(const CachedCycle& cycle, float phase, glm::quat* out) 
 // The bucket of w for buckets of `width` (w clamped into [0, 1], NaN -> 0,
 // w = 1 in the last bucket): host and kernels compute it the same way.
 THRONG_HOST_DEVICE inline std::int32_t cache_bucket(float w, float width, std::int32_t bucket_count) {
-  if (!(w > 0.0f)) return 0;  // also NaN
-  const double b = glm::floor(static_cast<double>(w < 1.0f ? w : 1.0f) / static_cast<double>(width));
-  const auto i = static_cast<std::int32_t>(b);
-  return i < bucket_count - 1 ? i : bucket_count - 1;
+  return motion::weight_bucket(w, width, bucket_count);
 }
 
 // Angle of the rotation taking a to b, degrees in [0, 180] (q and -q are the same rotation).

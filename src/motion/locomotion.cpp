@@ -367,6 +367,7 @@ double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& c, const Lo
     }
     // IK on the middle copy's frames, which are the cycle's.
     const std::int32_t hip_parent = skeleton.parents[at(thigh)];
+    const glm::vec3 hinge = knee_hinge(skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], {&c.cycle}, knee);
     for (std::int32_t k = 0; k < F; ++k) {
       const std::int32_t i = F + k;
       const glm::dvec3& corr = faded[at(i)];
@@ -376,7 +377,8 @@ double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& c, const Lo
       glm::quat r_thigh = model.rotations[index(i, thigh)];
       glm::quat r_knee = model.rotations[index(i, knee)];
       const glm::quat r_foot = model.rotations[index(i, ankle)];
-      if (!two_bone_ik(model.positions[index(i, thigh)], skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], target, r_thigh, r_knee))
+      if (!two_bone_ik(model.positions[index(i, thigh)], skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], hinge, target, r_thigh,
+                       r_knee))
         continue;
       c.cycle.rotation(k, thigh) = glm::normalize(glm::inverse(model.rotations[index(i, hip_parent)]) * r_thigh);
       c.cycle.rotation(k, knee) = glm::normalize(glm::inverse(r_thigh) * r_knee);
@@ -452,6 +454,21 @@ SyncMarkers aligned_events(const LocomotionClip& a, const LocomotionClip& b, con
 
 }  // namespace
 
+glm::vec3 knee_hinge(const glm::vec3& knee_offset, const glm::vec3& ankle_offset, const std::vector<const Clip*>& clips,
+                     std::int32_t knee) {
+  // In the thigh's frame the thigh is knee_offset and the shin q * ankle_offset.
+  glm::dvec3 sum(0.0);
+  for (const Clip* c : clips)
+    for (std::int32_t f = 0; f < c->frame_count; ++f)
+      sum += glm::cross(glm::dvec3(knee_offset), glm::dvec3(c->rotation(f, knee) * ankle_offset));
+  const double n = glm::length(sum);
+  if (n > 1e-9) return glm::vec3(sum / n);
+  // Never bent: any axis across the thigh.
+  glm::dvec3 a = glm::cross(glm::dvec3(knee_offset), glm::dvec3(0, 0, 1));
+  if (glm::length(a) < 1e-9) a = glm::cross(glm::dvec3(knee_offset), glm::dvec3(1, 0, 0));
+  return glm::length(a) > 1e-12 ? glm::vec3(glm::normalize(a)) : glm::vec3(1, 0, 0);
+}
+
 SegmentSync sync_markers(const LocomotionClip& a, const LocomotionClip& b) {
   using E = FootEvent;
   SegmentSync s;
@@ -512,6 +529,16 @@ BlendSpace1D::BlendSpace1D(Skeleton skeleton, std::vector<LocomotionClip> clips,
   }
   texture_ = make_motion_texture(skeleton_, stacked, options.format);
   legs_ = leg_chains(skeleton_);
+  std::vector<const Clip*> cycles;
+  for (const LocomotionClip& c : clips_) cycles.push_back(&c.cycle);
+  for (LegChain& leg : legs_) {
+    if (leg.count < 4) continue;
+    const std::int32_t knee = leg.joints[leg.count - 2], ankle = leg.joints[leg.count - 1];
+    const glm::vec3 h = knee_hinge(skeleton_.offsets[at(knee)], skeleton_.offsets[at(ankle)], cycles, knee);
+    leg.hinge[0] = h.x;
+    leg.hinge[1] = h.y;
+    leg.hinge[2] = h.z;
+  }
   // The leg groups: each thigh's subtree (the joints its warp moves).
   joint_group_.assign(static_cast<std::size_t>(J), 0);
   for (std::size_t leg = 0; leg < 2; ++leg) {

@@ -155,7 +155,15 @@ struct LegChain {
   std::int32_t joints[kMaxLegChain] = {};
   float ball[3] = {0.0f, 0.0f, 0.0f};  // ball of the foot in the ankle's frame (toe joint or end site)
   bool has_ball = false;
+  // The knee's hinge in the thigh's frame: the axis it bends about (the
+  // IK bends the knee the same way as the clips do, even from straight).
+  float hinge[3] = {1.0f, 0.0f, 0.0f};
 };
+
+// The knee's hinge in the thigh's frame from clips' knee rotations: the mean
+// of thigh x shin over their frames, weighted by how much the knee bends.
+glm::vec3 knee_hinge(const glm::vec3& knee_offset, const glm::vec3& ankle_offset, const std::vector<const Clip*>& clips,
+                     std::int32_t knee);
 
 struct ClipInfo {
   std::int32_t first_row = 0;  // of the clip's frames in the stacked texture
@@ -180,6 +188,12 @@ struct BlendSpaceView {
   const glm::vec3* offsets = nullptr;         // joint_count, rest offsets (m)
   LegChain legs[2];                           // left, right: plant_legs
   bool plant_feet = true;
+  // Blend weights snapped to the centres of buckets this wide (0 = exact):
+  // with a motion cache every character shows its bucket's blend, so a
+  // cached cycle is exactly what it would synthesise (speed stays exact,
+  // the cadence follows the snapped stride).
+  float quantum = 0.0f;
+  std::int32_t quantum_buckets = 1;
 
   THRONG_HOST_DEVICE std::int32_t segment_count() const { return clip_count > 1 ? clip_count - 1 : 1; }
 };
@@ -255,6 +269,25 @@ BlendSpace1D make_default_blend_space();
 // ---------------------------------------------------------------------------
 // Per-frame sampling (host and device)
 
+// Buckets of a weight w in [0, 1] of a given width (the last may be
+// narrower): w -> bucket (clamped; NaN -> 0; w = 1 in the last), the bucket's
+// centre, and how many buckets there are.
+THRONG_HOST_DEVICE inline std::int32_t weight_bucket_count(float width) {
+  const double n = glm::ceil(1.0 / static_cast<double>(width) - 1e-6);  // 1 / 0.05 = 20.000000000000004
+  return n > 1.0 ? static_cast<std::int32_t>(n) : 1;
+}
+THRONG_HOST_DEVICE inline std::int32_t weight_bucket(float w, float width, std::int32_t bucket_count) {
+  if (!(w > 0.0f)) return 0;
+  const double b = glm::floor(static_cast<double>(w < 1.0f ? w : 1.0f) / static_cast<double>(width));
+  const auto i = static_cast<std::int32_t>(b);
+  return i < bucket_count - 1 ? i : bucket_count - 1;
+}
+THRONG_HOST_DEVICE inline float weight_bucket_centre(std::int32_t bucket, float width) {
+  const double lo = static_cast<double>(bucket) * width;
+  const double hi = glm::min(1.0, static_cast<double>(bucket + 1) * width);
+  return static_cast<float>(0.5 * (lo + hi));
+}
+
 // Two neighbouring clips and the weight of the second.
 struct BlendPoint {
   std::int32_t a = 0;
@@ -288,10 +321,19 @@ THRONG_HOST_DEVICE inline BlendPoint blend_point(const BlendSpaceView& v, float 
   p.b = k + 1;
   p.segment = k;
   p.w = x - static_cast<float>(k);
+  if (v.quantum > 0.0f) p.w = weight_bucket_centre(weight_bucket(p.w, v.quantum, v.quantum_buckets), v.quantum);
   return p;
 }
 
 THRONG_HOST_DEVICE inline float mix_weight(float a, float b, float w) { return a + w * (b - a); }
+
+// How far a clip's phase runs ahead of the canonical phase, in [-1/2, 1/2):
+// a warp moves phases by far less than half a cycle, so this is the lead
+// even when one of the two has just wrapped.
+THRONG_HOST_DEVICE inline float phase_lead(float clip_phase, float phase) {
+  const float d = clip_phase - phase;
+  return d - glm::floor(d + 0.5f);
+}
 
 // Each clip's phase at the canonical (blended) phase under one warp:
 // piecewise linear between the markers. w = 0 gives clip a the canonical
@@ -408,7 +450,7 @@ THRONG_HOST_DEVICE inline RootOffset blended_root_offset(const BlendSpaceView& v
     r.position = ob;
     return r;
   }
-  const float da = ph.a - phase, db = ph.b - phase;
+  const float da = phase_lead(ph.a, phase), db = phase_lead(ph.b, phase);
   r.position = oa + p.w * (ob - oa);
   r.position.z += (1.0f - p.w) * a.stride * da + p.w * b.stride * db;
   r.yaw = (1.0f - p.w) * a.turn * da + p.w * b.turn * db;
@@ -523,10 +565,11 @@ THRONG_HOST_DEVICE inline glm::quat rotation_between(const glm::vec3& a, const g
 // Two-bone IK: turns the world rotations of a thigh and its knee so that the
 // ankle (knee_offset, ankle_offset: rest offsets of knee and ankle) reaches
 // `target` from the hip, or as near as the leg reaches. The knee bends about
-// its current hinge axis (law of cosines), then the leg swings about the hip
-// by the shortest arc. False (nothing changed) for a degenerate leg.
+// its hinge (`hinge`: the axis in the thigh's frame, see LegChain) to the
+// angle the law of cosines gives, never backwards; then the leg swings about
+// the hip by the shortest arc. False (nothing changed) for a degenerate leg.
 THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3& knee_offset, const glm::vec3& ankle_offset,
-                                           const glm::vec3& target, glm::quat& r_thigh, glm::quat& r_knee) {
+                                           const glm::vec3& hinge, const glm::vec3& target, glm::quat& r_thigh, glm::quat& r_knee) {
   const glm::vec3 upper = r_thigh * knee_offset;
   const glm::vec3 lower = r_knee * ankle_offset;
   const float l1 = glm::length(upper), l2 = glm::length(lower);
@@ -535,13 +578,27 @@ THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3
   float d = glm::length(to_target);
   const float d_min = glm::abs(l1 - l2) + 1e-4f, d_max = 0.9999f * (l1 + l2);
   d = d < d_min ? d_min : (d > d_max ? d_max : d);
-  glm::vec3 axis = glm::cross(upper, lower);
-  if (glm::dot(axis, axis) < 1e-10f) axis = r_thigh * glm::vec3(1.0f, 0.0f, 0.0f);  // straight leg: the thigh's x axis
-  axis = glm::normalize(axis);
-  const float cos_now = glm::dot(upper, lower) / (l1 * l2);
+  // Bend about the plane of thigh and shin while the knee bends the way its
+  // hinge says; when the leg is straight (no plane) or bent backwards,
+  // about the hinge (perpendicular to the thigh) instead.
+  const glm::vec3 u = upper / l1;
+  glm::vec3 hinge_world = r_thigh * hinge;
+  hinge_world -= glm::dot(hinge_world, u) * u;
+  const glm::vec3 normal = glm::cross(upper, lower);
+  const float area = glm::length(normal);
+  glm::vec3 axis;
+  float bend_now;
+  if (area > 1e-3f * l1 * l2 && glm::dot(normal, hinge_world) >= 0.0f) {
+    axis = normal / area;
+    bend_now = glm::acos(glm::clamp(glm::dot(upper, lower) / (l1 * l2), -1.0f, 1.0f));
+  } else {
+    if (glm::dot(hinge_world, hinge_world) < 1e-10f) return false;
+    axis = glm::normalize(hinge_world);
+    bend_now = glm::atan(glm::dot(normal, axis), glm::dot(upper, lower));
+  }
   const float cos_want = (d * d - l1 * l1 - l2 * l2) / (2.0f * l1 * l2);
-  const float bend = glm::acos(glm::clamp(cos_want, -1.0f, 1.0f)) - glm::acos(glm::clamp(cos_now, -1.0f, 1.0f));
-  r_knee = glm::angleAxis(bend, axis) * r_knee;
+  const float bend_want = glm::acos(glm::clamp(cos_want, -1.0f, 1.0f));
+  r_knee = glm::angleAxis(bend_want - bend_now, axis) * r_knee;
   const glm::vec3 ankle_now = upper + r_knee * ankle_offset;
   if (glm::dot(ankle_now, ankle_now) > 1e-12f && glm::dot(to_target, to_target) > 1e-12f) {
     const glm::quat swing = rotation_between(glm::normalize(ankle_now), glm::normalize(to_target));
@@ -556,22 +613,30 @@ THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3
 // in the blend. Eq. 10's root is exactly the lerp of the clips' roots, so a
 // foot is exactly planted when its ankle, relative to the root, is the lerp
 // of the clips' ankles. Per leg: forward kinematics of the root-to-ankle
-// chain in each clip gives that target; analytic two-bone IK (knee angle by
-// the law of cosines about the knee's hinge, then a swing about the hip)
-// puts the blended ankle on it; the foot keeps its blended world rotation.
-// Nothing changes at w = 0 or 1, nor for a leg whose thigh or knee the mask
-// turns off. corrected[leg][0..2]: local rotations of thigh, knee, ankle.
-// The point matched is the ankle while the heel is down and the ball of the
-// foot once the heel is up (kHeelLift above the ankle's lowest height), as
-// feet roll over the ball. Blending a stationary clip (idle) with a walk
-// would also scale the step's foot lift down with w, so the foot drags:
-// there the lift comes from the walk (ramped in over w in [0, kLiftRamp]).
+// chain in each clip (at that leg's synchronised phase) gives that target;
+// analytic two-bone IK (two_bone_ik) puts the blended ankle on it; the foot
+// keeps its blended world rotation. Nothing changes at w = 0 or 1, nor for a
+// leg whose thigh or knee the mask turns off. corrected[leg][0..2]: local
+// rotations of thigh, knee, ankle.
+// * The point matched is the ankle while the heel is down and the ball of
+//   the foot once the heel is up (kHeelLift above the ankle's lowest
+//   height), as feet roll over the ball.
+// * A leg synchronised apart from the body can find its target beyond reach
+//   (the pelvis is at the body's phase): the pelvis drops just enough for
+//   both targets to be within kReach of the legs' length (at most
+//   kMaxPelvisDrop; pelvis_drop, metres at scale 1, lowers the root).
+// * Blending a stationary clip (idle) with a walk would also scale the
+//   step's foot lift down with w, so the foot drags: there the lift comes
+//   from the walk (ramped in over w in [0, kLiftRamp]).
 inline constexpr float kLiftRamp = 0.25f;
 inline constexpr float kHeelLift = 0.03f;
+inline constexpr float kReach = 0.998f;
+inline constexpr float kMaxPelvisDrop = 0.15f;
 struct PlantedLegs {
   bool active[2] = {false, false};
   bool ankle[2] = {false, false};
   glm::quat corrected[2][3];
+  float pelvis_drop = 0.0f;
 };
 THRONG_HOST_DEVICE inline bool mask_bit(const std::uint32_t* mask, std::int32_t joint) {
   return mask == nullptr || ((mask[joint >> 5] >> (joint & 31)) & 1u) != 0u;
@@ -580,6 +645,11 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
   PlantedLegs out;
   if (!v.plant_feet || f.point.w <= 0.0f || f.point.w >= 1.0f) return out;
   const BlendPoint& p = f.point;
+  // Per leg, before the IK: target, hip, and the blended world rotations.
+  glm::vec3 target[2], hip[2];
+  glm::quat hip_parent[2], r_thigh[2], r_knee[2], r_foot[2];
+  bool use[2] = {false, false};
+  float drop = 0.0f;
   for (int leg = 0; leg < 2; ++leg) {
     const LegChain& chain = v.legs[leg];
     const std::int32_t n = chain.count;
@@ -595,7 +665,7 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
       const std::int32_t clip = c == 0 ? p.a : p.b;
       const float clip_phase = c == 0 ? f.phases[1 + leg].a : f.phases[1 + leg].b;
       const ClipInfo& info = v.clips[clip];
-      const float ahead = clip_phase - f.phase;
+      const float ahead = phase_lead(clip_phase, f.phase);
       glm::vec3 pos = clip_root_offset(v, clip, clip_phase);
       pos.z += info.stride * ahead;
       glm::quat rot = yaw_quat(info.turn * ahead) * clip_rotation(v, clip, clip_phase, chain.joints[0]);
@@ -616,28 +686,45 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
       pos += rot * v.offsets[chain.joints[i]];
       rot = rot * joint_rotation(v, f, chain.joints[i]);
     }
-    const glm::quat hip_parent = rot;
-    const glm::vec3 hip = pos + rot * v.offsets[thigh];
-    glm::quat r_thigh = hip_parent * joint_rotation(v, f, thigh);
-    glm::quat r_knee = r_thigh * joint_rotation(v, f, knee);
+    hip_parent[leg] = rot;
+    hip[leg] = pos + rot * v.offsets[thigh];
+    r_thigh[leg] = rot * joint_rotation(v, f, thigh);
+    r_knee[leg] = r_thigh[leg] * joint_rotation(v, f, knee);
     const bool has_ankle = mask_bit(mask, ankle);
-    const glm::quat r_foot = has_ankle ? r_knee * joint_rotation(v, f, ankle) : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    r_foot[leg] = has_ankle ? r_knee[leg] * joint_rotation(v, f, ankle) : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
     // The pivot: the ankle while the blended heel is down, then the ball.
-    glm::vec3 target = ankle_target;
+    glm::vec3 t = ankle_target;
     if (chain.has_ball && has_ankle) {
       const float heel = glm::clamp((ankle_target.y - ground) / kHeelLift, 0.0f, 1.0f);
-      target += heel * (ball_target - r_foot * ball_offset - ankle_target);
+      t += heel * (ball_target - r_foot[leg] * ball_offset - ankle_target);
     }
     if (v.clips[p.a].stride <= kMinStride && v.clips[p.b].stride > kMinStride) {
       const float ramp = p.w < kLiftRamp ? p.w / kLiftRamp : 1.0f;
-      target.y += ramp * (1.0f - p.w) * (lift[1] - lift[0]);
+      t.y += ramp * (1.0f - p.w) * (lift[1] - lift[0]);
     }
-    if (!two_bone_ik(hip, v.offsets[knee], v.offsets[ankle], target, r_thigh, r_knee)) continue;
-    out.active[leg] = true;
+    target[leg] = t;
+    use[leg] = true;
     out.ankle[leg] = has_ankle;
-    out.corrected[leg][0] = glm::inverse(hip_parent) * r_thigh;
-    out.corrected[leg][1] = glm::inverse(r_thigh) * r_knee;
-    out.corrected[leg][2] = has_ankle ? glm::inverse(r_knee) * r_foot : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    // How far the pelvis must drop for this leg to reach.
+    const float reach = kReach * (glm::length(v.offsets[knee]) + glm::length(v.offsets[ankle]));
+    const glm::vec3 d = t - hip[leg];
+    const float across = d.x * d.x + d.z * d.z;
+    if (across < reach * reach) drop = glm::max(drop, -d.y - glm::sqrt(reach * reach - across));
+  }
+  out.pelvis_drop = glm::min(drop, kMaxPelvisDrop);
+  for (int leg = 0; leg < 2; ++leg) {
+    if (!use[leg]) continue;
+    const LegChain& chain = v.legs[leg];
+    const std::int32_t n = chain.count;
+    const std::int32_t knee = chain.joints[n - 2], ankle = chain.joints[n - 1];
+    const glm::vec3 lowered = hip[leg] - glm::vec3(0.0f, out.pelvis_drop, 0.0f);
+    if (!two_bone_ik(lowered, v.offsets[knee], v.offsets[ankle], glm::vec3(chain.hinge[0], chain.hinge[1], chain.hinge[2]),
+                     target[leg], r_thigh[leg], r_knee[leg]))
+      continue;
+    out.active[leg] = true;
+    out.corrected[leg][0] = glm::inverse(hip_parent[leg]) * r_thigh[leg];
+    out.corrected[leg][1] = glm::inverse(r_thigh[leg]) * r_knee[leg];
+    out.corrected[leg][2] = out.ankle[leg] ? glm::inverse(r_knee[leg]) * r_foot[leg] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   }
   return out;
 }
@@ -663,7 +750,7 @@ THRONG_HOST_DEVICE inline void synthesise_pose(const BlendSpaceView& v, const Ch
     const glm::quat local = synthesised_rotation(v, f, legs, j);
     const std::int32_t p = v.parents[j];
     if (p < 0) {
-      out_positions[j] = f.root_position;
+      out_positions[j] = f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f);
       out_rotations[j] = f.frame * local;
     } else {
       out_positions[j] = out_positions[p] + out_rotations[p] * (f.scale * v.offsets[j]);
