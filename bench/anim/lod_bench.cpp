@@ -1,9 +1,11 @@
-// Joint LOD and motion cache: the per-frame LOD stage for crowds of 10^3 to
-// 10^6 characters under an orbiting camera, and cache lookups.
+// Joint LOD, motion cache and locomotion: the per-frame LOD stage for crowds
+// of 10^3 to 10^6 characters under an orbiting camera, cache lookups, and the
+// whole locomotion frame (the 2019 paper's Figures 10 and 11).
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include "anim/locomotion.h"
 #include "anim/lod.h"
 #include "anim/motion_cache.h"
 #include "bench/registry.h"
@@ -168,6 +170,59 @@ void register_anim(const Options& options) {
                   state.SetItemsProcessed(state.iterations() * n);
                 },
                 true});
+
+  // The 2019 paper's Figures 10 and 11: one frame of locomotion for N
+  // characters (speed -> blend, phase, root motion, pose of every joint as
+  // world transforms) with full skeletons, + joint LOD under a camera
+  // orbiting the crowd, + the motion cache with every character's speed
+  // changing every 5 s. The registry runs each on 1 thread (the paper's CPU
+  // baseline) and on all threads, and on the GPU when there is one.
+  struct Variant {
+    const char* name;
+    bool lod, cache;
+  };
+  for (const Variant variant : {Variant{"anim/locomotion_full", false, false}, Variant{"anim/locomotion_lod", true, false},
+                                Variant{"anim/locomotion_lod_cache", true, true}}) {
+    add(options, {variant.name, {1000, 5000, 10000, 50000, 100000, 1000000},
+                  [variant](benchmark::State& state, Index n) {
+                    static const motion::BlendSpace1D space = motion::make_default_blend_space();
+                    GridCrowd crowd(n);
+                    const std::vector<glm::vec3> positions = crowd.positions.to_vector();
+                    const std::vector<float> yaws = crowd.headings.to_vector();
+                    CrowdAnimatorConfig config;
+                    config.lod = variant.lod;
+                    config.cache = variant.cache;
+                    CrowdAnimator animator(space, n, config);
+                    std::mt19937 rng(4);
+                    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+                    std::vector<float> phases(static_cast<std::size_t>(n)), speeds(static_cast<std::size_t>(n));
+                    for (float& p : phases) p = unit(rng);
+                    const auto new_speeds = [&] {
+                      for (float& v : speeds) v = space.max_speed() * unit(rng);
+                      animator.set_speeds(speeds);
+                    };
+                    animator.place(positions, yaws, {}, phases);
+                    new_speeds();
+                    constexpr float kDt = 1.0f / 60.0f;
+                    constexpr int kFramesPerSpeed = 300;  // 5 s
+                    int frame = 0;
+                    const auto step = [&] {
+                      if (variant.cache && frame > 0 && frame % kFramesPerSpeed == 0) new_speeds();
+                      const Camera cam = orbit_at(crowd.half_extent, static_cast<float>(frame) * kDt);
+                      animator.animate({kDt, variant.lod ? &cam : nullptr, true});
+                      ++frame;
+                    };
+                    // Warm up: the cache fills with the cycles these speeds need.
+                    step();
+                    while (variant.cache && animator.last_frame().cycles_stored > 0) step();
+                    for (auto _ : state) step();
+                    state.SetItemsProcessed(state.iterations() * n);
+                    state.counters["joints_per_character"] =
+                        static_cast<double>(animator.last_frame().joints_synthesised) / static_cast<double>(n);
+                    state.counters["from_cache"] = static_cast<double>(animator.last_frame().from_cache) / static_cast<double>(n);
+                  },
+                  true});
+  }
 
   // Cache reads: a bucket lookup plus a SLERP pose at the character's phase.
   add(options, {"anim/motion_cache_sample", {1000, 100000},

@@ -21,14 +21,14 @@ struct SynthesisedJoint {
   }
 };
 
-// ... and when it reads a cached cycle: SLERP between two cycle frames.
+// ... and when it reads a cached cycle: between two neighbouring cycle frames.
 struct CachedJoint {
   const glm::quat* a;
   const glm::quat* b;
   float t;
   glm::quat frame;
   THRONG_HOST_DEVICE glm::quat operator()(std::int32_t joint) const {
-    const glm::quat q = motion::slerp_shortest(a[joint], b[joint], t);
+    const glm::quat q = motion::interpolate_frames(a[joint], b[joint], t);
     return joint == 0 ? frame * q : q;
   }
 };

@@ -362,37 +362,66 @@ THRONG_HOST_DEVICE inline ClipPhases warp_phase(const SyncMarkers& s, float w, f
   return out;
 }
 
-// A joint's local rotation in one clip at that clip's phase: SLERP between
-// the two neighbouring frames (texelFetch of the orientation texel).
+// Where a clip's phase falls in the stacked texture: two neighbouring rows
+// and the fraction between them (computed once per clip and phase, used for
+// every joint).
+struct ClipRows {
+  std::int32_t r0 = 0;
+  std::int32_t r1 = 0;
+  float t = 0.0f;
+};
+THRONG_HOST_DEVICE inline ClipRows clip_rows(const BlendSpaceView& v, std::int32_t clip, float clip_phase) {
+  const ClipInfo& c = v.clips[clip];
+  const CyclePoint cp = cycle_point(c.rows, clip_phase);
+  ClipRows r;
+  r.r0 = c.first_row + cp.f0;
+  r.r1 = c.first_row + cp.f1;
+  r.t = cp.t;
+  return r;
+}
+
+// The orientation texel of a joint on a row (texelFetch semantics; rows
+// from clip_rows are always inside the texture).
 THRONG_HOST_DEVICE inline glm::quat texel_quat(const MotionTextureView& t, std::int32_t joint, std::int32_t row) {
+  if (t.format == TexelFormat::Float32) {
+    const float* q = t.texels_f32 + (static_cast<Index>(row) * t.width + 2 * joint) * 4;
+    return glm::quat(q[3], q[0], q[1], q[2]);
+  }
   const glm::vec4 r = t.texel_fetch(2 * joint, row);
-  const glm::quat q(r.w, r.x, r.y, r.z);
-  return t.format == TexelFormat::Float32 ? q : glm::normalize(q);
+  return glm::normalize(glm::quat(r.w, r.x, r.y, r.z));
+}
+
+// A joint's local rotation in one clip between its two rows (interpolate_frames).
+THRONG_HOST_DEVICE inline glm::quat clip_rotation(const BlendSpaceView& v, const ClipRows& r, std::int32_t joint) {
+  const glm::quat q0 = texel_quat(v.texture, joint, r.r0);
+  if (r.t <= 0.0f) return q0;
+  return interpolate_frames(q0, texel_quat(v.texture, joint, r.r1), r.t);
 }
 THRONG_HOST_DEVICE inline glm::quat clip_rotation(const BlendSpaceView& v, std::int32_t clip, float clip_phase, std::int32_t joint) {
-  const ClipInfo& c = v.clips[clip];
-  const CyclePoint cp = cycle_point(c.rows, clip_phase);
-  const glm::quat q0 = texel_quat(v.texture, joint, c.first_row + cp.f0);
-  if (cp.t <= 0.0f) return q0;
-  return slerp_shortest(q0, texel_quat(v.texture, joint, c.first_row + cp.f1), cp.t);
+  return clip_rotation(v, clip_rows(v, clip, clip_phase), joint);
 }
 // The root's offset from the path point (path frame, scale 1) in one clip.
+THRONG_HOST_DEVICE inline glm::vec3 clip_root_offset(const BlendSpaceView& v, const ClipRows& r) {
+  const glm::vec3 p0(v.texture.texel_fetch(1, r.r0));
+  if (r.t <= 0.0f) return p0;
+  const glm::vec3 p1(v.texture.texel_fetch(1, r.r1));
+  return p0 + r.t * (p1 - p0);
+}
 THRONG_HOST_DEVICE inline glm::vec3 clip_root_offset(const BlendSpaceView& v, std::int32_t clip, float clip_phase) {
-  const ClipInfo& c = v.clips[clip];
-  const CyclePoint cp = cycle_point(c.rows, clip_phase);
-  const glm::vec3 p0(v.texture.texel_fetch(1, c.first_row + cp.f0));
-  if (cp.t <= 0.0f) return p0;
-  const glm::vec3 p1(v.texture.texel_fetch(1, c.first_row + cp.f1));
-  return p0 + cp.t * (p1 - p0);
+  return clip_root_offset(v, clip_rows(v, clip, clip_phase));
 }
 
 // The blended local rotation of a joint: SLERP (shortest arc) of the two
 // clips' rotations by w; w = 0 and w = 1 return a clip's sample exactly.
+THRONG_HOST_DEVICE inline glm::quat blended_rotation(const BlendSpaceView& v, float w, const ClipRows& a, const ClipRows& b,
+                                                     std::int32_t joint) {
+  if (w <= 0.0f) return clip_rotation(v, a, joint);
+  if (w >= 1.0f) return clip_rotation(v, b, joint);
+  return slerp_shortest(clip_rotation(v, a, joint), clip_rotation(v, b, joint), w);
+}
 THRONG_HOST_DEVICE inline glm::quat blended_rotation(const BlendSpaceView& v, const BlendPoint& p, const ClipPhases& ph,
                                                      std::int32_t joint) {
-  if (p.w <= 0.0f) return clip_rotation(v, p.a, ph.a, joint);
-  if (p.w >= 1.0f) return clip_rotation(v, p.b, ph.b, joint);
-  return slerp_shortest(clip_rotation(v, p.a, ph.a, joint), clip_rotation(v, p.b, ph.b, joint), p.w);
+  return blended_rotation(v, p.w, clip_rows(v, p.a, ph.a), clip_rows(v, p.b, ph.b), joint);
 }
 
 // What a joint holds when LOD turns it off: the mean rotation of the clip
@@ -520,6 +549,7 @@ THRONG_HOST_DEVICE inline void advance_locomotion(const BlendSpaceView& v, const
 struct CharacterFrame {
   BlendPoint point;
   ClipPhases phases[kSyncGroups];  // per sync group (SegmentSync)
+  ClipRows rows[kSyncGroups][2];    // the same as texture rows, clip a and clip b
   float phase = 0.0f;  // canonical, [0, 1)
   RootOffset root;     // in the path frame, scale 1
   glm::vec3 root_position{0.0f};
@@ -532,7 +562,11 @@ THRONG_HOST_DEVICE inline CharacterFrame character_frame_at(const BlendSpaceView
   f.point = point;
   f.phase = wrap_phase(phase);
   const SegmentSync& sync = v.sync[f.point.segment];
-  for (int g = 0; g < kSyncGroups; ++g) f.phases[g] = warp_phase(sync.group[g], f.point.w, f.phase);
+  for (int g = 0; g < kSyncGroups; ++g) {
+    f.phases[g] = warp_phase(sync.group[g], f.point.w, f.phase);
+    f.rows[g][0] = clip_rows(v, f.point.a, f.phases[g].a);
+    f.rows[g][1] = clip_rows(v, f.point.b, f.phases[g].b);
+  }
   f.scale = scale > 0.0f ? scale : 1.0f;
   f.root = blended_root_offset(v, f.point, f.phase, f.phases[0]);
   const glm::quat heading = yaw_quat(yaw);
@@ -547,7 +581,8 @@ THRONG_HOST_DEVICE inline CharacterFrame character_frame(const BlendSpaceView& v
 
 // A joint's blended local rotation at its sync group's phases.
 THRONG_HOST_DEVICE inline glm::quat joint_rotation(const BlendSpaceView& v, const CharacterFrame& f, std::int32_t joint) {
-  return blended_rotation(v, f.point, f.phases[v.joint_group[joint]], joint);
+  const std::uint8_t g = v.joint_group[joint];
+  return blended_rotation(v, f.point.w, f.rows[g][0], f.rows[g][1], joint);
 }
 
 // Rotation taking unit vector a onto unit vector b along the shorter arc.
@@ -664,14 +699,16 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
     for (int c = 0; c < 2; ++c) {
       const std::int32_t clip = c == 0 ? p.a : p.b;
       const float clip_phase = c == 0 ? f.phases[1 + leg].a : f.phases[1 + leg].b;
+      const ClipRows& rows = f.rows[1 + leg][c];
       const ClipInfo& info = v.clips[clip];
       const float ahead = phase_lead(clip_phase, f.phase);
-      glm::vec3 pos = clip_root_offset(v, clip, clip_phase);
+      glm::vec3 pos = clip_root_offset(v, rows);
       pos.z += info.stride * ahead;
-      glm::quat rot = yaw_quat(info.turn * ahead) * clip_rotation(v, clip, clip_phase, chain.joints[0]);
+      glm::quat rot = clip_rotation(v, rows, chain.joints[0]);
+      if (info.turn != 0.0f) rot = yaw_quat(info.turn * ahead) * rot;
       for (std::int32_t i = 1; i < n; ++i) {
         pos += rot * v.offsets[chain.joints[i]];
-        rot = rot * clip_rotation(v, clip, clip_phase, chain.joints[i]);
+        rot = rot * clip_rotation(v, rows, chain.joints[i]);
       }
       const float weight = c == 0 ? 1.0f - p.w : p.w;
       ankle_target += weight * pos;

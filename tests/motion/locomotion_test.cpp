@@ -55,6 +55,26 @@ TEST(LocomotionSlerp, SlerpShortestMatchesTheExponentialMapAndKeepsEndsExact) {
   EXPECT_EQ(slerp_shortest(a, b, 1.0f), b);
 }
 
+// Within a clip, neighbouring frames are interpolated by normalised lerp:
+// on every pair of neighbouring frames of every clip, at several fractions,
+// it stays within 1e-3 degrees of SLERP.
+TEST(LocomotionSlerp, NeighbouringFramesInterpolateAsSlerpDoes) {
+  const BlendSpace1D& space = default_space();
+  double worst = 0.0, widest = 0.0;
+  for (const LocomotionClip& c : space.clips()) {
+    const std::int32_t F = c.frame_count();
+    for (std::int32_t i = 0; i < F; ++i)
+      for (std::int32_t j = 0; j < space.joint_count(); ++j) {
+        const glm::quat a = c.cycle.rotation(i, j), b = c.cycle.rotation((i + 1) % F, j);
+        widest = std::max(widest, angle_deg(glm::dquat(a), glm::dquat(b)));
+        for (float t : {0.1f, 0.25f, 0.5f, 0.8f})
+          worst = std::max(worst, angle_deg(glm::dquat(interpolate_frames(a, b, t)), reference_slerp(glm::dquat(a), glm::dquat(b), t)));
+      }
+  }
+  std::printf("neighbouring frames up to %.2f deg apart; normalised lerp within %.2e deg of SLERP\n", widest, worst);
+  EXPECT_LT(worst, 1e-3);
+}
+
 TEST(LocomotionSlerp, BlendedRotationIsTheReferenceSlerpOfBothClipsSamples) {
   const BlendSpace1D& space = default_space();
   const BlendSpaceView v = space.view();
