@@ -64,9 +64,11 @@ THRONG_HOST_DEVICE inline glm::quat slerp_shortest(const glm::quat& a, const glm
 }
 
 // Between two neighbouring frames of a cycle (a few degrees apart)
-// normalised lerp on the shorter arc is SLERP to within 1e-3 degrees
-// (tested on every clip), at a fraction of its cost (no acos, no sin); the
-// blend between clips, whose poses differ by far more, uses true SLERP.
+// normalised lerp on the shorter arc is SLERP to within 0.01 degrees (the
+// error grows with the cube of the angle; tested on every frame pair of the
+// default clips, up to 18 degrees apart) at a fraction of its cost (no acos,
+// no sin); the blend between clips, whose poses differ by far more, uses
+// true SLERP.
 THRONG_HOST_DEVICE inline glm::quat interpolate_frames(const glm::quat& a, const glm::quat& b, float t) {
   if (t <= 0.0f) return a;
   const float k = glm::dot(a, b) < 0.0f ? -1.0f : 1.0f;

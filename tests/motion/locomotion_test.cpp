@@ -56,8 +56,9 @@ TEST(LocomotionSlerp, SlerpShortestMatchesTheExponentialMapAndKeepsEndsExact) {
 }
 
 // Within a clip, neighbouring frames are interpolated by normalised lerp:
-// on every pair of neighbouring frames of every clip, at several fractions,
-// it stays within 1e-3 degrees of SLERP.
+// on every pair of neighbouring frames of every clip (up to ~18 degrees
+// apart: a fast run's toes), at several fractions, it stays within 0.01
+// degrees of SLERP (the error grows with the cube of the angle).
 TEST(LocomotionSlerp, NeighbouringFramesInterpolateAsSlerpDoes) {
   const BlendSpace1D& space = default_space();
   double worst = 0.0, widest = 0.0;
@@ -72,7 +73,7 @@ TEST(LocomotionSlerp, NeighbouringFramesInterpolateAsSlerpDoes) {
       }
   }
   std::printf("neighbouring frames up to %.2f deg apart; normalised lerp within %.2e deg of SLERP\n", widest, worst);
-  EXPECT_LT(worst, 1e-3);
+  EXPECT_LT(worst, 1e-2);
 }
 
 TEST(LocomotionSlerp, BlendedRotationIsTheReferenceSlerpOfBothClipsSamples) {
