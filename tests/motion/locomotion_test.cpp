@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "motion/default_set.h"
+#include "tests/motion/reference_rotation.h"
 
 namespace throng::motion {
 namespace {
@@ -27,17 +28,7 @@ double angle_deg(const glm::dquat& a, const glm::dquat& b) {
   return 2.0 * std::atan2(std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z), std::abs(r.w)) * 180.0 / kPi;
 }
 
-// q0 (q0^-1 q1)^t through log and exp, on the shorter arc.
-glm::dquat reference_slerp(glm::dquat q0, glm::dquat q1, double t) {
-  if (glm::dot(q0, q1) < 0.0) q1 = -q1;
-  const glm::dquat r = glm::inverse(q0) * q1;
-  const glm::dvec3 v(r.x, r.y, r.z);
-  const double s = glm::length(v);
-  if (s < 1e-15) return q0;
-  const double half = std::atan2(s, r.w) * t;
-  const glm::dvec3 axis = v / s;
-  return q0 * glm::dquat(std::cos(half), axis.x * std::sin(half), axis.y * std::sin(half), axis.z * std::sin(half));
-}
+using test::reference_slerp;
 
 TEST(LocomotionSlerp, SlerpShortestMatchesTheExponentialMapAndKeepsEndsExact) {
   std::mt19937 rng(7);
