@@ -1,21 +1,22 @@
 // Locomotion synthesis by speed: the 2019 method (blend a slow and a fast
 // cyclic clip joint by joint with SLERP at the same phase; root update
 // p_{f+1} = T(d_{f,w}) R(r_f) S(s_f) p_f), and past it: any number of clips
-// in a 1D blend space, foot-event synchronisation, exact arc integration.
+// in a 1D blend space, foot-event synchronisation (per leg), exact arc
+// integration, leg IK that plants blended feet, foot-skate cleanup of mocap.
 //
 // Two halves:
 // * Host, once: prepare_locomotion_clip / prepare_locomotion_cycle turn a
-//   clip into one clean cycle (loop found and closed, frame 0 at the left
-//   foot's touchdown, root split into a path and an offset from it, foot
-//   events found); BlendSpace1D sorts prepared clips by speed and packs them
-//   into one motion texture plus small tables (BlendSpaceTables puts them in
-//   device memory).
+//   clip into one clean cycle (loop found and closed, root split into a
+//   path and an offset from it, contacts cleaned, foot events found, frame
+//   0 at the left touchdown); BlendSpace1D sorts prepared clips by speed and
+//   packs them into one motion texture plus small tables (BlendSpaceTables
+//   puts them in device memory).
 // * Per frame, host or device: blend_coordinate (speed -> x), blend_point
-//   (x -> two clips and w), clip_phases (the canonical phase -> each clip's
+//   (x -> two clips and w), warp_phase (the canonical phase -> each clip's
 //   phase, synchronised by foot events), blended_rotation (SLERP of the two
-//   clips' SLERP-sampled rotations), advance_locomotion (phase and Eq. 10),
-//   character_frame + synthesise_pose (world joints). Per-frame work is
-//   sampling only. The batch stage for N characters is anim/locomotion.h.
+//   clips' samples), advance_locomotion (phase and Eq. 10), character_frame,
+//   plant_legs, synthesise_pose (world joints). Per-frame work is sampling
+//   only. The batch stage for N characters is anim/locomotion.h.
 //
 // Conventions: Y up, metres, seconds, characters face +Z at yaw 0 and turn
 // left (towards +X) for positive yaw (core/ground.h). The path frame of a
