@@ -129,7 +129,7 @@ std::vector<glm::mat4x3> joint_shapes(const motion::Skeleton& skeleton, float th
 CycleCacheTable::CycleCacheTable(const motion::BlendSpace1D& space, MotionCacheConfig config, std::int32_t frames)
     : space_(&space), cache_(config) {
   if (frames < 0 || frames > 100000) throw Error("must be in [0, 100000]", at_field("motion_cache.frames"));
-  frames_ = frames > 0 ? frames : space.max_frames();
+  frames_ = frames > 0 ? frames : default_cache_frames(space);
   const std::int32_t J = space.joint_count();
   key_count_ = space.segment_count() * cache_.bucket_count();
   const std::size_t cycle_bytes = static_cast<std::size_t>(frames_) * static_cast<std::size_t>(J) * sizeof(glm::quat);
@@ -139,6 +139,17 @@ CycleCacheTable::CycleCacheTable(const motion::BlendSpace1D& space, MotionCacheC
   slots_ = Buffer<std::int32_t>(std::span<const std::int32_t>(host_slots_), current_memory());
   cycles_ = Buffer<glm::quat>(static_cast<Index>(slot_count_) * frames_ * J, current_memory());
   drops_ = Buffer<float>(static_cast<Index>(slot_count_) * frames_, current_memory());
+}
+
+std::int32_t default_cache_frames(const motion::BlendSpace1D& space) {
+  // Every blend's cycle lasts at most the longest moving clip's period (a
+  // blend with idle takes the walk's); idle alone its own.
+  double period = 0.0;
+  for (const motion::LocomotionClip& c : space.clips())
+    if (c.stride_m > motion::kMinStride) period = std::max(period, c.period_s);
+  if (period <= 0.0)
+    for (const motion::LocomotionClip& c : space.clips()) period = std::max(period, c.period_s);
+  return std::clamp(static_cast<std::int32_t>(std::ceil(kCacheSamplesPerSecond * period)), 16, 100000);
 }
 
 CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w, std::vector<float>* drops) const {

@@ -142,8 +142,14 @@ THRONG_HOST_DEVICE inline glm::mat4x3 draw_matrix(const glm::vec3& p, const glm:
 // cycle in a slot of one device buffer, and a slot per key, for PoseJob.
 // Cycles are frames x joints local rotations at the bucket's centre w,
 // synthesised exactly as per-character synthesis (leg IK included).
+// Frames per cached cycle by default: 60 per second of the longest moving
+// clip's period (idle blends take the walk's period; 75 for the default set).
+inline constexpr double kCacheSamplesPerSecond = 60.0;
+std::int32_t default_cache_frames(const motion::BlendSpace1D& space);
+
 class CycleCacheTable {
  public:
+  // frames: per cached cycle; 0 = default_cache_frames(space).
   CycleCacheTable(const motion::BlendSpace1D& space, MotionCacheConfig config, std::int32_t frames = 0);
 
   const MotionCache& cache() const { return cache_; }
@@ -187,7 +193,7 @@ struct CrowdAnimatorConfig {
   std::vector<float> lod_thresholds = default_lod_thresholds();
   bool cache = true;
   MotionCacheConfig cache_config;
-  std::int32_t cache_frames = 0;             // per cached cycle; 0 = the longest clip's
+  std::int32_t cache_frames = 0;             // per cached cycle; 0 = default_cache_frames
   std::int32_t max_new_cycles_per_frame = 16;
   bool draw_matrices = false;  // also write J = F * O (48 bytes per joint)
   void validate() const;

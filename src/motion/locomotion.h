@@ -652,8 +652,9 @@ THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3
 // chain in each clip (at that leg's synchronised phase) gives that target;
 // analytic two-bone IK (two_bone_ik) puts the blended ankle on it; the foot
 // keeps its blended world rotation. Nothing changes at w = 0 or 1, nor for a
-// leg whose thigh or knee the mask turns off. corrected[leg][0..2]: local
-// rotations of thigh, knee, ankle.
+// leg whose thigh, knee or foot the mask turns off (planted feet are a detail
+// of the finest level). corrected[leg][0..2]: local rotations of thigh,
+// knee, ankle.
 // * The point matched is the ankle while the heel is down and the ball of
 //   the foot once the heel is up (kHeelLift above the ankle's lowest
 //   height), as feet roll over the ball.
@@ -670,7 +671,6 @@ inline constexpr float kReach = 0.998f;
 inline constexpr float kMaxPelvisDrop = 0.15f;
 struct PlantedLegs {
   bool active[2] = {false, false};
-  bool ankle[2] = {false, false};
   glm::quat corrected[2][3];
   float pelvis_drop = 0.0f;
 };
@@ -691,7 +691,7 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
     const std::int32_t n = chain.count;
     if (n < 4) continue;
     const std::int32_t thigh = chain.joints[n - 3], knee = chain.joints[n - 2], ankle = chain.joints[n - 1];
-    if (!mask_bit(mask, thigh) || !mask_bit(mask, knee)) continue;
+    if (!mask_bit(mask, thigh) || !mask_bit(mask, knee) || !mask_bit(mask, ankle)) continue;
     // Ankle and ball in each clip, in the path frame at the canonical phase.
     const glm::vec3 ball_offset(chain.ball[0], chain.ball[1], chain.ball[2]);
     glm::vec3 ankle_target(0.0f), ball_target(0.0f);
@@ -728,11 +728,10 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
     hip[leg] = pos + rot * v.offsets[thigh];
     r_thigh[leg] = rot * joint_rotation(v, f, thigh);
     r_knee[leg] = r_thigh[leg] * joint_rotation(v, f, knee);
-    const bool has_ankle = mask_bit(mask, ankle);
-    r_foot[leg] = has_ankle ? r_knee[leg] * joint_rotation(v, f, ankle) : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    r_foot[leg] = r_knee[leg] * joint_rotation(v, f, ankle);
     // The pivot: the ankle while the blended heel is down, then the ball.
     glm::vec3 t = ankle_target;
-    if (chain.has_ball && has_ankle) {
+    if (chain.has_ball) {
       const float heel = glm::clamp((ankle_target.y - ground) / kHeelLift, 0.0f, 1.0f);
       t += heel * (ball_target - r_foot[leg] * ball_offset - ankle_target);
     }
@@ -742,7 +741,6 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
     }
     target[leg] = t;
     use[leg] = true;
-    out.ankle[leg] = has_ankle;
     // How far the pelvis must drop for this leg to reach.
     const float reach = kReach * (glm::length(v.offsets[knee]) + glm::length(v.offsets[ankle]));
     const glm::vec3 d = t - hip[leg];
@@ -762,7 +760,7 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
     out.active[leg] = true;
     out.corrected[leg][0] = glm::inverse(hip_parent[leg]) * r_thigh[leg];
     out.corrected[leg][1] = glm::inverse(r_thigh[leg]) * r_knee[leg];
-    out.corrected[leg][2] = out.ankle[leg] ? glm::inverse(r_knee[leg]) * r_foot[leg] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    out.corrected[leg][2] = glm::inverse(r_knee[leg]) * r_foot[leg];
   }
   return out;
 }
@@ -774,7 +772,7 @@ THRONG_HOST_DEVICE inline glm::quat synthesised_rotation(const BlendSpaceView& v
     if (!legs.active[leg]) continue;
     const LegChain& chain = v.legs[leg];
     for (int k = 0; k < 3; ++k)
-      if (chain.joints[chain.count - 3 + k] == joint && (k < 2 || legs.ankle[leg])) return legs.corrected[leg][k];
+      if (chain.joints[chain.count - 3 + k] == joint) return legs.corrected[leg][k];
   }
   return joint_rotation(v, f, joint);
 }

@@ -193,9 +193,9 @@ TEST(CrowdAnimator, MaskedJointsAreNotSynthesised) {
     const auto lm = locals_of(world_masked, J, c);
     const auto lf = locals_of(world_full, J, c);
     const glm::quat* held = motion::held_rotations(v, motion::blend_point(v, motion::blend_coordinate(v, speeds[static_cast<std::size_t>(c)])));
-    // A leg whose foot LOD dropped aims its IK at the ankle alone (there is
-    // no synthesised foot to roll over the ball): its thigh and knee differ
-    // from full synthesis by design and are left out here.
+    // A leg whose foot LOD dropped is not planted (planted feet are a
+    // detail of the finest level): its thigh and knee are the plain blend,
+    // not full synthesis's IK, and are left out here.
     std::vector<std::uint8_t> ik_without_foot(static_cast<std::size_t>(J), 0);
     for (const motion::LegChain& leg : v.legs) {
       const std::int32_t thigh = leg.joints[leg.count - 3], knee = leg.joints[leg.count - 2], ankle = leg.joints[leg.count - 1];
@@ -264,7 +264,7 @@ TEST(CycleCache, CountsCharactersAndEvictsFirstInFirstOut) {
   Crowd crowd = random_crowd(n, 15);
   CrowdAnimatorConfig config;
   config.lod = false;
-  config.cache_config.capacity_bytes = 3 * static_cast<std::size_t>(space().max_frames()) * space().joint_count() * sizeof(glm::quat);
+  config.cache_config.capacity_bytes = 3 * static_cast<std::size_t>(default_cache_frames(space())) * space().joint_count() * sizeof(glm::quat);
   CrowdAnimator animator(space(), n, config);
   animator.place(crowd.positions, crowd.yaws, {}, crowd.phases);  // scale 1: one blend speed, one key
   ASSERT_EQ(animator.cache()->slot_count(), 3);
