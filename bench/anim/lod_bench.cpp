@@ -1,9 +1,11 @@
-// Joint LOD and motion cache: the per-frame LOD stage for crowds of 10^3 to
-// 10^6 characters under an orbiting camera, and cache lookups.
+// Joint LOD, motion cache and locomotion: the per-frame LOD stage for crowds
+// of 10^3 to 10^6 characters under an orbiting camera, cache lookups, and the
+// whole locomotion frame (the 2019 paper's Figures 10 and 11).
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include "anim/locomotion.h"
 #include "anim/lod.h"
 #include "anim/motion_cache.h"
 #include "bench/registry.h"
@@ -169,56 +171,55 @@ void register_anim(const Options& options) {
                 },
                 true});
 
-  // Per-character pose (a SLERP per synthesised joint, then forward
-  // kinematics): every joint, then only the joints the LOD masks keep.
-  for (const bool lod : {false, true}) {
-    add(options, {lod ? "anim/masked_pose_lod" : "anim/masked_pose_full", {1000, 10000, 100000},
-                  [lod](benchmark::State& state, Index n) {
-                    const motion::Skeleton skeleton = bench_skeleton();
-                    const BodyParts parts = make_body_parts(skeleton);
-                    const LodConfig config = make_lod_config(parts, default_lod_thresholds());
-                    const LodTables tables(config, current_memory());
-                    const std::int32_t J = skeleton.joint_count();
-                    const std::int32_t F = 30;
+  // The 2019 paper's Figures 10 and 11: one frame of locomotion for N
+  // characters (speed -> blend, phase, root motion, pose of every joint as
+  // world transforms) with full skeletons, + joint LOD under a camera
+  // orbiting the crowd, + the motion cache with every character's speed
+  // changing every 5 s. The registry runs each on 1 thread (the paper's CPU
+  // baseline) and on all threads, and on the GPU when there is one.
+  struct Variant {
+    const char* name;
+    bool lod, cache;
+  };
+  for (const Variant variant : {Variant{"anim/locomotion_full", false, false}, Variant{"anim/locomotion_lod", true, false},
+                                Variant{"anim/locomotion_lod_cache", true, true}}) {
+    add(options, {variant.name, {1000, 5000, 10000, 50000, 100000, 1000000},
+                  [variant](benchmark::State& state, Index n) {
+                    static const motion::BlendSpace1D space = motion::make_default_blend_space();
                     GridCrowd crowd(n);
-                    Buffer<std::uint8_t> levels(n * kBodyPartCount, current_memory());
-                    Buffer<std::uint32_t> masks(n * config.mask_words, current_memory());
-                    LodJob job;
-                    job.set_tables(tables);
-                    job.camera = make_camera_view(orbit_at(crowd.half_extent, 0.0f));
-                    job.root_positions = crowd.positions.span();
-                    job.root_headings = crowd.headings.span();
-                    job.template_spheres = parts.rest_spheres;
-                    job.levels = levels.span();
-                    job.joint_masks = masks.span();
-                    job.run();
-                    if (!lod) masks = Buffer<std::uint32_t>(std::vector<std::uint32_t>(static_cast<std::size_t>(n), (1u << J) - 1u), current_memory());
-                    std::vector<glm::quat> clip;
-                    for (std::int32_t i = 0; i < F * J; ++i)
-                      clip.push_back(glm::angleAxis(0.05f * static_cast<float>(i % 37), glm::normalize(glm::vec3(1.0f, 0.2f * static_cast<float>(i % 5), 0.5f))));
-                    std::vector<float> phases;
-                    for (Index i = 0; i < n; ++i) phases.push_back(static_cast<float>(i % 97) / 97.0f);
-                    const Buffer<std::int32_t> parents(std::span<const std::int32_t>(skeleton.parents), current_memory());
-                    const Buffer<glm::vec3> offsets(std::span<const glm::vec3>(skeleton.offsets), current_memory());
-                    const Buffer<glm::quat> clip_buf(std::span<const glm::quat>(clip), current_memory());
-                    const Buffer<float> phase_buf(std::span<const float>(phases), current_memory());
-                    Buffer<glm::vec3> out_p(n * J, current_memory());
-                    Buffer<glm::quat> out_r(n * J, current_memory());
-                    Buffer<std::int32_t> evaluated(n, current_memory());
-                    MaskedPoseJob pose;
-                    pose.joint_count = J;
-                    pose.frame_count = F;
-                    pose.parents = parents.span();
-                    pose.offsets = offsets.span();
-                    pose.clip_rotations = clip_buf.span();
-                    pose.phases = phase_buf.span();
-                    pose.root_positions = crowd.positions.span();
-                    pose.joint_masks = masks.span();
-                    pose.out_positions = out_p.span();
-                    pose.out_rotations = out_r.span();
-                    pose.evaluated = evaluated.span();
-                    for (auto _ : state) pose.run();
+                    const std::vector<glm::vec3> positions = crowd.positions.to_vector();
+                    const std::vector<float> yaws = crowd.headings.to_vector();
+                    CrowdAnimatorConfig config;
+                    config.lod = variant.lod;
+                    config.cache = variant.cache;
+                    CrowdAnimator animator(space, n, config);
+                    std::mt19937 rng(4);
+                    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+                    std::vector<float> phases(static_cast<std::size_t>(n)), speeds(static_cast<std::size_t>(n));
+                    for (float& p : phases) p = unit(rng);
+                    const auto new_speeds = [&] {
+                      for (float& v : speeds) v = space.max_speed() * unit(rng);
+                      animator.set_speeds(speeds);
+                    };
+                    animator.place(positions, yaws, {}, phases);
+                    new_speeds();
+                    constexpr float kDt = 1.0f / 60.0f;
+                    constexpr int kFramesPerSpeed = 300;  // 5 s
+                    int frame = 0;
+                    const auto step = [&] {
+                      if (variant.cache && frame > 0 && frame % kFramesPerSpeed == 0) new_speeds();
+                      const Camera cam = orbit_at(crowd.half_extent, static_cast<float>(frame) * kDt);
+                      animator.animate({kDt, variant.lod ? &cam : nullptr, true});
+                      ++frame;
+                    };
+                    // Warm up: the cache fills with the cycles these speeds need.
+                    step();
+                    while (variant.cache && animator.last_frame().cycles_stored > 0) step();
+                    for (auto _ : state) step();
                     state.SetItemsProcessed(state.iterations() * n);
+                    state.counters["joints_per_character"] =
+                        static_cast<double>(animator.last_frame().joints_synthesised) / static_cast<double>(n);
+                    state.counters["from_cache"] = static_cast<double>(animator.last_frame().from_cache) / static_cast<double>(n);
                   },
                   true});
   }

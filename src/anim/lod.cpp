@@ -210,23 +210,6 @@ void LodJob::validate() const {
   }
 }
 
-void MaskedPoseJob::validate() const {
-  if (joint_count <= 0 || joint_count > kMaxLodJoints)
-    throw Error("must be in [1, " + std::to_string(kMaxLodJoints) + "]", at_field("MaskedPoseJob.joint_count"));
-  if (frame_count <= 0) throw Error("must be positive", at_field("MaskedPoseJob.frame_count"));
-  const Index J = joint_count;
-  const Index n = character_count();
-  check_size("MaskedPoseJob", "parents", parents.size(), J);
-  check_size("MaskedPoseJob", "offsets", offsets.size(), J);
-  check_size("MaskedPoseJob", "clip_rotations", clip_rotations.size(), J * frame_count);
-  if (!held_rotations.empty()) check_size("MaskedPoseJob", "held_rotations", held_rotations.size(), J);
-  check_size("MaskedPoseJob", "root_positions", root_positions.size(), n);
-  check_size("MaskedPoseJob", "joint_masks", joint_masks.size(), n * mask_word_count(joint_count));
-  check_size("MaskedPoseJob", "out_positions", out_positions.size(), n * J);
-  check_size("MaskedPoseJob", "out_rotations", out_rotations.size(), n * J);
-  check_size("MaskedPoseJob", "evaluated", evaluated.size(), n);
-}
-
 MaskedPose synthesise_with_mask(const motion::Skeleton& skeleton, Span<const std::uint32_t> mask,
                                 const std::function<glm::quat(std::int32_t)>& local_rotation, glm::vec3 root_position,
                                 Span<const glm::quat> held_rotations) {

@@ -29,6 +29,7 @@
 #include "core/camera.h"
 #include "core/config.h"
 #include "core/span.h"
+#include "motion/locomotion.h"
 
 namespace throng::anim {
 
@@ -36,8 +37,9 @@ inline constexpr int kMaxLodLevels = 16;
 inline constexpr std::int32_t kMaxLodJoints = 1024;
 
 THRONG_HOST_DEVICE inline std::int32_t mask_word_count(std::int32_t joints) { return (joints + 31) / 32; }
+// A null mask keeps every joint.
 THRONG_HOST_DEVICE inline bool joint_synthesised(const std::uint32_t* mask, std::int32_t joint) {
-  return ((mask[joint >> 5] >> (joint & 31)) & 1u) != 0u;
+  return motion::mask_bit(mask, joint);
 }
 THRONG_HOST_DEVICE inline std::int32_t popcount32(std::uint32_t x) {
 #if defined(__CUDA_ARCH__)
@@ -165,15 +167,16 @@ LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint
                            std::int32_t joint_count);
 
 // The pose stage's contract with LOD: forward kinematics where joint j's
-// local rotation is evaluate(j) when its mask bit is set, and otherwise is
-// not evaluated: the joint holds its parent's frame (local rotation
-// held_rotations[j], identity when held_rotations is null) carried by its
-// rest offset. Returns how many joints were evaluated.
+// local rotation is evaluate(j) when its mask bit is set (a null mask sets
+// them all), and otherwise is not evaluated: the joint holds its parent's
+// frame (local rotation held_rotations[j], identity when held_rotations is
+// null) carried by its rest offset times `scale`. The root's evaluate(0) is
+// its world rotation. Returns how many joints were evaluated.
 template <class Evaluate>
 THRONG_HOST_DEVICE inline std::int32_t masked_pose(std::int32_t joints, const std::int32_t* parents, const glm::vec3* offsets,
                                                    const std::uint32_t* mask, const Evaluate& evaluate,
                                                    const glm::quat* held_rotations, glm::vec3 root_position,
-                                                   glm::vec3* out_positions, glm::quat* out_rotations) {
+                                                   glm::vec3* out_positions, glm::quat* out_rotations, float scale = 1.0f) {
   std::int32_t evaluated = 0;
   for (std::int32_t j = 0; j < joints; ++j) {
     glm::quat local(1.0f, 0.0f, 0.0f, 0.0f);
@@ -189,7 +192,7 @@ THRONG_HOST_DEVICE inline std::int32_t masked_pose(std::int32_t joints, const st
       out_positions[j] = root_position;
       out_rotations[j] = local;
     } else {
-      out_positions[j] = out_positions[p] + out_rotations[p] * offsets[j];
+      out_positions[j] = out_positions[p] + out_rotations[p] * (scale * offsets[j]);
       out_rotations[j] = out_rotations[p] * local;
     }
   }
@@ -205,27 +208,5 @@ struct MaskedPose {
 MaskedPose synthesise_with_mask(const motion::Skeleton& skeleton, Span<const std::uint32_t> mask,
                                 const std::function<glm::quat(std::int32_t)>& local_rotation, glm::vec3 root_position,
                                 Span<const glm::quat> held_rotations = {});
-
-// The batch form: each character shows a cyclic clip at its own normalised
-// phase, each synthesised joint a SLERP between two frames (the stand-in for
-// speed-blended synthesis until it lands), under its own joint mask.
-struct MaskedPoseJob {
-  std::int32_t joint_count = 0;
-  std::int32_t frame_count = 0;
-  Span<const std::int32_t> parents;        // joint_count
-  Span<const glm::vec3> offsets;           // joint_count
-  Span<const glm::quat> clip_rotations;    // frame_count * joint_count, frame-major, cyclic
-  Span<const glm::quat> held_rotations;    // joint_count, or empty for identity
-  Span<const float> phases;                // characters, normalised (wraps)
-  Span<const glm::vec3> root_positions;    // characters
-  Span<const std::uint32_t> joint_masks;   // characters * mask_word_count(joint_count)
-  Span<glm::vec3> out_positions;           // characters * joint_count
-  Span<glm::quat> out_rotations;           // characters * joint_count
-  Span<std::int32_t> evaluated;            // characters: joints evaluated
-
-  Index character_count() const { return phases.size(); }
-  void validate() const;
-  void run() const;  // parallel_for "anim.masked_pose"
-};
 
 }  // namespace throng::anim

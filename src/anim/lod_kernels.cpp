@@ -1,6 +1,5 @@
 // LOD kernels: compiled by nvcc in CUDA builds, by g++ otherwise.
 #include "anim/lod.h"
-#include "anim/motion_cache.h"
 #include "anim/sphere_projection.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -15,14 +14,6 @@ struct Anchors {
 };
 struct Templates {
   glm::vec4 s[kBodyPartCount];
-};
-
-// A joint's rotation between two clip frames: the evaluator of masked_pose.
-struct ClipBetweenFrames {
-  const glm::quat* a;
-  const glm::quat* b;
-  float t;
-  THRONG_HOST_DEVICE glm::quat operator()(std::int32_t joint) const { return glm::slerp(a[joint], b[joint], t); }
 };
 
 constexpr Index kHistogramBlock = 4096;
@@ -160,32 +151,6 @@ LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint
   }
   for (std::int32_t k = 0; k <= J; ++k) h.total_joints_synthesised += k * h.joints_synthesised[static_cast<std::size_t>(k)];
   return h;
-}
-
-void MaskedPoseJob::run() const {
-  validate();
-  const std::int32_t J = joint_count;
-  const std::int32_t W = mask_word_count(joint_count);
-  const std::int32_t F = frame_count;
-  const auto P = parents;
-  const auto O = offsets;
-  const auto clip = clip_rotations;
-  const auto held = held_rotations;
-  const auto phase = phases;
-  const auto roots = root_positions;
-  const auto masks = joint_masks;
-  const auto outP = out_positions;
-  const auto outR = out_rotations;
-  const auto count = evaluated;
-  parallel_for(
-      "anim.masked_pose", character_count(),
-      THRONG_LAMBDA(Index c) {
-        const CyclePoint at = cycle_point(F, phase[c]);
-        const ClipBetweenFrames evaluate{clip.data() + static_cast<Index>(at.f0) * J, clip.data() + static_cast<Index>(at.f1) * J, at.t};
-        count[c] = masked_pose(J, P.data(), O.data(), masks.data() + c * W, evaluate, held.empty() ? nullptr : held.data(),
-                               roots[c], outP.data() + c * J, outR.data() + c * J);
-      },
-      64);
 }
 
 }  // namespace throng::anim

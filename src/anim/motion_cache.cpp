@@ -33,29 +33,20 @@ void MotionCacheConfig::validate() const {
 
 MotionCache::MotionCache(MotionCacheConfig config) : config_(config) {
   config_.validate();
-  // Guard against 1 / 0.05 = 20.000000000000004 making a 21st empty bucket.
-  bucket_count_ = std::max(1, static_cast<std::int32_t>(std::ceil(1.0 / static_cast<double>(config_.bucket_width) - 1e-6)));
+  bucket_count_ = motion::weight_bucket_count(config_.bucket_width);
 }
 
-std::int32_t MotionCache::bucket_of(float w) const {
-  if (!(w > 0.0f)) return 0;  // also NaN
-  const auto b = static_cast<std::int32_t>(std::floor(static_cast<double>(std::min(w, 1.0f)) / config_.bucket_width));
-  return std::min(b, bucket_count_ - 1);
-}
+std::int32_t MotionCache::bucket_of(float w) const { return cache_bucket(w, config_.bucket_width, bucket_count_); }
 
-float MotionCache::bucket_centre(std::int32_t bucket) const {
-  const double lo = static_cast<double>(bucket) * config_.bucket_width;
-  const double hi = std::min(1.0, static_cast<double>(bucket + 1) * config_.bucket_width);
-  return static_cast<float>(0.5 * (lo + hi));
-}
+float MotionCache::bucket_centre(std::int32_t bucket) const { return motion::weight_bucket_centre(bucket, config_.bucket_width); }
 
-const CachedCycle* MotionCache::find(float w, std::uint32_t state) {
+const CachedCycle* MotionCache::find(float w, std::uint32_t state, std::int64_t lookups) {
   const auto it = entries_.find(key(state, bucket_of(w)));
   if (it == entries_.end()) {
-    ++stats_.misses;
+    stats_.misses += lookups;
     return nullptr;
   }
-  ++stats_.hits;
+  stats_.hits += lookups;
   return it->second.get();
 }
 
@@ -136,6 +127,24 @@ std::vector<std::pair<std::uint32_t, std::int32_t>> MotionCache::fifo_order() co
 
 QuantisationError measure_quantisation_error(const MotionCacheConfig& config, const MotionCache::Synthesise& synthesise,
                                              std::int32_t w_samples, std::int32_t phase_samples) {
+  // The exact pose: a cycle synthesised at w itself, read at the phase.
+  float cycle_w = NAN;
+  CachedCycle at_w;
+  const ExactPose exact = [&](float w, float phase, Span<glm::quat> out) {
+    if (!(w == cycle_w)) {
+      at_w = synthesise(w);
+      at_w.validate();
+      cycle_w = w;
+    }
+    if (out.size() != at_w.joint_count)
+      throw Error("synthesis gave cycles with different joint counts", at_field("quantisation_error.synthesise"));
+    sample_cycle(at_w, phase, out.data());
+  };
+  return measure_quantisation_error(config, synthesise, exact, w_samples, phase_samples);
+}
+
+QuantisationError measure_quantisation_error(const MotionCacheConfig& config, const MotionCache::Synthesise& synthesise,
+                                             const ExactPose& exact, std::int32_t w_samples, std::int32_t phase_samples) {
   if (w_samples < 1 || w_samples > 100000) throw Error("must be in [1, 100000]", at_field("quantisation_error.w_samples"));
   if (phase_samples < 1 || phase_samples > 100000)
     throw Error("must be in [1, 100000]", at_field("quantisation_error.phase_samples"));
@@ -144,7 +153,7 @@ QuantisationError measure_quantisation_error(const MotionCacheConfig& config, co
   double sum = 0.0;
   Index terms = 0;
   std::unordered_map<std::int32_t, CachedCycle> bucket_cycles;
-  std::vector<glm::quat> cached, exact;
+  std::vector<glm::quat> cached, exact_pose;
   for (std::int32_t i = 0; i < w_samples; ++i) {
     const float w = w_samples == 1 ? 0.5f : static_cast<float>(i) / static_cast<float>(w_samples - 1);
     const std::int32_t b = buckets.bucket_of(w);
@@ -154,25 +163,22 @@ QuantisationError measure_quantisation_error(const MotionCacheConfig& config, co
       it->second.validate();
     }
     const CachedCycle& from_bucket = it->second;
-    const CachedCycle at_w = synthesise(w);
-    at_w.validate();
-    if (at_w.joint_count != from_bucket.joint_count)
-      throw Error("synthesis gave cycles with different joint counts", at_field("quantisation_error.synthesise"));
-    cached.resize(static_cast<std::size_t>(at_w.joint_count));
-    exact.resize(static_cast<std::size_t>(at_w.joint_count));
+    const auto J = static_cast<std::size_t>(from_bucket.joint_count);
+    cached.resize(J);
+    exact_pose.resize(J);
     for (std::int32_t k = 0; k < phase_samples; ++k) {
       const float phase = static_cast<float>(k) / static_cast<float>(phase_samples);
       sample_cycle(from_bucket, phase, cached.data());
-      sample_cycle(at_w, phase, exact.data());
-      for (std::int32_t j = 0; j < at_w.joint_count; ++j) {
-        const double a = rotation_angle_deg(cached[static_cast<std::size_t>(j)], exact[static_cast<std::size_t>(j)]);
+      exact(w, phase, Span<glm::quat>(exact_pose.data(), static_cast<Index>(J)));
+      for (std::size_t j = 0; j < J; ++j) {
+        const double a = rotation_angle_deg(cached[j], exact_pose[j]);
         sum += a;
         ++terms;
         if (a > e.max_deg) {
           e.max_deg = a;
           e.worst_w = w;
           e.worst_phase = phase;
-          e.worst_joint = j;
+          e.worst_joint = static_cast<std::int32_t>(j);
         }
       }
       ++e.samples;

@@ -23,6 +23,8 @@
 
 #include "core/config.h"
 #include "core/span.h"
+#include "motion/locomotion.h"
+#include "motion/phase.h"
 
 namespace throng::anim {
 
@@ -39,40 +41,19 @@ struct CachedCycle {
   void validate() const;
 };
 
-// Where a normalised phase (any real number; it wraps) falls in a cycle of
-// `frames` frames: between frame f0 and f1 = f0 + 1 (or 0 after the last),
-// a fraction t of the way.
-struct CyclePoint {
-  std::int32_t f0 = 0;
-  std::int32_t f1 = 0;
-  float t = 0.0f;
-};
-THRONG_HOST_DEVICE inline CyclePoint cycle_point(std::int32_t frames, float phase) {
-  const float x = (phase - glm::floor(phase)) * static_cast<float>(frames);
-  CyclePoint p;
-  // A phase a hair below 1 can round up to `frames`; NaN and infinities
-  // fail the test too. Both read frame 0 (and no float-to-int overflow).
-  if (x >= 0.0f && x < static_cast<float>(frames)) {
-    p.f0 = static_cast<std::int32_t>(x);
-    p.t = x - static_cast<float>(p.f0);
-  }
-  p.f1 = p.f0 + 1 < frames ? p.f0 + 1 : 0;
-  return p;
-}
-
-// Local rotations at a normalised phase by SLERP between the two
-// neighbouring frames. glm::slerp takes the shorter arc (it flips the second
-// quaternion when their dot product is negative; tested against a reference).
-THRONG_HOST_DEVICE inline void sample_cycle(const glm::quat* rotations, std::int32_t frames, std::int32_t joints, float phase,
-                                            glm::quat* out) {
-  const CyclePoint p = cycle_point(frames, phase);
-  const glm::quat* a = rotations + static_cast<Index>(p.f0) * joints;
-  const glm::quat* b = rotations + static_cast<Index>(p.f1) * joints;
-  for (std::int32_t j = 0; j < joints; ++j) out[j] = glm::slerp(a[j], b[j], p.t);
-}
+// Phase sampling is motion's (motion/phase.h); the cache reads cycles with it.
+using motion::cycle_point;
+using motion::CyclePoint;
+using motion::sample_cycle;
 
 inline void sample_cycle(const CachedCycle& cycle, float phase, glm::quat* out) {
   sample_cycle(cycle.rotations.data(), cycle.frame_count, cycle.joint_count, phase, out);
+}
+
+// The bucket of w for buckets of `width` (w clamped into [0, 1], NaN -> 0,
+// w = 1 in the last bucket): host and kernels compute it the same way.
+THRONG_HOST_DEVICE inline std::int32_t cache_bucket(float w, float width, std::int32_t bucket_count) {
+  return motion::weight_bucket(w, width, bucket_count);
 }
 
 // Angle of the rotation taking a to b, degrees in [0, 180] (q and -q are the same rotation).
@@ -109,8 +90,10 @@ class MotionCache {
   // The w a bucket's cycle is synthesised at: the middle of its interval.
   float bucket_centre(std::int32_t bucket) const;
 
-  // Counted lookup (a hit or a miss): the cached cycle or null.
-  const CachedCycle* find(float w, std::uint32_t state = 0);
+  // Counted lookup (a hit or a miss): the cached cycle or null. A batch
+  // stage that looks a bucket up once for many characters passes their
+  // number as `lookups`, so hits and misses count characters.
+  const CachedCycle* find(float w, std::uint32_t state = 0, std::int64_t lookups = 1);
   // Uncounted.
   bool contains(std::int32_t bucket, std::uint32_t state = 0) const;
 
@@ -161,5 +144,13 @@ struct QuantisationError {
 // at its centre) and in the exact cycle at w, both at the same phase.
 QuantisationError measure_quantisation_error(const MotionCacheConfig& config, const MotionCache::Synthesise& synthesise,
                                              std::int32_t w_samples = 101, std::int32_t phase_samples = 64);
+
+// The same, with the exact pose at (w, phase) given directly (out has the
+// cycle's joint count) instead of read from a cycle synthesised at w: what a
+// stage that synthesises per character compares a cache read with.
+using ExactPose = std::function<void(float w, float phase, Span<glm::quat> out)>;
+QuantisationError measure_quantisation_error(const MotionCacheConfig& config, const MotionCache::Synthesise& synthesise,
+                                             const ExactPose& exact, std::int32_t w_samples = 101,
+                                             std::int32_t phase_samples = 64);
 
 }  // namespace throng::anim

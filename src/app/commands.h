@@ -17,6 +17,7 @@ struct GlobalOptions {
 void apply_global_options(const GlobalOptions& g);
 
 void add_run_command(CLI::App& app, const GlobalOptions& g);
+void add_animate_command(CLI::App& app, const GlobalOptions& g);
 void add_bench_command(CLI::App& app, const GlobalOptions& g);
 void add_info_command(CLI::App& app, const GlobalOptions& g);
 void add_convert_command(CLI::App& app, const GlobalOptions& g);

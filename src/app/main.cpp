@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   app.add_option("--threads", g.threads, "CPU threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", g.log_level, "trace, debug, info, warn, error or off");
   add_run_command(app, g);
+  add_animate_command(app, g);
   add_bench_command(app, g);
   add_info_command(app, g);
   add_convert_command(app, g);

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/error.h"
 
@@ -43,6 +44,12 @@ FootSkatingReport measure_foot_skating(const ModelSpaceClip& m, const ContactRep
       r.slides_cm.push_back(100.0 * slide);
     }
   }
+  return summarise_foot_skating(std::move(r.slides_cm));
+}
+
+FootSkatingReport summarise_foot_skating(std::vector<double> slides_cm) {
+  FootSkatingReport r;
+  r.slides_cm = std::move(slides_cm);
   r.contacts = static_cast<std::int32_t>(r.slides_cm.size());
   if (r.contacts == 0) return r;
   std::vector<double> sorted = r.slides_cm;
@@ -56,11 +63,15 @@ FootSkatingReport measure_foot_skating(const ModelSpaceClip& m, const ContactRep
   return r;
 }
 
-FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options) {
+FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpaceClip& posed, double frame_time,
+                                       const ContactOptions& options) {
   const FeetJoints feet = FeetJoints::from_roles(skeleton);
-  const ModelSpaceClip m = forward_kinematics(skeleton, clip);
-  const ContactReport contacts = detect_foot_contacts(skeleton, m, clip.frame_time, feet, options);
-  return measure_foot_skating(m, contacts, feet);
+  const ContactReport contacts = detect_foot_contacts(skeleton, posed, frame_time, feet, options);
+  return measure_foot_skating(posed, contacts, feet);
+}
+
+FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options) {
+  return measure_foot_skating(skeleton, forward_kinematics(skeleton, clip), clip.frame_time, options);
 }
 
 }  // namespace throng::motion

@@ -30,4 +30,13 @@ FootSkatingReport measure_foot_skating(const ModelSpaceClip& model, const Contac
 // Convenience: FK, contacts from the skeleton's roles, then the measure.
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options = {});
 
+// For joints already posed (e.g. a synthesised character's world joints per
+// frame, sampled every frame_time seconds): contacts from the skeleton's
+// roles, then the measure.
+FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpaceClip& posed, double frame_time,
+                                       const ContactOptions& options = {});
+
+// Mean, p95 and max of per-contact slides (cm), e.g. pooled over characters.
+FootSkatingReport summarise_foot_skating(std::vector<double> slides_cm);
+
 }  // namespace throng::motion

@@ -227,7 +227,7 @@ void DemoCrowd::update(double seconds, Span<const std::uint32_t> joint_masks) {
     p.ring = s.spec.layout == DemoLayout::Ring;
     demo_roots(p);
 
-    anim::MaskedPoseJob pose;
+    DemoPose pose;
     pose.joint_count = s.J;
     pose.frame_count = d.frames;
     pose.parents = s.parents.span();
@@ -239,7 +239,7 @@ void DemoCrowd::update(double seconds, Span<const std::uint32_t> joint_masks) {
     pose.out_positions = s.positions.span().subspan(d.first * s.J, d.count * s.J);
     pose.out_rotations = s.rotations.span().subspan(d.first * s.J, d.count * s.J);
     pose.evaluated = s.evaluated.span().subspan(d.first, d.count);
-    pose.run();
+    demo_pose(pose);
   }
   demo_place(s.J, s.ground.span(), s.yaws.span(), s.positions.span(), s.rotations.span());
 }

@@ -3,7 +3,7 @@
 // the default motion set (idle, walks, runs) at its own phase, placed on a
 // grid (walking straight, wrapping round the grid's extent) or on
 // concentric rings (walking round them at the clip's speed). Poses come
-// from the joint-LOD pose stage (anim::MaskedPoseJob), so coarse LOD
+// from the joint-LOD pose stage (anim::masked_pose), so coarse LOD
 // levels visibly hold joints still.
 #pragma once
 

@@ -2,11 +2,34 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "anim/lod.h"
 #include "anim/motion_cache.h"
 #include "core/ground.h"
 #include "core/parallel.h"
 
 namespace throng::render {
+
+namespace {
+// One clip's local rotation of joint j, between two neighbouring frames.
+struct ClipBetweenFrames {
+  const glm::quat* a;
+  const glm::quat* b;
+  float t;
+  THRONG_HOST_DEVICE glm::quat operator()(std::int32_t j) const { return glm::slerp(a[j], b[j], t); }
+};
+}  // namespace
+
+void demo_pose(const DemoPose& p) {
+  const DemoPose q = p;
+  const std::int32_t J = p.joint_count, W = anim::mask_word_count(p.joint_count);
+  parallel_for("render.demo_pose", p.phases.size(), THRONG_LAMBDA(Index c) {
+    const motion::CyclePoint at = motion::cycle_point(q.frame_count, q.phases[c]);
+    const ClipBetweenFrames evaluate{q.clip_rotations.data() + static_cast<Index>(at.f0) * J,
+                                     q.clip_rotations.data() + static_cast<Index>(at.f1) * J, at.t};
+    q.evaluated[c] = anim::masked_pose(J, q.parents.data(), q.offsets.data(), q.joint_masks.data() + c * W, evaluate, nullptr,
+                                       q.root_positions[c], q.out_positions.data() + c * J, q.out_rotations.data() + c * J);
+  }, 64);
+}
 
 void demo_roots(const DemoPlacement& p) {
   const DemoPlacement q = p;

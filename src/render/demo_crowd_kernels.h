@@ -26,6 +26,23 @@ struct DemoPlacement {
 };
 void demo_roots(const DemoPlacement& p);  // parallel_for "render.demo_roots"
 
+// Model-space pose of each character of one clip at its phase, under its
+// joint mask (anim::masked_pose; masked-out joints hold their parent's frame).
+struct DemoPose {
+  std::int32_t joint_count = 0;
+  std::int32_t frame_count = 0;
+  Span<const std::int32_t> parents;
+  Span<const glm::vec3> offsets;
+  Span<const glm::quat> clip_rotations;  // frame_count * joint_count, cyclic
+  Span<const float> phases;
+  Span<const glm::vec3> root_positions;
+  Span<const std::uint32_t> joint_masks;  // characters * mask words
+  Span<glm::vec3> out_positions;
+  Span<glm::quat> out_rotations;
+  Span<std::int32_t> evaluated;
+};
+void demo_pose(const DemoPose& p);  // parallel_for "render.demo_pose"
+
 // Moves each character's model-space joints to the world: rotate by its
 // yaw about +Y, translate to its ground position.
 void demo_place(std::int32_t joint_count, Span<const glm::vec3> ground, Span<const float> yaws, Span<glm::vec3> positions,

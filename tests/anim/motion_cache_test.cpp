@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "tests/motion/reference_rotation.h"
 
 namespace throng::anim {
 namespace {
@@ -22,20 +23,7 @@ glm::quat random_rotation(std::mt19937& rng) {
   return glm::normalize(glm::quat(g(rng), g(rng), g(rng), g(rng)));
 }
 
-// q0 (q0^-1 q1)^t through log and exp, choosing the sign of q1 that makes
-// the relative rotation the shorter one.
-glm::dquat reference_slerp(glm::dquat q0, glm::dquat q1, double t) {
-  if (glm::dot(q0, q1) < 0.0) q1 = -q1;
-  const glm::dquat r = glm::inverse(q0) * q1;
-  const glm::dvec3 v(r.x, r.y, r.z);
-  const double s = glm::length(v);
-  if (s < 1e-15) return q0;
-  const double half = std::atan2(s, r.w);  // in [0, pi/2] since r.w >= 0
-  const glm::dvec3 axis = v / s;
-  const double h = half * t;
-  const glm::dquat step(std::cos(h), axis.x * std::sin(h), axis.y * std::sin(h), axis.z * std::sin(h));
-  return q0 * step;
-}
+using test::reference_slerp;
 
 double angle_deg(glm::dquat a, glm::dquat b) { return rotation_angle_deg(glm::quat(a), glm::quat(b)); }
 

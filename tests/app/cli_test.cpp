@@ -82,3 +82,32 @@ TEST(Cli, BenchQuickWritesJsonRows) {
   }
   std::filesystem::remove(path);
 }
+
+TEST(Cli, AnimateWritesStatsJson) {
+  const auto dir = std::filesystem::temp_directory_path() / "throng_cli_animate";
+  std::filesystem::remove_all(dir);
+  const Result r = run("--threads 2 animate formation --duration 0.5 --characters 300 --out " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("foot skating"), std::string::npos) << r.out;
+  std::ifstream in(dir / "stats.json");
+  ASSERT_TRUE(in) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["characters"], 300);
+  EXPECT_EQ(j["frames"], 30);
+  for (const char* key : {"mean", "p95"}) EXPECT_TRUE(j["foot_skating_cm"][key].is_number()) << key;
+  EXPECT_GT(j["foot_skating_cm"]["contacts"].get<int>(), 0);
+  EXPECT_LT(j["formation"]["max_drift_from_ring_m"].get<double>(), 0.01);
+  EXPECT_GT(j["cache"]["hits"].get<long long>() + j["cache"]["misses"].get<long long>(), 0);
+  EXPECT_TRUE(j["lod"]["joints_synthesised_histogram"].is_array());
+  bool pose_timed = false;
+  for (const auto& t : j["timings"]) pose_timed = pose_timed || t["name"] == "anim.pose";
+  EXPECT_TRUE(pose_timed);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Cli, AnimateRejectsUnknownScenarios) {
+  const Result r = run("animate no_such_scenario");
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(lines(r.out), 1u) << r.out;
+  EXPECT_NE(r.out.find("throng: error:"), std::string::npos) << r.out;
+}

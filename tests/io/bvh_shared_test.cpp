@@ -18,19 +18,12 @@
 #include "io/bvh_reader.h"
 #include "io/bvh_writer.h"
 #include "motion/fk.h"
+#include "tests/io/shared_data.h"
 
 namespace throng::io {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::optional<fs::path> shared_bvh_dir() {
-  const char* dir = std::getenv("THRONG_SHARED_DIR");
-  if (dir == nullptr) return std::nullopt;
-  const fs::path p = fs::path(dir) / "data" / "bvh";
-  if (!fs::is_directory(p)) return std::nullopt;
-  return p;
-}
 
 #define REQUIRE_SHARED_BVH(dir)                                                                                  \
   const auto dir = shared_bvh_dir();                                                                             \

@@ -21,19 +21,12 @@
 #include "motion/default_set.h"
 #include "motion/fk.h"
 #include "motion/foot_skating.h"
+#include "tests/io/shared_data.h"
 
 namespace throng::io {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::optional<fs::path> shared_bvh_dir() {
-  const char* dir = std::getenv("THRONG_SHARED_DIR");
-  if (dir == nullptr) return std::nullopt;
-  const fs::path p = fs::path(dir) / "data" / "bvh";
-  if (!fs::is_directory(p)) return std::nullopt;
-  return p;
-}
 
 TEST(DefaultMotionsBvh, ExportReadsBackWithTheSameMotionAndCycle) {
   const motion::Skeleton skeleton = motion::default_skeleton();
