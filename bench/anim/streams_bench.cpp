@@ -12,7 +12,7 @@
 #include "core/buffer.h"
 #include "core/exec.h"
 #include "motion/default_set.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace throng::bench {
 
@@ -28,7 +28,7 @@ struct Placement {
   explicit Placement(Index n) {
     std::vector<glm::vec3> p(static_cast<std::size_t>(n));
     std::vector<float> y(static_cast<std::size_t>(n));
-    sim::Rng rng(5);
+    Rng rng(5);
     for (Index i = 0; i < n; ++i) {
       p[static_cast<std::size_t>(i)] = glm::vec3(rng.uniform(-500.0, 500.0), 0.0f, rng.uniform(-500.0, 500.0));
       y[static_cast<std::size_t>(i)] = static_cast<float>(rng.uniform(-3.14159, 3.14159));
@@ -114,7 +114,7 @@ struct ExactFixture {
     const motion::Clip& clip = default_motions()[2].clip;  // walk
     placement = std::make_unique<Placement>(n);
     std::vector<float> t(static_cast<std::size_t>(n));
-    sim::Rng rng(9);
+    Rng rng(9);
     for (float& x : t) x = static_cast<float>(rng.uniform(0.0, 10.0));
     times = Buffer<float>(std::span<const float>(t), mem);
     parents = Buffer<std::int32_t>(std::span<const std::int32_t>(rig.skeleton.parents), mem);
