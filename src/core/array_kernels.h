@@ -20,4 +20,7 @@ std::int32_t exclusive_scan(Span<const std::int32_t> in, Span<std::int32_t> out)
 std::int64_t exclusive_scan(Span<const std::int64_t> in, Span<std::int64_t> out);
 float exclusive_scan(Span<const float> in, Span<float> out);
 
+// How many flags are non-zero (deterministic).
+Index count_nonzero(Span<const std::uint8_t> flags);
+
 }  // namespace throng
