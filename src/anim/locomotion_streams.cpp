@@ -4,8 +4,10 @@
 #include <cmath>
 #include <string>
 
+#include "core/array_kernels.h"
 #include "core/error.h"
 #include "core/random.h"
+#include "core/timing.h"
 
 namespace throng::anim {
 
@@ -14,6 +16,13 @@ namespace {
 void check_count(const char* field, Index got, Index want) {
   if (got != want)
     throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("locomotion_streams.") + field));
+}
+
+// The blend space as streamed agents show it: every blend at its bucket's centre.
+motion::BlendSpaceView quantised_view(motion::BlendSpaceView v, float width, std::int32_t buckets) {
+  v.quantum = width;
+  v.quantum_buckets = buckets;
+  return v;
 }
 
 }  // namespace
@@ -95,14 +104,7 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
 
 void LocomotionStreams::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> headings) {
   check_count("drive_from_map.positions", positions.size(), count_);
-  MapInputJob job;
-  job.map_positions = positions;
-  job.map_velocities = velocities;
-  job.map_headings = headings;
-  job.positions = position_.span();
-  job.yaws = yaw_.span();
-  job.speeds = speed_.span();
-  job.run();
+  MapInputJob{positions, velocities, headings, position_.span(), yaw_.span(), speed_.span()}.run();
 }
 
 void LocomotionStreams::set_agents(std::span<const glm::vec3> positions, std::span<const float> yaws, std::span<const float> speeds) {
@@ -128,11 +130,15 @@ const LocomotionStreamsStats& LocomotionStreams::animate(const Camera* camera) {
   stats_.streams = keys_;
   const std::vector<Index> counts = classify(camera);  // exact flags, bucket keys, stats_.exact
   stats_.streamed = count_ - stats_.exact;
-  manage_streams(counts);
-  crowd_.step();
-  std::vector<float> phases(static_cast<std::size_t>(keys_), 0.0f);
-  for (std::int32_t k = 0; k < keys_; ++k) phases[static_cast<std::size_t>(k)] = controllers_[static_cast<std::size_t>(k)]->phase();
-  key_phase_.copy_from(std::span<const float>(phases));
+  {
+    // Host: streams started or stopped by use, the running ones evaluated (their events reach agents in a kernel).
+    ScopedTimer timer("anim.loco_streams_update");
+    manage_streams(counts);
+    crowd_.step();
+    std::vector<float> phases(static_cast<std::size_t>(keys_), 0.0f);
+    for (std::int32_t k = 0; k < keys_; ++k) phases[static_cast<std::size_t>(k)] = controllers_[static_cast<std::size_t>(k)]->phase();
+    key_phase_.copy_from(std::span<const float>(phases));
+  }
   select(1.0f / config_.frame_rate);
   stats_.retargeted = crowd_.retarget(source_.span(), offset_.span(), config_.blend_seconds, config_.cluster_mask);
   crowd_.resolve(position_.span(), yaw_.span(), palettes_.span(), {}, exact_.span());
@@ -170,6 +176,102 @@ void LocomotionStreams::manage_streams(const std::vector<Index>& counts) {
       crowd_.streams().stop(k);
     }
   }
+}
+
+std::vector<Index> LocomotionStreams::classify(const Camera* camera) {
+  const bool lod = config_.exact_near_camera && camera != nullptr && count_ > 0;
+  if (lod) {
+    LodJob job;
+    job.camera = make_camera_view(*camera);
+    job.set_tables(*lod_tables_);
+    job.root_positions = position_.span();
+    job.root_headings = yaw_.span();
+    job.template_spheres = parts_->rest_spheres;
+    job.levels = levels_.span();
+    job.joint_masks = masks_.span();
+    job.run();
+  }
+  StreamBucketJob buckets;
+  buckets.blend = quantised_view(tables_.view(), config_.bucket_width, buckets_);
+  buckets.bucket_width = config_.bucket_width;
+  buckets.bucket_count = buckets_;
+  buckets.speeds = speed_.span();
+  if (lod) buckets.levels = levels_.span();
+  buckets.exact = exact_.span();
+  buckets.exact_flags = exact_rank_.span();
+  buckets.keys = key_.span();
+  buckets.run();
+  stats_.exact = lod ? count_nonzero(exact_.span()) : 0;
+  return histogram(key_.span(), keys_);
+}
+
+void LocomotionStreams::select(float dt) {
+  StreamSelectJob job;
+  job.blend = tables_.view();
+  job.quantised = quantised_view(job.blend, config_.bucket_width, buckets_);
+  job.dt = dt;
+  job.speeds = speed_.span();
+  job.exact = exact_.span();
+  job.keys = key_.span();
+  job.key_phases = key_phase_.span();
+  job.key_frames = key_frames_device_.span();
+  job.streams = crowd_.streams().views();
+  job.clusters = crowd_.cluster_refs();
+  job.cluster_stride = crowd_.cluster_stride();
+  for (std::int32_t c = kMaxClusters - 1; c >= 0; --c)
+    if (((config_.cluster_mask >> c) & 1u) != 0u && c < crowd_.cluster_stride()) job.cluster = c;
+  job.phases = phase_.span();
+  job.sources = source_.span();
+  job.offsets = offset_.span();
+  job.run();
+}
+
+void LocomotionStreams::synthesise_exact() {
+  if (stats_.exact == 0) return;
+  const Memory m = current_memory();
+  const Index n = stats_.exact;
+  exclusive_scan(exact_rank_.span(), exact_rank_.span());
+  if (exact_agents_.size() < n) {  // grows to the largest exact count seen
+    const Index cap = std::max(n, exact_agents_.size() * 2);
+    exact_agents_ = Buffer<Index>(cap, m);
+    exact_position_ = Buffer<glm::vec3>(cap, m);
+    exact_yaw_ = Buffer<float>(cap, m);
+    exact_phase_ = Buffer<float>(cap, m);
+    exact_speed_ = Buffer<float>(cap, m);
+    joint_position_ = Buffer<glm::vec3>(cap * joints_, m);
+    joint_rotation_ = Buffer<glm::quat>(cap * joints_, m);
+  }
+  ExactGatherJob gather;
+  gather.exact = exact_.span();
+  gather.ranks = exact_rank_.span();
+  gather.positions = position_.span();
+  gather.yaws = yaw_.span();
+  gather.phases = phase_.span();
+  gather.speeds = speed_.span();
+  gather.agents = exact_agents_.span().subspan(0, n);
+  gather.out_positions = exact_position_.span();
+  gather.out_yaws = exact_yaw_.span();
+  gather.out_phases = exact_phase_.span();
+  gather.out_speeds = exact_speed_.span();
+  gather.run();
+  PoseJob pose;
+  pose.blend = tables_.view();
+  pose.positions = exact_position_.span().subspan(0, n);
+  pose.yaws = exact_yaw_.span().subspan(0, n);
+  pose.phases = exact_phase_.span().subspan(0, n);
+  pose.blend_speeds = exact_speed_.span().subspan(0, n);
+  pose.joint_positions = joint_position_.span().subspan(0, n * joints_);
+  pose.joint_rotations = joint_rotation_.span().subspan(0, n * joints_);
+  pose.run();
+  JointPaletteJob palettes;
+  palettes.joint_count = joints_;
+  palettes.joint_positions = pose.joint_positions;
+  palettes.joint_rotations = pose.joint_rotations;
+  palettes.inverse_bind = inverse_bind_.span();
+  palettes.agents = exact_agents_.span().subspan(0, n);
+  palettes.palette_offsets = crowd_.palette_offsets();
+  palettes.palettes = palettes_.span();
+  palettes.run();
 }
 
 void LocomotionStreams::track(std::vector<Index> agents) {

@@ -71,6 +71,65 @@ struct JointPaletteJob {
   void run() const;
 };
 
+// Per agent: exact synthesis (some body part at LOD level 0) or the speed
+// bucket whose stream it reads. ("anim.loco_streams_keys")
+struct StreamBucketJob {
+  motion::BlendSpaceView blend;  // quantised to the buckets (BlendSpaceView::quantum)
+  float bucket_width = 0.05f;
+  std::int32_t bucket_count = 20;
+  Span<const float> speeds;           // per agent, m/s
+  Span<const std::uint8_t> levels;    // agents * kBodyPartCount (LodJob), or empty: nobody is exact
+  Span<std::uint8_t> exact;           // out: 1 = synthesised
+  Span<std::int32_t> exact_flags;     // out: the same as 0/1 integers (to scan)
+  Span<std::int32_t> keys;            // out: cache_key of the bucket, -1 for exact agents
+
+  Index agent_count() const { return speeds.size(); }
+  void validate() const;
+  void run() const;
+};
+
+// Per agent: the gait phase it shows this frame and the stream and offset
+// it should read ("anim.loco_streams_select"). An exact agent advances at
+// its own cadence and wants no stream. A streamed agent still on its
+// bucket's stream keeps its offset (it plays at the stream's cadence);
+// one joining a stream advances at the bucket's cadence and takes the slot
+// nearest its phase. Either way its phase becomes that slot's phase:
+// head phase - offset / frames per cycle. The stream of key k is stream k.
+struct StreamSelectJob {
+  motion::BlendSpaceView blend;      // exact agents' cadence
+  motion::BlendSpaceView quantised;  // streamed agents' cadence
+  float dt = 1.0f / 30.0f;
+  Span<const float> speeds;
+  Span<const std::uint8_t> exact;
+  Span<const std::int32_t> keys;
+  Span<const float> key_phases;   // per key: phase of its stream's newest slot
+  Span<const float> key_frames;   // per key: frames per cycle
+  Span<const SourceView> streams;
+  Span<const ClusterRef> clusters;  // the crowd's: which stream each agent reads now
+  std::int32_t cluster_stride = 1;
+  std::int32_t cluster = 0;         // the cluster whose source is compared
+  Span<float> phases;               // in/out
+  Span<std::int32_t> sources;       // out
+  Span<std::int32_t> offsets;       // out
+
+  Index agent_count() const { return speeds.size(); }
+  void validate() const;
+  void run() const;
+};
+
+// The exact agents' inputs gathered densely: agent a with exact[a] goes to
+// slot ranks[a] (an exclusive scan of the flags). ("anim.loco_streams_gather")
+struct ExactGatherJob {
+  Span<const std::uint8_t> exact;
+  Span<const std::int32_t> ranks;
+  Span<const glm::vec3> positions;
+  Span<const float> yaws, phases, speeds;
+  Span<Index> agents;  // out, dense
+  Span<glm::vec3> out_positions;
+  Span<float> out_yaws, out_phases, out_speeds;
+  void run() const;
+};
+
 struct LocomotionStreamsConfig {
   float frame_rate = 30.0f;     // animation frames per second: one animate() call is one frame
   float bucket_width = 0.05f;   // of w per segment (MotionCacheConfig::bucket_width's rule)
@@ -157,12 +216,14 @@ class LocomotionStreams {
   motion::FootSkatingReport foot_skating(const motion::ContactOptions& options = {}) const;
 
  private:
-  // locomotion_streams_kernels.cpp: exact or which bucket per agent; each
-  // agent's phase and desired (stream, offset); the exact path.
+  // The per-frame steps (their kernels are the jobs above, in
+  // locomotion_streams_kernels.cpp: nvcc takes no device lambda in a private
+  // member): exact or which bucket per agent; each agent's phase and desired
+  // (stream, offset); the exact path; streams started filled / stopped by
+  // use; the foot-skating probe.
   std::vector<Index> classify(const Camera* camera);  // agents per bucket
   void select(float dt);
   void synthesise_exact();
-  // locomotion_streams.cpp: start filled / stop streams by use; the probe.
   void manage_streams(const std::vector<Index>& counts);
   void record_tracks();
 

@@ -4,34 +4,11 @@
 #include <string>
 
 #include "anim/locomotion_streams.h"
-#include "core/array_kernels.h"
 #include "core/error.h"
 #include "core/parallel.h"
-#include "core/reduce.h"
 
 namespace throng::anim {
 
-namespace {
-
-struct BucketOf {
-  Span<const std::int32_t> keys;
-  THRONG_HOST_DEVICE std::int32_t operator()(Index a) const { return keys[a]; }
-};
-
-// The blend space as streamed agents show it: every blend at its bucket's centre.
-motion::BlendSpaceView quantised(motion::BlendSpaceView v, float width, std::int32_t buckets) {
-  v.quantum = width;
-  v.quantum_buckets = buckets;
-  return v;
-}
-
-std::int32_t first_cluster(std::uint32_t mask) {
-  for (std::int32_t c = 0; c < kMaxClusters; ++c)
-    if ((mask >> c) & 1u) return c;
-  return 0;
-}
-
-}  // namespace
 
 // ---- world joints -> palettes ------------------------------------------------------------------
 
@@ -80,83 +57,101 @@ void JointPaletteJob::run() const {
       64);
 }
 
-// ---- per frame ---------------------------------------------------------------------------------
+// ---- per frame -----------------------------------------------------------------------------------
 
-std::vector<Index> LocomotionStreams::classify(const Camera* camera) {
-  const bool lod = config_.exact_near_camera && camera != nullptr && count_ > 0;
-  if (lod) {
-    LodJob job;
-    job.camera = make_camera_view(*camera);
-    job.set_tables(*lod_tables_);
-    job.root_positions = position_.span();
-    job.root_headings = yaw_.span();
-    job.template_spheres = parts_->rest_spheres;
-    job.levels = levels_.span();
-    job.joint_masks = masks_.span();
-    job.run();
-  }
-  const motion::BlendSpaceView view = quantised(tables_.view(), config_.bucket_width, buckets_);
-  const float width = config_.bucket_width;
-  const std::int32_t buckets = buckets_;
-  const auto levels = levels_.span();
-  const auto speed = speed_.span();
-  const auto exact = exact_.span();
-  const auto rank = exact_rank_.span();
-  const auto key = key_.span();
-  parallel_for(
-      "anim.loco_streams_keys", count_,
-      THRONG_LAMBDA(Index a) {
-        bool near = false;
-        if (lod)
-          for (int p = 0; p < kBodyPartCount; ++p) near = near || levels[a * kBodyPartCount + p] == 0;
-        exact[a] = near ? 1 : 0;
-        rank[a] = near ? 1 : 0;
-        key[a] = near ? -1 : cache_key(motion::blend_point(view, motion::blend_coordinate(view, speed[a])), width, buckets);
-      },
-      1024);
-  stats_.exact = lod ? count_nonzero(exact_.span()) : 0;
-  return deterministic_histogram("anim.loco_streams_buckets", count_, keys_, BucketOf{key_.span()});
+namespace {
+void check_length(const char* job, const char* field, Index got, Index want) {
+  if (got != want)
+    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string(job) + "." + field));
+}
+}  // namespace
+
+void StreamBucketJob::validate() const {
+  const Index n = agent_count();
+  if (!levels.empty()) check_length("StreamBucketJob", "levels", levels.size(), n * kBodyPartCount);
+  check_length("StreamBucketJob", "exact", exact.size(), n);
+  check_length("StreamBucketJob", "exact_flags", exact_flags.size(), n);
+  check_length("StreamBucketJob", "keys", keys.size(), n);
+  if (bucket_count < 1) throw Error("must be positive", at_field("StreamBucketJob.bucket_count"));
 }
 
-void LocomotionStreams::select(float dt) {
-  const motion::BlendSpaceView view = tables_.view();
-  const motion::BlendSpaceView view_q = quantised(view, config_.bucket_width, buckets_);
-  const auto speed = speed_.span();
-  const auto exact = exact_.span();
-  const auto key = key_.span();
-  const auto phase = phase_.span();
-  const auto source = source_.span();
-  const auto offset = offset_.span();
-  const auto head = key_phase_.span();
-  const auto frames = key_frames_device_.span();
-  const auto streams = crowd_.streams().views();
-  const auto refs = crowd_.cluster_refs();
-  const std::int32_t stride = crowd_.cluster_stride();
-  const std::int32_t first = first_cluster(config_.cluster_mask);
+void StreamBucketJob::run() const {
+  validate();
+  const motion::BlendSpaceView view = blend;
+  const float width = bucket_width;
+  const std::int32_t buckets = bucket_count;
+  const auto speed = speeds;
+  const auto level = levels;
+  const auto out_exact = exact;
+  const auto out_flags = exact_flags;
+  const auto out_key = keys;
   parallel_for(
-      "anim.loco_streams_select", count_,
+      "anim.loco_streams_keys", agent_count(),
+      THRONG_LAMBDA(Index a) {
+        bool near = false;
+        if (!level.empty())
+          for (int p = 0; p < kBodyPartCount; ++p) near = near || level[a * kBodyPartCount + p] == 0;
+        out_exact[a] = near ? 1 : 0;
+        out_flags[a] = near ? 1 : 0;
+        out_key[a] = near ? -1 : cache_key(motion::blend_point(view, motion::blend_coordinate(view, speed[a])), width, buckets);
+      },
+      1024);
+}
+
+void StreamSelectJob::validate() const {
+  const Index n = agent_count();
+  check_length("StreamSelectJob", "exact", exact.size(), n);
+  check_length("StreamSelectJob", "keys", keys.size(), n);
+  check_length("StreamSelectJob", "key_frames", key_frames.size(), key_phases.size());
+  check_length("StreamSelectJob", "streams", streams.size(), key_phases.size());
+  check_length("StreamSelectJob", "clusters", clusters.size(), n * cluster_stride);
+  check_length("StreamSelectJob", "phases", phases.size(), n);
+  check_length("StreamSelectJob", "sources", sources.size(), n);
+  check_length("StreamSelectJob", "offsets", offsets.size(), n);
+  if (cluster < 0 || cluster >= cluster_stride) throw Error("must be below the cluster stride", at_field("StreamSelectJob.cluster"));
+}
+
+void StreamSelectJob::run() const {
+  validate();
+  const motion::BlendSpaceView view = blend;
+  const motion::BlendSpaceView view_q = quantised;
+  const float step = dt;
+  const auto speed = speeds;
+  const auto is_exact = exact;
+  const auto key = keys;
+  const auto head = key_phases;
+  const auto frames = key_frames;
+  const auto stream = streams;
+  const auto refs = clusters;
+  const std::int32_t stride = cluster_stride;
+  const std::int32_t first = cluster;
+  const auto phase = phases;
+  const auto source = sources;
+  const auto offset = offsets;
+  const auto key_count = key_phases.size();
+  parallel_for(
+      "anim.loco_streams_select", agent_count(),
       THRONG_LAMBDA(Index a) {
         const float v = speed[a];
         float ph = phase[a];
-        if (exact[a] != 0) {  // synthesised: its own cadence at its own speed
-          ph += motion::cycle_rate(view, motion::blend_point(view, motion::blend_coordinate(view, v)), v) * dt;
+        const std::int32_t k = key[a];
+        if (is_exact[a] != 0 || k < 0 || k >= key_count) {  // synthesised: its own cadence at its own speed
+          ph += motion::cycle_rate(view, motion::blend_point(view, motion::blend_coordinate(view, v)), v) * step;
           phase[a] = motion::wrap_phase(ph);
           source[a] = kNoSource;
           offset[a] = 0;
           return;
         }
-        const std::int32_t k = key[a];
         const float F = frames[k];
         std::int32_t o = 0;
-        const ClusterRef& ref = refs[a * stride + first];
-        if (ref.source == k) {
-          o = ref.offset;  // same bucket: keep the offset, play at the stream's cadence
+        if (refs[a * stride + first].source == k) {
+          o = refs[a * stride + first].offset;  // same bucket: keep the offset, play at the stream's cadence
         } else {
           // Joining a stream: advance at the bucket's cadence, then take the
           // slot that shows this phase (the nearest; the phase snaps to it).
-          ph += motion::cycle_rate(view_q, motion::blend_point(view_q, motion::blend_coordinate(view_q, v)), v) * dt;
+          ph += motion::cycle_rate(view_q, motion::blend_point(view_q, motion::blend_coordinate(view_q, v)), v) * step;
           o = static_cast<std::int32_t>(glm::floor(motion::wrap_phase(head[k] - ph) * F + 0.5f));
-          const std::int32_t top = streams[k].history - 1;
+          const std::int32_t top = stream[k].history - 1;
           o = o < 0 ? 0 : (o > top ? top : o);
         }
         phase[a] = motion::wrap_phase(head[k] - static_cast<float>(o) / F);
@@ -166,62 +161,32 @@ void LocomotionStreams::select(float dt) {
       1024);
 }
 
-void LocomotionStreams::synthesise_exact() {
-  if (stats_.exact == 0) return;
-  const Memory m = current_memory();
-  const Index n = stats_.exact;
-  exclusive_scan(exact_rank_.span(), exact_rank_.span());
-  if (exact_agents_.size() < n) {  // grows to the largest exact count seen
-    const Index cap = std::max(n, exact_agents_.size() * 2);
-    exact_agents_ = Buffer<Index>(cap, m);
-    exact_position_ = Buffer<glm::vec3>(cap, m);
-    exact_yaw_ = Buffer<float>(cap, m);
-    exact_phase_ = Buffer<float>(cap, m);
-    exact_speed_ = Buffer<float>(cap, m);
-    joint_position_ = Buffer<glm::vec3>(cap * joints_, m);
-    joint_rotation_ = Buffer<glm::quat>(cap * joints_, m);
-  }
-  const auto exact = exact_.span();
-  const auto rank = exact_rank_.span();
-  const auto agents = exact_agents_.span();
-  const auto pos = position_.span();
-  const auto yaw = yaw_.span();
-  const auto phase = phase_.span();
-  const auto speed = speed_.span();
-  const auto out_pos = exact_position_.span();
-  const auto out_yaw = exact_yaw_.span();
-  const auto out_phase = exact_phase_.span();
-  const auto out_speed = exact_speed_.span();
+void ExactGatherJob::run() const {
+  const auto is_exact = exact;
+  const auto rank = ranks;
+  const auto pos = positions;
+  const auto yaw = yaws;
+  const auto phase = phases;
+  const auto speed = speeds;
+  const auto who = agents;
+  const auto out_pos = out_positions;
+  const auto out_yaw = out_yaws;
+  const auto out_phase = out_phases;
+  const auto out_speed = out_speeds;
+  const Index room = agents.size();
   parallel_for(
-      "anim.loco_streams_gather", count_,
+      "anim.loco_streams_gather", exact.size(),
       THRONG_LAMBDA(Index a) {
-        if (exact[a] == 0) return;
+        if (is_exact[a] == 0) return;
         const Index r = rank[a];
-        agents[r] = a;
+        if (r < 0 || r >= room) return;
+        who[r] = a;
         out_pos[r] = pos[a];
         out_yaw[r] = yaw[a];
         out_phase[r] = phase[a];
         out_speed[r] = speed[a];
       },
       1024);
-  PoseJob pose;
-  pose.blend = tables_.view();
-  pose.positions = exact_position_.span().subspan(0, n);
-  pose.yaws = exact_yaw_.span().subspan(0, n);
-  pose.phases = exact_phase_.span().subspan(0, n);
-  pose.blend_speeds = exact_speed_.span().subspan(0, n);
-  pose.joint_positions = joint_position_.span().subspan(0, n * joints_);
-  pose.joint_rotations = joint_rotation_.span().subspan(0, n * joints_);
-  pose.run();
-  JointPaletteJob palettes;
-  palettes.joint_count = joints_;
-  palettes.joint_positions = pose.joint_positions;
-  palettes.joint_rotations = pose.joint_rotations;
-  palettes.inverse_bind = inverse_bind_.span();
-  palettes.agents = exact_agents_.span().subspan(0, n);
-  palettes.palette_offsets = crowd_.palette_offsets();
-  palettes.palettes = palettes_.span();
-  palettes.run();
 }
 
 // ---- the error of sharing ----------------------------------------------------------------------

@@ -30,4 +30,15 @@ Index count_nonzero(Span<const std::uint8_t> flags) {
       detail::Plus{});
 }
 
+namespace {
+struct KeyAt {
+  Span<const std::int32_t> keys;
+  THRONG_HOST_DEVICE std::int32_t operator()(Index i) const { return keys[i]; }
+};
+}  // namespace
+
+std::vector<Index> histogram(Span<const std::int32_t> keys, std::int32_t bins) {
+  return deterministic_histogram("core.histogram", keys.size(), bins, KeyAt{keys});
+}
+
 }  // namespace throng

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <iostream>
 #include <set>
+#include <string>
 
 #include "core/error.h"
 #include "core/exec.h"
@@ -370,6 +371,33 @@ TEST(LocomotionStreams, RejectsBadInput) {
   EXPECT_THROW(loco.set_agents(std::vector<glm::vec3>(3), std::vector<float>(2), std::vector<float>(2)), Error);
   EXPECT_THROW(loco.set_phases(std::vector<float>{0.0f, 1.0f}), Error);
   EXPECT_THROW(loco.track({2}), Error);
+
+  // The per-frame jobs name the span that does not fit.
+  std::vector<float> speeds(2, 1.0f);
+  std::vector<std::uint8_t> exact(2);
+  std::vector<std::int32_t> flags(2), keys(1);
+  StreamBucketJob buckets;
+  buckets.speeds = speeds;
+  buckets.exact = exact;
+  buckets.exact_flags = flags;
+  buckets.keys = keys;
+  try {
+    buckets.run();
+    ADD_FAILURE() << "short keys accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("StreamBucketJob.keys"), std::string::npos) << e.what();
+  }
+  StreamSelectJob select;
+  select.speeds = speeds;
+  select.exact = exact;
+  select.keys = flags;
+  select.phases = speeds;
+  select.sources = flags;
+  select.offsets = flags;
+  std::vector<ClusterRef> refs(2);
+  select.clusters = refs;
+  select.cluster = 1;  // stride 1
+  EXPECT_THROW(select.run(), Error);
 }
 
 }  // namespace
