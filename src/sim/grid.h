@@ -73,7 +73,7 @@ struct GridView {
   THRONG_HOST_DEVICE Index capacity() const { return keys.size(); }
   // Slot holding the cell, or -1.
   THRONG_HOST_DEVICE Index find(std::int32_t cx, std::int32_t cy) const {
-    if (keys.size() == 0) return -1;
+    if (items.size() == 0) return -1;  // nothing binned (e.g. a world without walls)
     const std::uint64_t key = cell_key(cx, cy);
     std::uint64_t s = mix_key(key) & mask;
     for (;;) {
@@ -84,6 +84,28 @@ struct GridView {
     }
   }
 };
+
+// The table slots of the 3x3 cells around cell (cx, cy), row-major (dy,
+// then dx), -1 where a cell is empty. Worth keeping when the same
+// neighbourhood is visited several times in a step (the contact passes).
+struct Slots3x3 {
+  std::int32_t slot[9];
+};
+THRONG_HOST_DEVICE inline Slots3x3 slots_3x3(const GridView& g, std::int32_t cx, std::int32_t cy) {
+  Slots3x3 s;
+  for (std::int32_t dy = -1; dy <= 1; ++dy)
+    for (std::int32_t dx = -1; dx <= 1; ++dx) s.slot[(dy + 1) * 3 + dx + 1] = static_cast<std::int32_t>(g.find(cx + dx, cy + dy));
+  return s;
+}
+// Calls fn(item) for every item of those cells, in order.
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_in_slots(const GridView& g, const Slots3x3& s, Fn&& fn) {
+  for (int k = 0; k < 9; ++k) {
+    if (s.slot[k] < 0) continue;
+    const std::int32_t b = g.start[s.slot[k]], n = g.count[s.slot[k]];
+    for (std::int32_t m = 0; m < n; ++m) fn(g.items[b + m]);
+  }
+}
 
 // Calls fn(item) for every item of the 3x3 cells around cell (cx, cy), cells
 // in row-major order (dy, then dx), items in their stored order.
@@ -102,7 +124,8 @@ template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_in_3x3(const GridView& g, glm::vec2 p, Fn&& fn) {
   for_each_in_3x3(g, cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size), fn);
 }
-// The same for the one cell containing p.
+// The same for the one cell containing p. On the world's halo grids (walls,
+// circles: see world.h) this finds everything within one cell side of p.
 template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_in_cell(const GridView& g, glm::vec2 p, Fn&& fn) {
   const Index s = g.find(cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size));

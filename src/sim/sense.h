@@ -24,8 +24,8 @@ THRONG_HOST_DEVICE inline ObstacleSense sense_obstacles(const WorldView& w, cons
     best.hit = h;
     best.force = f;
   };
-  for_each_in_3x3(w.segment_grid, pr.origin, [&](std::int32_t k) { consider(probe_segment(pr, w.segments[k].a, w.segments[k].b)); });
-  for_each_in_3x3(w.circle_grid, pr.origin, [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
+  for_each_in_cell(w.segment_grid, pr.origin, [&](std::int32_t k) { consider(probe_segment(pr, w.segments[k].a, w.segments[k].b)); });
+  for_each_in_cell(w.circle_grid, pr.origin, [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
   return best;
 }
 
@@ -48,7 +48,10 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
     if (j == self || (n.flags[j] & kAgentActive) == 0) return;
     const glm::vec2 q = n.position[j];
     if (length2(q - p) >= query2) return;
-    const Threat t = predict_threat(p, v, forward, radius + m.personal_space, q, n.velocity[j], n.radius[j] + m.personal_space, m.pred_time);
+    // An agent standing at its goal is passed like a post: no personal space,
+    // so arriving agents can still reach goals next to those already there.
+    const float space = (n.flags[j] & kAgentStopped) != 0 ? 0.0f : m.personal_space;
+    const Threat t = predict_threat(p, v, forward, radius + space, q, n.velocity[j], n.radius[j] + space, m.pred_time);
     if (more_urgent(t, best)) best = t;
   });
   return best;
@@ -65,10 +68,11 @@ THRONG_HOST_DEVICE inline glm::vec2 tie_direction(Index i, Index j) {
 
 // Contact constraint (the addition to the paper's model): each overlapping
 // pair is pushed apart, this agent taking half of the overlap.
-THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self, glm::vec2 p, float radius,
+// Candidates: the contact bins' cells `cells` (the 3x3 around the agent's).
+THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Slots3x3& cells, Index self, glm::vec2 p, float radius,
                                                  Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags) {
   glm::vec2 push(0.0f);
-  for_each_in_3x3(bins, cx, cy, [&](std::int32_t j) {
+  for_each_in_slots(bins, cells, [&](std::int32_t j) {
     if (j == self || (flags[j] & kAgentActive) == 0) return;
     const glm::vec2 d = p - positions[j];
     const float reach = radius + radii[j];
@@ -86,7 +90,7 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, std::int3
 // lies on a wall.
 THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w, glm::vec2 p, float r, glm::vec2 anchor) {
   for (int pass = 0; pass < 2; ++pass) {
-    for_each_in_3x3(w.segment_grid, p, [&](std::int32_t k) {
+    for_each_in_cell(w.segment_grid, p, [&](std::int32_t k) {
       const Segment s = w.segments[k];
       const glm::vec2 q = closest_point_on_segment(p, s.a, s.b);
       const float d = length_of(p - q);
@@ -96,7 +100,7 @@ THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w,
       const glm::vec2 dir = d > 1e-6f ? (p - q) * (1.0f / d) : n;
       p = q + dir * r;
     });
-    for_each_in_3x3(w.circle_grid, p, [&](std::int32_t k) {
+    for_each_in_cell(w.circle_grid, p, [&](std::int32_t k) {
       const Circle c = w.circles[k];
       const glm::vec2 d = p - c.center;
       if (length2(d) >= (c.radius + r) * (c.radius + r)) return;

@@ -5,10 +5,12 @@
 // Obstacles are polygons (with holes) and circles. Walls are the edges of
 // every obstacle polygon and of the walkable boundary; holes of the walkable
 // region become obstacle polygons. Three sparse grids of side cell_size:
-//   segments: every cell an edge passes through (probe, projection);
-//   circles:  every cell a disc overlaps;
+//   segments: every cell an edge passes through, plus the ring of cells
+//             around those (probe, projection, clearance);
+//   circles:  every cell a disc overlaps, plus that ring;
 //   polygons: every cell of a polygon's bounding box (point containment).
-// An agent's 3x3 cells reach every wall within one cell side of it.
+// Because of the ring ("halo"), the one cell containing a point lists every
+// wall and circle within one cell side of it: one lookup instead of nine.
 #pragma once
 
 #include <cstdint>
@@ -80,15 +82,15 @@ THRONG_HOST_DEVICE inline bool in_free_space(const WorldView& w, glm::vec2 p) {
   return polygon_containing(w, p) < 0 && circle_containing(w, p) < 0;
 }
 
-// Distance from p to the nearest wall or circle boundary within the 3x3 cells
-// (beyond that: `far`).
+// Distance from p to the nearest wall or circle boundary within one cell
+// side (beyond that: `far`).
 THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, glm::vec2 p, float far) {
   float best = far;
-  for_each_in_3x3(w.segment_grid, p, [&](std::int32_t k) {
+  for_each_in_cell(w.segment_grid, p, [&](std::int32_t k) {
     const float d = distance_to_segment(p, w.segments[k].a, w.segments[k].b);
     if (d < best) best = d;
   });
-  for_each_in_3x3(w.circle_grid, p, [&](std::int32_t k) {
+  for_each_in_cell(w.circle_grid, p, [&](std::int32_t k) {
     const Circle c = w.circles[k];
     const float d = fabsf(length_of(p - c.center) - c.radius);
     if (d < best) best = d;

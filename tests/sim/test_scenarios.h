@@ -24,7 +24,7 @@ inline ScenarioSpec circle_spec(std::int64_t n, std::uint64_t seed = 1) {
   GoalSpec goal;
   goal.kind = GoalSpec::Kind::Mirror;
   goal.value = glm::vec2(0.0f);
-  g.goals = {goal};
+  g.goal = goal;
   g.arrival = ArrivalBehaviour::Stop;
   s.groups = {g};
   return s;
@@ -55,7 +55,7 @@ inline ScenarioSpec crossing_spec(std::int64_t n_per_flow, std::uint64_t seed = 
     GoalSpec goal;
     goal.kind = GoalSpec::Kind::Offset;
     goal.value = offset;
-    g.goals = {goal};
+    g.goal = goal;
     g.arrival = ArrivalBehaviour::Despawn;
     return g;
   };
