@@ -38,22 +38,40 @@ struct NeighbourArrays {
 };
 
 // Most urgent threat among active neighbours within the query radius,
-// visited in bin order (deterministic).
+// visited in bin order (deterministic). Of the 3x3 cells, those wholly
+// beyond the query radius or wholly behind the agent are skipped (a threat
+// must be ahead); `slack` widens both tests by how far neighbours may have
+// moved since they were binned (0 when positions are those binned).
 THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self, glm::vec2 p,
                                                   glm::vec2 v, glm::vec2 forward, float radius, const NeighbourArrays& n,
-                                                  const ModelParams& m) {
+                                                  const ModelParams& m, float slack) {
   Threat best;
-  const float query2 = m.query_radius() * m.query_radius();
-  for_each_in_3x3(bins, cx, cy, [&](std::int32_t j) {
-    if (j == self || (n.flags[j] & kAgentActive) == 0) return;
-    const glm::vec2 q = n.position[j];
-    if (length2(q - p) >= query2) return;
-    // An agent standing at its goal is passed like a post: no personal space,
-    // so arriving agents can still reach goals next to those already there.
-    const float space = (n.flags[j] & kAgentStopped) != 0 ? 0.0f : m.personal_space;
-    const Threat t = predict_threat(p, v, forward, radius + space, q, n.velocity[j], n.radius[j] + space, m.pred_time);
-    if (more_urgent(t, best)) best = t;
-  });
+  const float query = m.query_radius();
+  const float query2 = query * query;
+  const float side = bins.cell_size;
+  for (std::int32_t dy = -1; dy <= 1; ++dy)
+    for (std::int32_t dx = -1; dx <= 1; ++dx) {
+      const glm::vec2 lo(static_cast<float>(cx + dx) * side - slack, static_cast<float>(cy + dy) * side - slack);
+      const glm::vec2 hi = lo + glm::vec2(side + 2.0f * slack);
+      const glm::vec2 nearest(fminf(fmaxf(p.x, lo.x), hi.x), fminf(fmaxf(p.y, lo.y), hi.y));
+      if (length2(nearest - p) >= query2) continue;
+      // The corner of the cell furthest along `forward`.
+      const glm::vec2 front(forward.x >= 0.0f ? hi.x : lo.x, forward.y >= 0.0f ? hi.y : lo.y);
+      if (dot2(front - p, forward) <= 0.0f) continue;
+      const Index s = bins.find(cx + dx, cy + dy);
+      if (s < 0) continue;
+      const std::int32_t b = bins.start[s], count = bins.count[s];
+      for (std::int32_t k = 0; k < count; ++k) {
+        const std::int32_t j = bins.items[b + k];
+        const glm::vec2 q = n.position[j];
+        if (length2(q - p) >= query2 || j == self || (n.flags[j] & kAgentActive) == 0) continue;
+        // An agent standing at its goal is passed like a post: no personal
+        // space, so arriving agents can still reach goals next to those there.
+        const float space = (n.flags[j] & kAgentStopped) != 0 ? 0.0f : m.personal_space;
+        const Threat t = predict_threat(p, v, forward, radius + space, q, n.velocity[j], n.radius[j] + space, m.pred_time);
+        if (more_urgent(t, best)) best = t;
+      }
+    }
   return best;
 }
 

@@ -19,9 +19,8 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   world_ = World::build(spec_.world, spec_.model.query_radius(), options.limits, current_memory());
   crowd_ = upload_crowd(spawn_crowd(spec_, world_, options.limits, options.planner), current_memory());
   bins_ = AgentGrid(spec_.model.query_radius());
-  float max_radius = 0.0f;
-  for (const GroupSpec& g : spec_.groups) max_radius = std::max(max_radius, g.radius);
-  contact_bins_ = AgentGrid(std::min(4.0f * max_radius, spec_.model.query_radius()));
+  for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
+  contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));
   const Memory m = current_memory();
   anchor_ = Buffer<glm::vec2>(crowd_.count, m);
   candidate_ = Buffer<glm::vec2>(crowd_.count, m);
@@ -38,6 +37,8 @@ StepContext Simulation::context() const {
   ctx.model = spec_.model;
   ctx.dt = spec_.dt;
   ctx.time_after = static_cast<float>(static_cast<double>(steps_done_ + 1) * spec_.dt);
+  // The move stage accepts at most 0.95 radius per step (simulation_kernels.cpp).
+  ctx.bin_slack = scheduler_ == SchedulerKind::FourColour ? max_radius_ : 0.0f;
   return ctx;
 }
 

@@ -64,6 +64,9 @@ struct StepContext {
   ModelParams model;
   float dt = 0.1f;
   float time_after = 0.0f;  // simulated time at the end of this step
+  // How far an agent may be from where it was binned when others read it:
+  // 0 for the double buffer, one step's largest move for the four colours.
+  float bin_slack = 0.0f;
 };
 
 // Stages (each one or more parallel_for launches named "sim.<stage>...").
@@ -137,6 +140,7 @@ class Simulation {
   AgentGrid bins_;
   AgentGrid contact_bins_;
   SchedulerKind scheduler_ = SchedulerKind::DoubleBuffer;
+  float max_radius_ = 0.0f;
   std::int64_t steps_done_ = 0;
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
   Buffer<Slots3x3> contact_cells_;

@@ -28,7 +28,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_agent(const StepContext& ctx, const Ag
   const glm::vec2 obstacle = sense_obstacles(ctx.world, probe, m.max_force).force;
   if (length2(obstacle) > 1e-12f) return obstacle;
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-  return avoidance_force(probe.forward, sense_neighbours(ctx.bins, cx, cy, i, p, v, probe.forward, r, n, m), m.max_force);
+  return avoidance_force(probe.forward, sense_neighbours(ctx.bins, cx, cy, i, p, v, probe.forward, r, n, m, ctx.bin_slack), m.max_force);
 }
 
 // Steer: path following when the sensed force is zero, then integration.
