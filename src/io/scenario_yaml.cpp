@@ -1,6 +1,7 @@
 #include "io/scenario_yaml.h"
 
 #include <fmt/format.h>
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -52,7 +53,8 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 std::string shown(std::string_view s) {
   constexpr std::size_t kShown = 40;
   std::string out;
-  for (char c : s.substr(0, kShown)) out += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
+  // Printable ASCII only: messages stay one readable line whatever the file holds.
+  for (char c : s.substr(0, kShown)) out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) ? '?' : c;
   return "'" + out + (s.size() > kShown ? "...'" : "'");
 }
 
@@ -148,17 +150,28 @@ class Reader {
     return n;
   }
 
-  double number(const YAML::Node& n, const std::string& path) {
-    visit(n, path);
-    if (!n.IsScalar()) fail(n, path, "expected a number, got " + kind(n));
-    if (n.Tag() == "!") fail(n, path, "expected a number, got the quoted string " + shown(n.Scalar()));
+  // Why n is not a finite number, or "" when it is (then *out holds it).
+  static std::string number_problem(const YAML::Node& n, double* out) {
+    if (!n.IsScalar()) return "expected a number, got " + kind(n);
+    if (n.Tag() == "!") return "expected a number, got the quoted string " + shown(n.Scalar());
     std::string_view text = n.Scalar();
+    std::string_view bare = text;
+    if (!bare.empty() && (bare[0] == '+' || bare[0] == '-')) bare.remove_prefix(1);
+    for (std::string_view special : {".inf", ".Inf", ".INF", ".nan", ".NaN", ".NAN"})
+      if (bare == special) return "the number must be finite, got " + shown(text);
     if (!text.empty() && text[0] == '+') text.remove_prefix(1);
     double v = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || text.empty())
-      fail(n, path, "expected a number, got " + shown(n.Scalar()));
-    if (!std::isfinite(v) || std::fabs(v) > 3.0e38) fail(n, path, "the number must be finite, got " + shown(n.Scalar()));
+    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return "expected a number, got " + shown(n.Scalar());
+    if (!std::isfinite(v) || std::fabs(v) > 3.0e38) return "the number must be finite, got " + shown(n.Scalar());
+    *out = v;
+    return {};
+  }
+
+  double number(const YAML::Node& n, const std::string& path) {
+    visit(n, path);
+    double v = 0;
+    if (const std::string problem = number_problem(n, &v); !problem.empty()) fail(n, path, problem);
     return v;
   }
   float real(const YAML::Node& n, const std::string& path) { return static_cast<float>(number(n, path)); }
@@ -204,18 +217,34 @@ class Reader {
   void expect_list(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size, const char* what) {
     visit(n, path);
     if (!n.IsSequence()) fail(n, path, fmt::format("expected a list of {}, got {}", what, kind(n)));
-    if (n.size() < min_size) fail(n, path, fmt::format("needs at least {} {}, got {}", min_size, what, n.size()));
+    if (n.size() < min_size)
+      fail(n, path, min_size == 1 ? fmt::format("must not be empty: give at least one of the {}", what)
+                                  : fmt::format("needs at least {} {}, got {}", min_size, what, n.size()));
     if (n.size() > max_size) fail(n, path, fmt::format("has more than {} {}", max_size, what));
   }
 
   glm::vec2 point(const YAML::Node& n, const std::string& path) {
     visit(n, path);
-    if (!n.IsSequence() || n.size() != 2) fail(n, path, "expected a point [x, y], got " + kind(n));
-    const float max_extent = limits_.scenario.max_extent;
-    glm::vec2 p(real(n[0], item(path, 0)), real(n[1], item(path, 1)));
-    if (std::fabs(p.x) > max_extent || std::fabs(p.y) > max_extent)
-      fail(n, path, fmt::format("coordinates must be within +-{} m", max_extent));
-    return p;
+    return coordinates(n, [&] { return path; });
+  }
+
+  // [x, y] within the extent limit. Vertices of rings come here directly:
+  // counted against the node budget but not recorded, and their key path is
+  // only spelled out for an error (a polygon may have a million of them).
+  template <class PathFn>
+  glm::vec2 coordinates(const YAML::Node& n, const PathFn& path) {
+    if (!n.IsSequence() || n.size() != 2) fail(n, path(), "expected a point [x, y], got " + kind(n));
+    nodes_ += 2;
+    if (nodes_ > limits_.max_nodes) fail(n, path(), fmt::format("the file has more than {} YAML values", limits_.max_nodes));
+    double xy[2];
+    for (int k = 0; k < 2; ++k) {
+      const YAML::Node c = n[k];
+      if (const std::string problem = number_problem(c, &xy[k]); !problem.empty()) fail(c, item(path(), static_cast<std::size_t>(k)), problem);
+    }
+    const double max_extent = limits_.scenario.max_extent;
+    if (std::fabs(xy[0]) > max_extent || std::fabs(xy[1]) > max_extent)
+      fail(n, path(), fmt::format("coordinates must be within +-{} m", max_extent));
+    return {static_cast<float>(xy[0]), static_cast<float>(xy[1])};
   }
 
   glm::vec3 point3(const YAML::Node& n, const std::string& path) {
@@ -231,7 +260,10 @@ class Reader {
       fail(n, path, fmt::format("the scenario has more than {} polygon vertices", limits_.scenario.max_vertices));
     sim::Ring r;
     r.reserve(n.size());
-    for (std::size_t i = 0; i < n.size(); ++i) r.push_back(point(n[i], item(path, i)));
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      ++nodes_;
+      r.push_back(coordinates(n[i], [&] { return item(path, i); }));
+    }
     return r;
   }
 
@@ -313,8 +345,7 @@ class Reader {
     return g;
   }
 
-  sim::SpeedSpec speed(const YAML::Node& n, const std::string& path) {
-    sim::SpeedSpec s;
+  sim::SpeedSpec speed(const YAML::Node& n, const std::string& path, sim::SpeedSpec s) {
     if (n.IsScalar()) {  // one number: every agent walks at it
       s.mean = s.min = s.max = real(n, path);
       s.stddev = 0.0f;
@@ -403,13 +434,17 @@ class Reader {
     }
   }
 
-  sim::GroupSpec group(const YAML::Node& n, const std::string& path) {
+  sim::GroupSpec group(const YAML::Node& n, const std::string& path, const sim::ModelParams& model) {
     expect_map(n, path, {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius"});
     sim::GroupSpec g;
     if (n["name"]) g.name = text(n["name"], child(path, "name"));
     g.count = integer(required(n, path, "count"), child(path, "count"), 0, limits_.scenario.max_agents);
     if (n["radius"]) g.radius = real(n["radius"], child(path, "radius"));
-    if (n["speed"]) g.speed = speed(n["speed"], child(path, "speed"));
+    // Unless given, speeds stay within the model's maximum.
+    g.speed.max = std::min(g.speed.max, model.max_speed);
+    g.speed.min = std::min(g.speed.min, g.speed.max);
+    g.speed.mean = std::min(g.speed.mean, g.speed.max);
+    if (n["speed"]) g.speed = speed(n["speed"], child(path, "speed"), g.speed);
     g.spawn = region(required(n, path, "spawn"), child(path, "spawn"));
     if (const YAML::Node list = n["waypoints"]) {
       const std::string lp = child(path, "waypoints");
@@ -487,7 +522,7 @@ class Reader {
     expect_list(groups, "groups", 1, static_cast<std::size_t>(limits_.max_groups), "groups");
     std::int64_t agents = 0;
     for (std::size_t i = 0; i < groups.size(); ++i) {
-      s.groups.push_back(group(groups[i], item("groups", i)));
+      s.groups.push_back(group(groups[i], item("groups", i), s.model));
       agents += s.groups.back().count;
       if (agents > limits_.scenario.max_agents)
         fail(groups[i], item("groups", i), fmt::format("the scenario has more than {} agents", limits_.scenario.max_agents));
@@ -546,6 +581,8 @@ LoadedScenario parse_scenario(std::string_view text, const std::string& name, co
   YAML::Node root;
   try {
     root = YAML::Load(std::string(text));
+  } catch (const YAML::DeepRecursion& e) {
+    throw Error("lists and maps nested too deeply", Location{name, e.mark.line + 1, e.mark.column + 1, {}});
   } catch (const YAML::Exception& e) {
     const int line = e.mark.is_null() ? 1 : e.mark.line + 1, column = e.mark.is_null() ? 0 : e.mark.column + 1;
     throw Error("YAML syntax: " + e.msg, Location{name, line, column, {}});

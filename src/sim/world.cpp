@@ -308,7 +308,9 @@ bool World::disc_fits(glm::vec2 p, float r) const { return disc_is_clear(host_vi
 Reachability::Reachability(const World& world, Aabb extent, std::int32_t resolution) : extent_(extent) {
   if (extent.empty()) return;
   const glm::vec2 size = extent.size();
-  h_ = std::max({size.x / static_cast<float>(resolution), size.y / static_cast<float>(resolution), 0.05f});
+  // Cells of at least 0.1 m: a gap an agent fits through (0.5 m for the
+  // usual radius) still has several free cells across.
+  h_ = std::max({size.x / static_cast<float>(resolution), size.y / static_cast<float>(resolution), 0.1f});
   nx_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(size.x / h_)));
   ny_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(size.y / h_)));
   labels_.assign(static_cast<std::size_t>(nx_ * ny_), -1);
