@@ -60,8 +60,22 @@ THRONG_HOST_DEVICE inline std::uint64_t mix_key(std::uint64_t k) {
   return k;
 }
 
+// Where a cell's probe sequence starts in a table of mask + 1 slots (a power
+// of two, at least 16). Cells are grouped in 4 x 4 tiles: a tile is placed
+// by a hash, its 16 cells in 16 consecutive slots, so the 3x3 cells around
+// an agent lie in a few cache lines and agents near each other in space
+// touch the same part of the table.
+THRONG_HOST_DEVICE inline std::uint64_t home_slot(std::uint64_t key, std::uint64_t mask) {
+  const std::int32_t cx = key_cx(key), cy = key_cy(key);
+  const std::uint64_t tile = cell_key(cx >> 2, cy >> 2);
+  const auto local = static_cast<std::uint64_t>(((cy & 3) << 2) | (cx & 3));
+  return ((mix_key(tile) << 4) | local) & mask;
+}
+
 // What kernels see: the table (keys per slot, kEmptyCell when free), the run
-// of each slot in `items`, and the cell side.
+// of each slot in `items`, and the cell side. `items` holds every binned
+// item grouped by cell: iterating it visits agents cell by cell, which keeps
+// the lookups of neighbouring agents in the same part of memory.
 struct GridView {
   float cell_size = 1.0f;
   std::uint64_t mask = 0;  // capacity - 1 (capacity is a power of two)
@@ -75,7 +89,7 @@ struct GridView {
   THRONG_HOST_DEVICE Index find(std::int32_t cx, std::int32_t cy) const {
     if (items.size() == 0) return -1;  // nothing binned (e.g. a world without walls)
     const std::uint64_t key = cell_key(cx, cy);
-    std::uint64_t s = mix_key(key) & mask;
+    std::uint64_t s = home_slot(key, mask);
     for (;;) {
       const std::uint64_t k = keys[static_cast<Index>(s)];
       if (k == key) return static_cast<Index>(s);
@@ -85,26 +99,30 @@ struct GridView {
   }
 };
 
-// The table slots of the 3x3 cells around cell (cx, cy), row-major (dy,
-// then dx), -1 where a cell is empty. Worth keeping when the same
-// neighbourhood is visited several times in a step (the contact passes).
-struct Slots3x3 {
-  std::int32_t slot[9];
+// The item runs of the 3x3 cells around cell (cx, cy), row-major (dy, then
+// dx); an empty cell has count 0. Worth keeping when the same neighbourhood
+// is visited several times in a step (the contact passes): the table lookups
+// and their cache misses are paid once.
+struct Cells3x3 {
+  std::int32_t start[9];
+  std::int32_t count[9];
 };
-THRONG_HOST_DEVICE inline Slots3x3 slots_3x3(const GridView& g, std::int32_t cx, std::int32_t cy) {
-  Slots3x3 s;
+THRONG_HOST_DEVICE inline Cells3x3 cells_3x3(const GridView& g, std::int32_t cx, std::int32_t cy) {
+  Cells3x3 c;
   for (std::int32_t dy = -1; dy <= 1; ++dy)
-    for (std::int32_t dx = -1; dx <= 1; ++dx) s.slot[(dy + 1) * 3 + dx + 1] = static_cast<std::int32_t>(g.find(cx + dx, cy + dy));
-  return s;
+    for (std::int32_t dx = -1; dx <= 1; ++dx) {
+      const int k = (dy + 1) * 3 + dx + 1;
+      const Index s = g.find(cx + dx, cy + dy);
+      c.start[k] = s < 0 ? 0 : g.start[s];
+      c.count[k] = s < 0 ? 0 : g.count[s];
+    }
+  return c;
 }
 // Calls fn(item) for every item of those cells, in order.
 template <class Fn>
-THRONG_HOST_DEVICE inline void for_each_in_slots(const GridView& g, const Slots3x3& s, Fn&& fn) {
-  for (int k = 0; k < 9; ++k) {
-    if (s.slot[k] < 0) continue;
-    const std::int32_t b = g.start[s.slot[k]], n = g.count[s.slot[k]];
-    for (std::int32_t m = 0; m < n; ++m) fn(g.items[b + m]);
-  }
+THRONG_HOST_DEVICE inline void for_each_in_cells(const GridView& g, const Cells3x3& c, Fn&& fn) {
+  for (int k = 0; k < 9; ++k)
+    for (std::int32_t m = 0; m < c.count[k]; ++m) fn(g.items[c.start[k] + m]);
 }
 
 // Calls fn(item) for every item of the 3x3 cells around cell (cx, cy), cells

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "core/error.h"
 #include "core/timing.h"
 
 namespace throng::sim {
@@ -14,7 +15,8 @@ AgentArrays arrays_of(CrowdState& c) {
           c.flags.span(),           c.arrival_time.span(),   c.waypoints.span(),      c.groups.span()};
 }
 
-Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& options) : spec_(spec), scheduler_(spec.scheduler) {
+Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& options)
+    : spec_(spec), scheduler_(spec.scheduler), neighbours_(options.neighbours) {
   spec_.model.validate();
   world_ = World::build(spec_.world, spec_.model.query_radius(), options.limits, current_memory());
   crowd_ = upload_crowd(spawn_crowd(spec_, world_, options.limits, options.planner), current_memory());
@@ -25,8 +27,8 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   anchor_ = Buffer<glm::vec2>(crowd_.count, m);
   candidate_ = Buffer<glm::vec2>(crowd_.count, m);
   scratch_ = Buffer<glm::vec2>(crowd_.count, m);
-  sensed_ = Buffer<glm::vec2>(crowd_.count, m);
-  contact_cells_ = Buffer<Slots3x3>(crowd_.count, m);
+  sensed_ = Buffer<glm::vec2>::zeros(crowd_.count, m);      // inactive agents are never sensed
+  move_cells_ = Buffer<MoveCells>::zeros(crowd_.count, m);  // nor given move cells
 }
 
 StepContext Simulation::context() const {
@@ -59,7 +61,11 @@ void Simulation::bin() {
 
 void Simulation::sense_and_steer(const StepContext& ctx) {
   const AgentArrays a = arrays_of(crowd_);
-  if (scheduler_ == SchedulerKind::DoubleBuffer) {
+  if (neighbours_ == NeighbourSearch::AllPairs) {
+    if (scheduler_ != SchedulerKind::DoubleBuffer) throw Error("the all-pairs reference runs with the double buffer only", at_field("scheduler"));
+    sense_all_pairs(ctx, a, sensed_.span());
+    steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
+  } else if (scheduler_ == SchedulerKind::DoubleBuffer) {
     sense_double_buffer(ctx, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else {
@@ -70,17 +76,18 @@ void Simulation::sense_and_steer(const StepContext& ctx) {
 void Simulation::move(const StepContext& ctx) {
   const AgentArrays a = arrays_of(crowd_);
   const Span<const glm::vec2> anchor = anchor_.span();
-  if (scheduler_ == SchedulerKind::DoubleBuffer) {
+  const Span<const MoveCells> cells = move_cells_.span();
+  move_cells(ctx, anchor, move_cells_.span());
+  if (scheduler_ == SchedulerKind::DoubleBuffer) {  // (the all-pairs reference included)
     Span<glm::vec2> in = candidate_.span(), out = scratch_.span();
-    if (spec_.model.contact_iterations > 0) contact_cells(ctx, anchor, contact_cells_.span());
     for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) {
-      contacts_double_buffer(ctx, a, anchor, contact_cells_.span(), in, out);
+      contacts_double_buffer(ctx, a, anchor, cells, in, out);
       std::swap(in, out);
     }
-    finalize_step(ctx, a, anchor, in);
+    finalize_step(ctx, a, anchor, cells, in);
   } else {
-    for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) contacts_four_colour(ctx, a, anchor);
-    finalize_step(ctx, a, anchor, a.position);
+    for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) contacts_four_colour(ctx, a, anchor, cells);
+    finalize_step(ctx, a, anchor, cells, a.position);
   }
 }
 

@@ -57,6 +57,14 @@ struct AgentArrays {
 };
 AgentArrays arrays_of(CrowdState& c);
 
+// What the move stage looks up once per agent per step (around its position
+// at the start of the step) and reuses in every contact pass: the contact
+// bins' 3x3 cells and the walls and circles nearby.
+struct MoveCells {
+  Cells3x3 agents;
+  ObstacleCell obstacles;
+};
+
 struct StepContext {
   WorldView world;
   GridView bins;          // side query_radius: steering neighbours
@@ -70,28 +78,39 @@ struct StepContext {
 };
 
 // Stages (each one or more parallel_for launches named "sim.<stage>...").
-// Double buffer: the sensed force of every agent, then candidate positions.
+// Double buffer: the sensed force of every binned (active) agent, then
+// candidate positions.
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
+// The naive reference for the sense stage: every agent against every other,
+// O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
+void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
 void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed, Span<glm::vec2> out_position);
-// Double buffer: the contact cells around each anchor (position at the start
-// of the step), then one contact pass from `in` to `out`.
-void contact_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<Slots3x3> cells);
-void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const Slots3x3> cells,
+// Both: the move cells around each binned agent's anchor (its position at
+// the start of the step).
+void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells);
+// Double buffer: one contact pass from `in` to `out`.
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
                             Span<const glm::vec2> in, Span<glm::vec2> out);
 // Four colour: sense + steer, then each contact pass, in place on a.position
 // and a.velocity, colour by colour.
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a);
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor);
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells);
 // Both: accepts or rejects each moved position, sets velocity, heading,
 // arrivals and waypoints. `moved` may alias a.position.
-void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> moved);
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                   Span<const glm::vec2> moved);
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to);
 // Agents whose flags have `bit` set (deterministic reduction).
 Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit);
 
+// How the sense stage finds neighbours: the paper's bins, or every agent
+// (the O(N^2) reference of benchmarks and tests; double buffer only).
+enum class NeighbourSearch : std::uint8_t { Bins, AllPairs };
+
 struct SimulationOptions {
   ScenarioLimits limits;
   const RoutePlanner* planner = nullptr;  // path planning for groups with a goal and no waypoints
+  NeighbourSearch neighbours = NeighbourSearch::Bins;
 };
 
 class Simulation {
@@ -140,10 +159,11 @@ class Simulation {
   AgentGrid bins_;
   AgentGrid contact_bins_;
   SchedulerKind scheduler_ = SchedulerKind::DoubleBuffer;
+  NeighbourSearch neighbours_ = NeighbourSearch::Bins;
   float max_radius_ = 0.0f;
   std::int64_t steps_done_ = 0;
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
-  Buffer<Slots3x3> contact_cells_;
+  Buffer<MoveCells> move_cells_;
 };
 
 }  // namespace throng::sim

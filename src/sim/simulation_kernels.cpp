@@ -16,9 +16,10 @@ constexpr float kAcceptFraction = 0.95f;  // of the radius: largest accepted dis
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) { return (flags & kAgentActive) != 0 && (flags & kAgentStopped) == 0; }
 
 // Sense: the higher-priority force of one agent, obstacle avoidance or else
-// agent avoidance (zero when neither applies). Neighbours come from the 3x3
-// bins around (cx, cy), the agent's cell.
-THRONG_HOST_DEVICE inline glm::vec2 sense_agent(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy) {
+// agent avoidance (zero when neither applies). `neighbours(p, v, forward,
+// radius)` finds the most urgent threat: from the 3x3 bins, or all pairs.
+template <class Neighbours>
+THRONG_HOST_DEVICE inline glm::vec2 sense_agent(const StepContext& ctx, const AgentArrays& a, Index i, const Neighbours& neighbours) {
   if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
   const ModelParams& m = ctx.model;
   const glm::vec2 p = a.position[i], v = a.velocity[i];
@@ -27,8 +28,15 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_agent(const StepContext& ctx, const Ag
   // Priority: agent avoidance is only computed when no obstacle force applies.
   const glm::vec2 obstacle = sense_obstacles(ctx.world, probe, m.max_force).force;
   if (length2(obstacle) > 1e-12f) return obstacle;
+  return avoidance_force(probe.forward, neighbours(p, v, probe.forward, r), m.max_force);
+}
+
+// Neighbours from the 3x3 bins around (cx, cy), the agent's cell.
+THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-  return avoidance_force(probe.forward, sense_neighbours(ctx.bins, cx, cy, i, p, v, probe.forward, r, n, m, ctx.bin_slack), m.max_force);
+  return sense_agent(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
+    return sense_neighbours(ctx.bins, cx, cy, i, p, v, forward, r, n, ctx.model, ctx.bin_slack);
+  });
 }
 
 // Steer: path following when the sensed force is zero, then integration.
@@ -50,23 +58,43 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
 }
 
 // One contact pass for one agent reading positions P.
-THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i, const Slots3x3& cells,
+THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i, const MoveCells& cells,
                                                   glm::vec2 anchor, Span<const glm::vec2> P) {
   glm::vec2 p = P[i];
   if ((a.flags[i] & kAgentActive) == 0) return p;
   const float r = a.radius[i];
-  p += clamp_length(contact_push(ctx.contact_bins, cells, i, p, r, P, a.radius, a.flags), 0.5f * r);
+  p += clamp_length(contact_push(ctx.contact_bins, cells.agents, i, p, r, P, a.radius, a.flags), 0.5f * r);
   p = anchor + clamp_length(p - anchor, kMaxStepFraction * r);
-  return project_out_of_obstacles(ctx.world, p, r, anchor);
+  return project_out_of_obstacles(ctx.world, cells.obstacles, p, r, anchor);
 }
 
+// Agents are visited in bin order (k -> items[k]): neighbours in space are
+// sensed one after another, so their cells and neighbours stay in cache.
+// Inactive agents are not binned and keep a zero sensed force.
 struct Sense {
   StepContext ctx;
   AgentArrays a;
   Span<glm::vec2> sensed;
-  THRONG_HOST_DEVICE void operator()(Index i) const {
+  THRONG_HOST_DEVICE void operator()(Index k) const {
+    const Index i = k;
+    if ((a.flags[i] & kAgentActive) == 0) return;
     const glm::vec2 p = a.position[i];
-    sensed[i] = sense_agent(ctx, a, i, cell_coord(p.x, ctx.bins.cell_size), cell_coord(p.y, ctx.bins.cell_size));
+    sensed[i] = sense_binned(ctx, a, i, cell_coord(p.x, ctx.bins.cell_size), cell_coord(p.y, ctx.bins.cell_size));
+  }
+};
+
+// The naive reference: the same sense stage with every other agent as a
+// candidate (O(N^2)), for benchmarks and for checking the bins.
+struct SenseAllPairs {
+  StepContext ctx;
+  AgentArrays a;
+  Span<glm::vec2> sensed;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+    const ModelParams m = ctx.model;
+    sensed[i] = sense_agent(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
+      return sense_neighbours_all_pairs(i, p, v, forward, r, n, m);
+    });
   }
 };
 
@@ -82,16 +110,17 @@ struct Steer {
   }
 };
 
-// The contact cells of every agent (around its position at the start of the
-// step), found once and used by every contact pass.
-struct ContactCells {
+// The move cells of every agent (around its position at the start of the
+// step), found once and used by every contact pass and the final check.
+struct FindMoveCells {
   StepContext ctx;
   Span<const glm::vec2> anchor;
-  Span<Slots3x3> cells;
-  THRONG_HOST_DEVICE void operator()(Index i) const {
+  Span<MoveCells> cells;
+  THRONG_HOST_DEVICE void operator()(Index k) const {  // in contact-bin order, like Sense
+    const Index i = k;
     const glm::vec2 b = anchor[i];
     const float side = ctx.contact_bins.cell_size;
-    cells[i] = slots_3x3(ctx.contact_bins, cell_coord(b.x, side), cell_coord(b.y, side));
+    cells[i] = {cells_3x3(ctx.contact_bins, cell_coord(b.x, side), cell_coord(b.y, side)), obstacle_cell(ctx.world, b)};
   }
 };
 
@@ -99,7 +128,7 @@ struct ContactsDoubleBuffer {
   StepContext ctx;
   AgentArrays a;
   Span<const glm::vec2> anchor, in;
-  Span<const Slots3x3> cells;
+  Span<const MoveCells> cells;
   Span<glm::vec2> out;
   THRONG_HOST_DEVICE void operator()(Index i) const { out[i] = contact_agent(ctx, a, i, cells[i], anchor[i], in); }
 };
@@ -119,7 +148,7 @@ struct SenseSteerColour {
     for (std::int32_t k = 0; k < n; ++k) {
       const Index i = ctx.bins.items[b + k];
       glm::vec2 np, nv;
-      steer_agent(ctx, a, i, sense_agent(ctx, a, i, cx, cy), np, nv);
+      steer_agent(ctx, a, i, sense_binned(ctx, a, i, cx, cy), np, nv);
       a.position[i] = np;
       a.velocity[i] = nv;
     }
@@ -130,15 +159,15 @@ struct ContactsColour {
   StepContext ctx;
   AgentArrays a;
   Span<const glm::vec2> anchor;
+  Span<const MoveCells> cells;
   int colour;
   THRONG_HOST_DEVICE void operator()(Index s) const {
     const std::uint64_t key = ctx.contact_bins.keys[s];
     if (key == kEmptyCell || cell_colour(key) != colour) return;
-    const Slots3x3 cells = slots_3x3(ctx.contact_bins, key_cx(key), key_cy(key));
     const std::int32_t b = ctx.contact_bins.start[s], n = ctx.contact_bins.count[s];
     for (std::int32_t k = 0; k < n; ++k) {
       const Index i = ctx.contact_bins.items[b + k];
-      a.position[i] = contact_agent(ctx, a, i, cells, anchor[i], a.position);
+      a.position[i] = contact_agent(ctx, a, i, cells[i], anchor[i], a.position);
     }
   }
 };
@@ -146,7 +175,9 @@ struct ContactsColour {
 struct Finalize {
   StepContext ctx;
   AgentArrays a;
-  Span<const glm::vec2> anchor, moved;
+  Span<const glm::vec2> anchor;
+  Span<const MoveCells> cells;
+  Span<const glm::vec2> moved;
   THRONG_HOST_DEVICE void operator()(Index i) const {
     std::uint8_t flags = a.flags[i];
     if ((flags & kAgentActive) == 0) return;
@@ -156,7 +187,7 @@ struct Finalize {
     // Accept the move only if it keeps the disc off every wall and is short
     // enough that it cannot have crossed one (see the header).
     const bool short_enough = length2(p - from) <= (kAcceptFraction * r) * (kAcceptFraction * r);
-    if (!(short_enough && wall_clearance(ctx.world, p, r) >= r - kWallTolerance)) p = from;
+    if (!(short_enough && wall_clearance(ctx.world, cells[i].obstacles, p, r) >= r - kWallTolerance)) p = from;
     glm::vec2 v = clamp_length((p - from) * (1.0f / ctx.dt), ctx.model.max_speed);
     if ((flags & kAgentStopped) != 0) v = glm::vec2(0.0f);
     a.position[i] = p;
@@ -202,15 +233,19 @@ void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm:
   parallel_for("sim.sense", a.position.size(), Sense{ctx, a, sensed}, kAgentGrain);
 }
 
+void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
+  parallel_for("sim.sense.all_pairs", a.position.size(), SenseAllPairs{ctx, a, sensed}, 16);
+}
+
 void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed, Span<glm::vec2> out_position) {
   parallel_for("sim.steer", a.position.size(), Steer{ctx, a, sensed, out_position}, kAgentGrain);
 }
 
-void contact_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<Slots3x3> cells) {
-  parallel_for("sim.move.cells", anchor.size(), ContactCells{ctx, anchor, cells}, kAgentGrain);
+void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells) {
+  parallel_for("sim.move.cells", anchor.size(), FindMoveCells{ctx, anchor, cells}, kAgentGrain);
 }
 
-void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const Slots3x3> cells,
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
                             Span<const glm::vec2> in, Span<glm::vec2> out) {
   parallel_for("sim.move.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, cells, out}, kAgentGrain);
 }
@@ -219,13 +254,14 @@ void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
   for (int c = 0; c < 4; ++c) parallel_for("sim.sense_steer.colour", ctx.bins.capacity(), SenseSteerColour{ctx, a, c}, kSlotGrain);
 }
 
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor) {
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells) {
   for (int c = 0; c < 4; ++c)
-    parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, c}, kSlotGrain);
+    parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, cells, c}, kSlotGrain);
 }
 
-void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> moved) {
-  parallel_for("sim.move.finalize", a.position.size(), Finalize{ctx, a, anchor, moved});
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                   Span<const glm::vec2> moved) {
+  parallel_for("sim.move.finalize", a.position.size(), Finalize{ctx, a, anchor, cells, moved});
 }
 
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to) {

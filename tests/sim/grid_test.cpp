@@ -118,7 +118,7 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
     // The cached form visits the same items in the same order.
     std::vector<std::int32_t> a, b;
     for_each_in_3x3(v, p[i], [&](std::int32_t j) { a.push_back(j); });
-    for_each_in_slots(v, slots_3x3(v, cell_coord(p[i].x, side), cell_coord(p[i].y, side)), [&](std::int32_t j) { b.push_back(j); });
+    for_each_in_cells(v, cells_3x3(v, cell_coord(p[i].x, side), cell_coord(p[i].y, side)), [&](std::int32_t j) { b.push_back(j); });
     EXPECT_EQ(a, b);
   }
 }
