@@ -27,7 +27,7 @@ struct ModelParams {
   float relaxation_time = 0.5f;    // s: path following reaches the desired velocity in about this
   float probe_margin = 0.1f;       // m: probe half-width = radius + probe_margin
   std::int32_t contact_iterations = 4;  // contact/obstacle projection passes per step (the added constraint)
-  float query_radius() const { return 2.0f * pred_time * max_speed; }
+  THRONG_HOST_DEVICE float query_radius() const { return 2.0f * pred_time * max_speed; }
   // Throws Error naming the field ("model.pred_time") for NaN, negative or
   // out-of-range values.
   void validate() const;
