@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/array_kernels.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/random.h"
 #include "core/timing.h"
@@ -13,10 +14,6 @@ namespace throng::anim {
 
 namespace {
 
-void check_count(const char* field, Index got, Index want) {
-  if (got != want)
-    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("locomotion_streams.") + field));
-}
 
 // The blend space as streamed agents show it: every blend at its bucket's centre.
 motion::BlendSpaceView quantised_view(motion::BlendSpaceView v, float width, std::int32_t buckets) {
@@ -103,21 +100,21 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
 }
 
 void LocomotionStreams::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> headings) {
-  check_count("drive_from_map.positions", positions.size(), count_);
+  check_length("locomotion_streams", "drive_from_map.positions", positions.size(), count_);
   MapInputJob{positions, velocities, headings, position_.span(), yaw_.span(), speed_.span()}.run();
 }
 
 void LocomotionStreams::set_agents(std::span<const glm::vec3> positions, std::span<const float> yaws, std::span<const float> speeds) {
-  check_count("positions", static_cast<Index>(positions.size()), count_);
-  check_count("yaws", static_cast<Index>(yaws.size()), count_);
-  check_count("speeds", static_cast<Index>(speeds.size()), count_);
+  check_length("locomotion_streams", "positions", static_cast<Index>(positions.size()), count_);
+  check_length("locomotion_streams", "yaws", static_cast<Index>(yaws.size()), count_);
+  check_length("locomotion_streams", "speeds", static_cast<Index>(speeds.size()), count_);
   position_.copy_from(positions);
   yaw_.copy_from(yaws);
   speed_.copy_from(speeds);
 }
 
 void LocomotionStreams::set_phases(std::span<const float> phases) {
-  check_count("phases", static_cast<Index>(phases.size()), count_);
+  check_length("locomotion_streams", "phases", static_cast<Index>(phases.size()), count_);
   for (float p : phases)
     if (!(p >= 0.0f && p < 1.0f)) throw Error("must be in [0, 1)", at_field("locomotion_streams.phases"));
   phase_.copy_from(phases);
@@ -274,47 +271,30 @@ void LocomotionStreams::synthesise_exact() {
   palettes.run();
 }
 
-void LocomotionStreams::track(std::vector<Index> agents) {
-  for (Index a : agents)
-    if (a < 0 || a >= count_) throw Error("agent " + std::to_string(a) + " is not in [0, " + std::to_string(count_) + ")", at_field("track"));
-  tracked_ = std::move(agents);
-  track_positions_.assign(tracked_.size(), {});
-  track_rotations_.assign(tracked_.size(), {});
-  track_frames_ = 0;
-}
+void LocomotionStreams::track(std::vector<Index> agents) { skating_.track(std::move(agents), count_, joints_); }
 
 void LocomotionStreams::record_tracks() {
-  if (tracked_.empty()) return;
+  if (skating_.tracked().empty()) return;
   const auto J = static_cast<std::size_t>(joints_);
   const Rig& r = rig();
   std::vector<Mat3x4> palette(J);
-  for (std::size_t t = 0; t < tracked_.size(); ++t) {
-    detail::copy_bytes(palette.data(), Memory::Host, palettes_.data() + tracked_[t] * joints_, palettes_.memory(), J * sizeof(Mat3x4));
+  for (std::size_t t = 0; t < skating_.tracked().size(); ++t) {
+    detail::copy_bytes(palette.data(), Memory::Host, palettes_.data() + skating_.tracked()[t] * joints_, palettes_.memory(), J * sizeof(Mat3x4));
+    const motion::FootSkatingRecorder::Frame f = skating_.append(t);
     for (std::size_t j = 0; j < J; ++j) {
       // The palette maps the bind pose to the world; the bind rotations are
       // identity, so its linear part is the joint's world rotation.
       const Mat3x4& m = palette[j];
-      track_positions_[t].push_back(transform_point(m, r.bind_positions[j]));
+      f.positions[j] = transform_point(m, r.bind_positions[j]);
       const glm::mat3 rotation(glm::vec3(m.r0.x, m.r1.x, m.r2.x), glm::vec3(m.r0.y, m.r1.y, m.r2.y), glm::vec3(m.r0.z, m.r1.z, m.r2.z));
-      track_rotations_[t].push_back(glm::normalize(glm::quat_cast(rotation)));
+      f.rotations[j] = glm::normalize(glm::quat_cast(rotation));
     }
   }
-  ++track_frames_;
+  skating_.end_frame();
 }
 
 motion::FootSkatingReport LocomotionStreams::foot_skating(const motion::ContactOptions& options) const {
-  std::vector<double> slides;
-  if (track_frames_ < 3) return motion::summarise_foot_skating(slides);
-  for (std::size_t t = 0; t < tracked_.size(); ++t) {
-    motion::ModelSpaceClip posed;
-    posed.joint_count = joints_;
-    posed.frame_count = track_frames_;
-    posed.positions = track_positions_[t];
-    posed.rotations = track_rotations_[t];
-    const motion::FootSkatingReport r = motion::measure_foot_skating(space_->skeleton(), posed, 1.0 / config_.frame_rate, options);
-    slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
-  }
-  return motion::summarise_foot_skating(std::move(slides));
+  return skating_.measure(space_->skeleton(), 1.0 / config_.frame_rate, options);
 }
 
 }  // namespace throng::anim

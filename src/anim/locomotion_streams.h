@@ -262,10 +262,7 @@ class LocomotionStreams {
   Buffer<glm::quat> joint_rotation_;
   LocomotionStreamsStats stats_;
   // Foot-skating probe.
-  std::vector<Index> tracked_;
-  std::vector<std::vector<glm::vec3>> track_positions_;
-  std::vector<std::vector<glm::quat>> track_rotations_;
-  std::int32_t track_frames_ = 0;
+  motion::FootSkatingRecorder skating_;
 };
 
 }  // namespace throng::anim

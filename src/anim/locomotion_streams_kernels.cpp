@@ -4,6 +4,7 @@
 #include <string>
 
 #include "anim/locomotion_streams.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
 
@@ -13,17 +14,13 @@ namespace throng::anim {
 // ---- world joints -> palettes ------------------------------------------------------------------
 
 void JointPaletteJob::validate() const {
-  auto check = [](const char* field, Index got, Index want) {
-    if (got != want)
-      throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("JointPaletteJob.") + field));
-  };
   if (joint_count <= 0) throw Error("must be positive", at_field("JointPaletteJob.joint_count"));
   const Index n = character_count();
-  check("joint_positions", joint_positions.size(), n * joint_count);
-  check("joint_rotations", joint_rotations.size(), n * joint_count);
-  check("inverse_bind", inverse_bind.size(), joint_count);
-  if (!scales.empty()) check("scales", scales.size(), n);
-  if (!agents.empty()) check("agents", agents.size(), n);
+  check_length("JointPaletteJob", "joint_positions", joint_positions.size(), n * joint_count);
+  check_length("JointPaletteJob", "joint_rotations", joint_rotations.size(), n * joint_count);
+  check_length("JointPaletteJob", "inverse_bind", inverse_bind.size(), joint_count);
+  if (!scales.empty()) check_length("JointPaletteJob", "scales", scales.size(), n);
+  if (!agents.empty()) check_length("JointPaletteJob", "agents", agents.size(), n);
 }
 
 void JointPaletteJob::run() const {
@@ -58,13 +55,6 @@ void JointPaletteJob::run() const {
 }
 
 // ---- per frame -----------------------------------------------------------------------------------
-
-namespace {
-void check_length(const char* job, const char* field, Index got, Index want) {
-  if (got != want)
-    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string(job) + "." + field));
-}
-}  // namespace
 
 void StreamBucketJob::validate() const {
   const Index n = agent_count();

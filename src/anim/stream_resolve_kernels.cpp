@@ -1,6 +1,7 @@
 #include <string>
 
 #include "anim/stream_resolve.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
 
@@ -93,16 +94,12 @@ void StreamCommandJob::run() const {
 
 void StreamRetargetJob::validate() const {
   const Index n = agent_count();
-  auto check = [](const char* field, Index got, Index want) {
-    if (got != want)
-      throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("StreamRetargetJob.") + field));
-  };
   if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamRetargetJob.cluster_stride"));
   if (!(blend_frames >= 0.0f && blend_frames < 1e7f)) throw Error("must be in [0, 1e7) frames", at_field("StreamRetargetJob.blend_frames"));
-  check("sources", sources.size(), n);
-  check("offsets", offsets.size(), n);
-  check("clusters", clusters.size(), n * cluster_stride);
-  if (!changed.empty()) check("changed", changed.size(), n);
+  check_length("StreamRetargetJob", "sources", sources.size(), n);
+  check_length("StreamRetargetJob", "offsets", offsets.size(), n);
+  check_length("StreamRetargetJob", "clusters", clusters.size(), n * cluster_stride);
+  if (!changed.empty()) check_length("StreamRetargetJob", "changed", changed.size(), n);
 }
 
 void StreamRetargetJob::run() const {
@@ -212,23 +209,19 @@ void StreamEventsJob::run() const {
 
 void StreamResolveJob::validate() const {
   const Index n = agent_count();
-  auto check = [](const char* field, Index got, Index want) {
-    if (got != want)
-      throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("StreamResolveJob.") + field));
-  };
   if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamResolveJob.cluster_stride"));
-  check("palette_offsets", palette_offsets.size(), n);
-  check("clusters", clusters.size(), n * cluster_stride);
-  if (!positions.empty()) check("positions", positions.size(), n);
-  if (!yaws.empty()) check("yaws", yaws.size(), n);
-  if (!override_begin.empty()) check("override_begin", override_begin.size(), n + 1);
-  if (!read_offsets.empty()) check("read_offsets", read_offsets.size(), n * cluster_stride);
-  if (!skip.empty()) check("skip", skip.size(), n);
-  check("tables.offsets", tables.offsets.size(), tables.parents.size());
-  check("tables.joint_cluster", tables.joint_cluster.size(), tables.parents.size());
-  check("tables.inverse_bind", tables.inverse_bind.size(), tables.parents.size());
-  check("tables.joint_segment", tables.joint_segment.size(), tables.parents.size());
-  check("tables.bind_positions", tables.bind_positions.size(), tables.parents.size());
+  check_length("StreamResolveJob", "palette_offsets", palette_offsets.size(), n);
+  check_length("StreamResolveJob", "clusters", clusters.size(), n * cluster_stride);
+  if (!positions.empty()) check_length("StreamResolveJob", "positions", positions.size(), n);
+  if (!yaws.empty()) check_length("StreamResolveJob", "yaws", yaws.size(), n);
+  if (!override_begin.empty()) check_length("StreamResolveJob", "override_begin", override_begin.size(), n + 1);
+  if (!read_offsets.empty()) check_length("StreamResolveJob", "read_offsets", read_offsets.size(), n * cluster_stride);
+  if (!skip.empty()) check_length("StreamResolveJob", "skip", skip.size(), n);
+  check_length("StreamResolveJob", "tables.offsets", tables.offsets.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.joint_cluster", tables.joint_cluster.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.inverse_bind", tables.inverse_bind.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.joint_segment", tables.joint_segment.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.bind_positions", tables.bind_positions.size(), tables.parents.size());
 }
 
 void StreamResolveJob::run() const {
