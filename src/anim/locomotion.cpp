@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/check.h"
 #include "core/error.h"
 #include "core/timing.h"
 
@@ -13,14 +14,6 @@ namespace {
 
 std::size_t at(Index i) { return static_cast<std::size_t>(i); }
 
-void check_size(const char* job, const char* field, Index got, Index want) {
-  if (got != want)
-    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want),
-                at_field(std::string(job) + "." + field));
-}
-void check_optional(const char* job, const char* field, Index got, Index want) {
-  if (got != 0) check_size(job, field, got, want);
-}
 void check_blend(const char* job, const motion::BlendSpaceView& v) {
   if (v.joint_count < 1 || v.joint_count > kMaxLodJoints || v.clip_count < 1 || v.clips == nullptr || v.sync == nullptr ||
       v.parents == nullptr || v.offsets == nullptr || v.joint_group == nullptr || v.mean_rotations == nullptr)
@@ -39,54 +32,54 @@ void LocomoteJob::validate() const {
   check_blend("LocomoteJob", blend);
   if (!(std::isfinite(step.dt) && step.dt >= 0.0f && step.dt <= 10.0f)) throw Error("must be in [0, 10] s", at_field("LocomoteJob.step.dt"));
   const Index n = character_count();
-  check_size("LocomoteJob", "speeds", speeds.size(), n);
-  check_optional("LocomoteJob", "turn_rates", turn_rates.size(), n);
-  check_optional("LocomoteJob", "curvatures", curvatures.size(), n);
-  check_optional("LocomoteJob", "scales", scales.size(), n);
-  check_size("LocomoteJob", "yaws", yaws.size(), n);
-  check_size("LocomoteJob", "phases", phases.size(), n);
-  check_size("LocomoteJob", "blend_speeds", blend_speeds.size(), n);
+  check_length("LocomoteJob", "speeds", speeds.size(), n);
+  check_optional_length("LocomoteJob", "turn_rates", turn_rates.size(), n);
+  check_optional_length("LocomoteJob", "curvatures", curvatures.size(), n);
+  check_optional_length("LocomoteJob", "scales", scales.size(), n);
+  check_length("LocomoteJob", "yaws", yaws.size(), n);
+  check_length("LocomoteJob", "phases", phases.size(), n);
+  check_length("LocomoteJob", "blend_speeds", blend_speeds.size(), n);
 }
 
 void MapInputJob::validate() const {
   const Index n = character_count();
-  check_size("MapInputJob", "map_velocities", map_velocities.size(), n);
-  check_size("MapInputJob", "map_headings", map_headings.size(), n);
-  check_size("MapInputJob", "positions", positions.size(), n);
-  check_size("MapInputJob", "yaws", yaws.size(), n);
-  check_size("MapInputJob", "speeds", speeds.size(), n);
+  check_length("MapInputJob", "map_velocities", map_velocities.size(), n);
+  check_length("MapInputJob", "map_headings", map_headings.size(), n);
+  check_length("MapInputJob", "positions", positions.size(), n);
+  check_length("MapInputJob", "yaws", yaws.size(), n);
+  check_length("MapInputJob", "speeds", speeds.size(), n);
 }
 
 void PoseJob::validate() const {
   check_blend("PoseJob", blend);
   const Index n = character_count();
   const Index J = blend.joint_count;
-  check_size("PoseJob", "yaws", yaws.size(), n);
-  check_optional("PoseJob", "scales", scales.size(), n);
-  check_size("PoseJob", "phases", phases.size(), n);
-  check_size("PoseJob", "blend_speeds", blend_speeds.size(), n);
-  check_optional("PoseJob", "joint_masks", joint_masks.size(), n * mask_word_count(blend.joint_count));
+  check_length("PoseJob", "yaws", yaws.size(), n);
+  check_optional_length("PoseJob", "scales", scales.size(), n);
+  check_length("PoseJob", "phases", phases.size(), n);
+  check_length("PoseJob", "blend_speeds", blend_speeds.size(), n);
+  check_optional_length("PoseJob", "joint_masks", joint_masks.size(), n * mask_word_count(blend.joint_count));
   if (!cache_slots.empty()) {
     if (bucket_count < 1 || !(bucket_width > 0.0f)) throw Error("must be positive", at_field("PoseJob.bucket_count"));
-    check_size("PoseJob", "cache_slots", cache_slots.size(), static_cast<Index>(blend.segment_count()) * bucket_count);
+    check_length("PoseJob", "cache_slots", cache_slots.size(), static_cast<Index>(blend.segment_count()) * bucket_count);
     if (cache_frames < 1) throw Error("must be positive with a cache", at_field("PoseJob.cache_frames"));
     if (cache_cycles.size() % (static_cast<Index>(cache_frames) * J) != 0)
       throw Error("size must be a multiple of cache_frames * joints", at_field("PoseJob.cache_cycles"));
     const Index slots = cache_cycles.size() / (static_cast<Index>(cache_frames) * J);
-    check_size("PoseJob", "cache_drops", cache_drops.size(), slots * cache_frames);
+    check_length("PoseJob", "cache_drops", cache_drops.size(), slots * cache_frames);
     // Every slot a key names must exist (a bad table must not read past the arena).
     if (current_memory() == Memory::Host)
       for (Index k = 0; k < cache_slots.size(); ++k)
         if (cache_slots[k] >= slots) throw Error("names slot " + std::to_string(cache_slots[k]) + " of " + std::to_string(slots), at_field("PoseJob.cache_slots"));
   }
-  check_size("PoseJob", "joint_positions", joint_positions.size(), n * J);
-  check_size("PoseJob", "joint_rotations", joint_rotations.size(), n * J);
+  check_length("PoseJob", "joint_positions", joint_positions.size(), n * J);
+  check_length("PoseJob", "joint_rotations", joint_rotations.size(), n * J);
   if (!draw_matrices.empty()) {
-    check_size("PoseJob", "draw_matrices", draw_matrices.size(), n * J);
-    check_size("PoseJob", "joint_shapes", joint_shapes.size(), J);
+    check_length("PoseJob", "draw_matrices", draw_matrices.size(), n * J);
+    check_length("PoseJob", "joint_shapes", joint_shapes.size(), J);
   }
-  check_optional("PoseJob", "evaluated", evaluated.size(), n);
-  check_optional("PoseJob", "from_cache", from_cache.size(), n);
+  check_optional_length("PoseJob", "evaluated", evaluated.size(), n);
+  check_optional_length("PoseJob", "from_cache", from_cache.size(), n);
 }
 
 std::vector<glm::mat4x3> joint_shapes(const motion::Skeleton& skeleton, float thickness, float min_radius) {
@@ -298,10 +291,10 @@ CrowdAnimator::CrowdAnimator(const motion::BlendSpace1D& space, Index count, Cro
 
 void CrowdAnimator::place(std::span<const glm::vec3> positions, std::span<const float> yaws, std::span<const float> scales,
                           std::span<const float> phases) {
-  check_size("CrowdAnimator.place", "positions", static_cast<Index>(positions.size()), count_);
-  check_size("CrowdAnimator.place", "yaws", static_cast<Index>(yaws.size()), count_);
-  check_optional("CrowdAnimator.place", "scales", static_cast<Index>(scales.size()), count_);
-  check_optional("CrowdAnimator.place", "phases", static_cast<Index>(phases.size()), count_);
+  check_length("CrowdAnimator.place", "positions", static_cast<Index>(positions.size()), count_);
+  check_length("CrowdAnimator.place", "yaws", static_cast<Index>(yaws.size()), count_);
+  check_optional_length("CrowdAnimator.place", "scales", static_cast<Index>(scales.size()), count_);
+  check_optional_length("CrowdAnimator.place", "phases", static_cast<Index>(phases.size()), count_);
   for (float s : scales)
     if (!(std::isfinite(s) && s > 0.0f)) throw Error("scales must be positive and finite", at_field("CrowdAnimator.place.scales"));
   position_.copy_from(positions);
@@ -312,20 +305,20 @@ void CrowdAnimator::place(std::span<const glm::vec3> positions, std::span<const 
 }
 
 void CrowdAnimator::set_speeds(std::span<const float> speeds) {
-  check_size("CrowdAnimator", "speeds", static_cast<Index>(speeds.size()), count_);
+  check_length("CrowdAnimator", "speeds", static_cast<Index>(speeds.size()), count_);
   speed_.copy_from(speeds);
 }
 void CrowdAnimator::set_turn_rates(std::span<const float> turn_rates) {
-  check_size("CrowdAnimator", "turn_rates", static_cast<Index>(turn_rates.size()), count_);
+  check_length("CrowdAnimator", "turn_rates", static_cast<Index>(turn_rates.size()), count_);
   turn_rate_.copy_from(turn_rates);
 }
 void CrowdAnimator::set_curvatures(std::span<const float> curvatures) {
-  check_size("CrowdAnimator", "curvatures", static_cast<Index>(curvatures.size()), count_);
+  check_length("CrowdAnimator", "curvatures", static_cast<Index>(curvatures.size()), count_);
   curvature_.copy_from(curvatures);
 }
 
 void CrowdAnimator::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> headings) {
-  check_size("CrowdAnimator.drive_from_map", "positions", positions.size(), count_);
+  check_length("CrowdAnimator.drive_from_map", "positions", positions.size(), count_);
   MapInputJob job;
   job.map_positions = positions;
   job.map_velocities = velocities;
@@ -412,47 +405,24 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
   stats_.from_cache = totals.from_cache;
   if (cache_) stats_.cache = cache_->cache().stats();
 
-  if (!tracked_.empty()) {
-    if (track_frames_ == 0) track_dt_ = input.dt;
+  if (!skating_.tracked().empty()) {
+    if (skating_.frames() == 0) track_dt_ = input.dt;
     const std::size_t J = static_cast<std::size_t>(joints_);
-    for (std::size_t t = 0; t < tracked_.size(); ++t) {
-      auto& p = track_positions_[t];
-      auto& r = track_rotations_[t];
-      p.resize(p.size() + J);
-      r.resize(r.size() + J);
-      const Index first = tracked_[t] * joints_;
-      detail::copy_bytes(p.data() + p.size() - J, Memory::Host, joint_position_.data() + first, joint_position_.memory(),
-                         J * sizeof(glm::vec3));
-      detail::copy_bytes(r.data() + r.size() - J, Memory::Host, joint_rotation_.data() + first, joint_rotation_.memory(),
-                         J * sizeof(glm::quat));
+    for (std::size_t t = 0; t < skating_.tracked().size(); ++t) {
+      const motion::FootSkatingRecorder::Frame f = skating_.append(t);
+      const Index first = skating_.tracked()[t] * joints_;
+      detail::copy_bytes(f.positions.data(), Memory::Host, joint_position_.data() + first, joint_position_.memory(), J * sizeof(glm::vec3));
+      detail::copy_bytes(f.rotations.data(), Memory::Host, joint_rotation_.data() + first, joint_rotation_.memory(), J * sizeof(glm::quat));
     }
-    ++track_frames_;
+    skating_.end_frame();
   }
   return stats_;
 }
 
-void CrowdAnimator::track(std::vector<Index> characters) {
-  for (Index c : characters)
-    if (c < 0 || c >= count_) throw Error("character " + std::to_string(c) + " is not in [0, " + std::to_string(count_) + ")", at_field("track"));
-  tracked_ = std::move(characters);
-  track_positions_.assign(tracked_.size(), {});
-  track_rotations_.assign(tracked_.size(), {});
-  track_frames_ = 0;
-}
+void CrowdAnimator::track(std::vector<Index> characters) { skating_.track(std::move(characters), count_, joints_); }
 
 motion::FootSkatingReport CrowdAnimator::foot_skating(const motion::ContactOptions& options) const {
-  std::vector<double> slides;
-  if (track_frames_ < 3 || !(track_dt_ > 0.0f)) return motion::summarise_foot_skating(slides);
-  for (std::size_t t = 0; t < tracked_.size(); ++t) {
-    motion::ModelSpaceClip posed;
-    posed.joint_count = joints_;
-    posed.frame_count = track_frames_;
-    posed.positions = track_positions_[t];
-    posed.rotations = track_rotations_[t];
-    const motion::FootSkatingReport r = motion::measure_foot_skating(space_->skeleton(), posed, track_dt_, options);
-    slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
-  }
-  return motion::summarise_foot_skating(std::move(slides));
+  return skating_.measure(space_->skeleton(), track_dt_, options);
 }
 
 }  // namespace throng::anim

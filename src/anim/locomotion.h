@@ -280,11 +280,8 @@ class CrowdAnimator {
   std::optional<CycleCacheTable> cache_;
   FrameStats stats_;
   // Foot-skating probe.
-  std::vector<Index> tracked_;
-  std::vector<std::vector<glm::vec3>> track_positions_;
-  std::vector<std::vector<glm::quat>> track_rotations_;
+  motion::FootSkatingRecorder skating_;
   float track_dt_ = 0.0f;
-  std::int32_t track_frames_ = 0;
 };
 
 }  // namespace throng::anim

@@ -33,8 +33,6 @@ struct CachedJoint {
   }
 };
 
-constexpr Index kKeyBlock = 4096;
-
 }  // namespace
 
 void LocomoteJob::run() const {
@@ -153,33 +151,11 @@ std::vector<Index> cache_key_counts(const motion::BlendSpaceView& blend, Span<co
                                     std::int32_t bucket_count) {
   if (blend.clip_count < 1 || bucket_count < 1) throw Error("needs clips and buckets", at_field("cache_key_counts"));
   const Index keys = static_cast<Index>(blend.segment_count()) * bucket_count;
-  std::vector<Index> counts(static_cast<std::size_t>(keys), 0);
-  const Index n = blend_speeds.size();
-  if (n == 0) return counts;
-  // Each block counts into its own row (at most 4 M counters in all); rows
-  // are summed in order on the host: the same for any thread count.
-  const Index max_blocks = (n + kKeyBlock - 1) / kKeyBlock;
-  const Index room = (Index{1} << 22) / keys;
-  const Index blocks = max_blocks < room ? max_blocks : (room > 0 ? room : 1);
-  const Index per_block = (n + blocks - 1) / blocks;
-  Buffer<std::int32_t> partial(blocks * keys, current_memory());
-  const auto rows = partial.span();
   const motion::BlendSpaceView view = blend;
   const auto shown = blend_speeds;
-  parallel_for(
-      "anim.cache_keys", blocks,
-      THRONG_LAMBDA(Index b) {
-        std::int32_t* row = rows.data() + b * keys;
-        for (Index k = 0; k < keys; ++k) row[k] = 0;
-        const Index end = (b + 1) * per_block < n ? (b + 1) * per_block : n;
-        for (Index c = b * per_block; c < end; ++c)
-          ++row[cache_key(motion::blend_point(view, motion::blend_coordinate(view, shown[c])), bucket_width, bucket_count)];
-      },
-      1);
-  const std::vector<std::int32_t> all = partial.to_vector();
-  for (Index b = 0; b < blocks; ++b)
-    for (Index k = 0; k < keys; ++k) counts[static_cast<std::size_t>(k)] += all[static_cast<std::size_t>(b * keys + k)];
-  return counts;
+  return deterministic_histogram("anim.cache_keys", blend_speeds.size(), static_cast<std::int32_t>(keys), THRONG_LAMBDA(Index c) {
+    return cache_key(motion::blend_point(view, motion::blend_coordinate(view, shown[c])), bucket_width, bucket_count);
+  });
 }
 
 }  // namespace throng::anim

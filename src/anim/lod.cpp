@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/check.h"
 #include "core/error.h"
 
 namespace throng::anim {
@@ -15,12 +16,6 @@ std::size_t at(Index i) { return static_cast<std::size_t>(i); }
 std::string part_field(BodyPart p, const std::string& rest) { return std::string("lod.") + to_string(p) + "." + rest; }
 
 std::string indexed(const char* name, Index i) { return std::string(name) + "[" + std::to_string(i) + "]"; }
-
-void check_size(const char* job, const char* field, Index got, Index want) {
-  if (got != want)
-    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want),
-                at_field(std::string(job) + "." + field));
-}
 
 void check_part(BodyPart p) {
   const int i = static_cast<int>(p);
@@ -78,8 +73,8 @@ void LodConfig::validate(const BodyParts& parts) const {
   if (level_count < 1 || level_count > kMaxLodLevels)
     throw Error("must be in [1, " + std::to_string(kMaxLodLevels) + "]", at_field("lod.level_count"));
   if (mask_words != mask_word_count(joint_count)) throw Error("must be (joint_count + 31) / 32", at_field("lod.mask_words"));
-  check_size("lod", "thresholds", static_cast<Index>(thresholds.size()), static_cast<Index>(kBodyPartCount) * (level_count - 1));
-  check_size("lod", "masks", static_cast<Index>(masks.size()), static_cast<Index>(kBodyPartCount) * level_count * mask_words);
+  check_length("lod", "thresholds", static_cast<Index>(thresholds.size()), static_cast<Index>(kBodyPartCount) * (level_count - 1));
+  check_length("lod", "masks", static_cast<Index>(masks.size()), static_cast<Index>(kBodyPartCount) * level_count * mask_words);
   for (BodyPart p : kAllBodyParts) {
     float previous = INFINITY;
     for (int l = 0; l + 1 < level_count; ++l) {
@@ -168,8 +163,8 @@ void LodSpheresJob::validate() const {
   if (joint_count <= 0) throw Error("must be positive", at_field("LodSpheresJob.joint_count"));
   if (spheres.size() % kBodyPartCount != 0) throw Error("size must be a multiple of 5", at_field("LodSpheresJob.spheres"));
   const Index n = character_count();
-  check_size("LodSpheresJob", "joint_positions", joint_positions.size(), n * joint_count);
-  if (!scales.empty()) check_size("LodSpheresJob", "scales", scales.size(), n);
+  check_length("LodSpheresJob", "joint_positions", joint_positions.size(), n * joint_count);
+  if (!scales.empty()) check_length("LodSpheresJob", "scales", scales.size(), n);
   for (int p = 0; p < kBodyPartCount; ++p) {
     const SphereAnchor& a = anchors[at(p)];
     if (a.joint_a < 0 || a.joint_a >= joint_count || a.joint_b < 0 || a.joint_b >= joint_count)
@@ -192,21 +187,21 @@ void LodJob::validate() const {
     throw Error("must be in [1, " + std::to_string(kMaxLodLevels) + "]", at_field("LodJob.level_count"));
   if (mask_words < 1 || mask_words > mask_word_count(kMaxLodJoints))
     throw Error("must be in [1, " + std::to_string(mask_word_count(kMaxLodJoints)) + "]", at_field("LodJob.mask_words"));
-  check_size("LodJob", "thresholds", thresholds.size(), static_cast<Index>(kBodyPartCount) * (level_count - 1));
-  check_size("LodJob", "part_masks", part_masks.size(), static_cast<Index>(kBodyPartCount) * level_count * mask_words);
+  check_length("LodJob", "thresholds", thresholds.size(), static_cast<Index>(kBodyPartCount) * (level_count - 1));
+  check_length("LodJob", "part_masks", part_masks.size(), static_cast<Index>(kBodyPartCount) * level_count * mask_words);
   if (levels.size() % kBodyPartCount != 0) throw Error("size must be a multiple of 5", at_field("LodJob.levels"));
   const Index n = character_count();
-  check_size("LodJob", "joint_masks", joint_masks.size(), n * mask_words);
-  if (!coverage.empty()) check_size("LodJob", "coverage", coverage.size(), n * kBodyPartCount);
+  check_length("LodJob", "joint_masks", joint_masks.size(), n * mask_words);
+  if (!coverage.empty()) check_length("LodJob", "coverage", coverage.size(), n * kBodyPartCount);
   const bool from_roots = !root_positions.empty() || !root_headings.empty();
   if (from_roots == !spheres.empty())
     throw Error("give either spheres or root_positions and root_headings, not both or neither", at_field("LodJob.spheres"));
   if (from_roots) {
-    check_size("LodJob", "root_positions", root_positions.size(), n);
-    check_size("LodJob", "root_headings", root_headings.size(), n);
-    if (!root_scales.empty()) check_size("LodJob", "root_scales", root_scales.size(), n);
+    check_length("LodJob", "root_positions", root_positions.size(), n);
+    check_length("LodJob", "root_headings", root_headings.size(), n);
+    if (!root_scales.empty()) check_length("LodJob", "root_scales", root_scales.size(), n);
   } else {
-    check_size("LodJob", "spheres", spheres.size(), n * kBodyPartCount);
+    check_length("LodJob", "spheres", spheres.size(), n * kBodyPartCount);
   }
 }
 
@@ -215,8 +210,8 @@ MaskedPose synthesise_with_mask(const motion::Skeleton& skeleton, Span<const std
                                 Span<const glm::quat> held_rotations) {
   skeleton.validate();
   const std::int32_t J = skeleton.joint_count();
-  check_size("synthesise_with_mask", "mask", mask.size(), mask_word_count(J));
-  if (!held_rotations.empty()) check_size("synthesise_with_mask", "held_rotations", held_rotations.size(), J);
+  check_length("synthesise_with_mask", "mask", mask.size(), mask_word_count(J));
+  if (!held_rotations.empty()) check_length("synthesise_with_mask", "held_rotations", held_rotations.size(), J);
   MaskedPose out;
   out.positions.resize(at(J));
   out.rotations.resize(at(J));

@@ -1,6 +1,7 @@
 #include <string>
 
 #include "anim/skin.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
 
@@ -23,17 +24,13 @@ void skin_reference(const SkinnedMesh& mesh, std::span<const Mat3x4> palette, st
 }
 
 void SkinJob::validate() const {
-  auto check = [](const char* field, Index got, Index want) {
-    if (got != want)
-      throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("SkinJob.") + field));
-  };
   const Index V = positions.size();
   if (joint_count <= 0) throw Error("must be positive", at_field("SkinJob.joint_count"));
-  check("normals", normals.size(), V);
-  check("joints", joints.size(), V);
-  check("weights", weights.size(), V);
-  check("out_positions", out_positions.size(), V * character_count());
-  if (!out_normals.empty()) check("out_normals", out_normals.size(), V * character_count());
+  check_length("SkinJob", "normals", normals.size(), V);
+  check_length("SkinJob", "joints", joints.size(), V);
+  check_length("SkinJob", "weights", weights.size(), V);
+  check_length("SkinJob", "out_positions", out_positions.size(), V * character_count());
+  if (!out_normals.empty()) check_length("SkinJob", "out_normals", out_normals.size(), V * character_count());
 }
 
 void SkinJob::run() const {

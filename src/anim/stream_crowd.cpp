@@ -5,7 +5,8 @@
 #include <string>
 
 #include "core/error.h"
-#include "sim/random.h"
+#include "core/array_kernels.h"
+#include "core/random.h"
 
 namespace throng::anim {
 
@@ -178,7 +179,7 @@ void StreamCrowd::check_agent_cluster(Index agent, std::int32_t cluster) const {
 }
 
 std::int32_t StreamCrowd::random_offset(Index agent, std::int32_t cluster, std::int32_t stream, std::uint64_t salt) const {
-  sim::Rng rng(config_.seed ^ (salt * 0x9e3779b97f4a7c15ull), static_cast<std::uint64_t>(agent) * kMaxClusters + static_cast<std::uint64_t>(cluster));
+  Rng rng(config_.seed ^ (salt * 0x9e3779b97f4a7c15ull), static_cast<std::uint64_t>(agent) * kMaxClusters + static_cast<std::uint64_t>(cluster));
   return static_cast<std::int32_t>(rng.below(static_cast<std::uint64_t>((*streams_)[stream].history())));
 }
 
@@ -233,7 +234,7 @@ void StreamCrowd::assign_random(Index first, Index count, const VarietySpec& spe
   for (Index a = first; a < first + count; ++a) {
     const std::int32_t rig = host_agent_rig_[static_cast<std::size_t>(a)];
     const std::int32_t clusters = rigs_[static_cast<std::size_t>(rig)].clusters.count();
-    sim::Rng rng(seed, static_cast<std::uint64_t>(a));
+    Rng rng(seed, static_cast<std::uint64_t>(a));
     std::int32_t picked[kMaxClusters], offsets[kMaxClusters];
     for (std::int32_t c = 0; c < clusters && c < static_cast<std::int32_t>(spec.streams.size()); ++c) {
       const auto& candidates = spec.streams[static_cast<std::size_t>(c)];
@@ -477,7 +478,27 @@ void StreamCrowd::step() {
     transition_to_streamed(key / cluster_stride_, static_cast<std::int32_t>(key % cluster_stride_), ref.then_stream, ref.then_blend);
 }
 
-void StreamCrowd::resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes, Span<std::int32_t> read_offsets) const {
+Index StreamCrowd::retarget(Span<const std::int32_t> sources, Span<const std::int32_t> offsets, float blend_seconds, std::uint32_t cluster_mask) {
+  if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f)) throw Error("must be in [0, 1e4) seconds", at_field("retarget.blend"));
+  if (retarget_changed_.size() != agent_count_) retarget_changed_ = Buffer<std::uint8_t>(agent_count_, memory_);
+  StreamRetargetJob job;
+  job.sources = sources;
+  job.offsets = offsets;
+  job.streams = streams_->views();
+  job.rigs = tables_->rigs.span();
+  job.agent_rigs = agent_rig_.span();
+  job.clusters = clusters_.span();
+  job.cluster_stride = cluster_stride_;
+  job.cluster_mask = cluster_mask;
+  job.frame = frame_;
+  job.blend_frames = blend_seconds * config_.frame_rate;
+  job.changed = retarget_changed_.span();
+  job.run();
+  return count_nonzero(retarget_changed_.span());
+}
+
+void StreamCrowd::resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes, Span<std::int32_t> read_offsets,
+                          Span<const std::uint8_t> skip) const {
   if (palettes.size() != palette_size_)
     throw Error("has " + std::to_string(palettes.size()) + " matrices, the crowd needs " + std::to_string(palette_size_), at_field("resolve.palettes"));
   rebuild_overrides();
@@ -496,6 +517,7 @@ void StreamCrowd::resolve(Span<const glm::vec3> positions, Span<const float> yaw
   job.frame = frame_;
   job.palettes = palettes;
   job.read_offsets = read_offsets;
+  job.skip = skip;
   job.run();
 }
 

@@ -122,7 +122,17 @@ class StreamCrowd {
   // about +Y: core/ground.h) may be empty (model space). read_offsets, if
   // not empty (agents * cluster_stride), receives the history offset each
   // cluster actually read (-1 for none).
-  void resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes, Span<std::int32_t> read_offsets = {}) const;
+  // skip, if not empty (per agent): agents != 0 are posed by someone else
+  // (exact synthesis) and their palettes are left as they are.
+  void resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes, Span<std::int32_t> read_offsets = {},
+               Span<const std::uint8_t> skip = {}) const;
+  // A desired stream and offset per agent for the clusters in cluster_mask,
+  // applied now in one kernel (StreamRetargetJob: a new stream is blended
+  // in over blend_seconds, the same stream takes the new offset at once,
+  // kNoSource sets the rest pose, clusters on unique instances are left
+  // alone). Call after step() and before resolve(). Spans in the crowd's
+  // memory. Returns how many agents changed the source of some cluster.
+  Index retarget(Span<const std::int32_t> sources, Span<const std::int32_t> offsets, float blend_seconds, std::uint32_t cluster_mask = ~0u);
 
   // ---- data for the renderer and the simulation (in the crowd's memory)
   Index palette_size() const { return palette_size_; }                  // matrices for all agents
@@ -166,6 +176,7 @@ class StreamCrowd {
   Buffer<Index> palette_offsets_;
   Buffer<ClusterRef> clusters_;
   Buffer<EventMask> agent_events_;
+  Buffer<std::uint8_t> retarget_changed_;
 
   std::vector<ClusterCommand> pending_;
   std::unordered_map<Index, std::size_t> pending_index_;  // agent * stride + cluster -> pending_

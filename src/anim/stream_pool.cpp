@@ -126,6 +126,22 @@ void AnimStream::start(float frame_rate) {
   change_rate_ = static_cast<double>(spec_.history) / (static_cast<double>(spec_.time_to_dilate) * frame_rate);
 }
 
+void AnimStream::fill(float frame_rate, std::int32_t newest_frame, Pose& scratch, std::vector<Mat3x4>& palette_scratch) {
+  start(frame_rate);
+  const float dt = 1.0f / frame_rate;
+  const std::int32_t M = spec_.history;
+  for (std::int32_t k = 0; k < M; ++k) {
+    EventMask events = 0;
+    if (k > 0) controller_->advance(dt, parameters_, events);
+    controller_->evaluate(scratch);
+    apply_root_motion(spec_.root, scratch);
+    write(scratch, events, newest_frame - (M - 1 - k), palette_scratch);
+  }
+  // Every slot holds a pose of this run: offsets may reach M - 1 now.
+  dilation_from_ = M - 1;
+  dilation_steps_ = 0;
+}
+
 void AnimStream::resize_history(std::int32_t history, float time_to_dilate, float frame_rate) {
   const std::string at = "streams." + spec_.name;
   if (history < 1 || history > 65536) throw Error("must be in [1, 65536] slots", at_field(at + ".history"));
@@ -223,6 +239,12 @@ void StreamPool::start(std::int32_t stream) {
   if (stream < 0 || stream >= size()) throw Error("no stream " + std::to_string(stream), at_field("stream"));
   AnimStream& s = *streams_[static_cast<std::size_t>(stream)];
   if (s.state_ != StreamState::Running) s.start(frame_rate_);
+  refresh_views();
+}
+
+void StreamPool::start_filled(std::int32_t stream, std::int32_t newest_frame) {
+  if (stream < 0 || stream >= size()) throw Error("no stream " + std::to_string(stream), at_field("stream"));
+  streams_[static_cast<std::size_t>(stream)]->fill(frame_rate_, newest_frame, scratch_, palette_scratch_);
   refresh_views();
 }
 

@@ -118,6 +118,7 @@ class AnimStream {
  private:
   friend class StreamPool;
   void start(float frame_rate);
+  void fill(float frame_rate, std::int32_t newest_frame, Pose& scratch, std::vector<Mat3x4>& palette_scratch);
   void resize_history(std::int32_t history, float time_to_dilate, float frame_rate);
   void write(const Pose& pose, EventMask events, std::int32_t frame, std::vector<Mat3x4>& palette_scratch);
 
@@ -157,6 +158,13 @@ class StreamPool {
   // Stopped -> Running: the controller restarts from time 0, the history
   // counts as empty and offsets dilate again from 0. Running stays running.
   void start(std::int32_t stream);
+  // (Re)starts a stream with its whole history written at once: the
+  // controller plays from time 0 for M frames, the newest being frame
+  // `newest_frame` (the crowd's last stepped frame, so that the next step
+  // writes newest_frame + 1), and agents may read any offset at once (no
+  // dilation). For controllers whose past is as good as their present: a
+  // locomotion cycle at a fixed speed, started when agents need it.
+  void start_filled(std::int32_t stream, std::int32_t newest_frame);
   void stop(std::int32_t stream);
   // Changes M at run time: kept slots keep their offsets; growing dilates
   // from the current D at (M_new - M) / (time_to_dilate * frame_rate)

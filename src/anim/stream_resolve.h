@@ -1,7 +1,7 @@
 // The per-agent kernels of a stream crowd (anim/stream_crowd.h drives them):
-// applying transition commands, delivering events, and resolving every
-// agent's palette from (source, offset) pairs. Plus the exact per-agent
-// path they are compared with: a clip sampled at each agent's own time.
+// applying transition commands (one by one, or a desired stream per agent in
+// a batch), delivering events, and resolving every agent's palette from
+// (source, offset) pairs.
 #pragma once
 
 #include <array>
@@ -113,6 +113,37 @@ struct StreamCommandJob {
   void run() const;
 };
 
+// The batch form of transition_to_streamed, for a whole crowd at once
+// ("anim.stream_retarget", one thread per agent): per agent a desired
+// stream and offset for the clusters in cluster_mask (e.g. locomotion
+// choosing every agent's stream by its speed each frame). Per cluster:
+// * a cluster on a unique instance is left alone (host transitions own it);
+// * the same stream at another offset takes the offset at once;
+// * another stream is blended in over blend_frames (alpha as above, from
+//   `frame`) when the cluster is on a stream now, else set at once;
+// * a desired source of kNoSource sets the rest pose at once (an agent
+//   posed elsewhere, e.g. by exact synthesis).
+// sources[a] < kNoSource, a stream out of range or of another rig leave
+// agent a alone; offsets are clamped to the stream's history. changed[a]
+// (optional) is 1 when some cluster of agent a changed source.
+struct StreamRetargetJob {
+  Span<const std::int32_t> sources;  // per agent
+  Span<const std::int32_t> offsets;  // per agent
+  Span<const SourceView> streams;
+  Span<const RigView> rigs;
+  Span<const std::int32_t> agent_rigs;
+  Span<ClusterRef> clusters;
+  std::int32_t cluster_stride = 1;
+  std::uint32_t cluster_mask = ~0u;  // bit c: cluster c follows
+  std::int32_t frame = 0;
+  float blend_frames = 0.0f;
+  Span<std::uint8_t> changed;  // per agent, or empty
+
+  Index agent_count() const { return agent_rigs.size(); }
+  void validate() const;
+  void run() const;
+};
+
 // Per agent, the OR over its clusters of the events its sources fired in
 // the frames read since the last step (each cluster filtered by
 // cluster_event_filter[cluster index]); updates ClusterRef::last_read
@@ -155,34 +186,12 @@ struct StreamResolveJob {
   std::int32_t frame = 0;
   Span<Mat3x4> palettes;
   Span<std::int32_t> read_offsets;  // agents * cluster_stride, or empty
+  Span<const std::uint8_t> skip;    // per agent, or empty: agents != 0 are posed elsewhere and not written
 
   Index agent_count() const { return agent_rigs.size(); }
   void validate() const;  // Error naming the field
   void run() const;
 };
 
-// The exact per-agent path: every agent samples one clip at its own time
-// (SLERP of neighbouring frames, looping), then forward kinematics and the
-// palette ("anim.clip_palette").
-struct ClipPaletteJob {
-  std::int32_t joint_count = 0;
-  std::int32_t frame_count = 0;
-  float frame_time = 1.0f / 30.0f;
-  Span<const std::int32_t> parents;
-  Span<const glm::vec3> offsets;
-  Span<const Mat3x4> inverse_bind;
-  Span<const glm::quat> clip_rotations;  // frame-major
-  Span<const glm::vec3> clip_roots;
-  bool in_place = true;                  // drop the root's horizontal motion, as streams do
-  Span<const float> times;               // per agent, seconds
-  float time_offset = 0.0f;              // added to every agent's time (the clock)
-  Span<const glm::vec3> positions;       // agents, or empty
-  Span<const float> yaws;                // agents, or empty
-  Span<Mat3x4> palettes;                 // agents * joint_count
-
-  Index agent_count() const { return times.size(); }
-  void validate() const;
-  void run() const;
-};
 
 }  // namespace throng::anim

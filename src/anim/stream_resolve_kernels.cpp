@@ -1,7 +1,7 @@
 #include <string>
 
-#include "anim/motion_cache.h"
 #include "anim/stream_resolve.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
 
@@ -90,6 +90,78 @@ void StreamCommandJob::run() const {
       256);
 }
 
+// ---- batch retargeting ------------------------------------------------------------
+
+void StreamRetargetJob::validate() const {
+  const Index n = agent_count();
+  if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamRetargetJob.cluster_stride"));
+  if (!(blend_frames >= 0.0f && blend_frames < 1e7f)) throw Error("must be in [0, 1e7) frames", at_field("StreamRetargetJob.blend_frames"));
+  check_length("StreamRetargetJob", "sources", sources.size(), n);
+  check_length("StreamRetargetJob", "offsets", offsets.size(), n);
+  check_length("StreamRetargetJob", "clusters", clusters.size(), n * cluster_stride);
+  if (!changed.empty()) check_length("StreamRetargetJob", "changed", changed.size(), n);
+}
+
+void StreamRetargetJob::run() const {
+  validate();
+  const auto want = sources;
+  const auto want_offset = offsets;
+  const auto S = streams;
+  const auto R = rigs;
+  const auto AR = agent_rigs;
+  const auto refs = clusters;
+  const auto out_changed = changed;
+  const std::int32_t stride = cluster_stride;
+  const std::uint32_t mask = cluster_mask;
+  const std::int32_t now = frame;
+  const float blend = blend_frames;
+  parallel_for(
+      "anim.stream_retarget", agent_count(),
+      THRONG_LAMBDA(Index a) {
+        std::uint8_t changed_here = 0;
+        const std::int32_t source = want[a];
+        const std::int32_t rig = AR[a];
+        bool valid = source >= kNoSource && rig >= 0 && rig < R.size();
+        std::int32_t offset = 0;
+        if (valid && source >= 0) {
+          valid = source < S.size() && S[source].rig == rig;
+          if (valid) {
+            const std::int32_t top = S[source].history - 1;
+            offset = want_offset[a];
+            offset = offset < 0 ? 0 : (offset > top ? top : offset);
+          }
+        }
+        if (valid) {
+          const std::int32_t count = R[rig].cluster_count < stride ? R[rig].cluster_count : stride;
+          for (std::int32_t c = 0; c < count; ++c) {
+            if (((mask >> c) & 1u) == 0u) continue;
+            ClusterRef& ref = refs[a * stride + c];
+            if (is_unique_source(ref.source)) continue;
+            if (ref.source == source) {
+              ref.offset = offset;
+              continue;
+            }
+            if (source >= 0 && ref.source >= 0 && blend > 0.0f) {
+              ref.from_source = ref.source;
+              ref.from_offset = ref.offset;
+              ref.t0 = now;
+              ref.blend_frames = blend;
+            } else {
+              ref.from_source = kNoSource;
+              ref.from_offset = 0;
+              ref.blend_frames = 0.0f;
+            }
+            ref.source = source;
+            ref.offset = offset;
+            ref.last_read = kNeverRead;
+            changed_here = 1;
+          }
+        }
+        if (!out_changed.empty()) out_changed[a] = changed_here;
+      },
+      1024);
+}
+
 // ---- events ---------------------------------------------------------------------
 
 void StreamEventsJob::run() const {
@@ -137,22 +209,19 @@ void StreamEventsJob::run() const {
 
 void StreamResolveJob::validate() const {
   const Index n = agent_count();
-  auto check = [](const char* field, Index got, Index want) {
-    if (got != want)
-      throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("StreamResolveJob.") + field));
-  };
   if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamResolveJob.cluster_stride"));
-  check("palette_offsets", palette_offsets.size(), n);
-  check("clusters", clusters.size(), n * cluster_stride);
-  if (!positions.empty()) check("positions", positions.size(), n);
-  if (!yaws.empty()) check("yaws", yaws.size(), n);
-  if (!override_begin.empty()) check("override_begin", override_begin.size(), n + 1);
-  if (!read_offsets.empty()) check("read_offsets", read_offsets.size(), n * cluster_stride);
-  check("tables.offsets", tables.offsets.size(), tables.parents.size());
-  check("tables.joint_cluster", tables.joint_cluster.size(), tables.parents.size());
-  check("tables.inverse_bind", tables.inverse_bind.size(), tables.parents.size());
-  check("tables.joint_segment", tables.joint_segment.size(), tables.parents.size());
-  check("tables.bind_positions", tables.bind_positions.size(), tables.parents.size());
+  check_length("StreamResolveJob", "palette_offsets", palette_offsets.size(), n);
+  check_length("StreamResolveJob", "clusters", clusters.size(), n * cluster_stride);
+  if (!positions.empty()) check_length("StreamResolveJob", "positions", positions.size(), n);
+  if (!yaws.empty()) check_length("StreamResolveJob", "yaws", yaws.size(), n);
+  if (!override_begin.empty()) check_length("StreamResolveJob", "override_begin", override_begin.size(), n + 1);
+  if (!read_offsets.empty()) check_length("StreamResolveJob", "read_offsets", read_offsets.size(), n * cluster_stride);
+  if (!skip.empty()) check_length("StreamResolveJob", "skip", skip.size(), n);
+  check_length("StreamResolveJob", "tables.offsets", tables.offsets.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.joint_cluster", tables.joint_cluster.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.inverse_bind", tables.inverse_bind.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.joint_segment", tables.joint_segment.size(), tables.parents.size());
+  check_length("StreamResolveJob", "tables.bind_positions", tables.bind_positions.size(), tables.parents.size());
 }
 
 void StreamResolveJob::run() const {
@@ -171,10 +240,12 @@ void StreamResolveJob::run() const {
   const std::int32_t now = frame;
   const auto out = palettes;
   const auto read_out = read_offsets;
+  const auto skipped = skip;
   const Index palette_size = palettes.size();
   parallel_for(
       "anim.stream_resolve", agent_count(),
       THRONG_LAMBDA(Index a) {
+        if (!skipped.empty() && skipped[a] != 0) return;
         const std::int32_t r = AR[a];
         if (r < 0 || r >= T.rigs.size()) return;
         const RigView rig = T.rigs[r];
@@ -297,74 +368,6 @@ void StreamResolveJob::run() const {
             hook = hook >= 0 ? hook : 0;
             out[base + j] = collapse_to(transform_point(out[base + hook], T.bind_positions[rig.joint_base + hook]));
           }
-        }
-      },
-      64);
-}
-
-// ---- the exact per-agent path ------------------------------------------------------------
-
-void ClipPaletteJob::validate() const {
-  auto check = [](const char* field, Index got, Index want) {
-    if (got != want)
-      throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("ClipPaletteJob.") + field));
-  };
-  if (joint_count <= 0 || joint_count > kMaxRigJoints) throw Error("must be in [1, 128]", at_field("ClipPaletteJob.joint_count"));
-  if (frame_count <= 0) throw Error("must be positive", at_field("ClipPaletteJob.frame_count"));
-  if (!(frame_time > 0.0f)) throw Error("must be positive", at_field("ClipPaletteJob.frame_time"));
-  const Index n = agent_count();
-  check("parents", parents.size(), joint_count);
-  check("offsets", offsets.size(), joint_count);
-  check("inverse_bind", inverse_bind.size(), joint_count);
-  check("clip_rotations", clip_rotations.size(), static_cast<Index>(joint_count) * frame_count);
-  check("clip_roots", clip_roots.size(), frame_count);
-  if (!positions.empty()) check("positions", positions.size(), n);
-  if (!yaws.empty()) check("yaws", yaws.size(), n);
-  check("palettes", palettes.size(), n * joint_count);
-}
-
-void ClipPaletteJob::run() const {
-  validate();
-  const std::int32_t J = joint_count;
-  const std::int32_t N = frame_count;
-  const float period = static_cast<float>(frame_count) * frame_time;
-  const auto PA = parents;
-  const auto OF = offsets;
-  const auto IB = inverse_bind;
-  const auto CR = clip_rotations;
-  const auto CP = clip_roots;
-  const bool drop_xz = in_place;
-  const auto TI = times;
-  const float clock = time_offset;
-  const auto pos = positions;
-  const auto yaw = yaws;
-  const auto out = palettes;
-  parallel_for(
-      "anim.clip_palette", agent_count(),
-      THRONG_LAMBDA(Index a) {
-        const float phase = (TI[a] + clock) / period;
-        const CyclePoint cp = cycle_point(N, phase);
-        const glm::quat* q0 = CR.data() + static_cast<Index>(cp.f0) * J;
-        const glm::quat* q1 = CR.data() + static_cast<Index>(cp.f1) * J;
-        glm::vec3 root = glm::mix(CP[cp.f0], CP[cp.f1], cp.t);
-        if (drop_xz) root.x = root.z = 0.0f;
-        glm::quat world_q(1.0f, 0.0f, 0.0f, 0.0f);
-        glm::vec3 world_t(0.0f);
-        if (!yaw.empty()) world_q = glm::angleAxis(yaw[a], glm::vec3(0.0f, 1.0f, 0.0f));
-        if (!pos.empty()) world_t = pos[a];
-        glm::quat R[kMaxRigJoints];
-        glm::vec3 P[kMaxRigJoints];
-        for (std::int32_t j = 0; j < J; ++j) {
-          const glm::quat local = glm::slerp(q0[j], q1[j], cp.t);
-          const std::int32_t p = PA[j];
-          if (p < 0) {
-            R[j] = world_q * local;
-            P[j] = world_t + world_q * root;
-          } else {
-            R[j] = R[p] * local;
-            P[j] = P[p] + R[p] * OF[j];
-          }
-          out[a * J + j] = mat3x4_from(R[j], P[j]) * IB[j];
         }
       },
       64);

@@ -23,7 +23,7 @@
 #include "motion/default_set.h"
 #include "path/pipeline.h"
 #include "path/planner.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace throng::app {
 
@@ -112,7 +112,7 @@ void run_match(const MatchArgs& a) {
     planned = planner.plan_all(queries);
     plan_ms = ms_since(t0);
   }
-  sim::Rng speed_rng(a.seed, 0x5eed);
+  Rng speed_rng(a.seed, 0x5eed);
   if (a.random > 0) {
     for (std::size_t i = 0; i < planned.size(); ++i) {
       const float speed = static_cast<float>(speed_rng.uniform(1.0, 3.0));

@@ -24,4 +24,21 @@ std::int32_t exclusive_scan(Span<const std::int32_t> in, Span<std::int32_t> out)
 std::int64_t exclusive_scan(Span<const std::int64_t> in, Span<std::int64_t> out) { return scan_checked(in, out); }
 float exclusive_scan(Span<const float> in, Span<float> out) { return scan_checked(in, out); }
 
+Index count_nonzero(Span<const std::uint8_t> flags) {
+  return parallel_reduce(
+      "core.count_nonzero", flags.size(), Index{0}, THRONG_LAMBDA(Index i) { return static_cast<Index>(flags[i] != 0 ? 1 : 0); },
+      detail::Plus{});
+}
+
+namespace {
+struct KeyAt {
+  Span<const std::int32_t> keys;
+  THRONG_HOST_DEVICE std::int32_t operator()(Index i) const { return keys[i]; }
+};
+}  // namespace
+
+std::vector<Index> histogram(Span<const std::int32_t> keys, std::int32_t bins) {
+  return deterministic_histogram("core.histogram", keys.size(), bins, KeyAt{keys});
+}
+
 }  // namespace throng

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "core/span.h"
 
@@ -19,5 +20,12 @@ double sum(Span<const double> x);
 std::int32_t exclusive_scan(Span<const std::int32_t> in, Span<std::int32_t> out);
 std::int64_t exclusive_scan(Span<const std::int64_t> in, Span<std::int64_t> out);
 float exclusive_scan(Span<const float> in, Span<float> out);
+
+// How many flags are non-zero (deterministic).
+Index count_nonzero(Span<const std::uint8_t> flags);
+
+// counts[k] = how many keys equal k, for k in [0, bins); other keys are not
+// counted (deterministic_histogram).
+std::vector<Index> histogram(Span<const std::int32_t> keys, std::int32_t bins);
 
 }  // namespace throng

@@ -1,5 +1,7 @@
 #include "core/error.h"
 
+#include "core/check.h"
+
 namespace throng {
 
 std::string Location::to_string() const {
@@ -33,6 +35,15 @@ Location at_field(std::string field, std::string file) {
   l.file = std::move(file);
   l.field = std::move(field);
   return l;
+}
+
+void check_length(const char* owner, const char* field, std::int64_t got, std::int64_t want) {
+  if (got != want)
+    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string(owner) + "." + field));
+}
+
+void check_optional_length(const char* owner, const char* field, std::int64_t got, std::int64_t want) {
+  if (got != 0) check_length(owner, field, got, want);
 }
 
 }  // namespace throng

@@ -63,6 +63,26 @@ struct Load {
 };
 
 inline Index block_count(Index n) { return (n + kReduceBlock - 1) / kReduceBlock; }
+
+// Counts keys of a range of items into one row of bins per block.
+template <class KeyOf>
+struct CountBlocks {
+  Span<std::int32_t> rows;
+  Index n;
+  Index per_block;
+  std::int32_t bins;
+  KeyOf key_of;
+  THRONG_HOST_DEVICE void operator()(Index b) const {
+    std::int32_t* row = rows.data() + b * bins;
+    for (std::int32_t k = 0; k < bins; ++k) row[k] = 0;
+    const Index begin = b * per_block;
+    const Index end = begin + per_block < n ? begin + per_block : n;
+    for (Index i = begin; i < end; ++i) {
+      const std::int32_t k = key_of(i);
+      if (k >= 0 && k < bins) ++row[k];
+    }
+  }
+};
 }  // namespace detail
 
 // Folds map(i) for i in [0, n) with `combine` (associative), deterministically.
@@ -80,6 +100,26 @@ T parallel_reduce(const char* description, Index n, T identity, const Map& map, 
 template <class T>
 T deterministic_sum(const char* description, Span<const T> values) {
   return parallel_reduce(description, values.size(), T{}, detail::Load<T>{values}, detail::Plus{});
+}
+
+// How many i in [0, n) have key_of(i) == k, for every bin k in [0, bins)
+// (keys outside are not counted). Each block of items counts into its own
+// row of bins (at most 4 M counters in all) and the rows are summed in order
+// on the host: the same counts for any thread count or backend.
+template <class KeyOf>
+std::vector<Index> deterministic_histogram(const char* description, Index n, std::int32_t bins, const KeyOf& key_of) {
+  std::vector<Index> counts(static_cast<std::size_t>(bins > 0 ? bins : 0), 0);
+  if (n <= 0 || bins <= 0) return counts;
+  const Index max_blocks = detail::block_count(n);
+  const Index room = (Index{1} << 22) / bins;
+  const Index blocks = max_blocks < room ? max_blocks : (room > 0 ? room : 1);
+  const Index per_block = (n + blocks - 1) / blocks;
+  Buffer<std::int32_t> partial(blocks * bins, current_memory());
+  parallel_for(description, blocks, detail::CountBlocks<KeyOf>{partial.span(), n, per_block, bins, key_of}, 1);
+  const std::vector<std::int32_t> all = partial.to_vector();
+  for (Index b = 0; b < blocks; ++b)
+    for (std::int32_t k = 0; k < bins; ++k) counts[static_cast<std::size_t>(k)] += all[static_cast<std::size_t>(b * bins + k)];
+  return counts;
 }
 
 // out[i] = in[0] + ... + in[i-1]; returns the total. `out` may alias `in`.

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "anim/blend_controller.h"
 #include "core/error.h"
 #include "io/bvh_reader.h"
 #include "io/yaml_fields.h"
@@ -53,6 +54,7 @@ class Reader {
   struct NamedClip {
     AnimClip clip;
     std::int32_t rig = 0;
+    bool cycle = false;  // exactly one cycle (a default motion, uncut): no loop search for blends
   };
 
   // ---- errors and scalars (io/yaml_fields.h, plus what this format needs)
@@ -140,7 +142,7 @@ class Reader {
     if (r["unique_capacity"]) {
       const auto cap = static_cast<std::int32_t>(integer(r["unique_capacity"], 0, 1 << 24));
       const anim::Rig& rig = crowd_->rig(index);
-      count_pose_bytes(r["unique_capacity"], static_cast<std::size_t>(cap) * (static_cast<std::size_t>(rig.joint_count()) * 16u + 12u));
+      count_pose_bytes(r["unique_capacity"], static_cast<std::size_t>(cap) * anim::pose_slot_bytes(rig.joint_count()));
       wrap(r["unique_capacity"], [&] { crowd_->uniques().set_capacity(rig, index, cap); });
     }
   }
@@ -210,6 +212,7 @@ class Reader {
     } else {
       fail(c, "a clip needs 'default: NAME' or 'bvh: FILE'");
     }
+    out.cycle = c["default"] && !c["frames"];
     if (c["frames"]) {
       const YAML::Node fr = c["frames"];
       if (!fr.IsSequence() || fr.size() != 2) fail(fr, "expected [first, end): frames first..end-1");
@@ -243,25 +246,128 @@ class Reader {
     clips_[name] = std::move(out);
   }
 
-  const AnimClip& clip_of(const YAML::Node& n, std::int32_t rig) const {
+  const NamedClip& named_clip(const YAML::Node& n, std::int32_t rig) const {
     const std::string name = text(n);
     auto it = clips_.find(name);
     if (it == clips_.end()) fail(n, "no clip named '" + name + "'");
     if (it->second.rig != rig)
       fail(n, "clip '" + name + "' is of rig '" + crowd_->rig(it->second.rig).name + "', not '" + crowd_->rig(rig).name + "'");
-    return it->second.clip;
+    return it->second;
+  }
+  const AnimClip& clip_of(const YAML::Node& n, std::int32_t rig) const { return named_clip(n, rig).clip; }
+
+  // ---- blend spaces (shared by every controller that names the same clips)
+  motion::LocomotionClip prepared(const YAML::Node& n, std::int32_t rig) {
+    const NamedClip& c = named_clip(n, rig);
+    const motion::Skeleton& skeleton = crowd_->rig(rig).skeleton;
+    motion::LocomotionOptions options;
+    options.clean_contacts = !c.cycle;  // the default motions are planted by construction
+    return wrap(n, [&] {
+      return c.cycle ? motion::prepare_locomotion_cycle(skeleton, *c.clip.clip, c.clip.name, options)
+                     : motion::prepare_locomotion_clip(skeleton, *c.clip.clip, c.clip.name, options);
+    });
+  }
+
+  bool is_default_skeleton(std::int32_t rig) const { return crowd_->rig(rig).skeleton.names == motion::default_skeleton().names; }
+
+  // `space: default` or `clips: [NAME...]` (straight locomotion clips of the rig, by speed).
+  std::shared_ptr<const motion::BlendSpace1D> speed_space(const YAML::Node& n, std::int32_t rig, bool plant_feet) {
+    if (n["space"] && n["clips"]) fail(n, "give either 'space: default' or 'clips: [...]', not both");
+    if (n["space"]) {
+      if (text(n["space"]) != "default") fail(n["space"], "the only built-in blend space is 'default'");
+      if (!is_default_skeleton(rig)) fail(n["space"], "the default blend space needs a rig with 'skeleton: default'");
+      if (!plant_feet) fail(n["plant_feet"], "the default blend space plants feet; give 'clips' to turn it off");
+      return anim::default_blend_spaces().speeds;
+    }
+    const YAML::Node clips = need(n, "clips");
+    std::string key = std::to_string(rig) + (plant_feet ? "|ik" : "|free");
+    for (const YAML::Node& c : list(clips)) key += "|" + text(c);
+    auto found = spaces_.find(key);
+    if (found != spaces_.end()) return found->second;
+    std::vector<motion::LocomotionClip> prepared_clips;
+    for (const YAML::Node& c : list(clips)) prepared_clips.push_back(prepared(c, rig));
+    motion::BlendSpaceOptions options;
+    options.plant_feet = plant_feet;
+    auto space = wrap(clips, [&] {
+      return std::make_shared<const motion::BlendSpace1D>(crowd_->rig(rig).skeleton, std::move(prepared_clips), options);
+    });
+    spaces_[key] = space;
+    return space;
+  }
+
+  std::shared_ptr<const motion::BlendSpace1D> turn_space(const YAML::Node& n, std::int32_t rig) {
+    const std::string key = std::to_string(rig) + "|turn|" + text(n);
+    auto found = spaces_.find(key);
+    if (found != spaces_.end()) return found->second;
+    const NamedClip& c = named_clip(n, rig);
+    auto space = wrap(n, [&] { return anim::make_turn_space(crowd_->rig(rig).skeleton, *c.clip.clip, c.clip.name, c.cycle); });
+    spaces_[key] = space;
+    return space;
+  }
+
+  void footstep_ids(const YAML::Node& n, std::int32_t& left, std::int32_t& right) {
+    if (!n || !boolean(n)) return;
+    left = wrap(n, [&] { return crowd_->event_names().intern("footstep_left"); });
+    right = wrap(n, [&] { return crowd_->event_names().intern("footstep_right"); });
+  }
+
+  std::unique_ptr<Controller> blend1d(const YAML::Node& n, std::int32_t rig) {
+    if (!n.IsMap()) fail(n, "expected {clips: [NAME...] | space: default, parameter, speed, phase, footsteps, plant_feet}");
+    keys(n, {"clips", "space", "parameter", "speed", "phase", "footsteps", "plant_feet"});
+    anim::Blend1DOptions o;
+    if (n["parameter"]) o.parameter = name_of(n["parameter"]);
+    if (n["speed"]) o.speed = static_cast<float>(number(n["speed"], 0.0, 100.0));
+    if (n["phase"]) o.start_phase = static_cast<float>(number(n["phase"], 0.0, 0.999999));
+    footstep_ids(n["footsteps"], o.footstep_left, o.footstep_right);
+    const bool plant = n["plant_feet"] ? boolean(n["plant_feet"]) : true;
+    auto space = speed_space(n, rig, plant);
+    return wrap(n, [&] { return std::make_unique<anim::Blend1DController>(std::move(space), o); });
+  }
+
+  std::unique_ptr<Controller> blend2d(const YAML::Node& n, std::int32_t rig) {
+    if (!n.IsMap())
+      fail(n, "expected {clips: [NAME...] | space: default, turn_left: CLIP, turn_right: CLIP, speed_parameter, turn_parameter, speed, turn, "
+              "phase, footsteps, plant_feet}");
+    keys(n, {"clips", "space", "turn_left", "turn_right", "speed_parameter", "turn_parameter", "speed", "turn", "phase", "footsteps",
+             "plant_feet"});
+    anim::Blend2DOptions o;
+    if (n["speed_parameter"]) o.speed_parameter = name_of(n["speed_parameter"]);
+    if (n["turn_parameter"]) o.turn_parameter = name_of(n["turn_parameter"]);
+    if (n["speed"]) o.speed = static_cast<float>(number(n["speed"], 0.0, 100.0));
+    if (n["turn"]) o.turn = static_cast<float>(number(n["turn"], -100.0, 100.0));
+    if (n["phase"]) o.start_phase = static_cast<float>(number(n["phase"], 0.0, 0.999999));
+    footstep_ids(n["footsteps"], o.footstep_left, o.footstep_right);
+    const bool plant = n["plant_feet"] ? boolean(n["plant_feet"]) : true;
+    auto speeds = speed_space(n, rig, plant);
+    std::shared_ptr<const motion::BlendSpace1D> left, right;
+    if (n["space"] && !n["turn_left"] && !n["turn_right"]) {
+      left = anim::default_blend_spaces().turn_left;
+      right = anim::default_blend_spaces().turn_right;
+    } else {
+      left = turn_space(need(n, "turn_left"), rig);
+      right = turn_space(need(n, "turn_right"), rig);
+    }
+    return wrap(n, [&] { return std::make_unique<anim::Blend2DController>(std::move(speeds), std::move(left), std::move(right), o); });
   }
 
   // ---- controllers
   std::unique_ptr<Controller> controller(const YAML::Node& n, std::int32_t rig, int depth) {
     if (depth > options_.limits.max_controller_depth) fail(n, "controllers nested deeper than " + std::to_string(options_.limits.max_controller_depth));
-    if (!n.IsMap()) fail(n, "expected a controller: {clip: NAME, rate}, {layered: ...} or {state_machine: ...}");
+    if (!n.IsMap()) fail(n, "expected a controller: {clip: NAME, rate}, {blend1d: ...}, {blend2d: ...}, {layered: ...} or {state_machine: ...}");
     if (n["clip"]) {
       keys(n, {"clip", "rate", "start"});
       const float rate = n["rate"] ? static_cast<float>(number(n["rate"], -100.0, 100.0)) : 1.0f;
       const double start = n["start"] ? number(n["start"], -1e6, 1e6) : 0.0;
       const AnimClip& clip = clip_of(n["clip"], rig);
       return wrap(n, [&] { return std::make_unique<anim::ClipPlayer>(clip, rate, start); });
+    }
+    if (n["blend1d"]) {
+      keys(n, {"blend1d"});
+      return blend1d(n["blend1d"], rig);
+    }
+    if (n["blend2d"]) {
+      keys(n, {"blend2d"});
+      return blend2d(n["blend2d"], rig);
     }
     if (n["layered"]) {
       keys(n, {"layered"});
@@ -271,7 +377,7 @@ class Reader {
       keys(n, {"state_machine"});
       return state_machine(n["state_machine"], rig, depth);
     }
-    fail(n, "a controller needs one of 'clip', 'layered', 'state_machine'");
+    fail(n, "a controller needs one of 'clip', 'blend1d', 'blend2d', 'layered', 'state_machine'");
   }
 
   std::unique_ptr<Controller> layered(const YAML::Node& n, std::int32_t rig, int depth) {
@@ -436,7 +542,7 @@ class Reader {
     if (s["time_to_dilate"]) spec.time_to_dilate = static_cast<float>(number(s["time_to_dilate"], 0.0, 1e6));
     if (s["running"]) spec.running = boolean(s["running"]);
     const anim::Rig& rig = crowd_->rig(spec.rig);
-    count_pose_bytes(s, static_cast<std::size_t>(spec.history) * (static_cast<std::size_t>(rig.joint_count()) * 16u + 12u));
+    count_pose_bytes(s, static_cast<std::size_t>(spec.history) * anim::pose_slot_bytes(rig.joint_count()));
     auto ctl = controller(need(s, "controller"), spec.rig, 0);
     const std::int32_t index = wrap(s, [&] { return crowd_->streams().add(rig, spec.rig, spec, std::move(ctl)); });
     if (s["parameters"]) {
@@ -464,6 +570,7 @@ class Reader {
   StreamsYamlOptions options_;
   std::unique_ptr<anim::StreamCrowd> crowd_;
   std::map<std::string, NamedClip> clips_;
+  std::map<std::string, std::shared_ptr<const motion::BlendSpace1D>> spaces_;
   std::size_t pose_bytes_ = 0;
 };
 

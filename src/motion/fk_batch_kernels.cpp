@@ -1,5 +1,6 @@
 #include <string>
 
+#include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "motion/fk.h"
@@ -8,19 +9,15 @@
 namespace throng::motion {
 
 void BatchFkJob::validate() const {
-  auto check = [](const char* field, Index got, Index want) {
-    if (got != want)
-      throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string("BatchFkJob.") + field));
-  };
   if (joint_count <= 0) throw Error("must be positive", at_field("BatchFkJob.joint_count"));
   if (frame_count <= 0) throw Error("must be positive", at_field("BatchFkJob.frame_count"));
   const Index J = joint_count;
-  check("parents", parents.size(), J);
-  check("offsets", offsets.size(), J);
-  check("clip_rotations", clip_rotations.size(), J * frame_count);
-  check("clip_roots", clip_roots.size(), frame_count);
-  check("out_positions", out_positions.size(), J * character_count());
-  check("out_rotations", out_rotations.size(), J * character_count());
+  check_length("BatchFkJob", "parents", parents.size(), J);
+  check_length("BatchFkJob", "offsets", offsets.size(), J);
+  check_length("BatchFkJob", "clip_rotations", clip_rotations.size(), J * frame_count);
+  check_length("BatchFkJob", "clip_roots", clip_roots.size(), frame_count);
+  check_length("BatchFkJob", "out_positions", out_positions.size(), J * character_count());
+  check_length("BatchFkJob", "out_rotations", out_rotations.size(), J * character_count());
 }
 
 void BatchFkJob::run() const {

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include "core/error.h"
@@ -72,6 +73,41 @@ FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpac
 
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options) {
   return measure_foot_skating(skeleton, forward_kinematics(skeleton, clip), clip.frame_time, options);
+}
+
+void FootSkatingRecorder::track(std::vector<Index> characters, Index character_count, std::int32_t joint_count) {
+  for (const Index c : characters)
+    if (c < 0 || c >= character_count)
+      throw Error("character " + std::to_string(c) + " is not in [0, " + std::to_string(character_count) + ")", at_field("track"));
+  tracked_ = std::move(characters);
+  joints_ = joint_count;
+  frames_ = 0;
+  positions_.assign(tracked_.size(), {});
+  rotations_.assign(tracked_.size(), {});
+}
+
+FootSkatingRecorder::Frame FootSkatingRecorder::append(std::size_t t) {
+  const auto J = static_cast<std::size_t>(joints_);
+  std::vector<glm::vec3>& p = positions_[t];
+  std::vector<glm::quat>& r = rotations_[t];
+  p.resize(p.size() + J);
+  r.resize(r.size() + J);
+  return {std::span<glm::vec3>(p).last(J), std::span<glm::quat>(r).last(J)};
+}
+
+FootSkatingReport FootSkatingRecorder::measure(const Skeleton& skeleton, double frame_time, const ContactOptions& options) const {
+  std::vector<double> slides;
+  if (frames_ < 3 || !(frame_time > 0.0)) return summarise_foot_skating(slides);
+  for (std::size_t t = 0; t < tracked_.size(); ++t) {
+    ModelSpaceClip posed;
+    posed.joint_count = joints_;
+    posed.frame_count = frames_;
+    posed.positions = positions_[t];
+    posed.rotations = rotations_[t];
+    const FootSkatingReport r = measure_foot_skating(skeleton, posed, frame_time, options);
+    slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
+  }
+  return summarise_foot_skating(std::move(slides));
 }
 
 }  // namespace throng::motion

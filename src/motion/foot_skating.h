@@ -8,7 +8,11 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
 
 #include "motion/clip.h"
 #include "motion/cycle.h"
@@ -38,5 +42,35 @@ FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpac
 
 // Mean, p95 and max of per-contact slides (cm), e.g. pooled over characters.
 FootSkatingReport summarise_foot_skating(std::vector<double> slides_cm);
+
+// The world joints of a few characters of a crowd recorded frame by frame,
+// then measured together (per character measure_foot_skating, slides pooled).
+//   recorder.track({3, 17}, crowd_size, joints);
+//   each frame: for t: copy character tracked()[t]'s joints into append(t); then end_frame();
+//   recorder.measure(skeleton, frame_time)
+class FootSkatingRecorder {
+ public:
+  struct Frame {
+    std::span<glm::vec3> positions;  // joint_count each, world
+    std::span<glm::quat> rotations;
+  };
+  // Starts over with these characters; one outside [0, character_count) is
+  // an Error at field "track".
+  void track(std::vector<Index> characters, Index character_count, std::int32_t joint_count);
+  const std::vector<Index>& tracked() const { return tracked_; }
+  // Room for tracked()[t]'s joints of the frame being recorded.
+  Frame append(std::size_t t);
+  void end_frame() { ++frames_; }
+  std::int32_t frames() const { return frames_; }
+  // Fewer than 3 frames or frame_time not positive: no contacts.
+  FootSkatingReport measure(const Skeleton& skeleton, double frame_time, const ContactOptions& options = {}) const;
+
+ private:
+  std::vector<Index> tracked_;
+  std::int32_t joints_ = 0;
+  std::int32_t frames_ = 0;
+  std::vector<std::vector<glm::vec3>> positions_;
+  std::vector<std::vector<glm::quat>> rotations_;
+};
 
 }  // namespace throng::motion

@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "path/host_parallel.h"
 #include "path/playback.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace throng::path {
 
@@ -138,7 +138,7 @@ sim::World random_obstacle_world(const RandomWorldOptions& o) {
 std::vector<PathQuery> random_queries(const Planner& planner, std::int64_t count, std::uint64_t seed, float min_distance) {
   const sim::Aabb b = planner.space().bounds();
   if (b.empty()) throw Error("the planner's free space is empty", at_field("random_queries"));
-  sim::Rng rng(seed, 0x9a7);
+  Rng rng(seed, 0x9a7);
   const float need = planner.options().radius + 0.1f;
   auto sample = [&]() -> glm::vec2 {
     for (int attempt = 0; attempt < 10000; ++attempt) {

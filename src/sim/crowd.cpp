@@ -10,7 +10,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace throng::sim {
 

@@ -483,6 +483,90 @@ TEST(StreamCrowd, UniqueAnimationsPlayPerAgentAndHandBack) {
   EXPECT_EQ(crowd.uniques().acquire(anim) >= 0, true);
 }
 
+// The batch retarget: a desired (stream, offset) per agent in one kernel.
+TEST(StreamCrowd, RetargetSetsTransitionsOffsetsAndRestLikeTheOneByOneCalls) {
+  MixedCrowd m;
+  StreamCrowd& crowd = m.crowd;
+  const World w(crowd.agent_count());
+  const Rig& rig = crowd.rig(m.human);
+  crowd.uniques().set_capacity(rig, m.human, 1);
+  const auto anim = crowd.uniques().add_animation({"bow", m.human, std::make_unique<ClipPlayer>(wiggle_clip(rig.joint_count(), 31, kDt, "bow")),
+                                                   RootMotion::InPlace});
+  for (int f = 0; f < 70; ++f) crowd.step();
+  crowd.transition_to_unique(5, 2, anim, 0.0f);
+  crowd.step();
+  const Index n = crowd.agent_count();
+  std::vector<std::int32_t> sources(static_cast<std::size_t>(n), -5), offsets(static_cast<std::size_t>(n), 0);  // < -1: left alone
+  std::vector<std::vector<ClusterRef>> before;
+  for (Index a = 0; a < n; ++a) before.push_back(crowd.clusters_of(a));
+  sources[0] = m.wave;  // another stream: blended in
+  offsets[0] = 7;
+  sources[1] = m.walk;  // clusters already on walk take the offset, the others blend in
+  offsets[1] = 1000;    // clamped to the history
+  sources[2] = kNoSource;  // rest pose at once
+  sources[3] = m.f_walk;   // another rig's stream: ignored
+  sources[4] = 99;         // no such stream: ignored
+  sources[5] = m.wave;     // cluster 2 is on a unique instance: left alone
+  sources[60] = m.f_idle;
+  offsets[60] = 3;
+  const Buffer<std::int32_t> src(std::span<const std::int32_t>(sources), current_memory());
+  const Buffer<std::int32_t> off(std::span<const std::int32_t>(offsets), current_memory());
+  // Mask: clusters 0 and 1 follow (cluster 2 of every agent keeps its source).
+  const Index changed = crowd.retarget(src.span(), off.span(), 0.5f, 0b011u);
+  Index want_changed = 0;
+  for (Index a = 0; a < n; ++a) {
+    const auto after = crowd.clusters_of(a);
+    const auto& old = before[static_cast<std::size_t>(a)];
+    bool any = false;
+    for (std::size_t c = 0; c < after.size(); ++c) {
+      const std::int32_t s = sources[static_cast<std::size_t>(a)];
+      const bool follows = c < 2 && (a <= 2 || a == 5 || a == 60) && !is_unique_source(old[c].source);
+      if (!follows) {
+        EXPECT_EQ(after[c].source, old[c].source) << a << " " << c;
+        EXPECT_EQ(after[c].offset, old[c].offset) << a << " " << c;
+        EXPECT_EQ(after[c].from_source, old[c].from_source) << a << " " << c;
+        continue;
+      }
+      const std::int32_t want_offset = s < 0 ? 0 : std::min(offsets[static_cast<std::size_t>(a)], crowd.streams()[s].history() - 1);
+      EXPECT_EQ(after[c].source, s) << a << " " << c;
+      EXPECT_EQ(after[c].offset, want_offset) << a << " " << c;
+      if (old[c].source == s) {
+        EXPECT_EQ(after[c].from_source, old[c].from_source);  // same stream: only the offset moves
+      } else if (s >= 0 && old[c].source >= 0) {
+        any = true;
+        EXPECT_EQ(after[c].from_source, old[c].source) << a << " " << c;
+        EXPECT_EQ(after[c].from_offset, old[c].offset);
+        EXPECT_EQ(after[c].t0, crowd.frame());
+        EXPECT_FLOAT_EQ(after[c].blend_frames, 0.5f * kFps);
+      } else {
+        any = true;
+        EXPECT_EQ(after[c].blend_frames, 0.0f);
+      }
+    }
+    want_changed += any ? 1 : 0;
+  }
+  EXPECT_EQ(changed, want_changed);
+  EXPECT_GE(changed, 3);
+  // Palettes follow the references through the blends.
+  std::vector<Mat3x4> palettes(static_cast<std::size_t>(crowd.palette_size()));
+  for (int f = 0; f < 20; ++f) {
+    crowd.step();
+    crowd.resolve(w.positions, w.yaws, palettes);
+    for (const Index a : {0, 1, 2, 60}) ASSERT_LT(max_palette_error(crowd, palettes, w, a), 2e-4) << f << " " << a;
+  }
+  // Skipped agents are not written.
+  std::vector<std::uint8_t> skip(static_cast<std::size_t>(n), 0);
+  skip[7] = 1;
+  const Buffer<std::uint8_t> skip_buffer(std::span<const std::uint8_t>(skip), current_memory());
+  const Mat3x4 marker = collapse_to(glm::vec3(42.0f));
+  const auto base7 = static_cast<std::size_t>(crowd.palette_offsets()[7]);
+  palettes[base7] = marker;
+  crowd.resolve(w.positions, w.yaws, palettes, {}, skip_buffer.span());
+  EXPECT_EQ(palettes[base7].r0, marker.r0);
+  EXPECT_LT(max_palette_error(crowd, palettes, w, 8), 2e-4);
+  EXPECT_THROW(crowd.retarget(src.span(), off.span(), -1.0f), Error);
+}
+
 TEST(StreamCrowd, IdenticalResultsOnOneTwoAndManyThreads) {
   auto run = [](int threads) {
     ScopedExecution exec(Backend::Cpu, threads);

@@ -24,6 +24,37 @@ AnimClip counting_clip(int joints, int frames) {
   return c;
 }
 
+// A stream started filled holds M poses at once, frames newest - M + 1 ..
+// newest, and agents may read every offset without dilating.
+TEST(StreamHistory, StartFilledWritesTheWholeHistoryAtOnce) {
+  const Rig& rig = humanoid_rig();
+  StreamPool pool(kFps);
+  StreamSpec spec;
+  spec.name = "count";
+  spec.history = 12;
+  spec.root = RootMotion::Keep;
+  spec.running = false;
+  const AnimClip clip = counting_clip(rig.joint_count(), 100);
+  pool.add(rig, 0, spec, std::make_unique<ClipPlayer>(clip));
+  const AnimStream& s = pool[0];
+  pool.start_filled(0, 40);
+  EXPECT_EQ(s.state(), StreamState::Running);
+  EXPECT_EQ(s.written(), 12);
+  EXPECT_EQ(s.newest_frame(), 40);
+  EXPECT_EQ(s.max_offset(), 11);
+  EXPECT_EQ(s.view().max_offset, 11);
+  // Offset o: the controller o frames before its newest, i.e. clip frame 11 - o.
+  for (int o = 0; o < 12; ++o) EXPECT_FLOAT_EQ(s.pose_at(o).root.x, static_cast<float>(11 - o)) << o;
+  pool.step(41);
+  EXPECT_FLOAT_EQ(s.pose_at(0).root.x, 12.0f);
+  EXPECT_FLOAT_EQ(s.pose_at(11).root.x, 1.0f);
+  EXPECT_EQ(s.max_offset(), 11);
+  // A running stream restarts filled from time 0.
+  pool.start_filled(0, 41);
+  EXPECT_FLOAT_EQ(s.pose_at(0).root.x, 11.0f);
+  EXPECT_THROW(pool.start_filled(3, 0), Error);
+}
+
 TEST(StreamHistory, RingHoldsTheLastMPosesNewestFirst) {
   const Rig& rig = humanoid_rig();
   StreamPool pool(kFps);

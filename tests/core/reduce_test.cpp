@@ -59,4 +59,30 @@ TEST(Reduce, ScanAcrossBlockBoundaries) {
   }
 }
 
+TEST(Reduce, HistogramAndCountMatchBruteForceForAnyThreads) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<std::int32_t> key(-3, 40);  // some keys outside [0, 37)
+  const Index n = 3 * kReduceBlock + 101;
+  std::vector<std::int32_t> keys(static_cast<std::size_t>(n));
+  std::vector<std::uint8_t> flags(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    keys[i] = key(rng);
+    flags[i] = static_cast<std::uint8_t>(keys[i] % 3 == 0 ? 2 : 0);
+  }
+  const std::int32_t bins = 37;
+  std::vector<Index> expected(static_cast<std::size_t>(bins), 0);
+  Index nonzero = 0;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (keys[i] >= 0 && keys[i] < bins) ++expected[static_cast<std::size_t>(keys[i])];
+    nonzero += flags[i] != 0 ? 1 : 0;
+  }
+  for (int t : {1, 2, 5}) {
+    ScopedExecution exec(Backend::Cpu, t);
+    EXPECT_EQ(histogram(Span<const std::int32_t>(keys), bins), expected) << "threads=" << t;
+    EXPECT_EQ(count_nonzero(Span<const std::uint8_t>(flags)), nonzero) << "threads=" << t;
+  }
+  EXPECT_TRUE(histogram(Span<const std::int32_t>(keys), 0).empty());
+  EXPECT_EQ(histogram(Span<const std::int32_t>(), 4), std::vector<Index>(4, 0));
+}
+
 }  // namespace throng

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "anim/blend_controller.h"
 #include "core/error.h"
 #include "tests/anim/stream_reference.h"
 
@@ -30,7 +31,7 @@ TEST(StreamsYaml, ExampleBuildsAndItsStateMachineFollowsTheParameters) {
   auto crowd = load_stream_crowd("examples/streams/crowd.yaml");
   ASSERT_EQ(crowd->rig_count(), 1);
   EXPECT_EQ(crowd->rig(0).clusters.count(), 3);
-  EXPECT_EQ(crowd->streams().size(), 4);
+  EXPECT_EQ(crowd->streams().size(), 6);
   EXPECT_EQ(crowd->uniques().capacity(0), 64);
   EXPECT_EQ(crowd->uniques().find_animation("stop_and_turn"), 0);
   EXPECT_GE(crowd->event_names().find("footstep_left"), 0);
@@ -38,7 +39,7 @@ TEST(StreamsYaml, ExampleBuildsAndItsStateMachineFollowsTheParameters) {
   ASSERT_GE(run_event, 0);
   const std::int32_t loco = crowd->streams().find("locomotion");
   ASSERT_GE(loco, 0);
-  EXPECT_EQ(crowd->memory().stream_poses, 4u * 64u * (22u * 64u + 12u));
+  EXPECT_EQ(crowd->memory().stream_poses, 6u * 64u * (22u * 64u + 12u));
 
   crowd->add_agents(0, 300);
   crowd->assign_random(0, 300, {{{0, 1, 3}, {0, 1, 2, 3}, {0, 1, 2, 3}}, true}, 3);
@@ -59,6 +60,39 @@ TEST(StreamsYaml, ExampleBuildsAndItsStateMachineFollowsTheParameters) {
   EXPECT_EQ(states, (std::vector<std::string>{"idle", "walk", "run", "walk", "idle"}));
   EXPECT_EQ(run_events, 1);
   for (const Mat3x4& m : palettes) ASSERT_TRUE(std::isfinite(m.r0.w) && std::isfinite(m.r1.x) && std::isfinite(m.r2.z));
+}
+
+// blend1d and blend2d play what the controllers built in C++ play.
+TEST(StreamsYaml, BlendControllersMatchTheirCppCounterparts) {
+  auto crowd = load_stream_crowd("examples/streams/crowd.yaml");
+  const std::int32_t one = crowd->streams().find("walk_by_speed");
+  const std::int32_t two = crowd->streams().find("walk_and_turn");
+  ASSERT_GE(one, 0);
+  ASSERT_GE(two, 0);
+  const auto& blend = dynamic_cast<const Blend1DController&>(crowd->streams()[one].controller());
+  EXPECT_EQ(blend.space().clip_count(), 4);
+  EXPECT_EQ(blend.space().clips().front().name, "idle");
+  EXPECT_EQ(blend.space().clips().back().name, "run");
+  const std::int32_t left = crowd->event_names().find("footstep_left");
+  ASSERT_GE(left, 0);
+  EXPECT_EQ(blend.options().footstep_left, left);
+  const auto& default_spaces = default_blend_spaces();
+  Blend2DController reference(default_spaces.speeds, default_spaces.turn_left, default_spaces.turn_right);
+  ParameterSet params;
+  params.set("speed", 1.2f);
+  params.set("turn", 0.3f);
+  int steps = 0;
+  Pose want;
+  for (int f = 0; f < 40; ++f) {
+    crowd->step();
+    EventMask e = 0;
+    if (f > 0) reference.advance(1.0f / 30.0f, params, e);
+    reference.evaluate(want);
+    EXPECT_EQ(crowd->streams()[two].pose_at(0).local, want.local) << f;
+    steps += (crowd->streams()[one].events_at(0) >> left) & 1u;
+  }
+  EXPECT_GE(steps, 1);  // 1.33 s at 1.4 m/s: at least one left step
+  EXPECT_GT(reference.turn_weight(), 0.0f);
 }
 
 TEST(StreamsYaml, ErrorsNameLineAndColumn) {
@@ -90,6 +124,13 @@ TEST(StreamsYaml, ErrorsNameLineAndColumn) {
       {"rigs: [{name: h, skeleton: default, clusters: [{name: up, roots: [Spine]}]}]\n", "t.yaml:1:8",
        "must be a root of some cluster"},
       {rig + "unique:\n  - {name: u, rig: h, controller: {clip: w}}\n", "t.yaml:4:20", "has no unique_capacity"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, nope]}}}\n", "t.yaml:6:57", "no clip named 'nope'"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, w]}}}\n", "t.yaml:6:53", "have the same speed"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: mine}}}\n", "t.yaml:6:53", "the only built-in blend space"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: default, speed: -1}}}\n", "t.yaml:6:69", "out of range"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {clips: [w]}}}\n", "t.yaml:6:45", "missing key 'turn_left'"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {space: default, turn_left: w, turn_right: w}}}\n", "t.yaml:",
+       "must turn"},
   };
   // Each position is the first character of the offending value (or of the
   // mapping that lacks or contradicts something).

@@ -12,7 +12,7 @@
 #include "core/exec.h"
 #include "path/playback.h"
 #include "sim/geometry.h"
-#include "sim/random.h"
+#include "core/random.h"
 #include "tests/path/path_machine.h"
 
 namespace throng::path {
@@ -22,7 +22,7 @@ using testing::small_machine;
 
 // A smooth random walk of `n` edges, resampled at the machine's spacing.
 ResampledPath random_path(std::uint64_t seed, int n, float turn = 0.6f, std::vector<PathMark> marks = {}) {
-  sim::Rng rng(seed);
+  Rng rng(seed);
   std::vector<glm::vec2> p = {{0, 0}};
   float heading = static_cast<float>(rng.uniform(-3.14, 3.14));
   for (int i = 0; i < n; ++i) {
@@ -147,7 +147,7 @@ Reference exhaustive(const StateMachine& m, const CurveSet& cs, double speed_wei
 CurveSet random_curves(int paths, std::uint64_t seed, std::vector<float>* speeds = nullptr) {
   std::vector<ResampledPath> ps;
   std::vector<float> v;
-  sim::Rng rng(seed);
+  Rng rng(seed);
   for (int i = 0; i < paths; ++i) {
     ps.push_back(random_path(seed * 100 + static_cast<std::uint64_t>(i), 8));
     v.push_back(i % 3 == 0 ? 0.0f : static_cast<float>(rng.uniform(1.0, 3.0)));

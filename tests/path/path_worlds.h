@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "sim/geometry.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace throng::path::testing {
 
@@ -46,7 +46,7 @@ inline float segment_true_clearance(glm::vec2 a, glm::vec2 b, const Shapes& s, f
 inline Shapes obstacle_field(std::uint64_t seed, int count = 30) {
   Shapes s;
   s.walkable.outer = sim::rect_ring({0, 0}, {40, 30});
-  sim::Rng rng(seed);
+  Rng rng(seed);
   for (int i = 0; i < count; ++i) {
     const glm::vec2 c(static_cast<float>(rng.uniform(3, 37)), static_cast<float>(rng.uniform(3, 27)));
     const float size = static_cast<float>(rng.uniform(0.6, 3.0));

@@ -45,7 +45,7 @@ TEST(Planner, GapNarrowerThanTheAgentSeparatesTheRoom) {
     s.polygons.push_back({sim::rect_ring({9.5f, hi}, {10.5f, 11}), {}});
     const float radius = 0.3f;  // needs a 0.6 m gap
     const Planner planner = planner_for(s, radius);
-    sim::Rng rng(5);
+    Rng rng(5);
     for (int i = 0; i < 20; ++i) {
       const PathQuery q{{static_cast<float>(rng.uniform(1, 9)), static_cast<float>(rng.uniform(1, 9))},
                         {static_cast<float>(rng.uniform(11, 19)), static_cast<float>(rng.uniform(1, 9))}};
@@ -109,7 +109,7 @@ TEST(Planner, PathExistsExactlyWithinAFreeComponent) {
     const Raster strict = raster(s, h, radius + h, clearance, nx, ny);
     const Raster loose = raster(s, h, radius - h, clearance, nx, ny);
     std::vector<glm::vec2> starts;
-    sim::Rng rng(seed);
+    Rng rng(seed);
     while (starts.size() < 80) {
       // Every fourth point inside the pen.
       const bool pen = starts.size() % 4 == 0;
@@ -142,7 +142,7 @@ TEST(Planner, SameResultForAnyThreadCount) {
   const Shapes s = testing::obstacle_field(21, 40);
   const Planner planner = planner_for(s, 0.3f);
   std::vector<PathQuery> queries;
-  sim::Rng rng(3);
+  Rng rng(3);
   while (queries.size() < 64) {
     const glm::vec2 a(static_cast<float>(rng.uniform(1, 39)), static_cast<float>(rng.uniform(1, 29)));
     const glm::vec2 b(static_cast<float>(rng.uniform(1, 39)), static_cast<float>(rng.uniform(1, 29)));

@@ -7,13 +7,13 @@
 
 #include "core/error.h"
 #include "sim/geometry.h"
-#include "sim/random.h"
+#include "core/random.h"
 
 namespace throng::path {
 namespace {
 
 std::vector<glm::vec2> random_polyline(std::uint64_t seed, int n) {
-  sim::Rng rng(seed);
+  Rng rng(seed);
   std::vector<glm::vec2> p = {{0, 0}};
   float heading = 0;
   for (int i = 1; i < n; ++i) {

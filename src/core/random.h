@@ -9,7 +9,7 @@
 
 #include "core/config.h"
 
-namespace throng::sim {
+namespace throng {
 
 THRONG_HOST_DEVICE inline std::uint64_t splitmix64(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ull;
@@ -42,4 +42,4 @@ class Rng {
   std::uint64_t state_;
 };
 
-}  // namespace throng::sim
+}  // namespace throng
