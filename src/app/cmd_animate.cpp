@@ -13,17 +13,16 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "anim/locomotion.h"
 #include "app/commands.h"
+#include "app/formation.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/timing.h"
 #include "io/animate_yaml.h"
-#include "io/bvh_reader.h"
 #include "motion/locomotion.h"
 
 namespace throng::app {
@@ -40,83 +39,6 @@ std::vector<T> to_host(Span<const T> s) {
   return out;
 }
 
-io::AnimateSpec load_spec(const std::string& what, fs::path& folder) {
-  std::error_code ec;
-  if (fs::is_regular_file(what, ec)) {
-    folder = fs::path(what).parent_path();
-    return io::read_animate_spec(what);
-  }
-  for (const std::string& name : io::builtin_animate_specs())
-    if (what == name) return io::builtin_animate_spec(name);
-  throw Error("no such file or built-in scenario '" + what + "' (built-in: formation)", at_field("scenario"));
-}
-
-motion::BlendSpace1D load_blend_space(const io::AnimateSpec& spec, const fs::path& folder) {
-  if (spec.clips.empty()) return motion::make_default_blend_space();
-  std::vector<motion::LocomotionClip> clips;
-  motion::Skeleton skeleton;
-  for (std::size_t i = 0; i < spec.clips.size(); ++i) {
-    const io::AnimateClipSource& src = spec.clips[i];
-    const fs::path path = fs::path(src.file).is_absolute() ? fs::path(src.file) : folder / src.file;
-    const io::BvhFile file = io::read_bvh(path.string());
-    if (i == 0) skeleton = file.skeleton;
-    else if (file.skeleton.joint_count() != skeleton.joint_count())
-      throw Error("has " + std::to_string(file.skeleton.joint_count()) + " joints, the first clip " + std::to_string(skeleton.joint_count()) +
-                      ": clips of a blend space share one skeleton",
-                  at_field("motion[" + std::to_string(i) + "]", spec.source));
-    motion::LocomotionOptions options;
-    options.cycle.skip_frames = src.skip_frames;
-    clips.push_back(motion::prepare_locomotion_clip(skeleton, file.clip, src.name, options));
-    spdlog::info("{}: cycle of {} frames, {:.2f} m/s, stride {:.2f} m", src.name, clips.back().frame_count(), clips.back().speed,
-                 clips.back().stride_m);
-  }
-  return motion::BlendSpace1D(std::move(skeleton), std::move(clips));
-}
-
-// Where everyone stands, faces and turns.
-struct Formation {
-  std::vector<glm::vec3> positions;
-  std::vector<float> yaws, curvatures, rings;  // rings: the circle each keeps to (0 on the grid)
-  float extent = 0.0f;                         // m from the centre to the farthest character
-};
-
-Formation make_formation(const io::AnimateSpec& s) {
-  Formation f;
-  const auto n = static_cast<std::size_t>(s.characters);
-  if (s.shape == io::AnimateSpec::Shape::Circle) {
-    // Rings outward from `radius`, each as full as the spacing allows; the
-    // last ring holds the rest, evenly spread.
-    std::size_t placed = 0;
-    for (int ring = 0; placed < n; ++ring) {
-      const float r = s.radius + static_cast<float>(ring) * s.ring_spacing;
-      const auto capacity = std::max<std::size_t>(1, static_cast<std::size_t>(2.0f * kPi * r / s.spacing));
-      const std::size_t here = std::min(capacity, n - placed);
-      for (std::size_t k = 0; k < here; ++k) {
-        const float a = 2.0f * kPi * (static_cast<float>(k) + 0.5f * static_cast<float>(ring % 2)) / static_cast<float>(here);
-        // Counter-clockwise seen from above: angle a at (cos a, -sin a) in XZ,
-        // walking along (-sin a, -cos a), a left turn of curvature 1 / r.
-        f.positions.emplace_back(r * std::cos(a), 0.0f, -r * std::sin(a));
-        f.yaws.push_back(s.clockwise ? a : a + kPi);
-        f.curvatures.push_back(s.clockwise ? -1.0f / r : 1.0f / r);
-        f.rings.push_back(r);
-      }
-      placed += here;
-      f.extent = r;
-    }
-  } else {
-    const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
-    const float half = 0.5f * s.spacing * static_cast<float>(side - 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      f.positions.emplace_back(s.spacing * static_cast<float>(i % side) - half, 0.0f, s.spacing * static_cast<float>(i / side) - half);
-      f.yaws.push_back(0.0f);
-      f.curvatures.push_back(0.0f);
-      f.rings.push_back(0.0f);
-    }
-    f.extent = half * std::numbers::sqrt2_v<float>;
-  }
-  return f;
-}
-
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -130,31 +52,11 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
   if (characters_override > 0) spec.characters = characters_override;
   const std::string out_dir = out_override.empty() ? spec.output : out_override;
 
-  const motion::BlendSpace1D space = load_blend_space(spec, folder);
-  const Formation formation = make_formation(spec);
+  FormationCrowd formation_crowd(spec, folder);  // blend space, formation, speeds drawn from the seed
+  const motion::BlendSpace1D& space = formation_crowd.space();
+  const Formation& formation = formation_crowd.formation();
+  anim::CrowdAnimator& crowd = formation_crowd.animator();
   const Index n = spec.characters;
-
-  anim::CrowdAnimatorConfig config;
-  config.hold_until_cycle_end = spec.paper_mode;
-  config.lod = spec.lod;
-  config.lod_thresholds = spec.lod_thresholds;
-  config.cache = spec.cache;
-  config.cache_config.bucket_width = spec.bucket_width;
-  config.cache_config.capacity_bytes = static_cast<std::size_t>(static_cast<double>(spec.cache_capacity_mb) * 1024.0 * 1024.0);
-  anim::CrowdAnimator crowd(space, n, config);
-
-  std::mt19937 rng(spec.seed);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  std::vector<float> scales(static_cast<std::size_t>(n)), phases(static_cast<std::size_t>(n)), speeds(static_cast<std::size_t>(n));
-  for (float& x : scales) x = spec.scale_min + (spec.scale_max - spec.scale_min) * unit(rng);
-  for (float& x : phases) x = unit(rng);
-  const auto draw_speeds = [&] {
-    for (float& v : speeds) v = spec.speed_min + (spec.speed_max - spec.speed_min) * unit(rng);
-    crowd.set_speeds(speeds);
-  };
-  crowd.place(formation.positions, formation.yaws, scales, phases);
-  crowd.set_curvatures(formation.curvatures);
-  draw_speeds();
   std::vector<Index> tracked;
   const auto skating = std::min<Index>(spec.skating_characters, n);
   for (Index k = 0; k < skating; ++k) tracked.push_back(k * n / skating);
@@ -172,7 +74,6 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
 
   const float dt = 1.0f / spec.fps;
   const auto frames = std::max<std::int64_t>(1, std::llround(static_cast<double>(spec.duration_s) * spec.fps));
-  const auto frames_per_speed = spec.change_every_s > 0.0f ? std::max<std::int64_t>(1, std::llround(spec.change_every_s * spec.fps)) : 0;
   spdlog::info("animating {} characters ({} joints, {} clips, {} mode) for {} frames at {} fps", n, space.joint_count(), space.clip_count(),
                spec.paper_mode ? "paper" : "continuous", frames, spec.fps);
 
@@ -183,10 +84,9 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
   std::int64_t stored = 0;
   auto last_report = std::chrono::steady_clock::now();
   for (std::int64_t f = 0; f < frames; ++f) {
-    if (frames_per_speed > 0 && f > 0 && f % frames_per_speed == 0) draw_speeds();
     const Camera camera = orbit_camera(orbit, lens, static_cast<float>(f) * dt);
     const auto t0 = std::chrono::steady_clock::now();
-    const anim::FrameStats& s = crowd.animate({dt, spec.lod ? &camera : nullptr, true});
+    const anim::FrameStats& s = formation_crowd.advance(dt, spec.lod ? &camera : nullptr);
     frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     joints_total += s.joints_synthesised;
     from_cache += s.from_cache;
@@ -311,7 +211,7 @@ void add_animate_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--characters", characters, "How many characters (overrides the scenario)")->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));
   cmd->callback([&g] {
     fs::path folder;
-    io::AnimateSpec spec = load_spec(scenario, folder);  // a bad name fails before any backend talk
+    io::AnimateSpec spec = load_animate_spec(scenario, folder);  // a bad name fails before any backend talk
     apply_global_options(g);
     animate(std::move(spec), folder, out_dir, duration, characters);
   });
