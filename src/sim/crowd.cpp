@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <span>
 #include <unordered_map>
 
 #include "core/error.h"
@@ -93,7 +94,7 @@ std::string point_text(glm::vec2 p) { return fmt::format("({:.3g}, {:.3g})", p.x
 
 }  // namespace
 
-CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits) {
+CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits, const RoutePlanner* planner) {
   spec.model.validate();
   if (!(spec.dt > 0) || !(spec.dt <= 10.0f)) throw Error(fmt::format("time step must be in (0, 10] s (got {})", spec.dt), at_field("dt"));
   const float cell = world.cell_size();
@@ -126,13 +127,10 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
       throw Error(fmt::format("speed.max {} exceeds model.max_speed {}", S.max, spec.model.max_speed), at_field(field + ".speed.max"));
     if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
       throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius), at_field(field + ".arrival_radius"));
-    if (G.goals.empty()) throw Error("a group needs at least one goal", at_field(field + ".goals"));
-    if (static_cast<std::int64_t>(G.goals.size()) > limits.max_waypoints)
-      throw Error(fmt::format("more than {} goals", limits.max_waypoints), at_field(field + ".goals"));
+    if (static_cast<std::int64_t>(G.waypoints.size()) > limits.max_waypoints)
+      throw Error(fmt::format("more than {} waypoints", limits.max_waypoints), at_field(field + ".waypoints"));
     check_region(G.spawn, field + ".spawn", limits.max_extent);
-    for (std::size_t w = 0; w < G.goals.size(); ++w) {
-      const GoalSpec& goal = G.goals[w];
-      const std::string gf = fmt::format("{}.goals[{}]", field, w);
+    auto check_goal = [&](const GoalSpec& goal, const std::string& gf) {
       if (!std::isfinite(goal.value.x) || !std::isfinite(goal.value.y) || std::fabs(goal.value.x) > limits.max_extent ||
           std::fabs(goal.value.y) > limits.max_extent)
         throw Error("goal coordinates must be finite numbers within the extent limit", at_field(gf));
@@ -140,14 +138,17 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
         check_region(goal.region, gf + ".random", limits.max_extent);
         if (goal.region.kind == Region::Kind::ring) throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
       }
-    }
+    };
+    for (std::size_t w = 0; w < G.waypoints.size(); ++w) check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w));
+    check_goal(G.goal, field + ".goal");
     max_radius = std::max(max_radius, G.radius);
   }
   std::int64_t total_waypoints = 0;
   for (const GroupSpec& G : spec.groups)
-    total_waypoints += G.count * static_cast<std::int64_t>(G.goals.size() + (G.arrival == ArrivalBehaviour::Loop ? 1 : 0));
+    total_waypoints += G.count * static_cast<std::int64_t>(G.arrival == ArrivalBehaviour::Loop ? 2 * G.waypoints.size() + 2 : G.waypoints.size() + 1);
   if (total_waypoints > 4 * limits.max_agents)
-    throw Error(fmt::format("{} waypoints in all (agents x goals) exceed the limit of {}", total_waypoints, 4 * limits.max_agents), at_field("groups"));
+    throw Error(fmt::format("{} waypoints in all (agents x route points) exceed the limit of {}", total_waypoints, 4 * limits.max_agents),
+                at_field("groups"));
 
   // Reachability raster over everything the agents could need.
   std::unique_ptr<Reachability> reach;
@@ -157,7 +158,11 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
       for (const GroupSpec& G : spec.groups) {
         const Aabb sb = region_bounds(G.spawn);
         extent.add(sb);
-        for (const GoalSpec& goal : G.goals) {
+        std::vector<const GoalSpec*> goals;
+        for (const GoalSpec& w : G.waypoints) goals.push_back(&w);
+        goals.push_back(&G.goal);
+        for (const GoalSpec* goal_ptr : goals) {
+          const GoalSpec& goal = *goal_ptr;
           switch (goal.kind) {
             case GoalSpec::Kind::Point: extent.add(goal.value); break;
             case GoalSpec::Kind::Offset:
@@ -262,9 +267,11 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     GroupRuntime rt;
     rt.arrival = G.arrival;
     rt.arrival_radius = G.arrival_radius;
-    rt.final_waypoint = static_cast<std::int32_t>(G.goals.size()) - 1;
     out.groups.push_back(rt);
     const auto first_agent = static_cast<std::int64_t>(out.position.size());
+    // Resolve every agent's waypoints and goal (stride W + 1).
+    const std::size_t W = G.waypoints.size();
+    std::vector<glm::vec2> resolved(chosen.size() * (W + 1));
     for (std::size_t k = 0; k < chosen.size(); ++k) {
       const glm::vec2 p = chosen[k];
       const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
@@ -276,11 +283,10 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
       out.radius.push_back(r);
       out.pref_speed.push_back(static_cast<float>(speed));
       out.group.push_back(static_cast<std::int32_t>(g));
-      out.waypoint_begin.push_back(static_cast<std::int32_t>(out.waypoints.size()));
       glm::vec2 from = p;
-      for (std::size_t w = 0; w < G.goals.size(); ++w) {
-        const GoalSpec& goal = G.goals[w];
-        const std::string gf = fmt::format("{}.goals[{}]", field, w);
+      for (std::size_t w = 0; w <= W; ++w) {
+        const GoalSpec& goal = w < W ? G.waypoints[w] : G.goal;
+        const std::string gf = w < W ? fmt::format("{}.waypoints[{}]", field, w) : field + ".goal";
         glm::vec2 q(0.0f);
         switch (goal.kind) {
           case GoalSpec::Kind::Point: q = goal.value; break;
@@ -303,18 +309,41 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
           throw Error(fmt::format("goal {} of agent {} is beyond the extent limit", point_text(q), agent), at_field(gf));
         if (const std::string blocked = world.what_blocks(q); !blocked.empty())
           throw Error(fmt::format("goal {} of agent {} lies {}", point_text(q), agent, blocked), at_field(gf));
+        // Planned routes go around obstacles; only a missing path is an error.
         if (reach && !reach->connected(from, q))
           throw Error(fmt::format("goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
                                   point_text(q), agent, point_text(from), reach->cell_size()),
                       at_field(gf));
-        out.waypoints.push_back(q);
+        resolved[k * (W + 1) + w] = q;
         from = q;
       }
-      // A loop walks the list and comes back to where the agent started.
-      if (G.arrival == ArrivalBehaviour::Loop) out.waypoints.push_back(p);
-      out.waypoint_count.push_back(static_cast<std::int32_t>(out.waypoints.size()) - out.waypoint_begin.back());
-      const glm::vec2 first_goal = out.waypoints[static_cast<std::size_t>(out.waypoint_begin.back())];
-      const glm::vec2 to = first_goal - p;
+    }
+    // A goal without waypoints: the planner (when there is one) gives the
+    // points in between.
+    std::vector<std::vector<glm::vec2>> planned;
+    if (planner != nullptr && W == 0 && !chosen.empty()) {
+      planned = planner->plan(chosen, resolved, r);
+      if (planned.size() != chosen.size())
+        throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()), at_field(field + ".goal"));
+    }
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      const glm::vec2 p = chosen[k];
+      const auto begin = static_cast<std::int32_t>(out.waypoints.size());
+      out.waypoint_begin.push_back(begin);
+      std::span<const glm::vec2> via(resolved.data() + k * (W + 1), W);
+      if (!planned.empty()) via = planned[k];
+      if (static_cast<std::int64_t>(via.size()) > limits.max_waypoints)
+        throw Error(fmt::format("a planned route has {} points, more than {}", via.size(), limits.max_waypoints), at_field(field + ".goal"));
+      out.waypoints.insert(out.waypoints.end(), via.begin(), via.end());
+      out.waypoints.push_back(resolved[k * (W + 1) + W]);
+      out.waypoint_goal.push_back(static_cast<std::int32_t>(out.waypoints.size()) - 1 - begin);
+      // A loop walks back along the route to where the agent started.
+      if (G.arrival == ArrivalBehaviour::Loop) {
+        for (std::size_t v = via.size(); v-- > 0;) out.waypoints.push_back(via[v]);
+        out.waypoints.push_back(p);
+      }
+      out.waypoint_count.push_back(static_cast<std::int32_t>(out.waypoints.size()) - begin);
+      const glm::vec2 to = out.waypoints[static_cast<std::size_t>(begin)] - p;
       out.heading.push_back(length2(to) > 0 ? std::atan2(to.y, to.x) : 0.0f);
     }
   }
@@ -340,6 +369,7 @@ CrowdState upload_crowd(const CrowdHost& h, Memory m) {
   c.goal = up(goals);
   c.waypoint_begin = up(h.waypoint_begin);
   c.waypoint_count = up(h.waypoint_count);
+  c.waypoint_goal = up(h.waypoint_goal);
   c.waypoint_cursor = Buffer<std::int32_t>::zeros(n, m);
   c.group = up(h.group);
   c.flags = up(std::vector<std::uint8_t>(h.position.size(), kAgentActive));

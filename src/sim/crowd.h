@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/buffer.h"
@@ -20,7 +21,6 @@ inline constexpr std::uint8_t kAgentStopped = 4;  // arrived with behaviour `sto
 struct GroupRuntime {
   ArrivalBehaviour arrival = ArrivalBehaviour::Stop;
   float arrival_radius = 0.5f;
-  std::int32_t final_waypoint = 0;  // cursor whose arrival counts as arriving
 };
 
 struct CrowdState {
@@ -35,6 +35,7 @@ struct CrowdState {
   Buffer<std::int32_t> waypoint_begin;   // into waypoints
   Buffer<std::int32_t> waypoint_count;
   Buffer<std::int32_t> waypoint_cursor;  // current waypoint, 0-based
+  Buffer<std::int32_t> waypoint_goal;    // the waypoint whose arrival counts as arriving
   Buffer<std::int32_t> group;
   Buffer<std::uint8_t> flags;
   Buffer<float> arrival_time;  // s, -1 until arrived
@@ -46,16 +47,28 @@ struct CrowdState {
 struct CrowdHost {
   std::vector<glm::vec2> position;
   std::vector<float> heading, radius, pref_speed;
-  std::vector<std::int32_t> group, waypoint_begin, waypoint_count;
+  std::vector<std::int32_t> group, waypoint_begin, waypoint_count, waypoint_goal;
   std::vector<glm::vec2> waypoints;
   std::vector<GroupRuntime> groups;
 };
 
+// Path planning plugs in here: for every group with a goal and no waypoints,
+// plan() gets the agents' start and goal points and returns, per agent, the
+// points to walk through in between (empty = straight to the goal).
+class RoutePlanner {
+ public:
+  virtual ~RoutePlanner() = default;
+  virtual std::vector<std::vector<glm::vec2>> plan(std::span<const glm::vec2> starts, std::span<const glm::vec2> goals,
+                                                   float agent_radius) const = 0;
+};
+
 // Places every group's agents without overlaps in free space, draws their
 // speeds and goals from the seed, and checks each goal lies in free space and
-// is reachable from where the agent starts. Errors name the group field
-// ("groups[1].spawn", "groups[0].goals[2]").
-CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits = {});
+// is reachable from where the agent starts. Each agent's route is its
+// waypoints (or the planner's points), then its goal; a loop adds the way
+// back. Errors name the group field ("groups[1].spawn", "groups[0].goal").
+CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits = {},
+                      const RoutePlanner* planner = nullptr);
 CrowdState upload_crowd(const CrowdHost& host, Memory memory = current_memory());
 
 }  // namespace throng::sim

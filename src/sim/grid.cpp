@@ -30,7 +30,7 @@ StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std
       host_items_[j] = pairs[j].second;
       ++j;
     }
-    std::uint64_t s = mix_key(pairs[i].first) & mask_;
+    std::uint64_t s = home_slot(pairs[i].first, mask_);
     while (host_keys_[s] != kEmptyCell) s = (s + 1) & mask_;
     host_keys_[s] = pairs[i].first;
     host_start_[s] = static_cast<std::int32_t>(i);
@@ -55,7 +55,8 @@ GridView StaticGrid::host_view() const {
 }
 
 GridView AgentGrid::view() const {
-  return {cell_size_, mask_, keys_.span(), start_.span(), count_.span(), items_.span()};
+  // Only the first binned_ items are agents (inactive ones are not binned).
+  return {cell_size_, mask_, keys_.span(), start_.span(), count_.span(), items_.span().subspan(0, binned_)};
 }
 
 Index AgentGrid::occupied_cells() const {

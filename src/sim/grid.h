@@ -60,8 +60,22 @@ THRONG_HOST_DEVICE inline std::uint64_t mix_key(std::uint64_t k) {
   return k;
 }
 
+// Where a cell's probe sequence starts in a table of mask + 1 slots (a power
+// of two, at least 16). Cells are grouped in 4 x 4 tiles: a tile is placed
+// by a hash, its 16 cells in 16 consecutive slots, so the 3x3 cells around
+// an agent lie in a few cache lines and agents near each other in space
+// touch the same part of the table.
+THRONG_HOST_DEVICE inline std::uint64_t home_slot(std::uint64_t key, std::uint64_t mask) {
+  const std::int32_t cx = key_cx(key), cy = key_cy(key);
+  const std::uint64_t tile = cell_key(cx >> 2, cy >> 2);
+  const auto local = static_cast<std::uint64_t>(((cy & 3) << 2) | (cx & 3));
+  return ((mix_key(tile) << 4) | local) & mask;
+}
+
 // What kernels see: the table (keys per slot, kEmptyCell when free), the run
-// of each slot in `items`, and the cell side.
+// of each slot in `items`, and the cell side. `items` holds every binned
+// item grouped by cell: iterating it visits agents cell by cell, which keeps
+// the lookups of neighbouring agents in the same part of memory.
 struct GridView {
   float cell_size = 1.0f;
   std::uint64_t mask = 0;  // capacity - 1 (capacity is a power of two)
@@ -73,9 +87,9 @@ struct GridView {
   THRONG_HOST_DEVICE Index capacity() const { return keys.size(); }
   // Slot holding the cell, or -1.
   THRONG_HOST_DEVICE Index find(std::int32_t cx, std::int32_t cy) const {
-    if (keys.size() == 0) return -1;
+    if (items.size() == 0) return -1;  // nothing binned (e.g. a world without walls)
     const std::uint64_t key = cell_key(cx, cy);
-    std::uint64_t s = mix_key(key) & mask;
+    std::uint64_t s = home_slot(key, mask);
     for (;;) {
       const std::uint64_t k = keys[static_cast<Index>(s)];
       if (k == key) return static_cast<Index>(s);
@@ -84,6 +98,32 @@ struct GridView {
     }
   }
 };
+
+// The item runs of the 3x3 cells around cell (cx, cy), row-major (dy, then
+// dx); an empty cell has count 0. Worth keeping when the same neighbourhood
+// is visited several times in a step (the contact passes): the table lookups
+// and their cache misses are paid once.
+struct Cells3x3 {
+  std::int32_t start[9];
+  std::int32_t count[9];
+};
+THRONG_HOST_DEVICE inline Cells3x3 cells_3x3(const GridView& g, std::int32_t cx, std::int32_t cy) {
+  Cells3x3 c;
+  for (std::int32_t dy = -1; dy <= 1; ++dy)
+    for (std::int32_t dx = -1; dx <= 1; ++dx) {
+      const int k = (dy + 1) * 3 + dx + 1;
+      const Index s = g.find(cx + dx, cy + dy);
+      c.start[k] = s < 0 ? 0 : g.start[s];
+      c.count[k] = s < 0 ? 0 : g.count[s];
+    }
+  return c;
+}
+// Calls fn(item) for every item of those cells, in order.
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_in_cells(const GridView& g, const Cells3x3& c, Fn&& fn) {
+  for (int k = 0; k < 9; ++k)
+    for (std::int32_t m = 0; m < c.count[k]; ++m) fn(g.items[c.start[k] + m]);
+}
 
 // Calls fn(item) for every item of the 3x3 cells around cell (cx, cy), cells
 // in row-major order (dy, then dx), items in their stored order.
@@ -102,7 +142,8 @@ template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_in_3x3(const GridView& g, glm::vec2 p, Fn&& fn) {
   for_each_in_3x3(g, cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size), fn);
 }
-// The same for the one cell containing p.
+// The same for the one cell containing p. On the world's halo grids (walls,
+// circles: see world.h) this finds everything within one cell side of p.
 template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_in_cell(const GridView& g, glm::vec2 p, Fn&& fn) {
   const Index s = g.find(cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size));

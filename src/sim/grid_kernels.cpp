@@ -80,7 +80,7 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
       return;
     }
     const std::uint64_t key = cell_key(cell_coord(positions[i].x, cell), cell_coord(positions[i].y, cell));
-    std::uint64_t s = mix_key(key) & mask;
+    std::uint64_t s = home_slot(key, mask);
     for (;;) {
       std::uint64_t found = atomic_load(&keys[static_cast<Index>(s)]);
       if (found == kEmptyCell) found = atomic_compare_swap(&keys[static_cast<Index>(s)], kEmptyCell, key);

@@ -16,6 +16,7 @@
 namespace throng::sim {
 
 struct OverlapStats {
+  Index touching = 0;         // pairs overlapping at all (discs closer than the sum of radii)
   Index pairs = 0;            // pairs overlapping by more than the tolerance
   float max_depth = 0.0f;     // deepest overlap, m (0 when none)
   float min_separation = INFINITY;  // smallest gap between discs, m (negative = overlap); inf when no two agents are within the bins' reach

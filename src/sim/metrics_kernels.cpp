@@ -9,13 +9,14 @@ namespace throng::sim {
 
 namespace {
 struct OverlapAcc {
+  Index touching;
   Index pairs;
   float max_depth;
   float min_separation;
 };
 struct CombineOverlap {
   THRONG_HOST_DEVICE OverlapAcc operator()(const OverlapAcc& a, const OverlapAcc& b) const {
-    return {a.pairs + b.pairs, a.max_depth > b.max_depth ? a.max_depth : b.max_depth,
+    return {a.touching + b.touching, a.pairs + b.pairs, a.max_depth > b.max_depth ? a.max_depth : b.max_depth,
             a.min_separation < b.min_separation ? a.min_separation : b.min_separation};
   }
 };
@@ -26,12 +27,13 @@ struct OverlapOf {
   Span<const std::uint8_t> flags;
   float tolerance;
   THRONG_HOST_DEVICE OverlapAcc operator()(Index i) const {
-    OverlapAcc acc{0, 0.0f, INFINITY};
+    OverlapAcc acc{0, 0, 0.0f, INFINITY};
     if ((flags[i] & kAgentActive) == 0) return acc;
     for_each_in_3x3(bins, p[i], [&](std::int32_t j) {
       if (j <= i || (flags[j] & kAgentActive) == 0) return;  // each pair once
       const float gap = length_of(p[i] - p[j]) - r[i] - r[j];
       acc.min_separation = gap < acc.min_separation ? gap : acc.min_separation;
+      if (gap < 0.0f) ++acc.touching;
       if (-gap > tolerance) ++acc.pairs;
       if (-gap > acc.max_depth) acc.max_depth = -gap;
     });
@@ -63,9 +65,9 @@ OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float>
                               float reach) {
   AgentGrid grid(reach);
   grid.rebuild(positions, flags);
-  const OverlapAcc acc = parallel_reduce("sim.metrics.overlaps", positions.size(), OverlapAcc{0, 0.0f, INFINITY},
+  const OverlapAcc acc = parallel_reduce("sim.metrics.overlaps", positions.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
                                          OverlapOf{grid.view(), positions, radii, flags, tolerance}, CombineOverlap{});
-  return {acc.pairs, acc.max_depth, acc.min_separation};
+  return {acc.touching, acc.pairs, acc.max_depth, acc.min_separation};
 }
 
 Index count_obstacle_penetrations(const World& world, Span<const glm::vec2> positions, Span<const float> radii,

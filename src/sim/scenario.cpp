@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/geometric.hpp>
 
 #include "core/error.h"
+#include "core/ground.h"
 
 namespace throng::sim {
 
@@ -55,6 +57,22 @@ std::int64_t ScenarioSpec::total_agents() const {
 std::int64_t ScenarioSpec::step_count() const {
   if (steps > 0) return steps;
   return static_cast<std::int64_t>(std::ceil(static_cast<double>(duration) / static_cast<double>(dt) - 1e-9));
+}
+
+Camera overview_camera(const Aabb& extent) {
+  const glm::vec2 centre = extent.empty() ? glm::vec2(0.0f) : 0.5f * (extent.min + extent.max);
+  const float reach = std::max(0.5f * glm::length(extent.size()), 5.0f);  // radius of a sphere around the scene
+  Camera c;
+  c.fov_y = 0.9272952f;
+  const float distance = reach / std::sin(0.5f * c.fov_y);  // the sphere fits the vertical field of view
+  const float elevation = 0.6981317f;                       // 40 degrees
+  const glm::vec2 from_south_west(-0.70710678f, -0.70710678f);
+  const glm::vec2 ground = centre + from_south_west * (distance * std::cos(elevation));
+  c.position = world_from_ground(ground, distance * std::sin(elevation));
+  c.target = world_from_ground(centre);
+  c.near_plane = std::max(0.1f, 0.01f * distance);
+  c.far_plane = distance + 2.0f * reach;
+  return c;
 }
 
 void scale_agent_counts(ScenarioSpec& spec, std::int64_t total) {

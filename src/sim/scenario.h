@@ -7,9 +7,11 @@
 #include <cstdint>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/config.h"
 #include "sim/geometry.h"
 
@@ -25,7 +27,7 @@ struct ModelParams {
   float relaxation_time = 0.5f;    // s: path following reaches the desired velocity in about this
   float probe_margin = 0.1f;       // m: probe half-width = radius + probe_margin
   std::int32_t contact_iterations = 4;  // contact/obstacle projection passes per step (the added constraint)
-  float query_radius() const { return 2.0f * pred_time * max_speed; }
+  THRONG_HOST_DEVICE float query_radius() const { return 2.0f * pred_time * max_speed; }
   // Throws Error naming the field ("model.pred_time") for NaN, negative or
   // out-of-range values.
   void validate() const;
@@ -75,15 +77,14 @@ struct GroupSpec {
   float radius = 0.25f;
   SpeedSpec speed;
   Region spawn;
-  std::vector<GoalSpec> goals;  // visited in order
-  ArrivalBehaviour arrival = ArrivalBehaviour::Stop;
+  // The route: `waypoints` in order, then `goal`. Reaching the goal counts as
+  // arriving. A group with a goal and no waypoints gets its waypoints from the
+  // route planner when the simulation has one (path planning), else walks
+  // straight to the goal.
+  std::vector<GoalSpec> waypoints;
+  GoalSpec goal;
+  ArrivalBehaviour arrival = ArrivalBehaviour::Stop;  // loop: back along the route to the start, and again
   float arrival_radius = 0.5f;
-};
-
-struct CameraSpec {
-  glm::vec3 position{0.0f, -40.0f, 60.0f};
-  glm::vec3 target{0.0f};
-  float fov_degrees = 60.0f;
 };
 
 struct OutputSpec {
@@ -120,12 +121,19 @@ struct ScenarioSpec {
   float dt = 0.1f;            // s
   std::int64_t steps = 0;     // derived from duration when 0
   float duration = 60.0f;     // s
+  bool stop_when_arrived = true;  // end the run early once every agent has arrived
   std::uint64_t seed = 1;
   SchedulerKind scheduler = SchedulerKind::DoubleBuffer;
   ModelParams model;
   WorldSpec world;
   std::vector<GroupSpec> groups;
-  CameraSpec camera;
+  // The view for rendering and LOD, in the Y-up world (converted from the
+  // map coordinates of the file with core/ground.h); nullopt = an overview
+  // chosen from the scene's extent (overview_camera).
+  std::optional<Camera> camera;
+  // Where density and speed are measured for the fundamental diagram
+  // (map coordinates); nullopt = a 10 m square at the centre of the scene.
+  std::optional<Aabb> measurement;
   OutputSpec outputs;
   std::int64_t total_agents() const;
   std::int64_t step_count() const;  // steps, or ceil(duration / dt)
@@ -142,6 +150,10 @@ struct ScenarioLimits {
   std::int32_t raster_resolution = 1024;   // cells per side of the reachability raster
   float max_extent = 1.0e6f;               // m: coordinates beyond +-this are rejected
 };
+
+// A camera looking down on the map rectangle `extent` from the south-west at
+// about 40 degrees, far enough to see all of it (Y-up world, core/ground.h).
+Camera overview_camera(const Aabb& extent);
 
 // Resizes group counts so they add up to `total` (largest remainder), keeping
 // their proportions; throws Error when total < number of groups or <= 0.

@@ -24,8 +24,8 @@ THRONG_HOST_DEVICE inline ObstacleSense sense_obstacles(const WorldView& w, cons
     best.hit = h;
     best.force = f;
   };
-  for_each_in_3x3(w.segment_grid, pr.origin, [&](std::int32_t k) { consider(probe_segment(pr, w.segments[k].a, w.segments[k].b)); });
-  for_each_in_3x3(w.circle_grid, pr.origin, [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
+  for_each_in_cell(w.segment_grid, pr.origin, [&](std::int32_t k) { consider(probe_segment(pr, w.segments[k].a, w.segments[k].b)); });
+  for_each_in_cell(w.circle_grid, pr.origin, [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
   return best;
 }
 
@@ -37,20 +37,54 @@ struct NeighbourArrays {
   Span<const std::uint8_t> flags;
 };
 
+// Neighbour j as a candidate threat of the agent at p: kept in `best` when
+// it is active, within the query radius and more urgent.
+THRONG_HOST_DEVICE inline void consider_neighbour(Threat& best, Index j, Index self, glm::vec2 p, glm::vec2 v, glm::vec2 forward,
+                                                  float radius, const NeighbourArrays& n, const ModelParams& m, float query2) {
+  const glm::vec2 q = n.position[j];
+  if (length2(q - p) >= query2 || j == self || (n.flags[j] & kAgentActive) == 0) return;
+  // An agent standing at its goal is passed like a post: no personal space,
+  // so arriving agents can still reach goals next to those already there.
+  const float space = (n.flags[j] & kAgentStopped) != 0 ? 0.0f : m.personal_space;
+  const Threat t = predict_threat(p, v, forward, radius + space, q, n.velocity[j], n.radius[j] + space, m.pred_time);
+  if (more_urgent(t, best)) best = t;
+}
+
 // Most urgent threat among active neighbours within the query radius,
-// visited in bin order (deterministic).
+// visited in bin order (deterministic). Of the 3x3 cells, those wholly
+// beyond the query radius or wholly behind the agent are skipped (a threat
+// must be ahead); `slack` widens both tests by how far neighbours may have
+// moved since they were binned (0 when positions are those binned).
 THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self, glm::vec2 p,
                                                   glm::vec2 v, glm::vec2 forward, float radius, const NeighbourArrays& n,
-                                                  const ModelParams& m) {
+                                                  const ModelParams& m, float slack) {
+  Threat best;
+  const float query = m.query_radius();
+  const float query2 = query * query;
+  const float side = bins.cell_size;
+  for (std::int32_t dy = -1; dy <= 1; ++dy)
+    for (std::int32_t dx = -1; dx <= 1; ++dx) {
+      const glm::vec2 lo(static_cast<float>(cx + dx) * side - slack, static_cast<float>(cy + dy) * side - slack);
+      const glm::vec2 hi = lo + glm::vec2(side + 2.0f * slack);
+      const glm::vec2 nearest(fminf(fmaxf(p.x, lo.x), hi.x), fminf(fmaxf(p.y, lo.y), hi.y));
+      if (length2(nearest - p) >= query2) continue;
+      // The corner of the cell furthest along `forward`.
+      const glm::vec2 front(forward.x >= 0.0f ? hi.x : lo.x, forward.y >= 0.0f ? hi.y : lo.y);
+      if (dot2(front - p, forward) <= 0.0f) continue;
+      const Index s = bins.find(cx + dx, cy + dy);
+      if (s < 0) continue;
+      const std::int32_t b = bins.start[s], count = bins.count[s];
+      for (std::int32_t k = 0; k < count; ++k) consider_neighbour(best, bins.items[b + k], self, p, v, forward, radius, n, m, query2);
+    }
+  return best;
+}
+
+// The same over every agent: the O(N^2) reference.
+THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec2 p, glm::vec2 v, glm::vec2 forward, float radius,
+                                                            const NeighbourArrays& n, const ModelParams& m) {
   Threat best;
   const float query2 = m.query_radius() * m.query_radius();
-  for_each_in_3x3(bins, cx, cy, [&](std::int32_t j) {
-    if (j == self || (n.flags[j] & kAgentActive) == 0) return;
-    const glm::vec2 q = n.position[j];
-    if (length2(q - p) >= query2) return;
-    const Threat t = predict_threat(p, v, forward, radius + m.personal_space, q, n.velocity[j], n.radius[j] + m.personal_space, m.pred_time);
-    if (more_urgent(t, best)) best = t;
-  });
+  for (Index j = 0; j < n.position.size(); ++j) consider_neighbour(best, j, self, p, v, forward, radius, n, m, query2);
   return best;
 }
 
@@ -65,10 +99,11 @@ THRONG_HOST_DEVICE inline glm::vec2 tie_direction(Index i, Index j) {
 
 // Contact constraint (the addition to the paper's model): each overlapping
 // pair is pushed apart, this agent taking half of the overlap.
-THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self, glm::vec2 p, float radius,
+// Candidates: the contact bins' cells `cells` (the 3x3 around the agent's).
+THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cells3x3& cells, Index self, glm::vec2 p, float radius,
                                                  Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags) {
   glm::vec2 push(0.0f);
-  for_each_in_3x3(bins, cx, cy, [&](std::int32_t j) {
+  for_each_in_cells(bins, cells, [&](std::int32_t j) {
     if (j == self || (flags[j] & kAgentActive) == 0) return;
     const glm::vec2 d = p - positions[j];
     const float reach = radius + radii[j];
@@ -81,28 +116,28 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, std::int3
   return push;
 }
 
-// Moves a disc out of every wall and circle it overlaps (two passes for
-// corners). `anchor` (the last valid position) breaks ties when the centre
-// lies on a wall.
-THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w, glm::vec2 p, float r, glm::vec2 anchor) {
-  for (int pass = 0; pass < 2; ++pass) {
-    for_each_in_3x3(w.segment_grid, p, [&](std::int32_t k) {
-      const Segment s = w.segments[k];
-      const glm::vec2 q = closest_point_on_segment(p, s.a, s.b);
-      const float d = length_of(p - q);
-      if (d >= r) return;
-      glm::vec2 n = normalize_or(perp_left(s.b - s.a), glm::vec2(1.0f, 0.0f));
-      if (dot2(n, anchor - s.a) < 0.0f) n = -n;
-      const glm::vec2 dir = d > 1e-6f ? (p - q) * (1.0f / d) : n;
-      p = q + dir * r;
-    });
-    for_each_in_3x3(w.circle_grid, p, [&](std::int32_t k) {
-      const Circle c = w.circles[k];
-      const glm::vec2 d = p - c.center;
-      if (length2(d) >= (c.radius + r) * (c.radius + r)) return;
-      p = c.center + normalize_or(d, normalize_or(anchor - c.center, glm::vec2(1.0f, 0.0f))) * (c.radius + r);
-    });
-  }
+// Moves a disc out of every wall and circle of `cell` it overlaps (two
+// passes for corners). `anchor` (the last valid position) breaks ties when
+// the centre lies on a wall.
+THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w, const ObstacleCell& cell, glm::vec2 p, float r,
+                                                             glm::vec2 anchor) {
+  for (int pass = 0; pass < 2; ++pass)
+    for_each_obstacle(
+        w, cell,
+        [&](const Segment& s) {
+          const glm::vec2 q = closest_point_on_segment(p, s.a, s.b);
+          const float d = length_of(p - q);
+          if (d >= r) return;
+          glm::vec2 n = normalize_or(perp_left(s.b - s.a), glm::vec2(1.0f, 0.0f));
+          if (dot2(n, anchor - s.a) < 0.0f) n = -n;
+          const glm::vec2 dir = d > 1e-6f ? (p - q) * (1.0f / d) : n;
+          p = q + dir * r;
+        },
+        [&](const Circle& c) {
+          const glm::vec2 d = p - c.center;
+          if (length2(d) >= (c.radius + r) * (c.radius + r)) return;
+          p = c.center + normalize_or(d, normalize_or(anchor - c.center, glm::vec2(1.0f, 0.0f))) * (c.radius + r);
+        });
   return p;
 }
 

@@ -3,36 +3,35 @@
 #include <algorithm>
 #include <utility>
 
+#include "core/error.h"
 #include "core/timing.h"
 
 namespace throng::sim {
 
 AgentArrays arrays_of(CrowdState& c) {
-  return {c.position.span(),       c.velocity.span(),       c.heading.span(),         c.radius.span(),
-          c.pref_speed.span(),     c.path_start.span(),     c.goal.span(),            c.waypoint_begin.span(),
-          c.waypoint_count.span(), c.waypoint_cursor.span(), c.group.span(),          c.flags.span(),
-          c.arrival_time.span(),   c.waypoints.span(),      c.groups.span()};
+  return {c.position.span(),        c.velocity.span(),       c.heading.span(),        c.radius.span(),
+          c.pref_speed.span(),      c.path_start.span(),     c.goal.span(),           c.waypoint_begin.span(),
+          c.waypoint_count.span(),  c.waypoint_cursor.span(), c.waypoint_goal.span(), c.group.span(),
+          c.flags.span(),           c.arrival_time.span(),   c.waypoints.span(),      c.groups.span()};
 }
 
-Simulation::Simulation(const ScenarioSpec& spec, const ScenarioLimits& limits) : spec_(spec), scheduler_(spec.scheduler) {
+Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& options)
+    : spec_(spec), scheduler_(spec.scheduler), neighbours_(options.neighbours) {
   spec_.model.validate();
-  world_ = World::build(spec_.world, spec_.model.query_radius(), limits, current_memory());
-  crowd_ = upload_crowd(spawn_crowd(spec_, world_, limits), current_memory());
+  world_ = World::build(spec_.world, spec_.model.query_radius(), options.limits, current_memory());
+  crowd_ = upload_crowd(spawn_crowd(spec_, world_, options.limits, options.planner), current_memory());
   bins_ = AgentGrid(spec_.model.query_radius());
-  float max_radius = 0.0f;
-  for (const GroupSpec& g : spec_.groups) max_radius = std::max(max_radius, g.radius);
-  contact_bins_ = AgentGrid(std::min(4.0f * max_radius, spec_.model.query_radius()));
+  for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
+  contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));
   const Memory m = current_memory();
   anchor_ = Buffer<glm::vec2>(crowd_.count, m);
   candidate_ = Buffer<glm::vec2>(crowd_.count, m);
   scratch_ = Buffer<glm::vec2>(crowd_.count, m);
+  sensed_ = Buffer<glm::vec2>::zeros(crowd_.count, m);      // inactive agents are never sensed
+  move_cells_ = Buffer<MoveCells>::zeros(crowd_.count, m);  // nor given move cells
 }
 
-void Simulation::step() {
-  ScopedTimer timer("sim.step");
-  const AgentArrays a = arrays_of(crowd_);
-  bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
-  contact_bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
+StepContext Simulation::context() const {
   StepContext ctx;
   ctx.world = world_.view();
   ctx.bins = bins_.view();
@@ -40,38 +39,63 @@ void Simulation::step() {
   ctx.model = spec_.model;
   ctx.dt = spec_.dt;
   ctx.time_after = static_cast<float>(static_cast<double>(steps_done_ + 1) * spec_.dt);
+  // The move stage accepts at most 0.95 radius per step (simulation_kernels.cpp).
+  ctx.bin_slack = scheduler_ == SchedulerKind::FourColour ? max_radius_ : 0.0f;
+  return ctx;
+}
+
+void Simulation::step() {
+  ScopedTimer timer("sim.step");
+  bin();
+  const StepContext ctx = context();
   copy_positions(crowd_.position.span(), anchor_.span());
+  sense_and_steer(ctx);
+  move(ctx);
+  ++steps_done_;
+}
+
+void Simulation::bin() {
+  bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
+  contact_bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
+}
+
+void Simulation::sense_and_steer(const StepContext& ctx) {
+  const AgentArrays a = arrays_of(crowd_);
+  if (neighbours_ == NeighbourSearch::AllPairs) {
+    if (scheduler_ != SchedulerKind::DoubleBuffer) throw Error("the all-pairs reference runs with the double buffer only", at_field("scheduler"));
+    sense_all_pairs(ctx, a, sensed_.span());
+    steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
+  } else if (scheduler_ == SchedulerKind::DoubleBuffer) {
+    sense_double_buffer(ctx, a, sensed_.span());
+    steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
+  } else {
+    sense_steer_four_colour(ctx, a);
+  }
+}
+
+void Simulation::move(const StepContext& ctx) {
+  const AgentArrays a = arrays_of(crowd_);
   const Span<const glm::vec2> anchor = anchor_.span();
-  if (scheduler_ == SchedulerKind::DoubleBuffer) {
-    steer_double_buffer(ctx, a, candidate_.span());
+  const Span<const MoveCells> cells = move_cells_.span();
+  move_cells(ctx, anchor, move_cells_.span());
+  if (scheduler_ == SchedulerKind::DoubleBuffer) {  // (the all-pairs reference included)
     Span<glm::vec2> in = candidate_.span(), out = scratch_.span();
     for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) {
-      contacts_double_buffer(ctx, a, anchor, in, out);
+      contacts_double_buffer(ctx, a, anchor, cells, in, out);
       std::swap(in, out);
     }
-    finalize_step(ctx, a, anchor, in);
+    finalize_step(ctx, a, anchor, cells, in);
   } else {
-    steer_four_colour(ctx, a);
-    for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) contacts_four_colour(ctx, a, anchor);
-    finalize_step(ctx, a, anchor, a.position);
+    for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) contacts_four_colour(ctx, a, anchor, cells);
+    finalize_step(ctx, a, anchor, cells, a.position);
   }
-  ++steps_done_;
 }
 
 void Simulation::run(std::int64_t steps) {
   for (std::int64_t s = 0; s < steps; ++s) step();
 }
 
-Index Simulation::active_count() const {
-  Index n = 0;
-  for (std::uint8_t f : flags()) n += (f & kAgentActive) != 0;
-  return n;
-}
-
-Index Simulation::arrived_count() const {
-  Index n = 0;
-  for (float t : arrival_times()) n += t >= 0.0f;
-  return n;
-}
+Index Simulation::active_count() const { return count_flag(crowd_.flags.span(), kAgentActive); }
+Index Simulation::arrived_count() const { return count_flag(crowd_.flags.span(), kAgentArrived); }
 
 }  // namespace throng::sim

@@ -1,10 +1,18 @@
-// One crowd simulation: world, crowd state, bins and the per-step stages
-//   bin -> sense + steer -> move (contacts, obstacle projection) -> finalize
+// One crowd simulation: world, crowd state, bins and the per-step stages of
+// the perception layer, in the order of the frame (../shared/DESIGN.md):
+//   1 bin    agents into uniform bins by a counting sort (grid.h)
+//   2 sense  per agent, the higher-priority force: obstacle avoidance from
+//            the probe, else agent avoidance from the 3x3 bins (sense.h)
+//   3 steer  path following when nothing was sensed, then integration
+//   4 move   contact passes and wall projection, accept or reject the move,
+//            velocity, heading, arrivals and waypoints
 // under one of two schedulers:
 //   DoubleBuffer: every agent reads the previous step and writes the next;
 //                 fully parallel, bitwise the same for any thread count.
 //   FourColour:   the paper's batches: bins of one colour (cx & 1, cy & 1) in
-//                 parallel, agents inside a bin in sequence, updated in place.
+//                 parallel, agents inside a bin in sequence, updated in place
+//                 (sense and steer of one agent run back to back). Also the
+//                 same for any thread count: no two cells of a batch touch.
 //
 // The move stage adds to the paper's forces a contact constraint: after
 // integration, `model.contact_iterations` passes push overlapping pairs
@@ -12,6 +20,9 @@
 // position still closer than its radius to a wall is rejected (the agent
 // stays put), so agents never penetrate obstacles. Velocity is the actual
 // displacement / dt, so blocked agents slow down.
+//
+// Later stages of the frame (locomotion, LOD, pose, skin, emit) read the
+// crowd's state after step(): see sim/frame_loop.h.
 #pragma once
 
 #include <cstdint>
@@ -37,6 +48,7 @@ struct AgentArrays {
   Span<const std::int32_t> waypoint_begin;
   Span<const std::int32_t> waypoint_count;
   Span<std::int32_t> waypoint_cursor;
+  Span<const std::int32_t> waypoint_goal;
   Span<const std::int32_t> group;
   Span<std::uint8_t> flags;
   Span<float> arrival_time;
@@ -45,6 +57,14 @@ struct AgentArrays {
 };
 AgentArrays arrays_of(CrowdState& c);
 
+// What the move stage looks up once per agent per step (around its position
+// at the start of the step) and reuses in every contact pass: the contact
+// bins' 3x3 cells and the walls and circles nearby.
+struct MoveCells {
+  Cells3x3 agents;
+  ObstacleCell obstacles;
+};
+
 struct StepContext {
   WorldView world;
   GridView bins;          // side query_radius: steering neighbours
@@ -52,28 +72,54 @@ struct StepContext {
   ModelParams model;
   float dt = 0.1f;
   float time_after = 0.0f;  // simulated time at the end of this step
+  // How far an agent may be from where it was binned when others read it:
+  // 0 for the double buffer, one step's largest move for the four colours.
+  float bin_slack = 0.0f;
 };
 
-// Stages (each one or more parallel_for launches).
-// Double buffer: reads a.position/velocity/heading, writes candidate positions.
-void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> out_position);
-// Double buffer: one contact pass from `in` to `out` (anchor = last valid positions).
-void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> in,
-                            Span<glm::vec2> out);
-// Four colour: steering and then each contact pass, in place on a.position
+// Stages (each one or more parallel_for launches named "sim.<stage>...").
+// Double buffer: the sensed force of every binned (active) agent, then
+// candidate positions.
+void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
+// The naive reference for the sense stage: every agent against every other,
+// O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
+void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
+void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed, Span<glm::vec2> out_position);
+// Both: the move cells around each binned agent's anchor (its position at
+// the start of the step).
+void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells);
+// Double buffer: one contact pass from `in` to `out`.
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                            Span<const glm::vec2> in, Span<glm::vec2> out);
+// Four colour: sense + steer, then each contact pass, in place on a.position
 // and a.velocity, colour by colour.
-void steer_four_colour(const StepContext& ctx, const AgentArrays& a);
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor);
+void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a);
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells);
 // Both: accepts or rejects each moved position, sets velocity, heading,
-// arrivals and waypoints. `moved` may alias nothing in a except by index.
-void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> moved);
+// arrivals and waypoints. `moved` may alias a.position.
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                   Span<const glm::vec2> moved);
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to);
+// Agents whose flags have `bit` set (deterministic reduction).
+Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit);
+
+// How the sense stage finds neighbours: the paper's bins, or every agent
+// (the O(N^2) reference of benchmarks and tests; double buffer only).
+enum class NeighbourSearch : std::uint8_t { Bins, AllPairs };
+
+struct SimulationOptions {
+  ScenarioLimits limits;
+  const RoutePlanner* planner = nullptr;  // path planning for groups with a goal and no waypoints
+  NeighbourSearch neighbours = NeighbourSearch::Bins;
+};
 
 class Simulation {
  public:
-  // Builds the world and spawns the crowd in current_memory().
-  explicit Simulation(const ScenarioSpec& spec, const ScenarioLimits& limits = {});
+  // Builds the world and spawns the crowd in current_memory(). Errors name
+  // the scenario field at fault (io/scenario_yaml maps them to file lines).
+  explicit Simulation(const ScenarioSpec& spec, const SimulationOptions& options = {});
 
+  // One step of dt: bin, sense, steer, move.
   void step();
   void run(std::int64_t steps);
 
@@ -97,18 +143,27 @@ class Simulation {
   std::vector<float> headings() const { return crowd_.heading.to_vector(); }
   std::vector<std::uint8_t> flags() const { return crowd_.flags.to_vector(); }
   std::vector<float> arrival_times() const { return crowd_.arrival_time.to_vector(); }
-  Index active_count() const;
-  Index arrived_count() const;
+  Index active_count() const;   // not despawned
+  Index arrived_count() const;  // reached their goal at least once
+  bool all_arrived() const { return arrived_count() == agent_count(); }
 
  private:
+  void bin();
+  void sense_and_steer(const StepContext& ctx);
+  void move(const StepContext& ctx);
+  StepContext context() const;
+
   ScenarioSpec spec_;
   World world_;
   CrowdState crowd_;
   AgentGrid bins_;
   AgentGrid contact_bins_;
   SchedulerKind scheduler_ = SchedulerKind::DoubleBuffer;
+  NeighbourSearch neighbours_ = NeighbourSearch::Bins;
+  float max_radius_ = 0.0f;
   std::int64_t steps_done_ = 0;
-  Buffer<glm::vec2> anchor_, candidate_, scratch_;
+  Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
+  Buffer<MoveCells> move_cells_;
 };
 
 }  // namespace throng::sim

@@ -1,6 +1,7 @@
 // The per-step stages of the crowd simulation. Compiled by nvcc in CUDA
 // builds: bodies touch only spans and values.
 #include "core/parallel.h"
+#include "core/reduce.h"
 #include "sim/sense.h"
 #include "sim/simulation.h"
 
@@ -12,51 +13,114 @@ constexpr float kWallTolerance = 1e-4f;   // m: accepted float error against wal
 constexpr float kMaxStepFraction = 0.9f;  // of the radius: displacement cap in a contact pass
 constexpr float kAcceptFraction = 0.95f;  // of the radius: largest accepted displacement per step
 
-// Steering + integration of one agent; neighbours from the 3x3 bins around
-// (cx, cy) (the agent's cell when binned).
-THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy,
-                                           glm::vec2& out_p, glm::vec2& out_v) {
+THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) { return (flags & kAgentActive) != 0 && (flags & kAgentStopped) == 0; }
+
+// Sense: the higher-priority force of one agent, obstacle avoidance or else
+// agent avoidance (zero when neither applies). `neighbours(p, v, forward,
+// radius)` finds the most urgent threat: from the 3x3 bins, or all pairs.
+template <class Neighbours>
+THRONG_HOST_DEVICE inline glm::vec2 sense_agent(const StepContext& ctx, const AgentArrays& a, Index i, const Neighbours& neighbours) {
+  if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
+  const ModelParams& m = ctx.model;
   const glm::vec2 p = a.position[i], v = a.velocity[i];
-  const std::uint8_t flags = a.flags[i];
-  if ((flags & kAgentActive) == 0 || (flags & kAgentStopped) != 0) {
+  const float r = a.radius[i];
+  const Probe probe = make_probe(p, v, a.heading[i], r, m);
+  // Priority: agent avoidance is only computed when no obstacle force applies.
+  const glm::vec2 obstacle = sense_obstacles(ctx.world, probe, m.max_force).force;
+  if (length2(obstacle) > 1e-12f) return obstacle;
+  return avoidance_force(probe.forward, neighbours(p, v, probe.forward, r), m.max_force);
+}
+
+// Neighbours from the 3x3 bins around (cx, cy), the agent's cell.
+THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy) {
+  const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+  return sense_agent(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
+    return sense_neighbours(ctx.bins, cx, cy, i, p, v, forward, r, n, ctx.model, ctx.bin_slack);
+  });
+}
+
+// Steer: path following when the sensed force is zero, then integration.
+THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentArrays& a, Index i, glm::vec2 sensed, glm::vec2& out_p,
+                                           glm::vec2& out_v) {
+  const glm::vec2 p = a.position[i], v = a.velocity[i];
+  if (!is_steering(a.flags[i])) {
     out_p = p;
     out_v = glm::vec2(0.0f);
     return;
   }
   const ModelParams& m = ctx.model;
-  const float r = a.radius[i];
-  const Probe probe = make_probe(p, v, a.heading[i], r, m);
-  // Priority: a lower force is only computed when the higher ones are zero.
-  glm::vec2 force = sense_obstacles(ctx.world, probe, m.max_force).force;
-  if (length2(force) <= 1e-12f) {
-    const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-    force = avoidance_force(probe.forward, sense_neighbours(ctx.bins, cx, cy, i, p, v, probe.forward, r, n, m), m.max_force);
-    if (length2(force) <= 1e-12f) force = path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
-  }
-  out_v = clamp_length(v + force * ctx.dt, m.max_speed);
+  // Priority: path following only when no avoidance force was sensed.
+  const glm::vec2 force =
+      length2(sensed) > 1e-12f ? sensed : path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
+  // Forces turn and brake; none makes an agent walk faster than it prefers.
+  out_v = clamp_length(v + force * ctx.dt, a.pref_speed[i]);
   out_p = p + out_v * ctx.dt;
 }
 
 // One contact pass for one agent reading positions P.
-THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy,
+THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i, const MoveCells& cells,
                                                   glm::vec2 anchor, Span<const glm::vec2> P) {
   glm::vec2 p = P[i];
   if ((a.flags[i] & kAgentActive) == 0) return p;
   const float r = a.radius[i];
-  p += clamp_length(contact_push(ctx.contact_bins, cx, cy, i, p, r, P, a.radius, a.flags), 0.5f * r);
+  p += clamp_length(contact_push(ctx.contact_bins, cells.agents, i, p, r, P, a.radius, a.flags), 0.5f * r);
   p = anchor + clamp_length(p - anchor, kMaxStepFraction * r);
-  return project_out_of_obstacles(ctx.world, p, r, anchor);
+  return project_out_of_obstacles(ctx.world, cells.obstacles, p, r, anchor);
 }
 
-struct SteerDoubleBuffer {
+// Agents are visited in bin order (k -> items[k]): neighbours in space are
+// sensed one after another, so their cells and neighbours stay in cache.
+// Inactive agents are not binned and keep a zero sensed force.
+struct Sense {
   StepContext ctx;
   AgentArrays a;
+  Span<glm::vec2> sensed;
+  THRONG_HOST_DEVICE void operator()(Index k) const {
+    const Index i = k;
+    if ((a.flags[i] & kAgentActive) == 0) return;
+    const glm::vec2 p = a.position[i];
+    sensed[i] = sense_binned(ctx, a, i, cell_coord(p.x, ctx.bins.cell_size), cell_coord(p.y, ctx.bins.cell_size));
+  }
+};
+
+// The naive reference: the same sense stage with every other agent as a
+// candidate (O(N^2)), for benchmarks and for checking the bins.
+struct SenseAllPairs {
+  StepContext ctx;
+  AgentArrays a;
+  Span<glm::vec2> sensed;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+    const ModelParams m = ctx.model;
+    sensed[i] = sense_agent(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
+      return sense_neighbours_all_pairs(i, p, v, forward, r, n, m);
+    });
+  }
+};
+
+struct Steer {
+  StepContext ctx;
+  AgentArrays a;
+  Span<const glm::vec2> sensed;
   Span<glm::vec2> out_p;
   THRONG_HOST_DEVICE void operator()(Index i) const {
-    const glm::vec2 p = a.position[i];
     glm::vec2 np, nv;
-    steer_agent(ctx, a, i, cell_coord(p.x, ctx.bins.cell_size), cell_coord(p.y, ctx.bins.cell_size), np, nv);
+    steer_agent(ctx, a, i, sensed[i], np, nv);
     out_p[i] = np;
+  }
+};
+
+// The move cells of every agent (around its position at the start of the
+// step), found once and used by every contact pass and the final check.
+struct FindMoveCells {
+  StepContext ctx;
+  Span<const glm::vec2> anchor;
+  Span<MoveCells> cells;
+  THRONG_HOST_DEVICE void operator()(Index k) const {  // in contact-bin order, like Sense
+    const Index i = k;
+    const glm::vec2 b = anchor[i];
+    const float side = ctx.contact_bins.cell_size;
+    cells[i] = {cells_3x3(ctx.contact_bins, cell_coord(b.x, side), cell_coord(b.y, side)), obstacle_cell(ctx.world, b)};
   }
 };
 
@@ -64,16 +128,15 @@ struct ContactsDoubleBuffer {
   StepContext ctx;
   AgentArrays a;
   Span<const glm::vec2> anchor, in;
+  Span<const MoveCells> cells;
   Span<glm::vec2> out;
-  THRONG_HOST_DEVICE void operator()(Index i) const {
-    const glm::vec2 b = anchor[i];
-    out[i] = contact_agent(ctx, a, i, cell_coord(b.x, ctx.contact_bins.cell_size), cell_coord(b.y, ctx.contact_bins.cell_size), b, in);
-  }
+  THRONG_HOST_DEVICE void operator()(Index i) const { out[i] = contact_agent(ctx, a, i, cells[i], anchor[i], in); }
 };
 
 // Four colour: one launch per colour over the table slots; a slot of that
-// colour updates its agents one after another, in place.
-struct SteerColour {
+// colour updates its agents one after another, in place. Cells of one colour
+// are two apart in x or y, so no cell of the launch reads another's agents.
+struct SenseSteerColour {
   StepContext ctx;
   AgentArrays a;
   int colour;
@@ -85,7 +148,7 @@ struct SteerColour {
     for (std::int32_t k = 0; k < n; ++k) {
       const Index i = ctx.bins.items[b + k];
       glm::vec2 np, nv;
-      steer_agent(ctx, a, i, cx, cy, np, nv);
+      steer_agent(ctx, a, i, sense_binned(ctx, a, i, cx, cy), np, nv);
       a.position[i] = np;
       a.velocity[i] = nv;
     }
@@ -96,15 +159,15 @@ struct ContactsColour {
   StepContext ctx;
   AgentArrays a;
   Span<const glm::vec2> anchor;
+  Span<const MoveCells> cells;
   int colour;
   THRONG_HOST_DEVICE void operator()(Index s) const {
     const std::uint64_t key = ctx.contact_bins.keys[s];
     if (key == kEmptyCell || cell_colour(key) != colour) return;
-    const std::int32_t cx = key_cx(key), cy = key_cy(key);
     const std::int32_t b = ctx.contact_bins.start[s], n = ctx.contact_bins.count[s];
     for (std::int32_t k = 0; k < n; ++k) {
       const Index i = ctx.contact_bins.items[b + k];
-      a.position[i] = contact_agent(ctx, a, i, cx, cy, anchor[i], a.position);
+      a.position[i] = contact_agent(ctx, a, i, cells[i], anchor[i], a.position);
     }
   }
 };
@@ -112,7 +175,9 @@ struct ContactsColour {
 struct Finalize {
   StepContext ctx;
   AgentArrays a;
-  Span<const glm::vec2> anchor, moved;
+  Span<const glm::vec2> anchor;
+  Span<const MoveCells> cells;
+  Span<const glm::vec2> moved;
   THRONG_HOST_DEVICE void operator()(Index i) const {
     std::uint8_t flags = a.flags[i];
     if ((flags & kAgentActive) == 0) return;
@@ -122,7 +187,7 @@ struct Finalize {
     // Accept the move only if it keeps the disc off every wall and is short
     // enough that it cannot have crossed one (see the header).
     const bool short_enough = length2(p - from) <= (kAcceptFraction * r) * (kAcceptFraction * r);
-    if (!(short_enough && wall_clearance(ctx.world, p, r) >= r - kWallTolerance)) p = from;
+    if (!(short_enough && wall_clearance(ctx.world, cells[i].obstacles, p, r) >= r - kWallTolerance)) p = from;
     glm::vec2 v = clamp_length((p - from) * (1.0f / ctx.dt), ctx.model.max_speed);
     if ((flags & kAgentStopped) != 0) v = glm::vec2(0.0f);
     a.position[i] = p;
@@ -133,7 +198,7 @@ struct Finalize {
       if (length2(goal - p) <= g.arrival_radius * g.arrival_radius) {
         const std::int32_t cursor = a.waypoint_cursor[i];
         const std::int32_t begin = a.waypoint_begin[i], count = a.waypoint_count[i];
-        if (cursor == g.final_waypoint && a.arrival_time[i] < 0.0f) {
+        if (cursor == a.waypoint_goal[i] && a.arrival_time[i] < 0.0f) {
           a.arrival_time[i] = ctx.time_after;
           flags |= kAgentArrived;
         }
@@ -159,33 +224,54 @@ struct Finalize {
   }
 };
 
+constexpr Index kAgentGrain = 256;
 constexpr Index kSlotGrain = 256;
 
 }  // namespace
 
-void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> out_position) {
-  parallel_for("sim.steer", a.position.size(), SteerDoubleBuffer{ctx, a, out_position}, 256);
+void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
+  parallel_for("sim.sense", a.position.size(), Sense{ctx, a, sensed}, kAgentGrain);
 }
 
-void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> in,
-                            Span<glm::vec2> out) {
-  parallel_for("sim.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, out}, 256);
+void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
+  parallel_for("sim.sense.all_pairs", a.position.size(), SenseAllPairs{ctx, a, sensed}, 16);
 }
 
-void steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
-  for (int c = 0; c < 4; ++c) parallel_for("sim.steer_colour", ctx.bins.capacity(), SteerColour{ctx, a, c}, kSlotGrain);
+void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed, Span<glm::vec2> out_position) {
+  parallel_for("sim.steer", a.position.size(), Steer{ctx, a, sensed, out_position}, kAgentGrain);
 }
 
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor) {
-  for (int c = 0; c < 4; ++c) parallel_for("sim.contacts_colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, c}, kSlotGrain);
+void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells) {
+  parallel_for("sim.move.cells", anchor.size(), FindMoveCells{ctx, anchor, cells}, kAgentGrain);
 }
 
-void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const glm::vec2> moved) {
-  parallel_for("sim.finalize", a.position.size(), Finalize{ctx, a, anchor, moved});
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                            Span<const glm::vec2> in, Span<glm::vec2> out) {
+  parallel_for("sim.move.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, cells, out}, kAgentGrain);
+}
+
+void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
+  for (int c = 0; c < 4; ++c) parallel_for("sim.sense_steer.colour", ctx.bins.capacity(), SenseSteerColour{ctx, a, c}, kSlotGrain);
+}
+
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells) {
+  for (int c = 0; c < 4; ++c)
+    parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, cells, c}, kSlotGrain);
+}
+
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                   Span<const glm::vec2> moved) {
+  parallel_for("sim.move.finalize", a.position.size(), Finalize{ctx, a, anchor, cells, moved});
 }
 
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to) {
-  parallel_for("sim.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
+  parallel_for("sim.move.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
+}
+
+Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit) {
+  return parallel_reduce(
+      "sim.count", flags.size(), Index{0}, THRONG_LAMBDA(Index i)->Index { return (flags[i] & bit) != 0 ? 1 : 0; },
+      THRONG_LAMBDA(Index x, Index y)->Index { return x + y; });
 }
 
 }  // namespace throng::sim

@@ -29,9 +29,10 @@ struct Probe {
   glm::vec2 forward{1.0f, 0.0f};
   float length = 0.0f;
   float half_width = 0.0f;
+  float radius = 0.0f;  // the agent's; half_width - radius is the margin band on each side
 };
 THRONG_HOST_DEVICE inline Probe make_probe(glm::vec2 p, glm::vec2 v, float heading, float radius, const ModelParams& m) {
-  return {p, forward_of(v, heading), radius + m.pred_time * length_of(v), radius + m.probe_margin};
+  return {p, forward_of(v, heading), radius + m.pred_time * length_of(v), radius + m.probe_margin, radius};
 }
 
 // The nearest point of an obstacle inside the probe: `distance` along the
@@ -134,6 +135,10 @@ THRONG_HOST_DEVICE inline ProbeHit probe_circle(const Probe& pr, glm::vec2 c, fl
 // forward; surfaces it moves along or away from are no threat). Direction:
 // repulsion (from the hit point to the agent) plus a lateral pull along the
 // surface (towards the side the normal leans to; to the right when head-on).
+// A hit only in the margin band (at least a radius to the side: the agent's
+// disc would pass it) gives a sideways nudge away from it instead, so an
+// agent sliding along a wall past a corner keeps going rather than turning
+// back and forth at the corner.
 THRONG_HOST_DEVICE inline glm::vec2 obstacle_force(const Probe& pr, const ProbeHit& h, float max_force) {
   if (!h.hit || pr.length <= 0.0f) return glm::vec2(0.0f);
   const float approach = -dot2(h.normal, pr.forward);
@@ -142,6 +147,8 @@ THRONG_HOST_DEVICE inline glm::vec2 obstacle_force(const Probe& pr, const ProbeH
   const float strength = max_force * (1.0f - d / pr.length) * approach;
   if (strength <= 0.0f) return glm::vec2(0.0f);
   const glm::vec2 l = perp_left(pr.forward);
+  const float lateral = dot2(h.point - pr.origin, l);
+  if (h.distance > 0.0f && fabsf(lateral) >= pr.radius - 1e-3f) return (lateral > 0.0f ? -l : l) * strength;
   const glm::vec2 repulsion = normalize_or(pr.origin - h.point, h.normal);
   const float lean = dot2(h.normal, l);
   const glm::vec2 pull = fabsf(lean) < 1e-3f ? -l : (lean > 0.0f ? l : -l);
@@ -207,7 +214,8 @@ THRONG_HOST_DEVICE inline glm::vec2 avoidance_force(glm::vec2 forward, const Thr
 // pred_time ahead, projects it onto the leg and, when it lies outside the
 // lane, seeks the projection moved one look-ahead further along the leg;
 // inside the lane it walks along the leg. Within one look-ahead of the goal
-// it seeks the goal, slowing over the last pref_speed * relaxation_time metres.
+// (or once past the end of the leg) it seeks the goal, slowing over the
+// last pref_speed * relaxation_time metres.
 // Force = (desired velocity - velocity) / relaxation_time, at most max_force.
 THRONG_HOST_DEVICE inline glm::vec2 path_following_force(glm::vec2 p, glm::vec2 v, float pref_speed, glm::vec2 start, glm::vec2 goal,
                                                          const ModelParams& m) {
@@ -215,7 +223,10 @@ THRONG_HOST_DEVICE inline glm::vec2 path_following_force(glm::vec2 p, glm::vec2 
   const float dist = length_of(to_goal);
   const float lookahead = fmaxf(pref_speed * m.pred_time, m.lane_half_width);
   glm::vec2 desired;
-  if (dist <= lookahead) {
+  // Near the goal, or past the end of the leg (it missed the arrival disc
+  // while avoiding someone): seek the goal itself.
+  const bool past_end = dot2(p - goal, goal - start) > 0.0f;
+  if (dist <= lookahead || past_end) {
     const float slow = pref_speed * m.relaxation_time;
     const float speed = slow > 0.0f && dist < slow ? pref_speed * dist / slow : pref_speed;
     desired = normalize_or(to_goal, glm::vec2(0.0f)) * speed;

@@ -218,9 +218,10 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
 
   // Count registrations before allocating them.
   double total = 0;
+  // (Halo registrations: 9 per cell before duplicates are merged.)
   for (const Segment& s : segments_)
-    total += 2.0 * (std::fabs(s.b.x - s.a.x) + std::fabs(s.b.y - s.a.y)) / cell + 4.0;
-  for (const Circle& c : circles_) total += cells_in_box(sim::bounds(c), cell);
+    total += 9.0 * (2.0 * (std::fabs(s.b.x - s.a.x) + std::fabs(s.b.y - s.a.y)) / cell + 4.0);
+  for (const Circle& c : circles_) total += 9.0 * cells_in_box(sim::bounds(c), cell);
   for (const Polygon& p : polygons_) total += cells_in_box(sim::bounds(p), cell);
   if (total > static_cast<double>(limits.max_grid_items))
     throw Error(fmt::format("obstacles would need about {:.0f} grid cells at cell size {} m (limit {}): use fewer or smaller obstacles "
@@ -229,12 +230,18 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
                 at_field("world.obstacles"));
 
   std::vector<std::pair<std::uint64_t, std::int32_t>> pairs;
-  for (std::size_t k = 0; k < segments_.size(); ++k)
-    cells_of_segment(segments_[k], cell, [&](std::int32_t x, std::int32_t y) { pairs.push_back({cell_key(x, y), static_cast<std::int32_t>(k)}); });
+  // Walls and circles go into every cell they touch and the ring of cells
+  // around those (the halo), so one lookup finds all within one cell side.
+  auto with_halo = [&](std::int32_t k) {
+    return [&pairs, k](std::int32_t x, std::int32_t y) {
+      for (std::int32_t dy = -1; dy <= 1; ++dy)
+        for (std::int32_t dx = -1; dx <= 1; ++dx) pairs.push_back({cell_key(x + dx, y + dy), k});
+    };
+  };
+  for (std::size_t k = 0; k < segments_.size(); ++k) cells_of_segment(segments_[k], cell, with_halo(static_cast<std::int32_t>(k)));
   segment_grid_ = StaticGrid(cell, std::move(pairs), memory);
   pairs.clear();
-  for (std::size_t k = 0; k < circles_.size(); ++k)
-    cells_of_circle(circles_[k], cell, [&](std::int32_t x, std::int32_t y) { pairs.push_back({cell_key(x, y), static_cast<std::int32_t>(k)}); });
+  for (std::size_t k = 0; k < circles_.size(); ++k) cells_of_circle(circles_[k], cell, with_halo(static_cast<std::int32_t>(k)));
   circle_grid_ = StaticGrid(cell, std::move(pairs), memory);
   pairs.clear();
   for (std::size_t k = 0; k < polygons_.size(); ++k) {
@@ -301,7 +308,9 @@ bool World::disc_fits(glm::vec2 p, float r) const { return disc_is_clear(host_vi
 Reachability::Reachability(const World& world, Aabb extent, std::int32_t resolution) : extent_(extent) {
   if (extent.empty()) return;
   const glm::vec2 size = extent.size();
-  h_ = std::max({size.x / static_cast<float>(resolution), size.y / static_cast<float>(resolution), 0.05f});
+  // Cells of at least 0.1 m: a gap an agent fits through (0.5 m for the
+  // usual radius) still has several free cells across.
+  h_ = std::max({size.x / static_cast<float>(resolution), size.y / static_cast<float>(resolution), 0.1f});
   nx_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(size.x / h_)));
   ny_ = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(size.y / h_)));
   labels_.assign(static_cast<std::size_t>(nx_ * ny_), -1);

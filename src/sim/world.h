@@ -5,10 +5,12 @@
 // Obstacles are polygons (with holes) and circles. Walls are the edges of
 // every obstacle polygon and of the walkable boundary; holes of the walkable
 // region become obstacle polygons. Three sparse grids of side cell_size:
-//   segments: every cell an edge passes through (probe, projection);
-//   circles:  every cell a disc overlaps;
+//   segments: every cell an edge passes through, plus the ring of cells
+//             around those (probe, projection, clearance);
+//   circles:  every cell a disc overlaps, plus that ring;
 //   polygons: every cell of a polygon's bounding box (point containment).
-// An agent's 3x3 cells reach every wall within one cell side of it.
+// Because of the ring ("halo"), the one cell containing a point lists every
+// wall and circle within one cell side of it: one lookup instead of nine.
 #pragma once
 
 #include <cstdint>
@@ -80,21 +82,38 @@ THRONG_HOST_DEVICE inline bool in_free_space(const WorldView& w, glm::vec2 p) {
   return polygon_containing(w, p) < 0 && circle_containing(w, p) < 0;
 }
 
-// Distance from p to the nearest wall or circle boundary within the 3x3 cells
-// (beyond that: `far`).
-THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, glm::vec2 p, float far) {
+// The walls and circles listed in the halo cell of a point: every one within
+// a cell side of it. The move stage keeps this per agent for a step (an
+// agent moves less than its radius in a step, far less than a cell side).
+struct ObstacleCell {
+  std::int32_t wall_start = 0, wall_count = 0;
+  std::int32_t circle_start = 0, circle_count = 0;
+};
+THRONG_HOST_DEVICE inline ObstacleCell obstacle_cell(const WorldView& w, glm::vec2 p) {
+  ObstacleCell c;
+  const Index ws = w.segment_grid.find(cell_coord(p.x, w.segment_grid.cell_size), cell_coord(p.y, w.segment_grid.cell_size));
+  if (ws >= 0) c.wall_start = w.segment_grid.start[ws], c.wall_count = w.segment_grid.count[ws];
+  const Index cs = w.circle_grid.find(cell_coord(p.x, w.circle_grid.cell_size), cell_coord(p.y, w.circle_grid.cell_size));
+  if (cs >= 0) c.circle_start = w.circle_grid.start[cs], c.circle_count = w.circle_grid.count[cs];
+  return c;
+}
+template <class WallFn, class CircleFn>
+THRONG_HOST_DEVICE inline void for_each_obstacle(const WorldView& w, const ObstacleCell& c, WallFn&& wall, CircleFn&& circle) {
+  for (std::int32_t m = 0; m < c.wall_count; ++m) wall(w.segments[w.segment_grid.items[c.wall_start + m]]);
+  for (std::int32_t m = 0; m < c.circle_count; ++m) circle(w.circles[w.circle_grid.items[c.circle_start + m]]);
+}
+
+// Distance from p to the nearest wall or circle boundary of `cell` (beyond
+// them: `far`).
+THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, const ObstacleCell& cell, glm::vec2 p, float far) {
   float best = far;
-  for_each_in_3x3(w.segment_grid, p, [&](std::int32_t k) {
-    const float d = distance_to_segment(p, w.segments[k].a, w.segments[k].b);
-    if (d < best) best = d;
-  });
-  for_each_in_3x3(w.circle_grid, p, [&](std::int32_t k) {
-    const Circle c = w.circles[k];
-    const float d = fabsf(length_of(p - c.center) - c.radius);
-    if (d < best) best = d;
-  });
+  for_each_obstacle(
+      w, cell, [&](const Segment& s) { best = fminf(best, distance_to_segment(p, s.a, s.b)); },
+      [&](const Circle& c) { best = fminf(best, fabsf(length_of(p - c.center) - c.radius)); });
   return best;
 }
+// The same for the walls within one cell side of p.
+THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, glm::vec2 p, float far) { return wall_clearance(w, obstacle_cell(w, p), p, far); }
 
 // A disc of radius r at p penetrates no obstacle by more than `tolerance`:
 // walls and circle boundaries at least r - tolerance away, centre in free space.

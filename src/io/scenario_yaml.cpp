@@ -1,0 +1,655 @@
+#include "io/scenario_yaml.h"
+
+#include <fmt/format.h>
+#include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+
+#include "core/ground.h"
+
+namespace throng::io {
+
+namespace detail {
+struct EmbeddedFile {
+  const char* name;  // file name without .yaml
+  const char* text;
+  std::size_t size;
+};
+// Generated at build time from examples/*.yaml (cmake/ThrongEmbed.cmake).
+extern const EmbeddedFile kBuiltinScenarios[];
+extern const std::size_t kBuiltinScenarioCount;
+}  // namespace detail
+
+namespace {
+
+using sim::GoalSpec;
+using sim::Region;
+
+constexpr double kDegrees = 0.017453292519943295;
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string shown(std::string_view s) {
+  constexpr std::size_t kShown = 40;
+  std::string out;
+  // Printable ASCII only: messages stay one readable line whatever the file holds.
+  for (char c : s.substr(0, kShown)) out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) ? '?' : c;
+  return "'" + out + (s.size() > kShown ? "...'" : "'");
+}
+
+std::string child(const std::string& path, std::string_view key) { return path.empty() ? std::string(key) : path + "." + std::string(key); }
+std::string item(const std::string& path, std::size_t i) { return fmt::format("{}[{}]", path, i); }
+
+class Reader {
+ public:
+  Reader(const std::string& file, const ScenarioReadLimits& limits, ScenarioSource& source) : file_(file), limits_(limits), source_(source) {}
+
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& path, const std::string& message) const {
+    const YAML::Mark m = n.Mark();
+    throw Error(message, Location{file_, m.is_null() ? 0 : m.line + 1, m.is_null() ? 0 : m.column + 1, path});
+  }
+  [[noreturn]] void fail_at(const YAML::Mark& m, const std::string& path, const std::string& message) const {
+    throw Error(message, Location{file_, m.line + 1, m.column + 1, path});
+  }
+
+  // Every node read passes here: counted against the budget (aliases make a
+  // small file look big) and its position recorded for later errors.
+  void visit(const YAML::Node& n, const std::string& path) {
+    if (++nodes_ > limits_.max_nodes) fail(n, path, fmt::format("the file has more than {} YAML values", limits_.max_nodes));
+    const YAML::Mark m = n.Mark();
+    if (!m.is_null()) source_.marks.emplace(path, std::make_pair(m.line + 1, m.column + 1));
+  }
+
+  static std::string kind(const YAML::Node& n) {
+    if (n.IsMap()) return "a map";
+    if (n.IsSequence()) return "a list";
+    if (n.IsNull()) return "nothing";
+    return "the value " + shown(n.Scalar());
+  }
+
+  // The keys of map n, each in `allowed` and none twice; an unknown key is
+  // an error at the key, with the nearest allowed key as a hint.
+  std::vector<std::string> keys_of(const YAML::Node& n, const std::string& path, const std::vector<std::string_view>& allowed) const {
+    std::vector<std::string> keys;
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const YAML::Node key = it->first;
+      if (!key.IsScalar()) fail(key, path, "keys must be plain words, got " + kind(key));
+      const std::string& k = key.Scalar();
+      const std::string where = child(path, k);
+      if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
+        std::string hint;
+        std::size_t best = 3;
+        for (std::string_view a : allowed)
+          if (const std::size_t d = edit_distance(k, a); d < best) {
+            best = d;
+            hint = fmt::format(" (did you mean '{}'?)", a);
+          }
+        fail_at(key.Mark(), where, fmt::format("unknown key {}{}; expected one of {}", shown(k), hint, join(allowed)));
+      }
+      if (std::find(keys.begin(), keys.end(), k) != keys.end()) fail_at(key.Mark(), where, fmt::format("duplicate key {}", shown(k)));
+      keys.push_back(k);
+    }
+    return keys;
+  }
+
+  // A map whose keys are all in `allowed`.
+  void expect_map(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> allowed) {
+    visit(n, path);
+    if (!n.IsMap()) fail(n, path, "expected a map with keys " + join(allowed) + ", got " + kind(n));
+    keys_of(n, path, std::vector<std::string_view>(allowed));
+  }
+
+  // A map with exactly one of the keys `kinds` (and optionally some of `extra`); returns that key.
+  std::string one_of(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> kinds,
+                     std::initializer_list<std::string_view> extra = {}) {
+    visit(n, path);
+    if (!n.IsMap()) fail(n, path, "expected a map with one of the keys " + join(kinds) + ", got " + kind(n));
+    std::vector<std::string_view> allowed(kinds);
+    allowed.insert(allowed.end(), extra.begin(), extra.end());
+    std::string found;
+    for (const std::string& k : keys_of(n, path, allowed)) {
+      if (std::find(kinds.begin(), kinds.end(), k) == kinds.end()) continue;
+      if (!found.empty()) fail(n, child(path, k), fmt::format("give only one of {} (found '{}' and '{}')", join(kinds), found, k));
+      found = k;
+    }
+    if (found.empty()) fail(n, path, "needs one of the keys " + join(kinds));
+    return found;
+  }
+
+  template <class Words>
+  static std::string join(const Words& words) {
+    std::string s;
+    for (std::string_view w : words) s += (s.empty() ? "" : ", ") + std::string(w);
+    return s;
+  }
+
+  const YAML::Node required(const YAML::Node& map, const std::string& path, const char* key) {
+    const YAML::Node n = map[key];
+    if (!n) fail(map, path, fmt::format("missing required key '{}'", key));
+    return n;
+  }
+
+  // Why n is not a finite number, or "" when it is (then *out holds it).
+  static std::string number_problem(const YAML::Node& n, double* out) {
+    if (!n.IsScalar()) return "expected a number, got " + kind(n);
+    if (n.Tag() == "!") return "expected a number, got the quoted string " + shown(n.Scalar());
+    std::string_view text = n.Scalar();
+    std::string_view bare = text;
+    if (!bare.empty() && (bare[0] == '+' || bare[0] == '-')) bare.remove_prefix(1);
+    for (std::string_view special : {".inf", ".Inf", ".INF", ".nan", ".NaN", ".NAN"})
+      if (bare == special) return "the number must be finite, got " + shown(text);
+    if (!text.empty() && text[0] == '+') text.remove_prefix(1);
+    double v = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return "expected a number, got " + shown(n.Scalar());
+    if (!std::isfinite(v) || std::fabs(v) > 3.0e38) return "the number must be finite, got " + shown(n.Scalar());
+    *out = v;
+    return {};
+  }
+
+  double number(const YAML::Node& n, const std::string& path) {
+    visit(n, path);
+    double v = 0;
+    if (const std::string problem = number_problem(n, &v); !problem.empty()) fail(n, path, problem);
+    return v;
+  }
+  float real(const YAML::Node& n, const std::string& path) { return static_cast<float>(number(n, path)); }
+  float real_in(const YAML::Node& n, const std::string& path, double lo, double hi) {
+    const double v = number(n, path);
+    if (v < lo || v > hi) fail(n, path, fmt::format("must be in [{}, {}], got {}", lo, hi, v));
+    return static_cast<float>(v);
+  }
+
+  std::int64_t integer(const YAML::Node& n, const std::string& path, std::int64_t lo, std::int64_t hi) {
+    const double v = number(n, path);
+    // Integers written as 1e6 are fine; 2.5 is not.
+    if (v != std::floor(v) || std::fabs(v) > 9.0e15) fail(n, path, "expected a whole number, got " + shown(n.Scalar()));
+    const auto i = static_cast<std::int64_t>(v);
+    if (i < lo || i > hi) fail(n, path, fmt::format("must be in [{}, {}], got {}", lo, hi, i));
+    return i;
+  }
+
+  bool boolean(const YAML::Node& n, const std::string& path) {
+    visit(n, path);
+    if (n.IsScalar() && n.Tag() != "!") {
+      const std::string& s = n.Scalar();
+      if (s == "true" || s == "True" || s == "TRUE") return true;
+      if (s == "false" || s == "False" || s == "FALSE") return false;
+    }
+    fail(n, path, "expected true or false, got " + kind(n));
+  }
+
+  std::string text(const YAML::Node& n, const std::string& path) {
+    visit(n, path);
+    if (!n.IsScalar()) fail(n, path, "expected a string, got " + kind(n));
+    if (n.Scalar().size() > 4096) fail(n, path, "the string is longer than 4096 characters");
+    return n.Scalar();
+  }
+
+  std::string word(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> choices) {
+    const std::string s = text(n, path);
+    if (std::find(choices.begin(), choices.end(), s) == choices.end())
+      fail(n, path, fmt::format("expected one of {}, got {}", join(choices), shown(s)));
+    return s;
+  }
+
+  void expect_list(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size, const char* what) {
+    visit(n, path);
+    if (!n.IsSequence()) fail(n, path, fmt::format("expected a list of {}, got {}", what, kind(n)));
+    if (n.size() < min_size)
+      fail(n, path, min_size == 1 ? fmt::format("must not be empty: give at least one of the {}", what)
+                                  : fmt::format("needs at least {} {}, got {}", min_size, what, n.size()));
+    if (n.size() > max_size) fail(n, path, fmt::format("has more than {} {}", max_size, what));
+  }
+
+  glm::vec2 point(const YAML::Node& n, const std::string& path) {
+    visit(n, path);
+    return coordinates(n, [&] { return path; });
+  }
+
+  // [x, y] within the extent limit. Vertices of rings come here directly:
+  // counted against the node budget but not recorded, and their key path is
+  // only spelled out for an error (a polygon may have a million of them).
+  template <class PathFn>
+  glm::vec2 coordinates(const YAML::Node& n, const PathFn& path) {
+    if (!n.IsSequence() || n.size() != 2) fail(n, path(), "expected a point [x, y], got " + kind(n));
+    nodes_ += 2;
+    if (nodes_ > limits_.max_nodes) fail(n, path(), fmt::format("the file has more than {} YAML values", limits_.max_nodes));
+    double xy[2];
+    for (int k = 0; k < 2; ++k) {
+      const YAML::Node c = n[k];
+      if (const std::string problem = number_problem(c, &xy[k]); !problem.empty()) fail(c, item(path(), static_cast<std::size_t>(k)), problem);
+    }
+    const double max_extent = limits_.scenario.max_extent;
+    if (std::fabs(xy[0]) > max_extent || std::fabs(xy[1]) > max_extent)
+      fail(n, path(), fmt::format("coordinates must be within +-{} m", max_extent));
+    return {static_cast<float>(xy[0]), static_cast<float>(xy[1])};
+  }
+
+  glm::vec3 point3(const YAML::Node& n, const std::string& path) {
+    visit(n, path);
+    if (!n.IsSequence() || n.size() != 3) fail(n, path, "expected a point [x, y, z], got " + kind(n));
+    return {real(n[0], item(path, 0)), real(n[1], item(path, 1)), real(n[2], item(path, 2))};
+  }
+
+  sim::Ring ring(const YAML::Node& n, const std::string& path) {
+    expect_list(n, path, 3, static_cast<std::size_t>(limits_.scenario.max_vertices), "points [x, y]");
+    vertices_ += static_cast<std::int64_t>(n.size());
+    if (vertices_ > limits_.scenario.max_vertices)
+      fail(n, path, fmt::format("the scenario has more than {} polygon vertices", limits_.scenario.max_vertices));
+    sim::Ring r;
+    r.reserve(n.size());
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      ++nodes_;
+      r.push_back(coordinates(n[i], [&] { return item(path, i); }));
+    }
+    return r;
+  }
+
+  std::vector<sim::Ring> holes(const YAML::Node& n, const std::string& path) {
+    expect_list(n, path, 0, static_cast<std::size_t>(limits_.scenario.max_obstacles), "holes");
+    std::vector<sim::Ring> out;
+    for (std::size_t i = 0; i < n.size(); ++i) out.push_back(ring(n[i], item(path, i)));
+    return out;
+  }
+
+  sim::Polygon rect_polygon(const YAML::Node& n, const std::string& path) {
+    expect_map(n, path, {"min", "max"});
+    const glm::vec2 lo = point(required(n, path, "min"), child(path, "min"));
+    const glm::vec2 hi = point(required(n, path, "max"), child(path, "max"));
+    if (!(hi.x > lo.x && hi.y > lo.y)) fail(n, path, "a rect needs max > min in x and in y");
+    return {sim::rect_ring(lo, hi), {}};
+  }
+
+  // {polygon: [...], holes: [...]} or {rect: {min, max}}.
+  sim::Polygon area(const YAML::Node& n, const std::string& path) {
+    const std::string k = one_of(n, path, {"polygon", "rect"}, {"holes"});
+    sim::Polygon p = k == "rect" ? rect_polygon(n["rect"], child(path, "rect")) : sim::Polygon{ring(n["polygon"], child(path, "polygon")), {}};
+    if (n["holes"]) p.holes = holes(n["holes"], child(path, "holes"));
+    return p;
+  }
+
+  sim::Circle circle(const YAML::Node& n, const std::string& path) {
+    expect_map(n, path, {"center", "radius"});
+    sim::Circle c;
+    c.center = point(required(n, path, "center"), child(path, "center"));
+    c.radius = real(required(n, path, "radius"), child(path, "radius"));
+    return c;
+  }
+
+  Region region(const YAML::Node& n, const std::string& path) {
+    const std::string k = one_of(n, path, {"rect", "disc", "ring", "polygon"});
+    const std::string sub = child(path, k);
+    const YAML::Node v = n[k];
+    Region r;
+    if (k == "rect") {
+      r.kind = Region::Kind::rect;
+      const sim::Polygon p = rect_polygon(v, sub);
+      r.min = p.outer[0];
+      r.max = p.outer[2];
+    } else if (k == "disc") {
+      r.kind = Region::Kind::disc;
+      expect_map(v, sub, {"center", "radius"});
+      r.center = point(required(v, sub, "center"), child(sub, "center"));
+      r.radius = real(required(v, sub, "radius"), child(sub, "radius"));
+    } else if (k == "ring") {
+      r.kind = Region::Kind::ring;
+      expect_map(v, sub, {"center", "radius", "spacing"});
+      r.center = v["center"] ? point(v["center"], child(sub, "center")) : glm::vec2(0.0f);
+      if (v["radius"].IsDefined() == v["spacing"].IsDefined()) fail(v, sub, "a ring needs one of 'radius' or 'spacing'");
+      if (v["radius"]) r.radius = real(v["radius"], child(sub, "radius"));
+      if (v["spacing"]) r.spacing = real(v["spacing"], child(sub, "spacing"));
+    } else {
+      r.kind = Region::Kind::polygon;
+      r.polygon.outer = ring(v, sub);
+    }
+    return r;
+  }
+
+  GoalSpec goal(const YAML::Node& n, const std::string& path) {
+    GoalSpec g;
+    if (n.IsSequence()) {  // a bare [x, y] is a point
+      g.value = point(n, path);
+      return g;
+    }
+    const std::string k = one_of(n, path, {"point", "offset", "mirror", "random"});
+    const std::string sub = child(path, k);
+    if (k == "random") {
+      g.kind = GoalSpec::Kind::Random;
+      g.region = region(n[k], sub);
+      return g;
+    }
+    g.kind = k == "point" ? GoalSpec::Kind::Point : (k == "offset" ? GoalSpec::Kind::Offset : GoalSpec::Kind::Mirror);
+    g.value = point(n[k], sub);
+    return g;
+  }
+
+  sim::SpeedSpec speed(const YAML::Node& n, const std::string& path, sim::SpeedSpec s) {
+    if (n.IsScalar()) {  // one number: every agent walks at it
+      s.mean = s.min = s.max = real(n, path);
+      s.stddev = 0.0f;
+      return s;
+    }
+    expect_map(n, path, {"mean", "stddev", "min", "max"});
+    if (n["mean"]) s.mean = real(n["mean"], child(path, "mean"));
+    if (n["stddev"]) s.stddev = real(n["stddev"], child(path, "stddev"));
+    if (n["min"]) s.min = real(n["min"], child(path, "min"));
+    if (n["max"]) s.max = real(n["max"], child(path, "max"));
+    if (!n["min"]) s.min = std::min(s.min, s.mean);
+    if (!n["max"]) s.max = std::max(s.max, s.mean);
+    return s;
+  }
+
+  sim::ModelParams model(const YAML::Node& n, const std::string& path) {
+    expect_map(n, path,
+               {"pred_time", "max_speed", "max_force", "personal_space", "lane_half_width", "relaxation_time", "probe_margin",
+                "contact_iterations"});
+    sim::ModelParams m;
+    auto opt = [&](const char* key, float& out) {
+      if (n[key]) out = real(n[key], child(path, key));
+    };
+    opt("pred_time", m.pred_time);
+    opt("max_speed", m.max_speed);
+    opt("max_force", m.max_force);
+    opt("personal_space", m.personal_space);
+    opt("lane_half_width", m.lane_half_width);
+    opt("relaxation_time", m.relaxation_time);
+    opt("probe_margin", m.probe_margin);
+    if (n["contact_iterations"]) m.contact_iterations = static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
+    return m;
+  }
+
+  void world(const YAML::Node& n, const std::string& path, sim::WorldSpec& w) {
+    expect_map(n, path, {"walkable", "obstacles", "scatter"});
+    if (n["walkable"]) {
+      w.has_walkable = true;
+      w.walkable = area(n["walkable"], child(path, "walkable"));
+    }
+    std::int64_t obstacles = 0;
+    if (const YAML::Node list = n["obstacles"]) {
+      const std::string lp = child(path, "obstacles");
+      expect_list(list, lp, 0, static_cast<std::size_t>(limits_.scenario.max_obstacles), "obstacles");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string ip = item(lp, i);
+        const std::string k = one_of(list[i], ip, {"polygon", "rect", "circle"}, {"holes"});
+        if (k == "circle") {
+          if (list[i]["holes"]) fail(list[i]["holes"], child(ip, "holes"), "a circle has no holes");
+          w.circles.push_back(circle(list[i]["circle"], child(ip, "circle")));
+          w.circle_fields.push_back(ip);
+        } else {
+          w.polygons.push_back(area(list[i], ip));
+          w.polygon_fields.push_back(ip);
+        }
+        ++obstacles;
+      }
+    }
+    if (const YAML::Node list = n["scatter"]) {
+      const std::string lp = child(path, "scatter");
+      expect_list(list, lp, 0, 1000, "scattered obstacle fields");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string ip = item(lp, i);
+        const YAML::Node s = list[i];
+        expect_map(s, ip, {"count", "region", "size", "clearance", "seed"});
+        sim::ScatterSpec spec;
+        spec.count = integer(required(s, ip, "count"), child(ip, "count"), 0, limits_.scenario.max_obstacles);
+        obstacles += spec.count;
+        if (obstacles > limits_.scenario.max_obstacles)
+          fail(s, ip, fmt::format("the scenario has more than {} obstacles", limits_.scenario.max_obstacles));
+        const std::string rp = child(ip, "region");
+        spec.region = region(required(s, ip, "region"), rp);
+        if (spec.region.kind != Region::Kind::rect) fail(s["region"], rp, "obstacles are scattered in a rect");
+        if (const YAML::Node size = s["size"]) {
+          const std::string sp = child(ip, "size");
+          visit(size, sp);
+          if (!size.IsSequence() || size.size() != 2) fail(size, sp, "expected [min, max] in metres, got " + kind(size));
+          spec.min_size = real(size[0], item(sp, 0));
+          spec.max_size = real(size[1], item(sp, 1));
+        }
+        if (s["clearance"]) spec.clearance = real(s["clearance"], child(ip, "clearance"));
+        if (s["seed"]) spec.seed = static_cast<std::uint64_t>(integer(s["seed"], child(ip, "seed"), 0, std::int64_t{1} << 53));
+        w.scatters.push_back(spec);
+        w.scatter_fields.push_back(ip);
+      }
+    }
+  }
+
+  sim::GroupSpec group(const YAML::Node& n, const std::string& path, const sim::ModelParams& model) {
+    expect_map(n, path, {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius"});
+    sim::GroupSpec g;
+    if (n["name"]) g.name = text(n["name"], child(path, "name"));
+    g.count = integer(required(n, path, "count"), child(path, "count"), 0, limits_.scenario.max_agents);
+    if (n["radius"]) g.radius = real(n["radius"], child(path, "radius"));
+    // Unless given, speeds stay within the model's maximum.
+    g.speed.max = std::min(g.speed.max, model.max_speed);
+    g.speed.min = std::min(g.speed.min, g.speed.max);
+    g.speed.mean = std::min(g.speed.mean, g.speed.max);
+    if (n["speed"]) g.speed = speed(n["speed"], child(path, "speed"), g.speed);
+    g.spawn = region(required(n, path, "spawn"), child(path, "spawn"));
+    if (const YAML::Node list = n["waypoints"]) {
+      const std::string lp = child(path, "waypoints");
+      expect_list(list, lp, 0, static_cast<std::size_t>(limits_.scenario.max_waypoints), "waypoints");
+      for (std::size_t i = 0; i < list.size(); ++i) g.waypoints.push_back(goal(list[i], item(lp, i)));
+    }
+    g.goal = goal(required(n, path, "goal"), child(path, "goal"));
+    if (n["on_arrival"]) {
+      const std::string a = word(n["on_arrival"], child(path, "on_arrival"), {"stop", "despawn", "loop"});
+      g.arrival = a == "stop" ? sim::ArrivalBehaviour::Stop : (a == "despawn" ? sim::ArrivalBehaviour::Despawn : sim::ArrivalBehaviour::Loop);
+    }
+    if (n["arrival_radius"]) g.arrival_radius = real(n["arrival_radius"], child(path, "arrival_radius"));
+    return g;
+  }
+
+  Camera camera(const YAML::Node& n, const std::string& path) {
+    expect_map(n, path, {"position", "target", "fov_degrees", "width", "height", "near", "far"});
+    Camera c;
+    const glm::vec3 eye = point3(required(n, path, "position"), child(path, "position"));
+    const glm::vec3 target = point3(required(n, path, "target"), child(path, "target"));
+    c.position = world_from_map(eye);
+    c.target = world_from_map(target);
+    // Looking straight down: put the map's north (+y) at the top of the image.
+    const glm::vec3 d = target - eye;
+    if (std::fabs(d.x) + std::fabs(d.y) <= 1e-4f * std::fabs(d.z)) c.up = world_from_map(glm::vec3(0.0f, 1.0f, 0.0f));
+    if (n["fov_degrees"]) c.fov_y = static_cast<float>(real_in(n["fov_degrees"], child(path, "fov_degrees"), 1.0, 179.0) * kDegrees);
+    if (n["width"]) c.width = static_cast<std::int32_t>(integer(n["width"], child(path, "width"), 1, 1 << 15));
+    if (n["height"]) c.height = static_cast<std::int32_t>(integer(n["height"], child(path, "height"), 1, 1 << 15));
+    if (n["near"]) c.near_plane = real(n["near"], child(path, "near"));
+    if (n["far"]) c.far_plane = real(n["far"], child(path, "far"));
+    try {
+      c.validate();
+    } catch (const Error& e) {
+      // Camera names its own fields; say it in the file's words.
+      std::string field = e.location().field;
+      for (const auto& [from, to] : {std::pair<std::string_view, std::string_view>{"camera.fov_y", "camera.fov_degrees"},
+                                     {"camera.near_plane", "camera.near"},
+                                     {"camera.far_plane", "camera.far"},
+                                     {"camera.up", "camera.target"}})
+        if (field == from) field = to;
+      const std::string key = field.substr(field.find('.') + 1);
+      fail(n[key] ? n[key] : n, field, e.message());
+    }
+    return c;
+  }
+
+  sim::OutputSpec outputs(const YAML::Node& n, const std::string& path) {
+    expect_map(n, path, {"dir", "every", "trajectories", "stats"});
+    sim::OutputSpec o;
+    if (n["dir"]) o.dir = text(n["dir"], child(path, "dir"));
+    if (n["every"]) o.every = integer(n["every"], child(path, "every"), 0, limits_.scenario.max_steps);
+    if (n["trajectories"]) o.trajectories = boolean(n["trajectories"], child(path, "trajectories"));
+    if (n["stats"]) o.stats = boolean(n["stats"], child(path, "stats"));
+    return o;
+  }
+
+  sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name) {
+    expect_map(root, "",
+               {"name", "description", "seed", "scheduler", "dt", "duration", "steps", "stop_when_arrived", "model", "world", "groups",
+                "camera", "measurement", "outputs"});
+    sim::ScenarioSpec s;
+    s.name = root["name"] ? text(root["name"], "name") : default_name;
+    if (root["description"]) s.description = text(root["description"], "description");
+    if (root["seed"]) s.seed = static_cast<std::uint64_t>(integer(root["seed"], "seed", 0, std::int64_t{1} << 53));
+    if (root["scheduler"]) s.scheduler = sim::parse_scheduler(word(root["scheduler"], "scheduler", {"double_buffer", "four_colour", "four_color"}), "scheduler");
+    if (root["dt"]) s.dt = real_in(root["dt"], "dt", 1e-4, 10.0);
+    if (root["duration"]) s.duration = real_in(root["duration"], "duration", 1e-3, 1e9);
+    if (root["steps"]) s.steps = integer(root["steps"], "steps", 1, limits_.scenario.max_steps);
+    if (s.step_count() > limits_.scenario.max_steps)
+      fail(root["duration"] ? root["duration"] : root, "duration", fmt::format("duration / dt exceeds {} steps", limits_.scenario.max_steps));
+    if (root["stop_when_arrived"]) s.stop_when_arrived = boolean(root["stop_when_arrived"], "stop_when_arrived");
+    if (root["model"]) s.model = model(root["model"], "model");
+    if (root["world"]) world(root["world"], "world", s.world);
+    const YAML::Node groups = required(root, "", "groups");
+    expect_list(groups, "groups", 1, static_cast<std::size_t>(limits_.max_groups), "groups");
+    std::int64_t agents = 0;
+    for (std::size_t i = 0; i < groups.size(); ++i) {
+      s.groups.push_back(group(groups[i], item("groups", i), s.model));
+      agents += s.groups.back().count;
+      if (agents > limits_.scenario.max_agents)
+        fail(groups[i], item("groups", i), fmt::format("the scenario has more than {} agents", limits_.scenario.max_agents));
+    }
+    if (root["camera"]) s.camera = camera(root["camera"], "camera");
+    if (const YAML::Node m = root["measurement"]) {
+      const Region r = region(m, "measurement");
+      if (r.kind != Region::Kind::rect) fail(m, "measurement", "the measurement area is a rect");
+      sim::Aabb box;
+      box.add(r.min);
+      box.add(r.max);
+      s.measurement = box;
+    }
+    if (root["outputs"]) s.outputs = outputs(root["outputs"], "outputs");
+    return s;
+  }
+
+ private:
+  std::string file_;
+  ScenarioReadLimits limits_;
+  ScenarioSource& source_;
+  std::int64_t nodes_ = 0;
+  std::int64_t vertices_ = 0;
+};
+
+std::string stem_of(const std::string& name) {
+  std::string stem = std::filesystem::path(name).stem().string();
+  return stem.empty() ? "scenario" : stem;
+}
+
+}  // namespace
+
+Location ScenarioSource::locate(const std::string& field) const {
+  std::string key = field;
+  // Drop trailing parts ("[3]", ".radius", " (shape 5)") until a recorded key remains.
+  while (!key.empty()) {
+    if (const auto it = marks.find(key); it != marks.end()) return Location{file, it->second.first, it->second.second, field};
+    const std::size_t cut = key.find_last_of(".[ ");
+    if (cut == std::string::npos || cut == 0) break;
+    key.resize(cut);
+  }
+  return Location{file, 0, 0, field};
+}
+
+Error ScenarioSource::located(const Error& e) const {
+  const Location& where = e.location();
+  if (where.field.empty() || where.line > 0) return e;
+  return Error(e.message(), locate(where.field));
+}
+
+LoadedScenario parse_scenario(std::string_view text, const std::string& name, const ScenarioReadLimits& limits) {
+  if (text.size() > limits.max_file_bytes)
+    throw Error(fmt::format("the file is larger than {} bytes", limits.max_file_bytes), Location{name, 1, 1, {}});
+  LoadedScenario out;
+  out.source.file = name;
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(text));
+  } catch (const YAML::DeepRecursion& e) {
+    throw Error("lists and maps nested too deeply", Location{name, e.mark.line + 1, e.mark.column + 1, {}});
+  } catch (const YAML::Exception& e) {
+    const int line = e.mark.is_null() ? 1 : e.mark.line + 1, column = e.mark.is_null() ? 0 : e.mark.column + 1;
+    throw Error("YAML syntax: " + e.msg, Location{name, line, column, {}});
+  }
+  if (!root || root.IsNull()) throw Error("the file is empty; a scenario needs at least 'groups'", Location{name, 1, 1, {}});
+  try {
+    Reader reader(name, limits, out.source);
+    out.spec = reader.scenario(root, stem_of(name));
+  } catch (const YAML::Exception& e) {
+    // yaml-cpp's own checks (e.g. a bad conversion) still get a position.
+    throw Error("YAML: " + e.msg, Location{name, e.mark.is_null() ? 1 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1, {}});
+  } catch (const Error& e) {
+    throw out.source.located(e);
+  }
+  return out;
+}
+
+LoadedScenario read_scenario_file(const std::string& path, const ScenarioReadLimits& limits) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw Error("cannot read the scenario file: " + ec.message(), Location{path, 0, 0, {}});
+  if (size > limits.max_file_bytes) throw Error(fmt::format("the file is larger than {} bytes", limits.max_file_bytes), Location{path, 0, 0, {}});
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open the scenario file", Location{path, 0, 0, {}});
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_scenario(ss.str(), path, limits);
+}
+
+std::vector<std::string> builtin_scenario_names() {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < detail::kBuiltinScenarioCount; ++i) names.emplace_back(detail::kBuiltinScenarios[i].name);
+  return names;
+}
+
+std::optional<std::string_view> builtin_scenario_text(std::string_view name) {
+  for (std::size_t i = 0; i < detail::kBuiltinScenarioCount; ++i)
+    if (name == detail::kBuiltinScenarios[i].name) return std::string_view(detail::kBuiltinScenarios[i].text, detail::kBuiltinScenarios[i].size);
+  return std::nullopt;
+}
+
+LoadedScenario load_builtin_scenario(std::string_view name, const ScenarioReadLimits& limits) {
+  const auto text = builtin_scenario_text(name);
+  if (!text) {
+    std::string list;
+    for (const std::string& n : builtin_scenario_names()) list += (list.empty() ? "" : ", ") + n;
+    throw Error(fmt::format("no built-in scenario '{}' (built-ins: {})", name, list), at_field("scenario"));
+  }
+  LoadedScenario s = parse_scenario(*text, "builtin:" + std::string(name), limits);
+  return s;
+}
+
+LoadedScenario load_scenario(const std::string& name_or_path, const ScenarioReadLimits& limits) {
+  if (builtin_scenario_text(name_or_path)) return load_builtin_scenario(name_or_path, limits);
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(name_or_path, ec)) return read_scenario_file(name_or_path, limits);
+  const bool looks_like_path = name_or_path.find('/') != std::string::npos || name_or_path.find('.') != std::string::npos;
+  if (looks_like_path) throw Error("no such scenario file", Location{name_or_path, 0, 0, {}});
+  return load_builtin_scenario(name_or_path, limits);  // throws, listing the built-ins
+}
+
+std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario, const sim::SimulationOptions& options) {
+  try {
+    return std::make_unique<sim::Simulation>(scenario.spec, options);
+  } catch (const Error& e) {
+    throw scenario.source.located(e);
+  }
+}
+
+}  // namespace throng::io

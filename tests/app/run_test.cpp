@@ -1,0 +1,216 @@
+// `throng run` end to end: the real executable writes valid trajectories.csv
+// and stats.json, prints a summary, reports bad scenarios on one line, and
+// leaves complete files when interrupted with Ctrl-C (SIGINT).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int code = -1;  // exit status, or 128 + signal
+  std::string out;
+};
+
+// Starts `throng args...` with stdout and stderr into `log`; returns the pid.
+pid_t start(const std::vector<std::string>& args, const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::FILE* f = std::fopen(log.c_str(), "w");
+    if (f != nullptr) {
+      dup2(fileno(f), STDOUT_FILENO);
+      dup2(fileno(f), STDERR_FILENO);
+    }
+    std::vector<char*> argv{const_cast<char*>(THRONG_EXE)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(THRONG_EXE, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+Outcome finish(pid_t pid, const fs::path& log) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  Outcome o;
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  o.out = slurp(log);
+  return o;
+}
+
+class RunCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("throng_run_test_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Outcome run(std::vector<std::string> args) { return finish(start(args, dir_ / "log.txt"), dir_ / "log.txt"); }
+  fs::path dir_;
+};
+
+bool sanitized() {
+  const char* v = std::getenv("THRONG_SANITIZED");
+  return v != nullptr && *v != '\0' && std::string(v) != "0";
+}
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string part;
+  while (std::getline(ss, part, sep)) out.push_back(part);
+  return out;
+}
+
+// Parses trajectories.csv: rows per frame, checking every field.
+std::map<long, int> read_trajectories(const fs::path& csv, long agents) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "frame,time,agent,x,y,heading,speed");
+  std::map<long, int> rows;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> f = split(line, ',');
+    EXPECT_EQ(f.size(), 7u) << line;
+    if (f.size() != 7) break;
+    std::size_t used = 0;
+    const long frame = std::stol(f[0], &used);
+    EXPECT_EQ(used, f[0].size());
+    EXPECT_NEAR(std::stod(f[1]), 0.1 * static_cast<double>(frame), 1e-6) << line;
+    const long agent = std::stol(f[2]);
+    EXPECT_TRUE(agent >= 0 && agent < agents) << line;
+    for (int k = 3; k < 7; ++k) EXPECT_TRUE(std::isfinite(std::stod(f[static_cast<std::size_t>(k)]))) << line;
+    EXPECT_LE(std::stod(f[6]), 2.0) << line;  // speed within the model's maximum
+    ++rows[frame];
+  }
+  return rows;
+}
+
+TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
+  const Outcome o = run({"--threads", "2", "run", "circle", "--agents", "50", "--steps", "120", "--every", "10", "--out", dir_.string(), "--quiet"});
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("circle: 50 agents, 120 steps"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("arrived"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("obstacle penetrations 0"), std::string::npos) << o.out;
+
+  const std::map<long, int> rows = read_trajectories(dir_ / "trajectories.csv", 50);
+  std::map<long, int> want;
+  for (long f = 0; f <= 120; f += 10) want[f] = 50;  // agents stop at their goals and stay
+  EXPECT_EQ(rows, want);
+
+  const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "stats.json"));
+  for (const char* section : {"run", "timings", "crowd", "density_histogram", "fundamental_diagram", "trajectories", "scenario"})
+    EXPECT_TRUE(stats.contains(section)) << section;
+  EXPECT_EQ(stats["run"]["steps"], 120);
+  EXPECT_EQ(stats["run"]["agents"], 50);
+  EXPECT_EQ(stats["run"]["threads"], 2);
+  EXPECT_FALSE(stats["run"]["interrupted"].get<bool>());
+  EXPECT_EQ(stats["crowd"]["agents"], 50);
+  EXPECT_EQ(stats["crowd"]["obstacle_penetrations"]["max"], 0);
+  EXPECT_EQ(stats["trajectories"]["rows"], 13 * 50);
+  for (const char* stage : {"sim.bin", "sim.sense", "sim.steer", "sim.move", "emit.trajectories", "sim.metrics"})
+    EXPECT_TRUE(stats["timings"]["stages"].contains(stage)) << stage;
+  EXPECT_GT(stats["timings"]["step_ms"].get<double>(), 0.0);
+  EXPECT_EQ(stats["scenario"]["source"], "builtin:circle");
+}
+
+// The README's demo: `throng run` with no scenario runs the circle to the
+// end and prints its summary (with fewer agents under the sanitizers).
+TEST_F(RunCommand, TheDefaultDemoRunsTheCircleToTheEnd) {
+  std::vector<std::string> args = {"run", "--out", dir_.string()};
+  if (sanitized()) args.insert(args.end(), {"--agents", "200"});
+  const Outcome o = run(args);
+  ASSERT_EQ(o.code, 0) << o.out;
+  const std::string n = sanitized() ? "200" : "1000";
+  EXPECT_NE(o.out.find("circle: " + n + " agents"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("arrived " + n + "/" + n), std::string::npos) << o.out;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "stats.json"));
+  EXPECT_TRUE(stats["run"]["all_arrived"].get<bool>());
+}
+
+TEST_F(RunCommand, ABadScenarioFileIsOneLineWithItsPosition) {
+  const fs::path bad = dir_ / "bad.yaml";
+  std::ofstream(bad) << "name: bad\ngroups:\n  - count: ten\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: [9, 9]\n";
+  const Outcome o = run({"--backend", "cpu", "run", bad.string(), "--out", dir_.string()});
+  EXPECT_EQ(o.code, 1);
+  EXPECT_EQ(o.out, "throng: error: " + bad.string() + ":3:12: groups[0].count: expected a number, got 'ten'\n");
+
+  const fs::path blocked = dir_ / "blocked.yaml";
+  std::ofstream(blocked) << "world:\n  obstacles:\n    - circle: {center: [9, 9], radius: 2}\ngroups:\n"
+                            "  - count: 5\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: [9, 9]\n";
+  const Outcome g = run({"--backend", "cpu", "run", blocked.string(), "--out", dir_.string()});
+  EXPECT_EQ(g.code, 1);
+  EXPECT_NE(g.out.find(blocked.string() + ":7:11: groups[0].goal: goal (9, 9) of agent 0 lies inside obstacle world.obstacles[0]"),
+            std::string::npos)
+      << g.out;
+}
+
+TEST_F(RunCommand, UnknownNamesAndBadOptionsAreErrors) {
+  Outcome o = run({"run", "circel"});
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.out.find("no built-in scenario 'circel' (built-ins: bottleneck, circle, corridor, crossing, plaza)"), std::string::npos) << o.out;
+  o = run({"run", "circle", "--steps", "5", "--seconds", "3"});
+  EXPECT_NE(o.code, 0);
+  EXPECT_NE(o.out.find("error"), std::string::npos);
+  o = run({"run", "circle", "--scheduler", "three_colour"});
+  EXPECT_NE(o.code, 0);
+  o = run({"run", "circle", "--agents", "0"});
+  EXPECT_NE(o.code, 0);
+}
+
+// Ctrl-C: the run ends after the current frame, the CSV ends on a complete
+// frame, stats.json is valid and says so, and the exit status is 130.
+TEST_F(RunCommand, InterruptLeavesCompleteFiles) {
+  const fs::path log = dir_ / "log.txt";
+  const fs::path out = dir_ / "out";
+  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--out", out.string(), "--quiet"}, log);
+  // Wait for a few frames to be written.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::error_code ec;
+    if (fs::file_size(out / "trajectories.csv", ec) > 3 * 400 * 30 && !ec) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  const Outcome o = finish(pid, log);
+  ASSERT_EQ(o.code, 130) << o.out;
+  EXPECT_NE(o.out.find("(interrupted)"), std::string::npos) << o.out;
+  const std::string csv = slurp(out / "trajectories.csv");
+  ASSERT_FALSE(csv.empty());
+  EXPECT_EQ(csv.back(), '\n');
+  const std::map<long, int> rows = read_trajectories(out / "trajectories.csv", 400);
+  ASSERT_GE(rows.size(), 3u);
+  for (const auto& [frame, n] : rows) EXPECT_EQ(n, 400) << "frame " << frame;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out / "stats.json"));
+  EXPECT_TRUE(stats["run"]["interrupted"].get<bool>());
+  EXPECT_FALSE(stats["run"]["all_arrived"].get<bool>());
+  EXPECT_EQ(stats["run"]["steps"].get<long>(), rows.rbegin()->first);
+  EXPECT_FALSE(fs::exists(out / "stats.json.tmp"));
+}
+
+}  // namespace

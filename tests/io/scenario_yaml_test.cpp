@@ -1,0 +1,294 @@
+// Scenario YAML: the schema read into a ScenarioSpec, the built-ins (the
+// examples/ files themselves), and the malformed corpus (tests/data/
+// scenario_bad): every file gives one clear error at its file:line:column
+// and key path, none crashes.
+#include "io/scenario_yaml.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "core/ground.h"
+
+namespace throng::io {
+namespace {
+
+const std::filesystem::path kRoot = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
+const std::filesystem::path kCorpus = kRoot / "tests" / "data" / "scenario_bad";
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct Expectation {
+  std::string file, field, text;
+  int line = 0, column = 0;
+};
+
+std::vector<Expectation> expectations() {
+  std::vector<Expectation> out;
+  std::ifstream in(kCorpus / "EXPECTED.txt");
+  std::string row;
+  while (std::getline(in, row)) {
+    if (row.empty() || row[0] == '#') continue;
+    std::vector<std::string> cols;
+    std::size_t start = 0;
+    for (std::size_t tab; (tab = row.find('\t', start)) != std::string::npos; start = tab + 1) cols.push_back(row.substr(start, tab - start));
+    cols.push_back(row.substr(start));
+    EXPECT_EQ(cols.size(), 5u) << row;
+    if (cols.size() == 5) out.push_back({cols[0], cols[3], cols[4], std::stoi(cols[1]), std::stoi(cols[2])});
+  }
+  return out;
+}
+
+TEST(ScenarioBadCorpus, EveryFileGivesOneClearErrorAtItsKey) {
+  const auto cases = expectations();
+  ASSERT_GE(cases.size(), 50u) << "corpus missing at " << kCorpus;
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.file);
+    const std::string path = (kCorpus / c.file).string();
+    try {
+      const LoadedScenario s = read_scenario_file(path);
+      build_simulation(s);  // geometry and model errors surface here
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(e.location().file, path);
+      EXPECT_EQ(e.location().line, c.line) << what;
+      EXPECT_EQ(e.location().column, c.column) << what;
+      EXPECT_EQ(e.location().field, c.field) << what;
+      EXPECT_NE(what.find(path + ":" + std::to_string(c.line) + ":" + std::to_string(c.column)), std::string::npos) << what;
+      EXPECT_NE(what.find(c.text), std::string::npos) << "\n  got:    " << what << "\n  wanted: " << c.text;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+    }
+  }
+}
+
+TEST(ScenarioBadCorpus, EveryFileIsListed) {
+  std::set<std::string> listed;
+  for (const auto& c : expectations()) listed.insert(c.file);
+  for (const auto& entry : std::filesystem::directory_iterator(kCorpus))
+    if (entry.path().extension() == ".yaml") {
+      EXPECT_TRUE(listed.count(entry.path().filename().string())) << entry.path();
+    }
+}
+
+// Every prefix of a valid file (a truncated download) and many single-byte
+// changes either read or give a located Error; none crashes or hangs.
+TEST(ScenarioBadCorpus, TruncationsAndByteFlipsNeverCrash) {
+  const std::string text = slurp(kRoot / "examples" / "bottleneck.yaml");
+  ASSERT_NO_THROW(parse_scenario(text, "valid.yaml"));
+  ScenarioReadLimits small;
+  small.scenario.max_agents = 400;
+  auto attempt = [&](std::string_view t, const char* name) {
+    try {
+      LoadedScenario s = parse_scenario(t, name, small);
+      if (s.spec.total_agents() <= 400) build_simulation(s);
+    } catch (const Error& e) {
+      EXPECT_TRUE(e.location().line > 0 || !e.location().field.empty()) << e.what();
+    }
+  };
+  for (std::size_t n = 0; n < text.size(); n += 11) attempt(std::string_view(text).substr(0, n), "prefix.yaml");
+  std::string flipped = text;
+  for (std::size_t i = 0; i < text.size(); i += 9) {
+    for (char c : {'\0', '[', ':', '9', '\n'}) {
+      flipped[i] = c;
+      attempt(flipped, "flipped.yaml");
+    }
+    flipped[i] = text[i];
+  }
+}
+
+TEST(ScenarioYaml, EveryKeyOfTheSchema) {
+  const std::string text = R"(name: all
+description: every key once
+seed: 42
+scheduler: four_colour
+dt: 0.05
+steps: 120
+stop_when_arrived: false
+model:
+  pred_time: 1.5
+  max_speed: 1.8
+  max_force: 5
+  personal_space: 0.2
+  lane_half_width: 1.0
+  relaxation_time: 0.4
+  probe_margin: 0.15
+  contact_iterations: 3
+world:
+  walkable:
+    polygon: [[-50, -50], [50, -50], [50, 50], [-50, 50]]
+    holes:
+      - [[-1, -1], [1, -1], [1, 1], [-1, 1]]
+  obstacles:
+    - polygon: [[10, 10], [12, 10], [12, 12]]
+    - rect: {min: [20, 20], max: [22, 25]}
+    - circle: {center: [-20, 5], radius: 1.5}
+  scatter:
+    - count: 3
+      region: {rect: {min: [30, -40], max: [45, -30]}}
+      size: [1, 2]
+      clearance: 1
+      seed: 9
+groups:
+  - name: first
+    count: 12
+    radius: 0.3
+    speed: {mean: 1.2, stddev: 0.1, min: 0.9, max: 1.5}
+    spawn: {disc: {center: [-30, -30], radius: 4}}
+    waypoints:
+      - [0, -30]
+      - {offset: [5, 5]}
+    goal: {random: {rect: {min: [30, 30], max: [40, 40]}}}
+    on_arrival: loop
+    arrival_radius: 0.8
+  - count: 8
+    speed: 1.1
+    spawn: {ring: {center: [0, 20], spacing: 1.5}}
+    goal: {mirror: [0, 20]}
+  - count: 4
+    spawn: {polygon: [[-40, 30], [-35, 30], [-35, 35]]}
+    goal: {point: [-10, 40]}
+    on_arrival: despawn
+camera:
+  position: [0, -30, 20]
+  target: [0, 0, 1]
+  fov_degrees: 45
+  width: 640
+  height: 480
+  near: 0.5
+  far: 500
+measurement: {rect: {min: [-5, 10], max: [5, 15]}}
+outputs:
+  dir: out/all
+  every: 4
+  trajectories: false
+  stats: true
+)";
+  const LoadedScenario l = parse_scenario(text, "all.yaml");
+  const sim::ScenarioSpec& s = l.spec;
+  EXPECT_EQ(s.name, "all");
+  EXPECT_EQ(s.description, "every key once");
+  EXPECT_EQ(s.seed, 42u);
+  EXPECT_EQ(s.scheduler, sim::SchedulerKind::FourColour);
+  EXPECT_FLOAT_EQ(s.dt, 0.05f);
+  EXPECT_EQ(s.step_count(), 120);
+  EXPECT_FALSE(s.stop_when_arrived);
+  EXPECT_FLOAT_EQ(s.model.pred_time, 1.5f);
+  EXPECT_FLOAT_EQ(s.model.max_speed, 1.8f);
+  EXPECT_FLOAT_EQ(s.model.max_force, 5.0f);
+  EXPECT_FLOAT_EQ(s.model.personal_space, 0.2f);
+  EXPECT_FLOAT_EQ(s.model.lane_half_width, 1.0f);
+  EXPECT_FLOAT_EQ(s.model.relaxation_time, 0.4f);
+  EXPECT_FLOAT_EQ(s.model.probe_margin, 0.15f);
+  EXPECT_EQ(s.model.contact_iterations, 3);
+  ASSERT_TRUE(s.world.has_walkable);
+  EXPECT_EQ(s.world.walkable.outer.size(), 4u);
+  EXPECT_EQ(s.world.walkable.holes.size(), 1u);
+  ASSERT_EQ(s.world.polygons.size(), 2u);  // the polygon and the rect
+  EXPECT_EQ(s.world.polygons[1].outer[2], glm::vec2(22, 25));
+  EXPECT_EQ(s.world.polygon_fields[1], "world.obstacles[1]");
+  ASSERT_EQ(s.world.circles.size(), 1u);
+  EXPECT_EQ(s.world.circle_fields[0], "world.obstacles[2]");
+  EXPECT_FLOAT_EQ(s.world.circles[0].radius, 1.5f);
+  ASSERT_EQ(s.world.scatters.size(), 1u);
+  EXPECT_EQ(s.world.scatters[0].count, 3);
+  EXPECT_FLOAT_EQ(s.world.scatters[0].max_size, 2.0f);
+  EXPECT_EQ(s.world.scatters[0].seed, 9u);
+  ASSERT_EQ(s.groups.size(), 3u);
+  const sim::GroupSpec& g = s.groups[0];
+  EXPECT_EQ(g.name, "first");
+  EXPECT_EQ(g.count, 12);
+  EXPECT_FLOAT_EQ(g.radius, 0.3f);
+  EXPECT_FLOAT_EQ(g.speed.stddev, 0.1f);
+  EXPECT_EQ(g.spawn.kind, sim::Region::Kind::disc);
+  ASSERT_EQ(g.waypoints.size(), 2u);
+  EXPECT_EQ(g.waypoints[0].kind, sim::GoalSpec::Kind::Point);
+  EXPECT_EQ(g.waypoints[1].kind, sim::GoalSpec::Kind::Offset);
+  EXPECT_EQ(g.goal.kind, sim::GoalSpec::Kind::Random);
+  EXPECT_EQ(g.arrival, sim::ArrivalBehaviour::Loop);
+  EXPECT_FLOAT_EQ(g.arrival_radius, 0.8f);
+  EXPECT_FLOAT_EQ(s.groups[1].speed.min, 1.1f);  // one number: everyone at that speed
+  EXPECT_FLOAT_EQ(s.groups[1].speed.max, 1.1f);
+  EXPECT_EQ(s.groups[1].spawn.kind, sim::Region::Kind::ring);
+  EXPECT_EQ(s.groups[1].goal.kind, sim::GoalSpec::Kind::Mirror);
+  EXPECT_EQ(s.groups[2].spawn.kind, sim::Region::Kind::polygon);
+  EXPECT_EQ(s.groups[2].arrival, sim::ArrivalBehaviour::Despawn);
+  // The camera is given on the map (z up) and kept in the Y-up world.
+  ASSERT_TRUE(s.camera.has_value());
+  EXPECT_EQ(s.camera->position, world_from_map({0, -30, 20}));
+  EXPECT_EQ(s.camera->position, glm::vec3(0, 20, 30));
+  EXPECT_EQ(s.camera->target, glm::vec3(0, 1, 0));
+  EXPECT_NEAR(s.camera->fov_y, 45.0f * 0.0174532925f, 1e-6f);
+  EXPECT_EQ(s.camera->width, 640);
+  EXPECT_FLOAT_EQ(s.camera->far_plane, 500.0f);
+  ASSERT_TRUE(s.measurement.has_value());
+  EXPECT_EQ(s.measurement->min, glm::vec2(-5, 10));
+  EXPECT_EQ(s.outputs.dir, "out/all");
+  EXPECT_EQ(s.outputs.every, 4);
+  EXPECT_FALSE(s.outputs.trajectories);
+  // Every key's position is known.
+  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 40);
+  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 49);
+  // And it all builds and runs.
+  const auto sim = build_simulation(l);
+  EXPECT_EQ(sim->agent_count(), 24);
+  sim->run(5);
+}
+
+TEST(ScenarioYaml, CameraLookingStraightDownHasNorthUp) {
+  const LoadedScenario l = parse_scenario(
+      "groups: [{count: 1, spawn: {rect: {min: [0, 0], max: [1, 1]}}, goal: [5, 5]}]\ncamera: {position: [3, 4, 50], target: [3, 4, 0]}\n",
+      "down.yaml");
+  ASSERT_TRUE(l.spec.camera);
+  l.spec.camera->validate();
+  EXPECT_EQ(l.spec.camera->up, world_from_map({0, 1, 0}));
+}
+
+TEST(BuiltinScenarios, AreTheExamplesFiles) {
+  std::set<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(kRoot / "examples"))
+    if (entry.path().extension() == ".yaml") files.insert(entry.path().stem().string());
+  const std::vector<std::string> names = builtin_scenario_names();
+  EXPECT_EQ(std::set<std::string>(names.begin(), names.end()), files);
+  for (const char* required : {"circle", "crossing", "corridor", "bottleneck", "plaza"}) EXPECT_TRUE(files.count(required)) << required;
+  for (const std::string& n : names) EXPECT_EQ(*builtin_scenario_text(n), slurp(kRoot / "examples" / (n + ".yaml"))) << n;
+}
+
+TEST(BuiltinScenarios, EachReadsBuildsAndRuns) {
+  for (const std::string& n : builtin_scenario_names()) {
+    SCOPED_TRACE(n);
+    LoadedScenario l = load_scenario(n);
+    EXPECT_EQ(l.spec.name, n);
+    EXPECT_FALSE(l.spec.description.empty());
+    EXPECT_EQ(l.source.file, "builtin:" + n);
+    if (l.spec.total_agents() > 2000) sim::scale_agent_counts(l.spec, 2000);  // plaza ships with 10^5
+    const auto sim = build_simulation(l);
+    sim->run(3);
+    // A file path reads the same scenario.
+    const LoadedScenario from_file = load_scenario((kRoot / "examples" / (n + ".yaml")).string());
+    EXPECT_EQ(from_file.spec.total_agents(), load_scenario(n).spec.total_agents());
+  }
+  EXPECT_EQ(load_scenario("circle").spec.total_agents(), 1000);
+  EXPECT_EQ(load_scenario("crossing").spec.total_agents(), 2000);
+}
+
+TEST(BuiltinScenarios, UnknownNamesListTheBuiltins) {
+  try {
+    load_scenario("circel");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("built-ins: bottleneck, circle"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_scenario("no/such/file.yaml"), Error);
+}
+
+}  // namespace
+}  // namespace throng::io

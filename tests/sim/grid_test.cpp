@@ -1,0 +1,199 @@
+// Bins: the counting sort against a sort on the host, neighbour queries
+// against brute force, the obstacle halo, sparseness, determinism.
+#include "sim/grid.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <random>
+#include <set>
+
+#include "core/exec.h"
+#include "sim/crowd.h"
+#include "sim/world.h"
+
+namespace throng::sim {
+namespace {
+
+std::vector<glm::vec2> random_points(std::size_t n, float extent, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> d(-extent, extent);
+  std::vector<glm::vec2> p(n);
+  for (auto& q : p) q = {d(rng), d(rng)};
+  return p;
+}
+
+struct Binned {
+  std::map<std::pair<std::int32_t, std::int32_t>, std::vector<std::int32_t>> cells;
+  Index binned = 0;
+};
+
+// Reads a grid back through its public view: every occupied slot's cell and items.
+Binned read_back(const AgentGrid& g) {
+  const GridView v = g.view();
+  Binned out;
+  out.binned = g.binned_agents();
+  for (Index s = 0; s < v.capacity(); ++s) {
+    const std::uint64_t key = v.keys[s];
+    if (key == kEmptyCell) continue;
+    auto& items = out.cells[{key_cx(key), key_cy(key)}];
+    for (std::int32_t k = 0; k < v.count[s]; ++k) items.push_back(v.items[v.start[s] + k]);
+  }
+  return out;
+}
+
+TEST(CountingSort, EveryActiveAgentOnceInItsCellInIndexOrder) {
+  const float cell = 4.0f;
+  std::vector<glm::vec2> p = random_points(20000, 150.0f, 1);
+  // Crowded cells and cell borders too.
+  for (int k = 0; k < 500; ++k) p.push_back({1.0f, 1.0f});
+  for (int k = 0; k < 50; ++k) p.push_back({4.0f * static_cast<float>(k % 7), -8.0f});
+  std::vector<std::uint8_t> flags(p.size(), kAgentActive);
+  for (std::size_t i = 0; i < flags.size(); i += 7) flags[i] = 0;  // inactive agents are not binned
+
+  // Reference: (cell, index) pairs sorted on the host.
+  std::map<std::pair<std::int32_t, std::int32_t>, std::vector<std::int32_t>> want;
+  Index active = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!flags[i]) continue;
+    want[{cell_coord(p[i].x, cell), cell_coord(p[i].y, cell)}].push_back(static_cast<std::int32_t>(i));
+    ++active;
+  }
+  for (int threads : {1, 2, 4}) {
+    ScopedExecution exec(Backend::Cpu, threads);
+    AgentGrid g(cell);
+    g.rebuild(p, flags);
+    const Binned got = read_back(g);
+    EXPECT_EQ(got.binned, active) << threads;
+    EXPECT_EQ(got.cells, want) << threads << " threads";
+    EXPECT_EQ(g.occupied_cells(), static_cast<Index>(want.size()));
+    // find() reaches every cell; an empty cell is not found.
+    const GridView v = g.view();
+    for (const auto& [c, items] : want) ASSERT_GE(v.find(c.first, c.second), 0);
+    EXPECT_EQ(v.find(100000, 100000), -1);
+  }
+}
+
+TEST(CountingSort, RebuildAfterMovingAndWithNoAgents) {
+  AgentGrid g(2.0f);
+  std::vector<glm::vec2> p = random_points(1000, 50.0f, 2);
+  std::vector<std::uint8_t> flags(p.size(), kAgentActive);
+  g.rebuild(p, flags);
+  for (auto& q : p) q += glm::vec2(13.0f, -7.0f);
+  g.rebuild(p, flags);
+  Index total = 0;
+  for (const auto& [c, items] : read_back(g).cells) {
+    for (std::int32_t i : items) {
+      EXPECT_EQ(cell_coord(p[static_cast<std::size_t>(i)].x, 2.0f), c.first);
+      EXPECT_EQ(cell_coord(p[static_cast<std::size_t>(i)].y, 2.0f), c.second);
+    }
+    total += static_cast<Index>(items.size());
+  }
+  EXPECT_EQ(total, 1000);
+  std::vector<glm::vec2> none;
+  std::vector<std::uint8_t> no_flags;
+  g.rebuild(none, no_flags);
+  EXPECT_EQ(g.binned_agents(), 0);
+  EXPECT_EQ(g.view().find(0, 0), -1);
+}
+
+TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
+  const float side = 4.0f;
+  const std::vector<glm::vec2> p = random_points(3000, 60.0f, 3);
+  const std::vector<std::uint8_t> flags(p.size(), kAgentActive);
+  AgentGrid g(side);
+  g.rebuild(p, flags);
+  const GridView v = g.view();
+  std::mt19937 rng(4);
+  for (int q = 0; q < 300; ++q) {
+    const std::size_t i = rng() % p.size();
+    std::set<std::int32_t> brute, binned;
+    for (std::size_t j = 0; j < p.size(); ++j)
+      if (length2(p[j] - p[i]) < side * side) brute.insert(static_cast<std::int32_t>(j));
+    for_each_in_3x3(v, p[i], [&](std::int32_t j) { binned.insert(j); });
+    for (std::int32_t j : brute) ASSERT_TRUE(binned.count(j)) << "agent " << i << " misses neighbour " << j;
+    // The 3x3 holds nothing beyond its 3 cells: at most 2 * side * sqrt 2 away.
+    for (std::int32_t j : binned) EXPECT_LE(length_of(p[static_cast<std::size_t>(j)] - p[i]), 2.0f * side * 1.4143f);
+    // The cached form visits the same items in the same order.
+    std::vector<std::int32_t> a, b;
+    for_each_in_3x3(v, p[i], [&](std::int32_t j) { a.push_back(j); });
+    for_each_in_cells(v, cells_3x3(v, cell_coord(p[i].x, side), cell_coord(p[i].y, side)), [&](std::int32_t j) { b.push_back(j); });
+    EXPECT_EQ(a, b);
+  }
+}
+
+TEST(Bins, WallHaloFindsEveryWallWithinOneCellOfAPoint) {
+  WorldSpec spec;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> d(-40.0f, 40.0f), size(0.5f, 6.0f);
+  for (int k = 0; k < 60; ++k) {
+    const glm::vec2 c(d(rng), d(rng));
+    const float s = size(rng);
+    spec.polygons.push_back({{c, c + glm::vec2(s, 0.3f * s), c + glm::vec2(0.2f * s, s)}, {}});
+  }
+  for (int k = 0; k < 30; ++k) spec.circles.push_back({{d(rng), d(rng)}, 0.2f + 0.05f * static_cast<float>(k)});
+  const World w = World::build(spec, 4.0f);
+  const WorldView v = w.host_view();
+  for (int q = 0; q < 2000; ++q) {
+    const glm::vec2 p(d(rng), d(rng));
+    std::set<std::int32_t> segs, circles;
+    for_each_in_cell(v.segment_grid, p, [&](std::int32_t k) { segs.insert(k); });
+    for_each_in_cell(v.circle_grid, p, [&](std::int32_t k) { circles.insert(k); });
+    for (std::size_t k = 0; k < w.segments().size(); ++k)
+      if (distance_to_segment(p, w.segments()[k].a, w.segments()[k].b) < 4.0f) {
+        ASSERT_TRUE(segs.count(static_cast<std::int32_t>(k)));
+      }
+    for (std::size_t k = 0; k < w.circles().size(); ++k)
+      if (length_of(p - w.circles()[k].center) - w.circles()[k].radius < 4.0f) {
+        ASSERT_TRUE(circles.count(static_cast<std::int32_t>(k)));
+      }
+  }
+}
+
+// A 10 km scene with a few agents and obstacles at its corners: the grids
+// hold what is occupied, not the extent (a dense 4 m grid would have
+// 6.25 million cells).
+TEST(Bins, MemoryFollowsAgentsAndOccupiedAreaNotTheExtent) {
+  std::vector<glm::vec2> p;
+  for (int k = 0; k < 100; ++k) p.push_back({static_cast<float>(k % 10) * 1000.0f, static_cast<float>(k / 10) * 1000.0f});
+  const std::vector<std::uint8_t> flags(p.size(), kAgentActive);
+  AgentGrid g(4.0f);
+  g.rebuild(p, flags);
+  EXPECT_EQ(g.occupied_cells(), 100);
+  EXPECT_LE(g.bytes(), 100u * 100u);  // a few slots per agent (a dense 4 m grid: 6.25 million cells)
+
+  WorldSpec spec;
+  spec.polygons.push_back({rect_ring({0, 0}, {2, 2}), {}});
+  spec.polygons.push_back({rect_ring({9990, 9990}, {9992, 9992}), {}});
+  spec.circles.push_back({{0, 9990}, 1.0f});
+  const World w = World::build(spec, 4.0f);
+  const WorldView v = w.host_view();
+  Index used = 0;
+  for (Index s = 0; s < v.segment_grid.capacity(); ++s) used += v.segment_grid.keys[s] != kEmptyCell;
+  EXPECT_LE(used, 2 * 16);  // each square touches at most 2x2 cells, 4x4 with the halo
+  EXPECT_LE(v.segment_grid.capacity(), 128);
+}
+
+TEST(Bins, CellCoordinatesAreSafeForHugeAndNonFiniteValues) {
+  EXPECT_EQ(cell_coord(1e30f, 4.0f), kCellCoordLimit - 1);
+  EXPECT_EQ(cell_coord(-1e30f, 4.0f), -kCellCoordLimit);
+  EXPECT_EQ(cell_coord(NAN, 4.0f), 0);
+  EXPECT_EQ(key_cx(cell_key(-5, 7)), -5);
+  EXPECT_EQ(key_cy(cell_key(-5, 7)), 7);
+  EXPECT_NE(cell_key(kCellCoordLimit - 1, kCellCoordLimit - 1), kEmptyCell);
+}
+
+TEST(Bins, FourColoursKeepSameColourCellsTwoApart) {
+  for (std::int32_t x = -3; x <= 3; ++x)
+    for (std::int32_t y = -3; y <= 3; ++y)
+      for (std::int32_t dx = -2; dx <= 2; ++dx)
+        for (std::int32_t dy = -2; dy <= 2; ++dy) {
+          if ((dx == 0 && dy == 0) || cell_colour(cell_key(x, y)) != cell_colour(cell_key(x + dx, y + dy))) continue;
+          // Same colour, different cell: their 3x3 blocks share no cell of either.
+          EXPECT_TRUE(std::abs(dx) >= 2 || std::abs(dy) >= 2);
+        }
+}
+
+}  // namespace
+}  // namespace throng::sim
