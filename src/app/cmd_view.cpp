@@ -1,6 +1,8 @@
-// throng view [SCENARIO|NAME]: the interactive viewer (render/viewer.h) on
-// characters animated by the locomotion stage: a formation (`formation`, or
-// an animate scenario file as `throng animate` reads it).
+// throng view [SCENARIO|NAME]: the interactive viewer (render/viewer.h), or
+// with --headless a video or screenshot of the same, on characters animated
+// by the locomotion stage: a scenario run by the crowd simulation (a file or
+// a built-in, as `throng run` takes them), or the formation of `throng
+// animate` (`formation`, or an animate file).
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -13,10 +15,22 @@
 #include "app/commands.h"
 #include "app/formation.h"
 #include "core/error.h"
+#include "io/scenario_yaml.h"
 
 #if defined(THRONG_HAVE_RENDER)
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <optional>
+#include <random>
+
+#include "core/buffer.h"
+#include "core/ground.h"
+#include "render/agent_motion.h"
 #include "render/renderer.h"
 #include "render/viewer.h"
+#include "sim/simulation.h"
 #endif
 
 namespace throng::app {
@@ -60,6 +74,126 @@ class FormationScene final : public render::ViewerScene {
   FormationCrowd crowd_;
 };
 
+// A scenario run by the crowd simulation, one step of dt whenever the
+// shown time passes it, agents interpolated between steps and animated by
+// the locomotion stage from their map state (anim::CrowdAnimator::drive_from_map).
+class SimulationScene final : public render::ViewerScene {
+ public:
+  SimulationScene(const io::LoadedScenario& loaded, const std::vector<float>& lod_thresholds)
+      : sim_(io::build_simulation(loaded)), space_(motion::make_default_blend_space()) {
+    const sim::ScenarioSpec& spec = sim_->spec();
+    max_steps_ = spec.step_count();
+    const Index n = sim_->agent_count();
+    anim::CrowdAnimatorConfig config;
+    if (!lod_thresholds.empty()) config.lod_thresholds = lod_thresholds;
+    crowd_ = std::make_unique<anim::CrowdAnimator>(space_, n, config);
+    const std::vector<glm::vec2> at = sim_->positions();
+    const std::vector<float> headings = sim_->headings();
+    std::vector<glm::vec3> positions;
+    std::vector<float> yaws, phases;
+    std::mt19937 rng(static_cast<std::uint32_t>(spec.seed));
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    sim::Aabb box = sim_->world().bounds();
+    for (Index i = 0; i < n; ++i) {
+      positions.push_back(world_from_ground(at[static_cast<std::size_t>(i)]));
+      yaws.push_back(yaw_from_heading(headings[static_cast<std::size_t>(i)]));
+      phases.push_back(unit(rng));
+      box.add(at[static_cast<std::size_t>(i)]);
+    }
+    crowd_->place(positions, yaws, {}, phases);
+    if (box.empty()) box.add(glm::vec2(0.0f));
+    centre_ = world_from_ground(0.5f * (box.min + box.max));
+    extent_ = std::max(5.0f, 0.5f * glm::length(box.max - box.min));
+    camera_ = spec.camera ? *spec.camera : sim::overview_camera(box);
+    const Memory m = current_memory();
+    previous_positions_ = Buffer<glm::vec2>(n, m);
+    previous_headings_ = Buffer<float>(n, m);
+    shown_positions_ = Buffer<glm::vec2>(n, m);
+    shown_headings_ = Buffer<float>(n, m);
+    still_ = Buffer<glm::vec2>::zeros(n, m);
+    remember_step();
+  }
+  std::string title() const override { return "throng: " + sim_->spec().name; }
+  anim::CrowdAnimator& animator() override { return *crowd_; }
+  std::optional<Camera> camera() const override { return camera_; }
+  float bin_size() const override { return sim_->bins().cell_size(); }
+  glm::vec3 centre() const override { return centre_; }
+  float extent() const override { return extent_; }
+  std::string status() const override {
+    return fmt::format("{}: step {}, {:.1f} s simulated, arrived {}/{}{}", sim_->spec().name, sim_->steps_done(), sim_->time(),
+                       sim_->arrived_count(), sim_->agent_count(), finished_ ? " (ended)" : "");
+  }
+  render::CharacterPoses poses() override {
+    render::CharacterPoses p = render::poses_of(*crowd_);
+    p.flags = sim_->crowd().flags.span();  // despawned agents vanish
+    p.visible_bits = sim::kAgentActive;
+    return p;
+  }
+  void decorate(render::Renderer& renderer) const override {
+    const sim::World& world = sim_->world();
+    renderer.set_obstacles(world.polygons(), world.circles());
+    if (world.has_walkable()) {
+      render::MapPolyline boundary(world.walkable().outer.begin(), world.walkable().outer.end());
+      if (!boundary.empty()) boundary.push_back(boundary.front());
+      renderer.set_paths({boundary});
+    }
+  }
+  void advance(double dt, const Camera& camera) override {
+    const double step = static_cast<double>(sim_->spec().dt);
+    shown_ += dt;
+    while (!finished_ && sim_->time() < shown_) {
+      remember_step();
+      sim_->step();
+      finished_ = sim_->steps_done() >= max_steps_ || (sim_->spec().stop_when_arrived && sim_->all_arrived());
+    }
+    if (finished_) shown_ = std::min(shown_, sim_->time());
+    // Between the previous step and the current one.
+    render::InterpolateAgentsJob between;
+    between.alpha = static_cast<float>(std::clamp(1.0 - (sim_->time() - shown_) / step, 0.0, 1.0));
+    between.previous_positions = previous_positions_.span();
+    between.positions = sim_->crowd().position.span();
+    between.previous_headings = previous_headings_.span();
+    between.headings = sim_->crowd().heading.span();
+    between.out_positions = shown_positions_.span();
+    between.out_headings = shown_headings_.span();
+    between.run();
+    crowd_->drive_from_map(shown_positions_.span(), finished_ ? still_.span() : sim_->crowd().velocity.span(), shown_headings_.span());
+    crowd_->animate({static_cast<float>(dt), &camera, false});
+  }
+
+ private:
+  void remember_step() {
+    const Index n = sim_->agent_count();
+    const Memory m = current_memory();
+    throng::detail::copy_bytes(previous_positions_.data(), m, sim_->crowd().position.data(), m, static_cast<std::size_t>(n) * sizeof(glm::vec2));
+    throng::detail::copy_bytes(previous_headings_.data(), m, sim_->crowd().heading.data(), m, static_cast<std::size_t>(n) * sizeof(float));
+  }
+
+  std::unique_ptr<sim::Simulation> sim_;
+  motion::BlendSpace1D space_;
+  std::unique_ptr<anim::CrowdAnimator> crowd_;
+  std::int64_t max_steps_ = 0;
+  bool finished_ = false;
+  double shown_ = 0.0;  // simulated seconds on screen
+  glm::vec3 centre_{0.0f};
+  float extent_ = 10.0f;
+  Camera camera_;
+  Buffer<glm::vec2> previous_positions_, shown_positions_, still_;
+  Buffer<float> previous_headings_, shown_headings_;
+};
+
+// An animate scenario (a formation) rather than a simulation scenario: the
+// built-in `formation`, or a file whose top level has a `formation` key.
+bool is_formation(const std::string& what) {
+  for (const std::string& name : io::builtin_animate_specs())
+    if (what == name) return true;
+  std::ifstream in(what);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("formation:", 0) == 0) return true;
+  return false;
+}
+
 }  // namespace
 #endif
 
@@ -67,7 +201,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   auto* cmd = app.add_subcommand("view", "Open the viewer: the crowd in a window, orbit/pan/zoom, LOD panel");
 #if defined(THRONG_HAVE_RENDER)
   static render::ViewerOptions o;
-  static std::string scenario = "formation";
+  static std::string scenario = "circle";
   static std::string layout;
   static std::string mode = "skinned";
   static Index agents = 0;
@@ -76,9 +210,14 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   static std::string render_output;
   static std::string out_dir = "out/view";
   static double fps = 30.0;
-  cmd->add_option("scenario", scenario, "Animate scenario file or built-in name (formation)");
-  cmd->add_option("--agents", agents, "How many characters (overrides the scenario)")->check(CLI::Range(Index{1}, Index{1} << 24));
-  cmd->add_option("--layout", layout, "Formation: ring (walking round rings) or grid (overrides the scenario)")
+  static std::string camera_kind = "orbit";
+  static float camera_period = 60.0f;
+  std::string names;
+  for (const std::string& n : io::builtin_scenario_names()) names += n + ", ";
+  cmd->add_option("scenario", scenario, "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
+      ->capture_default_str();
+  cmd->add_option("--agents", agents, "How many agents (groups keep their proportions)")->check(CLI::Range(Index{1}, Index{1} << 24));
+  cmd->add_option("--layout", layout, "For formation: ring (walking round rings) or grid")
       ->check(CLI::IsMember({"ring", "grid"}));
   cmd->add_option("--mode", mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")->check(CLI::IsMember({"skinned", "joints"}));
   cmd->add_flag("!--no-lod-colours", o.lod_colours, "Clothing colours instead of joint-LOD levels (L toggles)");
@@ -89,12 +228,15 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--speed", o.speed, "Animation speed factor");
   cmd->add_flag("--paused", o.paused, "Start paused (space toggles, period steps)");
   cmd->add_flag("!--no-panel", o.panel, "Hide the ImGui panel");
-  cmd->add_flag("--bins", o.bins, "Show agents per 4 m cell as a heat map");
+  cmd->add_flag("--bins", o.bins, "Show agents per cell (the simulation's bins; 4 m for the formation) as a heat map");
   cmd->add_flag("--headless", headless, "No window: render --frames frames offscreen (EGL), for videos and screenshots");
   cmd->add_option("--render", render_output, "With --headless: write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames)")
       ->check(CLI::IsMember({"video", "frames"}));
   cmd->add_option("--out", out_dir, "Folder for --render (default out/view)");
   cmd->add_option("--fps", fps, "With --headless: frames per second of the video")->check(CLI::Range(1.0, 240.0));
+  cmd->add_option("--camera", camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over")
+      ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
+  cmd->add_option("--camera-period", camera_period, "With --headless: seconds per orbit or fly-over")->check(CLI::PositiveNumber);
   cmd->add_option("--lod-thresholds", thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
   cmd->callback([&g] {
     if (!o.screenshot.empty() && o.frames == 0) throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
@@ -102,15 +244,27 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
     for (std::size_t i = 0; i < thresholds.size(); ++i)
       if (!(thresholds[i] > 0.0f) || !std::isfinite(thresholds[i]) || (i > 0 && !(thresholds[i] < thresholds[i - 1])))
         throw Error("thresholds must be positive and decreasing", at_field("--lod-thresholds"));
-    std::filesystem::path folder;
-    io::AnimateSpec spec = load_animate_spec(scenario, folder);  // a bad name fails before any window opens
-    if (agents > 0) spec.characters = agents;
-    if (!layout.empty()) spec.shape = layout == "grid" ? io::AnimateSpec::Shape::Grid : io::AnimateSpec::Shape::Circle;
-    if (!thresholds.empty()) spec.lod_thresholds = thresholds;
-    o.mode = render::parse_render_mode(mode, "--mode");
     if (!render_output.empty() && !headless) throw Error("--render needs --headless", at_field("--render"));
-    apply_global_options(g);
-    FormationScene scene(std::move(spec), folder);
+    if (headless && render_output.empty() && o.screenshot.empty())
+      throw Error("--headless writes nothing without --render or --screenshot", at_field("--headless"));
+    o.mode = render::parse_render_mode(mode, "--mode");
+    // A bad name or file fails before any window opens.
+    std::unique_ptr<render::ViewerScene> scene;
+    if (is_formation(scenario)) {
+      std::filesystem::path folder;
+      io::AnimateSpec spec = load_animate_spec(scenario, folder);
+      if (agents > 0) spec.characters = agents;
+      if (!layout.empty()) spec.shape = layout == "grid" ? io::AnimateSpec::Shape::Grid : io::AnimateSpec::Shape::Circle;
+      if (!thresholds.empty()) spec.lod_thresholds = thresholds;
+      apply_global_options(g);
+      scene = std::make_unique<FormationScene>(std::move(spec), folder);
+    } else {
+      if (!layout.empty()) throw Error("--layout is for the formation", at_field("--layout"));
+      io::LoadedScenario loaded = io::load_scenario(scenario);
+      if (agents > 0) sim::scale_agent_counts(loaded.spec, agents);
+      apply_global_options(g);
+      scene = std::make_unique<SimulationScene>(loaded, thresholds);
+    }
     if (headless) {
       render::HeadlessViewOptions h;
       h.record.output = render_output.empty() ? render::RecordOutput::None : render::parse_record_output(render_output, "--render");
@@ -124,13 +278,14 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
       h.frames = o.frames;
       h.screenshot = o.screenshot;
       h.speed = o.speed;
-      if (render_output.empty() && h.screenshot.empty()) throw Error("--headless writes nothing without --render or --screenshot", at_field("--headless"));
-      const render::HeadlessViewResult r = render::record_view(scene, h);
+      h.camera_kind = render::parse_camera_kind(camera_kind, "--camera");
+      h.camera_period = camera_period;
+      const render::HeadlessViewResult r = render::record_view(*scene, h);
       if (!r.output.empty()) std::printf("view: %lld frames in %s\n", static_cast<long long>(r.frames), r.output.c_str());
       if (!h.screenshot.empty()) std::printf("view: screenshot %s\n", h.screenshot.c_str());
       return;
     }
-    const render::ViewerResult r = render::run_viewer(scene, o);
+    const render::ViewerResult r = render::run_viewer(*scene, o);
     if (!o.screenshot.empty()) spdlog::info("view: {} frames, screenshot {}", r.frames, o.screenshot);
   });
 #else

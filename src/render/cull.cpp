@@ -37,6 +37,7 @@ void CullJob::validate() const {
     if (!character_rigs.empty()) check_size(character_rigs.size(), n, "cull.character_rigs");
   }
   if (force_tier < -1 || force_tier >= kDrawTiers) throw Error(fmt::format("must be in -1..{}", kDrawTiers - 1), at_field("cull.force_tier"));
+  if (!flags.empty()) check_size(flags.size(), n, "cull.flags");
   if (!(fine_min_pixels >= 0.0f)) throw Error("must be >= 0", at_field("cull.fine_min_pixels"));
   if (!(lines_max_pixels >= 0.0f)) throw Error("must be >= 0", at_field("cull.lines_max_pixels"));
 }

@@ -68,6 +68,9 @@ struct CullJob {
   Span<const anim::Mat3x4> palettes;
   Span<const Index> palette_offsets;
   Span<const std::int32_t> character_rigs;
+  // Characters whose flags lack a bit of visible_bits are not drawn; empty = all.
+  Span<const std::uint8_t> flags;
+  std::uint8_t visible_bits = 0;
   // out, rigs.count * kDrawTiers * characters, group-major: [g * characters
   // + c] is 1 when character c is visible and drawn in group g = rig *
   // kDrawTiers + tier. One exclusive scan over it gives every visible

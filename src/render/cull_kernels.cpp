@@ -20,9 +20,12 @@ void CullJob::run() const {
   const Span<const anim::Mat3x4> pal = palettes;
   const Span<const Index> offsets = palette_offsets;
   const Span<const std::int32_t> rig_of = character_rigs;
-  const Span<std::uint32_t> flags = group_flags;
+  const Span<const std::uint8_t> shown = flags;
+  const std::uint8_t bits = visible_bits;
+  const Span<std::uint32_t> out = group_flags;
   parallel_for("render.cull", n, THRONG_LAMBDA(Index c) {
-    for (std::int32_t g = 0; g < groups; ++g) flags[g * n + c] = 0u;
+    for (std::int32_t g = 0; g < groups; ++g) out[g * n + c] = 0u;
+    if (!shown.empty() && (shown[c] & bits) != bits) return;
     std::int32_t r = 0;
     glm::vec3 root(0.0f);
     float s = 1.0f;
@@ -51,7 +54,7 @@ void CullJob::run() const {
     const bool fine = close || size >= fine_px * depth;
     const bool lines = !close && size < lines_px * depth;
     const std::int32_t tier = forced >= 0 ? forced : (fine ? 0 : (lines ? 2 : 1));
-    flags[(r * kDrawTiers + tier) * n + c] = 1u;
+    out[(r * kDrawTiers + tier) * n + c] = 1u;
   });
 }
 

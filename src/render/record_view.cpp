@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 
 #include "anim/locomotion.h"
 #include "core/error.h"
@@ -10,10 +11,13 @@
 
 namespace throng::render {
 
+CharacterPoses ViewerScene::poses() { return poses_of(animator()); }
+
 void HeadlessViewOptions::validate() const {
   record.validate();
   if (frames < 1) throw Error("must be at least 1", at_field("--frames"));
   if (!(speed > 0.0 && speed <= 100.0)) throw Error("must be within (0, 100]", at_field("--speed"));
+  if (!(camera_period > 0.0f) || !std::isfinite(camera_period)) throw Error("must be positive seconds", at_field("--camera-period"));
   if (camera) camera->validate();
 }
 
@@ -26,7 +30,15 @@ HeadlessViewResult record_view(ViewerScene& scene, const HeadlessViewOptions& op
   lens.width = options.record.width;
   lens.height = options.record.height;
   lens.far_plane = std::max(1000.0f, 20.0f * scene.extent());
-  const CameraPath path = options.camera ? *options.camera : framing_orbit(scene.centre(), scene.extent(), lens, 60.0f);
+  CameraPath path = framing_orbit(scene.centre(), scene.extent(), lens, options.camera_period);
+  if (options.camera) {
+    path = *options.camera;
+  } else if (const std::optional<Camera> own = scene.camera()) {
+    Camera start = *own;
+    start.width = lens.width;
+    start.height = lens.height;
+    path = animate_camera(start, options.camera_kind, options.camera_period);
+  }
   const double dt = options.speed / options.record.fps;
   HeadlessViewResult result;
   auto last_report = std::chrono::steady_clock::now();
@@ -35,7 +47,7 @@ HeadlessViewResult record_view(ViewerScene& scene, const HeadlessViewOptions& op
     camera.width = lens.width;  // the camera that draws is the one LOD measures with
     camera.height = lens.height;
     scene.advance(f == 0 ? 0.0 : dt, camera);
-    result.last = recorder.add_frame(camera, poses_of(animator));
+    result.last = recorder.add_frame(camera, scene.poses());
     ++result.frames;
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(2)) {

@@ -265,6 +265,8 @@ DrawGroups Renderer::State::cull(const Camera* camera, const CharacterPoses& pos
   job.palettes = poses.palettes;
   job.palette_offsets = poses.palette_offsets;
   job.character_rigs = poses.rigs;
+  job.flags = poses.flags;
+  job.visible_bits = poses.visible_bits;
   job.group_flags = group_flags.span().subspan(0, flags);
   Index visible = 0;
   if (n > 0) {

@@ -281,6 +281,7 @@ void CharacterPoses::validate(const CrowdRigs& crowd, RenderMode mode) const {
   if (!lod_levels.empty() && lod_levels.size() != n && lod_levels.size() != n * anim::kBodyPartCount)
     throw Error(fmt::format("{} levels for {} characters (want 0, {} or {})", lod_levels.size(), n, n, n * anim::kBodyPartCount),
                 at_field("poses.lod_levels"));
+  if (!flags.empty() && flags.size() != n) throw Error(fmt::format("{} flags for {} characters", flags.size(), n), at_field("poses.flags"));
 }
 
 CharacterPoses poses_of(const anim::CrowdAnimator& crowd) {

@@ -136,6 +136,11 @@ struct CharacterPoses {
   // Joint-LOD levels, 0 = finest: empty (all 0), one per character, or one
   // per character and body part (characters * 5, as anim::LodJob writes).
   Span<const std::uint8_t> lod_levels;
+  // Which characters are drawn: those whose flags hold every bit of
+  // visible_bits (the simulation's flags and kAgentActive: despawned agents
+  // vanish); empty = all.
+  Span<const std::uint8_t> flags;
+  std::uint8_t visible_bits = 0;
 
   bool from_palettes() const { return joint_positions.empty() && !palette_offsets.empty(); }
   Index character_count() const {

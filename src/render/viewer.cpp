@@ -192,6 +192,14 @@ ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
   OrbitControl orbit;
   orbit.target = scene.centre() + glm::vec3(0.0f, 1.0f, 0.0f);
   orbit.distance = std::max(8.0f, 1.05f * extent / std::tan(0.5f * Camera{}.fov_y));
+  if (const std::optional<Camera> own = scene.camera()) {
+    // Start where the scene's camera stands.
+    const glm::vec3 d = own->position - own->target;
+    orbit.target = own->target;
+    orbit.distance = std::clamp(glm::length(d), 1.5f, 5000.0f);
+    orbit.pitch = std::clamp(std::asin(d.y / glm::length(d)), 0.05f, 1.5f);
+    orbit.yaw = std::atan2(d.x, d.z);
+  }
   InputState input;
   input.orbit = &orbit;
   input.paused = options.paused;
@@ -252,17 +260,21 @@ ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
     const anim::FrameStats& animated = animator.last_frame();
     if (animated.lod) histogram = *animated.lod;
 
+    const CharacterPoses poses = scene.poses();
     if (render_options.bins) {
-      // Agents per 4 m cell over the crowd's square: the bins overlay.
-      const float cell = 4.0f;
-      const auto side = static_cast<std::int32_t>(std::ceil(2.0f * extent / cell));
+      // Agents per cell (the simulation's bin size), cells aligned with its bins.
+      const float cell = scene.bin_size();
+      const glm::vec2 corner = glm::floor((ground_from_world(scene.centre()) - glm::vec2(extent)) / cell) * cell;
+      const auto side = std::min<std::int32_t>(4096, static_cast<std::int32_t>(std::ceil(2.0f * extent / cell)) + 1);
       std::vector<glm::vec3> ground(static_cast<std::size_t>(n));
+      std::vector<std::uint8_t> flags(static_cast<std::size_t>(poses.flags.size()));
       if (n > 0)
         throng::detail::copy_bytes(ground.data(), Memory::Host, animator.positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
-      const glm::vec2 corner = ground_from_world(scene.centre()) - glm::vec2(extent);
+      if (!flags.empty()) throng::detail::copy_bytes(flags.data(), Memory::Host, poses.flags.data(), current_memory(), flags.size());
       bin_counts.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side), 0);
-      for (const glm::vec3& p : ground) {
-        const glm::vec2 m = (ground_from_world(p) - corner) / cell;
+      for (std::size_t i = 0; i < ground.size(); ++i) {
+        if (!flags.empty() && (flags[i] & poses.visible_bits) != poses.visible_bits) continue;
+        const glm::vec2 m = (ground_from_world(ground[i]) - corner) / cell;
         const auto x = static_cast<std::int32_t>(std::floor(m.x)), y = static_cast<std::int32_t>(std::floor(m.y));
         if (x >= 0 && x < side && y >= 0 && y < side) ++bin_counts[static_cast<std::size_t>(y * side + x)];
       }
@@ -275,7 +287,6 @@ ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
       bins.saturate_at = 12;
       renderer.set_bins(bins);
     }
-    const CharacterPoses poses = poses_of(animator);
     render_options.lod_colours = input.lod_colours;
     render_options.mode = input.mode;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -41,6 +41,13 @@ class ViewerScene {
   // A ground disc (world, y = 0) holding the scene, to frame it.
   virtual glm::vec3 centre() const = 0;
   virtual float extent() const = 0;
+  // What to draw after advance(): by default the animator's poses.
+  virtual CharacterPoses poses();
+  // The scene's own camera (a scenario's), if it has one: the viewer starts
+  // there and headless views set it in motion (animate_camera).
+  virtual std::optional<Camera> camera() const { return std::nullopt; }
+  // Side of the cells of the agents-per-cell overlay (the simulation's bins).
+  virtual float bin_size() const { return 4.0f; }
   // Static parts (obstacles, paths), given to the renderer once.
   virtual void decorate(Renderer& renderer) const {}
   // Extra lines for the panel (simulation time, agents arrived...).
@@ -76,15 +83,18 @@ struct ViewerResult {
 ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options);
 
 // The same scene without a window (EGL, no display needed): `frames`
-// frames of 1/record.fps seconds each under a camera path (default: an
-// orbit framing the scene, a turn a minute), written as the RecordSpec says
-// (a video, PNG frames, or nothing), and the last frame as a PNG when
-// `screenshot` is given.
+// frames of 1/record.fps seconds each, written as the RecordSpec says (a
+// video, PNG frames, or nothing), and the last frame as a PNG when
+// `screenshot` is given. The camera: `camera` when given, else the scene's
+// camera set in motion (camera_kind, one turn or pass per camera_period
+// seconds), else an orbit framing the scene.
 struct HeadlessViewOptions {
   RecordSpec record;  // output, folder, size, fps; its options: mode, colours
   Index frames = 90;
   std::string screenshot;
   std::optional<CameraPath> camera;
+  CameraPath::Kind camera_kind = CameraPath::Kind::Orbit;
+  float camera_period = 60.0f;
   double speed = 1.0;  // animation seconds per video second
   void validate() const;
 };
