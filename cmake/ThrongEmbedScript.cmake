@@ -1,6 +1,7 @@
-# cmake -DINPUT_DIR=examples -DOUTPUT=builtin_scenarios.cpp -P ThrongEmbedScript.cmake
-# Writes every INPUT_DIR/*.yaml as a byte array (any content is safe).
-file(GLOB files ${INPUT_DIR}/*.yaml)
+# cmake -DINPUT_DIR=dir -DPATTERN=*.yaml -DSYMBOL=name -DOUTPUT=file.cpp -P ThrongEmbedScript.cmake
+# Writes every INPUT_DIR/PATTERN as a byte array (any content is safe) and an
+# io::EmbeddedSet SYMBOL listing them by file stem.
+file(GLOB files ${INPUT_DIR}/${PATTERN})
 list(SORT files)
 set(body "")
 set(table "")
@@ -19,21 +20,17 @@ endforeach()
 if(index EQUAL 0)
   string(APPEND table "    {\"\", \"\", 0},\n")
 endif()
-file(WRITE ${OUTPUT}.tmp "// Generated from ${INPUT_DIR}/*.yaml by cmake/ThrongEmbedScript.cmake: do not edit.
-#include <cstddef>
+file(WRITE ${OUTPUT}.tmp "// Generated from ${INPUT_DIR}/${PATTERN} by cmake/ThrongEmbedScript.cmake: do not edit.
+#include \"io/embedded.h\"
 
-namespace throng::io::detail {
-struct EmbeddedFile {
-  const char* name;
-  const char* text;
-  std::size_t size;
-};
+namespace throng::io {
 namespace {
-${body}}  // namespace
-extern const EmbeddedFile kBuiltinScenarios[] = {
+${body}const EmbeddedFile kFiles[] = {
 ${table}};
-extern const std::size_t kBuiltinScenarioCount = ${index};
-}  // namespace throng::io::detail
+}  // namespace
+extern const EmbeddedSet ${SYMBOL};
+const EmbeddedSet ${SYMBOL}{kFiles, ${index}};
+}  // namespace throng::io
 ")
 file(COPY_FILE ${OUTPUT}.tmp ${OUTPUT} ONLY_IF_DIFFERENT)
 file(REMOVE ${OUTPUT}.tmp)

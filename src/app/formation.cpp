@@ -23,9 +23,12 @@ io::AnimateSpec load_animate_spec(const std::string& what, fs::path& folder) {
     folder = fs::path(what).parent_path();
     return io::read_animate_spec(what);
   }
-  for (const std::string& name : io::builtin_animate_specs())
+  std::string list;
+  for (const std::string& name : io::builtin_animate_specs()) {
     if (what == name) return io::builtin_animate_spec(name);
-  throw Error("no such file or built-in scenario '" + what + "' (built-in: formation)", at_field("scenario"));
+    list += (list.empty() ? "" : ", ") + name;
+  }
+  throw Error("no such file or built-in scenario '" + what + "' (built-in: " + list + ")", at_field("scenario"));
 }
 
 motion::BlendSpace1D load_blend_space(const io::AnimateSpec& spec, const fs::path& folder) {

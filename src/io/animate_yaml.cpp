@@ -10,53 +10,11 @@
 #include <string>
 
 #include "core/error.h"
+#include "io/embedded.h"
 
 namespace throng::io {
 
 namespace {
-
-// The built-in "formation": examples/formation_circle.yaml (a test keeps the two equal).
-constexpr const char* kFormationYaml = R"(# 1,000 characters walking round concentric circles (the 2019 paper's Fig. 9),
-# animated by the locomotion stage alone: `throng animate formation` or
-# `throng animate examples/formation_circle.yaml`. Every key is optional;
-# the values below are the defaults unless marked otherwise.
-name: formation_circle
-characters: 1000
-formation:
-  shape: circle          # circle | grid
-  radius: 12.0           # m, the innermost ring (circle)
-  ring_spacing: 1.6      # m between rings (circle)
-  spacing: 1.3           # m between neighbours on a ring, or on the grid
-  direction: ccw         # ccw | cw, seen from above (circle)
-speed:
-  min: 0.8               # m/s: each character draws its own speed ...
-  max: 2.4
-  change_every: 5.0      # ... and a new one this often (s); 0 keeps the first
-scale: {min: 1.0, max: 1.0}
-motion: default          # the default set, or BVH clips blended by speed, e.g.
-#  - {file: ../../shared/data/bvh/cmu_16_15_walk_daz.bvh, skip_frames: 1}
-#  - {file: ../../shared/data/bvh/cmu_16_36_run_jog_daz.bvh, skip_frames: 1}
-mode: continuous         # continuous (w may change any frame) | paper (at cycle ends)
-duration: 10.0           # s
-fps: 60
-seed: 1
-camera:                  # orbits the formation; LOD measures pixels through it
-  orbit_radius: 0        # m; 0 = just outside the formation
-  elevation: 14.0        # m
-  angular_speed: 0.1     # rad/s
-  fov_deg: 50
-  resolution: [1920, 1080]
-lod:
-  enabled: true
-  thresholds: [1000, 30] # square pixels per body part: 3 levels
-cache:
-  enabled: true
-  bucket_width: 0.05     # of the blend weight w
-  capacity_mb: 20
-foot_skating:
-  characters: 16         # measured on this many characters, spread over the crowd
-output: out/formation_circle   # folder for stats.json
-)";
 
 Location where(const std::string& file, const YAML::Node& node, const std::string& field) {
   const YAML::Mark m = node.Mark();
@@ -263,11 +221,16 @@ AnimateSpec read_animate_spec(const std::string& path) {
   return parse_animate_spec(text.str(), path);
 }
 
-std::vector<std::string> builtin_animate_specs() { return {"formation"}; }
+std::vector<std::string> builtin_animate_specs() { return kBuiltinAnimateScenarios.names(); }
 
 AnimateSpec builtin_animate_spec(std::string_view name) {
-  if (name != "formation") throw Error("no built-in animate scenario '" + std::string(name) + "' (built-in: formation)", at_field("scenario"));
-  AnimateSpec s = parse_animate_spec(kFormationYaml, "built-in:formation");
+  const auto text = kBuiltinAnimateScenarios.find(name);
+  if (!text) {
+    std::string list;
+    for (const auto& n : kBuiltinAnimateScenarios.names()) list += (list.empty() ? "" : ", ") + n;
+    throw Error("no built-in animate scenario '" + std::string(name) + "' (built-in: " + list + ")", at_field("scenario"));
+  }
+  AnimateSpec s = parse_animate_spec(std::string(*text), "built-in:" + std::string(name));
   s.source = "built-in";
   return s;
 }

@@ -1,6 +1,6 @@
 // `throng animate` scenarios: characters in a formation animated by the
 // locomotion stage alone (no crowd simulation), as YAML. The schema, with
-// every key optional and its default, is examples/formation_circle.yaml and
+// every key optional and its default, is examples/animate/formation.yaml and
 // docs/locomotion.md. Errors name file:line:column and the key.
 #pragma once
 
@@ -66,7 +66,7 @@ struct AnimateSpec {
 AnimateSpec read_animate_spec(const std::string& path);
 AnimateSpec parse_animate_spec(std::string_view text, const std::string& name);
 
-// Built-in scenarios by name: "formation" (the same as examples/formation_circle.yaml).
+// Built-in scenarios by name: "formation" (the same as examples/animate/formation.yaml).
 std::vector<std::string> builtin_animate_specs();
 AnimateSpec builtin_animate_spec(std::string_view name);  // Error for an unknown name
 

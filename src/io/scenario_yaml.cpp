@@ -14,19 +14,9 @@
 #include <sstream>
 
 #include "core/ground.h"
+#include "io/embedded.h"
 
 namespace throng::io {
-
-namespace detail {
-struct EmbeddedFile {
-  const char* name;  // file name without .yaml
-  const char* text;
-  std::size_t size;
-};
-// Generated at build time from examples/*.yaml (cmake/ThrongEmbed.cmake).
-extern const EmbeddedFile kBuiltinScenarios[];
-extern const std::size_t kBuiltinScenarioCount;
-}  // namespace detail
 
 namespace {
 
@@ -612,17 +602,9 @@ LoadedScenario read_scenario_file(const std::string& path, const ScenarioReadLim
   return parse_scenario(ss.str(), path, limits);
 }
 
-std::vector<std::string> builtin_scenario_names() {
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < detail::kBuiltinScenarioCount; ++i) names.emplace_back(detail::kBuiltinScenarios[i].name);
-  return names;
-}
+std::vector<std::string> builtin_scenario_names() { return kBuiltinScenarios.names(); }
 
-std::optional<std::string_view> builtin_scenario_text(std::string_view name) {
-  for (std::size_t i = 0; i < detail::kBuiltinScenarioCount; ++i)
-    if (name == detail::kBuiltinScenarios[i].name) return std::string_view(detail::kBuiltinScenarios[i].text, detail::kBuiltinScenarios[i].size);
-  return std::nullopt;
-}
+std::optional<std::string_view> builtin_scenario_text(std::string_view name) { return kBuiltinScenarios.find(name); }
 
 LoadedScenario load_builtin_scenario(std::string_view name, const ScenarioReadLimits& limits) {
   const auto text = builtin_scenario_text(name);

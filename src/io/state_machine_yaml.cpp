@@ -7,12 +7,11 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "io/embedded.h"
 #include "io/yaml_fields.h"
 #include "motion/default_set.h"
 
 namespace throng::io {
-
-extern const char* const kDefaultMachineYaml;  // generated from data/motion/default_machine.yaml
 
 namespace {
 
@@ -180,8 +179,10 @@ path::StateMachineSpec read_state_machine(const std::string& file) {
   return parse_state_machine(ss.str(), file);
 }
 
-std::string_view default_state_machine_yaml() { return kDefaultMachineYaml; }
+std::string_view default_state_machine_yaml() { return *kBuiltinMotionData.find("default_machine"); }
 
-path::StateMachineSpec default_state_machine_spec() { return parse_state_machine(kDefaultMachineYaml, "default_machine.yaml"); }
+path::StateMachineSpec default_state_machine_spec() {
+  return parse_state_machine(std::string(default_state_machine_yaml()), "default_machine.yaml");
+}
 
 }  // namespace throng::io
