@@ -23,11 +23,9 @@
 #include <algorithm>
 #include <fstream>
 #include <optional>
-#include <random>
 
-#include "core/buffer.h"
+#include "app/sim_locomotion.h"
 #include "core/ground.h"
-#include "render/agent_motion.h"
 #include "render/renderer.h"
 #include "render/viewer.h"
 #include "sim/simulation.h"
@@ -76,45 +74,20 @@ class FormationScene final : public render::ViewerScene {
 
 // A scenario run by the crowd simulation, one step of dt whenever the
 // shown time passes it, agents interpolated between steps and animated by
-// the locomotion stage from their map state (anim::CrowdAnimator::drive_from_map).
+// the locomotion stage as `throng run` animates them (app/sim_locomotion.h).
 class SimulationScene final : public render::ViewerScene {
  public:
   SimulationScene(const io::LoadedScenario& loaded, const std::vector<float>& lod_thresholds)
-      : sim_(io::build_simulation(loaded)), space_(motion::make_default_blend_space()) {
-    const sim::ScenarioSpec& spec = sim_->spec();
-    max_steps_ = spec.step_count();
-    const Index n = sim_->agent_count();
-    anim::CrowdAnimatorConfig config;
-    if (!lod_thresholds.empty()) config.lod_thresholds = lod_thresholds;
-    crowd_ = std::make_unique<anim::CrowdAnimator>(space_, n, config);
-    const std::vector<glm::vec2> at = sim_->positions();
-    const std::vector<float> headings = sim_->headings();
-    std::vector<glm::vec3> positions;
-    std::vector<float> yaws, phases;
-    std::mt19937 rng(static_cast<std::uint32_t>(spec.seed));
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+      : sim_(io::build_simulation(loaded)), locomotion_(*sim_, locomotion_options(lod_thresholds)), camera_(scenario_camera(*sim_)) {
+    max_steps_ = sim_->spec().step_count();
     sim::Aabb box = sim_->world().bounds();
-    for (Index i = 0; i < n; ++i) {
-      positions.push_back(world_from_ground(at[static_cast<std::size_t>(i)]));
-      yaws.push_back(yaw_from_heading(headings[static_cast<std::size_t>(i)]));
-      phases.push_back(unit(rng));
-      box.add(at[static_cast<std::size_t>(i)]);
-    }
-    crowd_->place(positions, yaws, {}, phases);
+    for (const glm::vec2& p : sim_->positions()) box.add(p);
     if (box.empty()) box.add(glm::vec2(0.0f));
     centre_ = world_from_ground(0.5f * (box.min + box.max));
     extent_ = std::max(5.0f, 0.5f * glm::length(box.max - box.min));
-    camera_ = spec.camera ? *spec.camera : sim::overview_camera(box);
-    const Memory m = current_memory();
-    previous_positions_ = Buffer<glm::vec2>(n, m);
-    previous_headings_ = Buffer<float>(n, m);
-    shown_positions_ = Buffer<glm::vec2>(n, m);
-    shown_headings_ = Buffer<float>(n, m);
-    still_ = Buffer<glm::vec2>::zeros(n, m);
-    remember_step();
   }
   std::string title() const override { return "throng: " + sim_->spec().name; }
-  anim::CrowdAnimator& animator() override { return *crowd_; }
+  anim::CrowdAnimator& animator() override { return locomotion_.animator(); }
   std::optional<Camera> camera() const override { return camera_; }
   float bin_size() const override { return sim_->bins().cell_size(); }
   glm::vec3 centre() const override { return centre_; }
@@ -123,63 +96,37 @@ class SimulationScene final : public render::ViewerScene {
     return fmt::format("{}: step {}, {:.1f} s simulated, arrived {}/{}{}", sim_->spec().name, sim_->steps_done(), sim_->time(),
                        sim_->arrived_count(), sim_->agent_count(), finished_ ? " (ended)" : "");
   }
-  render::CharacterPoses poses() override {
-    render::CharacterPoses p = render::poses_of(*crowd_);
-    p.flags = sim_->crowd().flags.span();  // despawned agents vanish
-    p.visible_bits = sim::kAgentActive;
-    return p;
-  }
-  void decorate(render::Renderer& renderer) const override {
-    const sim::World& world = sim_->world();
-    renderer.set_obstacles(world.polygons(), world.circles());
-    if (world.has_walkable()) {
-      render::MapPolyline boundary(world.walkable().outer.begin(), world.walkable().outer.end());
-      if (!boundary.empty()) boundary.push_back(boundary.front());
-      renderer.set_paths({boundary});
-    }
-  }
+  render::CharacterPoses poses() override { return render::poses_of(locomotion_.animator(), sim_->crowd()); }
+  void decorate(render::Renderer& renderer) const override { render::show_world(renderer, sim_->world()); }
   void advance(double dt, const Camera& camera) override {
     const double step = static_cast<double>(sim_->spec().dt);
     shown_ += dt;
     while (!finished_ && sim_->time() < shown_) {
-      remember_step();
+      locomotion_.remember(*sim_);
       sim_->step();
       finished_ = sim_->steps_done() >= max_steps_ || (sim_->spec().stop_when_arrived && sim_->all_arrived());
     }
     if (finished_) shown_ = std::min(shown_, sim_->time());
-    // Between the previous step and the current one.
-    render::InterpolateAgentsJob between;
-    between.alpha = static_cast<float>(std::clamp(1.0 - (sim_->time() - shown_) / step, 0.0, 1.0));
-    between.previous_positions = previous_positions_.span();
-    between.positions = sim_->crowd().position.span();
-    between.previous_headings = previous_headings_.span();
-    between.headings = sim_->crowd().heading.span();
-    between.out_positions = shown_positions_.span();
-    between.out_headings = shown_headings_.span();
-    between.run();
-    crowd_->drive_from_map(shown_positions_.span(), finished_ ? still_.span() : sim_->crowd().velocity.span(), shown_headings_.span());
-    crowd_->animate({static_cast<float>(dt), &camera, false});
+    const double alpha = std::clamp(1.0 - (sim_->time() - shown_) / step, 0.0, 1.0);
+    locomotion_.animate(*sim_, static_cast<float>(alpha), static_cast<float>(dt), &camera, !finished_);
   }
 
  private:
-  void remember_step() {
-    const Index n = sim_->agent_count();
-    const Memory m = current_memory();
-    throng::detail::copy_bytes(previous_positions_.data(), m, sim_->crowd().position.data(), m, static_cast<std::size_t>(n) * sizeof(glm::vec2));
-    throng::detail::copy_bytes(previous_headings_.data(), m, sim_->crowd().heading.data(), m, static_cast<std::size_t>(n) * sizeof(float));
+  static LocomotionOptions locomotion_options(const std::vector<float>& thresholds) {
+    LocomotionOptions o;
+    o.lod_thresholds = thresholds;
+    o.skating_agents = 0;  // measured by throng run, not here
+    return o;
   }
 
   std::unique_ptr<sim::Simulation> sim_;
-  motion::BlendSpace1D space_;
-  std::unique_ptr<anim::CrowdAnimator> crowd_;
+  SimulationLocomotion locomotion_;
+  Camera camera_;
   std::int64_t max_steps_ = 0;
   bool finished_ = false;
   double shown_ = 0.0;  // simulated seconds on screen
   glm::vec3 centre_{0.0f};
   float extent_ = 10.0f;
-  Camera camera_;
-  Buffer<glm::vec2> previous_positions_, shown_positions_, still_;
-  Buffer<float> previous_headings_, shown_headings_;
 };
 
 // An animate scenario (a formation) rather than a simulation scenario: the
@@ -210,8 +157,8 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   static std::string render_output;
   static std::string out_dir = "out/view";
   static double fps = 30.0;
-  static std::string camera_kind = "orbit";
-  static float camera_period = 60.0f;
+  static std::string camera_kind;  // empty: the scenario's camera.motion, else orbit
+  static float camera_period = 0.0f;
   std::string names;
   for (const std::string& n : io::builtin_scenario_names()) names += n + ", ";
   cmd->add_option("scenario", scenario, "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
@@ -234,9 +181,9 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
       ->check(CLI::IsMember({"video", "frames"}));
   cmd->add_option("--out", out_dir, "Folder for --render (default out/view)");
   cmd->add_option("--fps", fps, "With --headless: frames per second of the video")->check(CLI::Range(1.0, 240.0));
-  cmd->add_option("--camera", camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over")
+  cmd->add_option("--camera", camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over (default: the scenario's camera.motion, else orbit)")
       ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
-  cmd->add_option("--camera-period", camera_period, "With --headless: seconds per orbit or fly-over")->check(CLI::PositiveNumber);
+  cmd->add_option("--camera-period", camera_period, "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")->check(CLI::PositiveNumber);
   cmd->add_option("--lod-thresholds", thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
   cmd->callback([&g] {
     if (!o.screenshot.empty() && o.frames == 0) throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
@@ -264,6 +211,8 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
       if (agents > 0) sim::scale_agent_counts(loaded.spec, agents);
       apply_global_options(g);
       scene = std::make_unique<SimulationScene>(loaded, thresholds);
+      if (camera_kind.empty()) camera_kind = loaded.spec.camera_motion;
+      if (!(camera_period > 0.0f)) camera_period = loaded.spec.camera_period_s;
     }
     if (headless) {
       render::HeadlessViewOptions h;
@@ -278,8 +227,8 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
       h.frames = o.frames;
       h.screenshot = o.screenshot;
       h.speed = o.speed;
-      h.camera_kind = render::parse_camera_kind(camera_kind, "--camera");
-      h.camera_period = camera_period;
+      h.camera_kind = render::parse_camera_kind(camera_kind.empty() ? "orbit" : camera_kind, "--camera");
+      h.camera_period = camera_period > 0.0f ? camera_period : 60.0f;
       const render::HeadlessViewResult r = render::record_view(*scene, h);
       if (!r.output.empty()) std::printf("view: %lld frames in %s\n", static_cast<long long>(r.frames), r.output.c_str());
       if (!h.screenshot.empty()) std::printf("view: screenshot %s\n", h.screenshot.c_str());

@@ -87,9 +87,18 @@ const HeadlessContext& Recorder::context() const { return s_->context; }
 const Image& Recorder::last_frame() const { return s_->frame; }
 Index Recorder::frames() const { return s_->frames; }
 
+void show_world(Renderer& renderer, const sim::World& world, const ObstacleStyle& style) {
+  renderer.set_obstacles(world.polygons(), world.circles(), style);
+  if (world.has_walkable()) {
+    MapPolyline boundary(world.walkable().outer.begin(), world.walkable().outer.end());
+    if (!boundary.empty()) boundary.push_back(boundary.front());
+    renderer.set_paths({boundary});
+  }
+}
+
 void Recorder::set_world(const sim::World& world, const ObstacleStyle& style) {
   s_->context.make_current();
-  s_->renderer.set_obstacles(world.polygons(), world.circles(), style);
+  show_world(s_->renderer, world, style);
 }
 
 RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses) { return add_frame(camera, poses, s_->spec.options); }

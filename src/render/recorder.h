@@ -39,6 +39,10 @@ struct RecordSpec {
   void validate() const;  // Error naming the field ("render.width")
 };
 
+// The simulation's world on a renderer: obstacles (polygons with holes,
+// circles) extruded, and the walkable area's outline as a path line.
+void show_world(Renderer& renderer, const sim::World& world, const ObstacleStyle& style = {});
+
 class Recorder {
  public:
   Recorder(const RecordSpec& spec, const CrowdRigs& rigs);
@@ -49,7 +53,7 @@ class Recorder {
 
   Renderer& renderer();
   const HeadlessContext& context() const;
-  // The simulation's obstacles (polygons with holes, circles), extruded.
+  // The simulation's world (show_world).
   void set_world(const sim::World& world, const ObstacleStyle& style = {});
   // Renders one frame with `camera` (its viewport is set to the spec's
   // size) and appends it. The picture stays available in last_frame().

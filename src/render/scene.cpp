@@ -10,6 +10,7 @@
 #include "anim/rig.h"
 #include "anim/stream_crowd.h"
 #include "core/error.h"
+#include "sim/crowd.h"
 
 namespace throng::render {
 
@@ -291,6 +292,13 @@ CharacterPoses poses_of(const anim::CrowdAnimator& crowd) {
   p.joint_rotations = crowd.joint_rotations();
   p.scales = crowd.scales();
   if (crowd.last_frame().lod) p.lod_levels = crowd.lod_levels();  // levels of the last animate()
+  return p;
+}
+
+CharacterPoses poses_of(const anim::CrowdAnimator& crowd, const sim::CrowdState& agents) {
+  CharacterPoses p = poses_of(crowd);
+  p.flags = agents.flags.span();
+  p.visible_bits = sim::kAgentActive;
   return p;
 }
 

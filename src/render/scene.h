@@ -27,6 +27,9 @@ class CrowdAnimator;
 class StreamCrowd;
 struct Rig;
 }  // namespace throng::anim
+namespace throng::sim {
+struct CrowdState;
+}  // namespace throng::sim
 
 namespace throng::render {
 
@@ -153,6 +156,8 @@ struct CharacterPoses {
 
 // The locomotion stage's output: world joint frames, scales, LOD levels.
 CharacterPoses poses_of(const anim::CrowdAnimator& crowd);
+// The same for the simulation's agents: despawned ones are not drawn.
+CharacterPoses poses_of(const anim::CrowdAnimator& crowd, const sim::CrowdState& agents);
 // A stream crowd's palettes (resolved with world positions and yaws).
 CharacterPoses poses_of(const anim::StreamCrowd& crowd, Span<const anim::Mat3x4> palettes);
 

@@ -193,5 +193,27 @@ TEST_F(VideoTest, RecorderWritesNumberedPngFrames) {
   }
 }
 
+// The acceptance: `throng run circle --agents 1000 --render video` writes a
+// playable MP4 of the simulated, animated crowd. Kept short: 2 simulated
+// seconds at 12 fps and 160x90 (1000 agents, 20 steps, 25 frames with the
+// first).
+TEST_F(VideoTest, ThrongRunRendersTheCircleAsAVideo) {
+  const std::string dir = temp_dir("run");
+  const std::string cmd = std::string(THRONG_EXE) + " --threads 2 run circle --agents 1000 --seconds 2 --render video --width 160 --height 90 " +
+                          "--fps 12 --camera orbit --no-trajectories --quiet --out '" + dir + "' 2>&1";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  char buf[512];
+  while (pipe && fgets(buf, sizeof buf, pipe.get()) != nullptr) out += buf;
+  ASSERT_EQ(pclose(pipe.release()), 0) << out;
+  EXPECT_NE(out.find(dir + "/crowd.mp4 (25 frames, 160x90 at 12 fps)"), std::string::npos) << out;
+  const std::string p = probe(dir + "/crowd.mp4");
+  EXPECT_EQ(field(p, "codec_name"), "h264") << p;
+  EXPECT_EQ(field(p, "width"), "160") << p;
+  EXPECT_EQ(field(p, "height"), "90") << p;
+  EXPECT_EQ(field(p, "nb_read_frames"), "25") << p;
+  EXPECT_NEAR(std::stod(field(p, "duration")), 25.0 / 12.0, 0.05) << p;
+}
+
 }  // namespace
 }  // namespace throng::render

@@ -1,12 +1,13 @@
-// Host-side checks of render/agent_motion.h (kernel in agent_motion_kernels.cpp).
+// Host-side checks of anim/between_steps.h (kernel in between_steps_kernels.cpp).
+#include "anim/between_steps.h"
+
 #include <fmt/format.h>
 
 #include <cmath>
 
 #include "core/error.h"
-#include "render/agent_motion.h"
 
-namespace throng::render {
+namespace throng::anim {
 
 void InterpolateAgentsJob::validate() const {
   if (!(alpha >= 0.0f && alpha <= 1.0f)) throw Error("must be within 0..1", at_field("interpolate.alpha"));
@@ -19,6 +20,10 @@ void InterpolateAgentsJob::validate() const {
   check(headings.size(), "interpolate.headings");
   check(out_positions.size(), "interpolate.out_positions");
   check(out_headings.size(), "interpolate.out_headings");
+  if (!out_velocities.empty()) {
+    check(out_velocities.size(), "interpolate.out_velocities");
+    if (!(step_seconds > 0.0f) || !std::isfinite(step_seconds)) throw Error("must be positive seconds", at_field("interpolate.step_seconds"));
+  }
 }
 
-}  // namespace throng::render
+}  // namespace throng::anim
