@@ -19,6 +19,7 @@
 #include "anim/locomotion.h"
 #include "app/commands.h"
 #include "app/formation.h"
+#include "app/locomotion_stats.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/timing.h"
@@ -37,13 +38,6 @@ std::vector<T> to_host(Span<const T> s) {
   std::vector<T> out(static_cast<std::size_t>(s.size()));
   if (s.size() > 0) detail::copy_bytes(out.data(), Memory::Host, s.data(), current_memory(), out.size() * sizeof(T));
   return out;
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size())));
-  return v[std::clamp<std::size_t>(rank, 1, v.size()) - 1];
 }
 
 void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& out_override, float duration_override,
@@ -78,27 +72,13 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
                spec.paper_mode ? "paper" : "continuous", frames, spec.fps);
 
   KernelTimings::global().reset();
-  std::vector<double> frame_ms;
-  std::vector<Index> level_counts, joints_histogram;
-  Index joints_total = 0, from_cache = 0;
-  std::int64_t stored = 0;
+  LocomotionTally tally;
   auto last_report = std::chrono::steady_clock::now();
   for (std::int64_t f = 0; f < frames; ++f) {
     const Camera camera = orbit_camera(orbit, lens, static_cast<float>(f) * dt);
     const auto t0 = std::chrono::steady_clock::now();
     const anim::FrameStats& s = formation_crowd.advance(dt, spec.lod ? &camera : nullptr);
-    frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    joints_total += s.joints_synthesised;
-    from_cache += s.from_cache;
-    stored += s.cycles_stored;
-    if (s.lod) {
-      if (level_counts.empty()) {
-        level_counts.assign(s.lod->level_counts.size(), 0);
-        joints_histogram.assign(s.lod->joints_synthesised.size(), 0);
-      }
-      for (std::size_t i = 0; i < level_counts.size(); ++i) level_counts[i] += s.lod->level_counts[i];
-      for (std::size_t i = 0; i < joints_histogram.size(); ++i) joints_histogram[i] += s.lod->joints_synthesised[i];
-    }
+    tally.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(2)) {
       spdlog::info("frame {}/{} ({:.0f}%)", f + 1, frames, 100.0 * static_cast<double>(f + 1) / static_cast<double>(frames));
@@ -114,10 +94,10 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
       drift = std::max(drift, std::abs(static_cast<double>(std::hypot(at[i].x, at[i].z)) - formation.rings[i]));
   }
   const motion::FootSkatingReport skate = crowd.foot_skating();
-  const double median = percentile(frame_ms, 0.5);
-  double mean = 0.0;
-  for (double m : frame_ms) mean += m / static_cast<double>(frame_ms.size());
-  const double character_frames = static_cast<double>(n) * static_cast<double>(frames);
+  const nlohmann::json frame_ms = tally.frame_ms_json();
+  const double median = frame_ms["median"].get<double>();
+  const double mean = frame_ms["mean"].get<double>();
+  const double character_frames = tally.character_frames();
 
   nlohmann::json stats;
   stats["scenario"] = {{"name", spec.name}, {"source", spec.source}, {"shape", spec.shape == io::AnimateSpec::Shape::Circle ? "circle" : "grid"}};
@@ -132,38 +112,15 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
   for (const motion::LocomotionClip& c : space.clips())
     clips.push_back({{"name", c.name}, {"speed_mps", c.speed}, {"stride_m", c.stride_m}, {"period_s", c.period_s}, {"frames", c.frame_count()}});
   stats["blend_space"] = clips;
-  stats["frame_ms"] = {{"median", median}, {"mean", mean}, {"p95", percentile(frame_ms, 0.95)},
-                       {"max", *std::max_element(frame_ms.begin(), frame_ms.end())}};
+  stats["frame_ms"] = frame_ms;
   stats["characters_per_second"] = median > 0.0 ? static_cast<double>(n) / (median / 1000.0) : 0.0;
   stats["timings"] = nlohmann::json::parse(KernelTimings::global().json());
-  stats["joints_synthesised_per_character"] = static_cast<double>(joints_total) / character_frames;
-  if (!level_counts.empty()) {
-    const anim::LodConfig& lod = *crowd.lod_config();
-    nlohmann::json parts;
-    for (anim::BodyPart p : anim::kAllBodyParts) {
-      std::vector<Index> levels;
-      for (int l = 0; l < lod.level_count; ++l) levels.push_back(level_counts[static_cast<std::size_t>(static_cast<int>(p) * lod.level_count + l)]);
-      parts[anim::to_string(p)] = levels;
-    }
-    stats["lod"] = {{"thresholds_px2", spec.lod_thresholds},
-                    {"levels", lod.level_count},
-                    {"character_frames_per_level", parts},
-                    {"joints_synthesised_histogram", joints_histogram}};
-  }
-  if (const anim::CycleCacheTable* cache = crowd.cache()) {
-    const anim::MotionCacheStats& c = cache->cache().stats();
-    const anim::QuantisationError q = cache->quantisation_error();
-    stats["cache"] = {{"bucket_width", spec.bucket_width},
-                      {"capacity_bytes", cache->cache().config().capacity_bytes},
-                      {"hits", c.hits},
-                      {"misses", c.misses},
-                      {"insertions", c.insertions},
-                      {"evictions", c.evictions},
-                      {"bytes", c.bytes},
-                      {"entries", c.entries},
-                      {"hit_rate", c.hit_rate()},
-                      {"from_cache_fraction", static_cast<double>(from_cache) / character_frames},
-                      {"quantisation_error_deg", {{"max", q.max_deg}, {"mean", q.mean_deg}}}};
+  stats["joints_synthesised_per_character"] = static_cast<double>(tally.joints_synthesised) / character_frames;
+  if (nlohmann::json lod = tally.lod_json(crowd, spec.lod_thresholds); !lod.is_null()) stats["lod"] = lod;
+  if (nlohmann::json cache = tally.cache_json(crowd); !cache.is_null()) {
+    const anim::QuantisationError q = crowd.cache()->quantisation_error();
+    cache["quantisation_error_deg"] = {{"max", q.max_deg}, {"mean", q.mean_deg}};
+    stats["cache"] = cache;
   }
   stats["foot_skating_cm"] = {{"mean", skate.mean_cm}, {"p95", skate.p95_cm}, {"max", skate.max_cm}, {"contacts", skate.contacts},
                               {"characters", tracked.size()}};
@@ -183,7 +140,7 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
               spec.paper_mode ? "paper" : "continuous", to_string(current_backend()), current_threads());
   std::printf("  locomotion frame: median %.3f ms, mean %.3f ms (%.3g characters/s)\n", median, mean,
               static_cast<double>(stats["characters_per_second"]));
-  std::printf("  joints synthesised: %.1f of %d per character%s\n", static_cast<double>(joints_total) / character_frames, space.joint_count(),
+  std::printf("  joints synthesised: %.1f of %d per character%s\n", static_cast<double>(tally.joints_synthesised) / character_frames, space.joint_count(),
               spec.lod ? " (joint LOD)" : "");
   if (stats.contains("cache"))
     std::printf("  cache: %.1f%% hits, %lld cycles held (%.2f MB), %lld evictions, quantisation error max %.2f deg, mean %.3f deg\n",

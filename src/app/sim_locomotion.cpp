@@ -6,6 +6,7 @@
 #include <random>
 
 #include "anim/between_steps.h"
+#include "app/locomotion_stats.h"
 #include "core/error.h"
 #include "core/ground.h"
 #include "core/timing.h"
@@ -19,13 +20,6 @@ namespace {
 // joint of every frame, so long runs are measured in windows (a contact cut
 // by a window's end counts as two shorter ones).
 constexpr std::int32_t kSkatingWindow = 600;
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size())));
-  return v[std::clamp<std::size_t>(rank, 1, v.size()) - 1];
-}
 
 std::vector<Index> tracked_agents(Index n, Index wanted) {
   std::vector<Index> out;
@@ -102,17 +96,7 @@ const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim
   between.run();
   crowd_->drive_from_map(shown_positions_.span(), moving ? moved_.span() : still_.span(), shown_headings_.span());
   const anim::FrameStats& s = crowd_->animate({dt, camera, false});
-  frame_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-
-  ++frames_;
-  joints_total_ += s.joints_synthesised;
-  from_cache_ += s.from_cache;
-  if (s.lod) {
-    level_counts_.resize(s.lod->level_counts.size(), 0);
-    joints_histogram_.resize(s.lod->joints_synthesised.size(), 0);
-    for (std::size_t i = 0; i < level_counts_.size(); ++i) level_counts_[i] += s.lod->level_counts[i];
-    for (std::size_t i = 0; i < joints_histogram_.size(); ++i) joints_histogram_[i] += s.lod->joints_synthesised[i];
-  }
+  tally_.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   // Foot tracking starts with the first frame that moves time on, in windows.
   if (dt > 0.0f && tracked_ > 0 && (skating_frames_ == 0 || skating_frames_ >= kSkatingWindow)) {
     if (skating_frames_ > 0) {
@@ -129,46 +113,22 @@ const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim
 nlohmann::json SimulationLocomotion::stats() const {
   nlohmann::json out;
   const anim::CrowdAnimator& crowd = *crowd_;
-  const double character_frames = static_cast<double>(crowd.count()) * static_cast<double>(std::max<std::int64_t>(1, frames_));
-  double mean = 0.0;
-  for (double m : frame_ms_) mean += m / static_cast<double>(frame_ms_.size());
+  const std::int64_t frames = tally_.frames;
   out["characters"] = crowd.count();
   out["joints"] = crowd.joint_count();
-  out["frames"] = frames_;
-  out["frame_ms"] = {{"median", percentile(frame_ms_, 0.5)}, {"mean", mean}, {"p95", percentile(frame_ms_, 0.95)}};
+  out["frames"] = frames;
+  out["frame_ms"] = tally_.frame_ms_json();
   // The stage's kernels (anim.*): milliseconds per frame.
   nlohmann::json kernels = nlohmann::json::object();
   for (const KernelStat& k : KernelTimings::global().stats())
     if (k.name.rfind("anim.", 0) == 0)
       kernels[k.name] = {{"count", k.count}, {"total_ms", k.total_ms}, {"median_ms", k.median_ms},
-                         {"ms_per_frame", frames_ > 0 ? k.total_ms / static_cast<double>(frames_) : 0.0}};
+                         {"ms_per_frame", frames > 0 ? k.total_ms / static_cast<double>(frames) : 0.0}};
   out["kernels"] = kernels;
-  out["joints_synthesised_per_character"] = static_cast<double>(joints_total_) / character_frames;
-  if (const anim::LodConfig* lod = crowd.lod_config(); lod != nullptr && !level_counts_.empty()) {
-    nlohmann::json parts;
-    for (anim::BodyPart p : anim::kAllBodyParts) {
-      std::vector<Index> levels;
-      for (int l = 0; l < lod->level_count; ++l) levels.push_back(level_counts_[static_cast<std::size_t>(static_cast<int>(p) * lod->level_count + l)]);
-      parts[anim::to_string(p)] = levels;
-    }
-    out["lod"] = {{"thresholds_px2", thresholds_},
-                  {"levels", lod->level_count},
-                  {"character_frames_per_level", parts},
-                  {"joints_synthesised_histogram", joints_histogram_}};
-  }
-  if (const anim::CycleCacheTable* cache = crowd.cache()) {
-    const anim::MotionCacheStats& c = cache->cache().stats();
-    out["cache"] = {{"bucket_width", cache->bucket_width()},
-                    {"capacity_bytes", cache->cache().config().capacity_bytes},
-                    {"hits", c.hits},
-                    {"misses", c.misses},
-                    {"insertions", c.insertions},
-                    {"evictions", c.evictions},
-                    {"bytes", c.bytes},
-                    {"entries", c.entries},
-                    {"hit_rate", c.hit_rate()},
-                    {"from_cache_fraction", static_cast<double>(from_cache_) / character_frames}};
-  }
+  out["joints_synthesised_per_character"] =
+      tally_.character_frames() > 0.0 ? static_cast<double>(tally_.joints_synthesised) / tally_.character_frames() : 0.0;
+  if (nlohmann::json lod = tally_.lod_json(crowd, thresholds_); !lod.is_null()) out["lod"] = lod;
+  if (nlohmann::json cache = tally_.cache_json(crowd); !cache.is_null()) out["cache"] = cache;
   std::vector<double> slides = slides_cm_;
   if (skating_frames_ > 0) {
     const motion::FootSkatingReport r = crowd.foot_skating();

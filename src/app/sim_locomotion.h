@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "anim/locomotion.h"
+#include "app/locomotion_stats.h"
 #include "core/buffer.h"
 #include "core/camera.h"
 #include "motion/locomotion.h"
@@ -57,7 +58,7 @@ class SimulationLocomotion {
   // moving = false shows everyone standing (a finished simulation).
   const anim::FrameStats& animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera, bool moving = true);
 
-  std::int64_t frames() const { return frames_; }
+  std::int64_t frames() const { return tally_.frames; }
   // stats.json's "locomotion" section: frame timings, kernels (anim.*),
   // joint-LOD histogram, cache counters, foot skating (cm: mean, p95).
   nlohmann::json stats() const;
@@ -69,11 +70,7 @@ class SimulationLocomotion {
   Index tracked_ = 0;
   Buffer<glm::vec2> previous_positions_, shown_positions_, moved_, still_;
   Buffer<float> previous_headings_, shown_headings_;
-  // Accumulated over the frames.
-  std::int64_t frames_ = 0;
-  std::vector<double> frame_ms_;
-  std::vector<Index> level_counts_, joints_histogram_;
-  Index joints_total_ = 0, from_cache_ = 0;
+  LocomotionTally tally_;  // over the frames
   std::int32_t skating_frames_ = 0;  // frames in the current foot-tracking window
   std::vector<double> slides_cm_;    // contacts of the windows closed so far
 };

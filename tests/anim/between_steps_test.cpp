@@ -52,22 +52,32 @@ struct Out {
 
 constexpr float kStep = 0.1f;
 
+// A case's arrays in buffers, and the job over them.
+struct Arrays {
+  explicit Arrays(const Case& c)
+      : p0(host(c.p0)), p1(host(c.p1)), out_p(static_cast<Index>(c.p0.size())), out_v(static_cast<Index>(c.p0.size())),
+        h0(host(c.h0)), h1(host(c.h1)), out_h(static_cast<Index>(c.p0.size())) {}
+  InterpolateAgentsJob job(float alpha) {
+    InterpolateAgentsJob j;
+    j.alpha = alpha;
+    j.previous_positions = p0.span();
+    j.positions = p1.span();
+    j.previous_headings = h0.span();
+    j.headings = h1.span();
+    j.out_positions = out_p.span();
+    j.out_headings = out_h.span();
+    j.step_seconds = kStep;
+    j.out_velocities = out_v.span();
+    return j;
+  }
+  Buffer<glm::vec2> p0, p1, out_p, out_v;
+  Buffer<float> h0, h1, out_h;
+};
+
 Out interpolate(const Case& c, float alpha) {
-  const Index n = static_cast<Index>(c.p0.size());
-  Buffer<glm::vec2> p0 = host(c.p0), p1 = host(c.p1), out_p(n), out_v(n);
-  Buffer<float> h0 = host(c.h0), h1 = host(c.h1), out_h(n);
-  InterpolateAgentsJob job;
-  job.alpha = alpha;
-  job.previous_positions = p0.span();
-  job.positions = p1.span();
-  job.previous_headings = h0.span();
-  job.headings = h1.span();
-  job.out_positions = out_p.span();
-  job.out_headings = out_h.span();
-  job.step_seconds = kStep;
-  job.out_velocities = out_v.span();
-  job.run();
-  return {out_p.to_vector(), out_h.to_vector(), out_v.to_vector()};
+  Arrays a(c);
+  a.job(alpha).run();
+  return {a.out_p.to_vector(), a.out_h.to_vector(), a.out_v.to_vector()};
 }
 
 // The heading reached turning from a to b by the smaller angle, a fraction t of the way.
@@ -124,32 +134,23 @@ TEST(InterpolateAgents, SameOnOneTwoAndSevenThreads) {
 }
 
 TEST(InterpolateAgents, BadInputIsAnErrorNamingTheField) {
-  Case c = random_case(4, 1);
-  Buffer<glm::vec2> p0 = host(c.p0), p1 = host(c.p1), out_p(Index{3});
-  Buffer<float> h0 = host(c.h0), h1 = host(c.h1), out_h(Index{4});
-  InterpolateAgentsJob job;
-  job.previous_positions = p0.span();
-  job.positions = p1.span();
-  job.previous_headings = h0.span();
-  job.headings = h1.span();
-  job.out_positions = out_p.span();
-  job.out_headings = out_h.span();
+  Arrays a(random_case(4, 1));
+  InterpolateAgentsJob job = a.job(0.5f);
+  Buffer<glm::vec2> short_output(Index{3});
+  job.out_positions = short_output.span();
   try {
     job.run();
     FAIL() << "a short output was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("interpolate.out_positions"), std::string::npos) << e.what();
   }
-  Buffer<glm::vec2> fine(Index{4});
-  job.out_positions = fine.span();
+  job.out_positions = a.out_p.span();
   for (float bad : {-0.1f, 1.5f, std::nanf("")}) {
     job.alpha = bad;
     EXPECT_THROW(job.run(), Error) << bad;
   }
   job.alpha = 0.5f;
   job.run();
-  Buffer<glm::vec2> velocities(Index{4});
-  job.out_velocities = velocities.span();
   job.step_seconds = 0.0f;  // velocities need the step's length
   EXPECT_THROW(job.run(), Error);
 }
