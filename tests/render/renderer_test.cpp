@@ -137,23 +137,28 @@ TEST_F(RendererTest, CullingCanBeTurnedOff) {
   EXPECT_EQ(stats.visible, 4);
 }
 
+// Each draw tier (fine, coarse, lines) draws every character, in both modes.
 TEST_F(RendererTest, EveryTierDrawsTheCharacters) {
   TPoseCrowd c = crowd();
-  Renderer r(make_joint_rig(c.skeleton));
+  Renderer r(make_crowd_rigs(c.skeleton));
   TPoseCrowd none;
-  const Image empty = draw(r, camera(), none.poses());
-  for (int tier = 0; tier < 3; ++tier) {
-    RenderOptions o;
-    o.fine_min_pixels = tier == 0 ? 0.0f : 1e6f;  // all fine, or none
-    o.lines_max_pixels = tier == 2 ? 1e6f : 0.0f; // all lines, or none
-    RenderStats stats;
-    const Image im = draw(r, camera(), c.poses(), o, &stats);
-    EXPECT_EQ(stats.visible, 3);
-    EXPECT_EQ(stats.fine, tier == 0 ? 3 : 0);
-    EXPECT_EQ(stats.lines, tier == 2 ? 3 : 0);
-    const ImageDifference d = compare_images(im, empty, 20);
-    // Three people of about a hundred pixels each at this distance; lines fewer.
-    EXPECT_GT(d.fraction_differing * im.width * im.height, tier == 2 ? 30.0 : 150.0) << "tier " << tier;
+  for (RenderMode mode : {RenderMode::Joints, RenderMode::Skinned}) {
+    RenderOptions look;
+    look.mode = mode;
+    const Image empty = draw(r, camera(), none.poses(), look);
+    for (int tier = 0; tier < 3; ++tier) {
+      RenderOptions o = look;
+      o.fine_min_pixels = tier == 0 ? 0.0f : 1e6f;   // all fine, or none
+      o.lines_max_pixels = tier == 2 ? 1e6f : 0.0f;  // all lines, or none
+      RenderStats stats;
+      const Image im = draw(r, camera(), c.poses(), o, &stats);
+      EXPECT_EQ(stats.visible, 3);
+      EXPECT_EQ(stats.fine, tier == 0 ? 3 : 0);
+      EXPECT_EQ(stats.lines, tier == 2 ? 3 : 0);
+      const ImageDifference d = compare_images(im, empty, 20);
+      // Three people of about a hundred pixels each at this distance; lines fewer.
+      EXPECT_GT(d.fraction_differing * im.width * im.height, tier == 2 ? 30.0 : 150.0) << to_string(mode) << " tier " << tier;
+    }
   }
 }
 
@@ -441,27 +446,6 @@ TEST_F(RendererTest, GpuSkinningMatchesTheCpuReference) {
   const std::vector<float> agent_yaws(yaws.begin(), yaws.begin() + agents);
   streams.resolve(positions, agent_yaws, resolved.span());
   compare(r.capture_skinned(poses_of(streams, resolved.span()), DrawTier::Fine), resolved.to_vector(), rig.mesh, agents);
-}
-
-TEST_F(RendererTest, SkinnedEveryTierDrawsTheCharacters) {
-  TPoseCrowd c = crowd();
-  Renderer r(make_crowd_rigs(c.skeleton));
-  TPoseCrowd none;
-  RenderOptions skinned;
-  skinned.mode = RenderMode::Skinned;
-  const Image empty = draw(r, camera(), none.poses(), skinned);
-  for (int tier = 0; tier < 3; ++tier) {
-    RenderOptions o = skinned;
-    o.fine_min_pixels = tier == 0 ? 0.0f : 1e6f;
-    o.lines_max_pixels = tier == 2 ? 1e6f : 0.0f;
-    RenderStats stats;
-    const Image im = draw(r, camera(), c.poses(), o, &stats);
-    EXPECT_EQ(stats.visible, 3);
-    EXPECT_EQ(stats.fine, tier == 0 ? 3 : 0);
-    EXPECT_EQ(stats.lines, tier == 2 ? 3 : 0);
-    const ImageDifference d = compare_images(im, empty, 20);
-    EXPECT_GT(d.fraction_differing * im.width * im.height, tier == 2 ? 30.0 : 150.0) << "tier " << tier;
-  }
 }
 
 // A fixed scene against a committed picture, in both modes. Regenerate
