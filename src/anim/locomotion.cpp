@@ -304,6 +304,14 @@ void CrowdAnimator::place(std::span<const glm::vec3> positions, std::span<const 
   blend_speed_ = filled(count_, -1.0f);
 }
 
+void CrowdAnimator::set_lod_thresholds(const std::vector<float>& thresholds) {
+  if (!parts_) throw Error("joint LOD is off for this crowd", at_field("lod.thresholds"));
+  LodConfig config = make_lod_config(*parts_, thresholds);  // validated
+  lod_tables_.emplace(config, current_memory());
+  lod_config_ = std::move(config);
+  config_.lod_thresholds = thresholds;
+}
+
 void CrowdAnimator::set_speeds(std::span<const float> speeds) {
   check_length("CrowdAnimator", "speeds", static_cast<Index>(speeds.size()), count_);
   speed_.copy_from(speeds);

@@ -244,13 +244,20 @@ class CrowdAnimator {
   Span<const float> yaws() const { return yaw_.span(); }
   Span<const float> phases() const { return phase_.span(); }
   Span<const float> blend_speeds() const { return blend_speed_.span(); }
+  Span<const float> scales() const { return scale_.span(); }
   Span<float> speeds() { return speed_.span(); }
   Span<const glm::vec3> joint_positions() const { return joint_position_.span(); }
   Span<const glm::quat> joint_rotations() const { return joint_rotation_.span(); }
   Span<const glm::mat4x3> draw_matrices() const { return draw_.span(); }
   Span<const std::int32_t> evaluated() const { return evaluated_.span(); }
   Span<const std::uint32_t> joint_masks() const { return masks_.span(); }
+  // Joint-LOD level per character and body part (characters * 5, LodJob's
+  // layout); empty without LOD. Written by animate() when given a camera.
+  Span<const std::uint8_t> lod_levels() const { return levels_.span(); }
   const LodConfig* lod_config() const { return lod_config_ ? &*lod_config_ : nullptr; }
+  // New joint-LOD thresholds from the next frame on (a viewer's sliders);
+  // same rules as CrowdAnimatorConfig::lod_thresholds. Needs config().lod.
+  void set_lod_thresholds(const std::vector<float>& thresholds);
   const CycleCacheTable* cache() const { return cache_ ? &*cache_ : nullptr; }
 
   // Foot skating of some characters: their world joints are recorded every

@@ -1,5 +1,7 @@
 // throng run [SCENARIO|NAME]: runs a scenario file or a built-in scenario,
-// writes DIR/trajectories.csv and DIR/stats.json, prints a summary.
+// animates every agent with the locomotion stage (app/sim_locomotion.h),
+// writes DIR/trajectories.csv and DIR/stats.json, with --render a video or
+// PNG frames under the scenario's camera, and prints a summary.
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -9,9 +11,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <limits>
+#include <memory>
 #include <optional>
 
 #include "app/commands.h"
+#include "app/sim_locomotion.h"
 #include "core/error.h"
 #include "core/exec.h"
 #include "core/timing.h"
@@ -19,6 +25,11 @@
 #include "io/scenario_yaml.h"
 #include "sim/frame_loop.h"
 #include "sim/metrics_stage.h"
+
+#if defined(THRONG_HAVE_RENDER)
+#include "render/camera_path.h"
+#include "render/recorder.h"
+#endif
 
 namespace throng::app {
 
@@ -58,7 +69,31 @@ struct RunOptions {
   std::int64_t every = 0;
   bool no_trajectories = false;
   bool quiet = false;
+  // Locomotion: on by default up to kAnimateUpTo agents.
+  bool animate = false;
+  bool no_animate = false;
+  bool no_lod = false;
+  std::vector<float> lod_thresholds;
+  // Rendering (video or frames) under the scenario's camera.
+  std::string render;
+  bool no_render = false;
+  std::string render_mode = "skinned";
+  std::int32_t width = 640;
+  std::int32_t height = 360;
+  double fps = 24.0;
+  double render_speed = 1.0;    // simulated seconds per video second
+  double render_seconds = 0.0;  // simulated seconds rendered; 0 = the whole run
+  std::string camera;           // fixed | orbit | flyover; empty = the scenario's, else orbit
+  double camera_period = 0.0;   // video seconds per orbit or fly-over; 0 = the scenario's, else 40
+  bool demo = false;            // no scenario named: the built-in demo
 };
+
+// Above this many agents `throng run` leaves the locomotion stage off unless
+// --animate asks for it (docs/render.md: its cost per agent and frame).
+constexpr std::int64_t kAnimateUpTo = 200000;
+
+// The demo (`throng run` with no scenario) writes a short time-lapse video.
+constexpr double kDemoRenderSpeed = 50.0;
 
 // A bar redrawn in place on a terminal; a plain line every 10% (or 10 s) otherwise.
 class Progress {
@@ -126,6 +161,14 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
   std::printf("  ms per step: %.3f (bin %.3f, %s %.3f, move %.3f)\n", stats["timings"]["step_ms"].get<double>(), stage_ms(stats, "sim.bin"),
               colour ? "sense+steer" : "sense", colour ? stage_ms(stats, "sim.sense_steer") : stage_ms(stats, "sim.sense"),
               stage_ms(stats, "sim.move"));
+  if (stats.contains("locomotion")) {
+    const auto& l = stats["locomotion"];
+    std::printf("  locomotion: %lld frames, median %.3f ms per frame; joints synthesised %.1f of %d per agent", l["frames"].get<long long>(),
+                l["frame_ms"]["median"].get<double>(), l["joints_synthesised_per_character"].get<double>(), l["joints"].get<int>());
+    if (l.contains("cache")) std::printf("; cache hits %.1f%%", 100.0 * l["cache"]["hit_rate"].get<double>());
+    std::printf("\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts\n", l["foot_skating_cm"]["mean"].get<double>(),
+                l["foot_skating_cm"]["p95"].get<double>(), l["foot_skating_cm"]["contacts"].get<int>());
+  }
   if (!written.empty()) std::printf("  wrote %s\n", written.c_str());
 }
 
@@ -166,6 +209,72 @@ void run_scenario(const RunOptions& o) {
     written = dir + "/trajectories.csv";
   }
 
+  const Index n = sim->agent_count();
+  if (o.no_animate && !o.render.empty()) throw Error("--render draws the animated agents: drop --no-animate", at_field("--render"));
+  const bool animate = !o.no_animate && (o.animate || !o.render.empty() || n <= kAnimateUpTo);
+  if (!animate && !o.no_animate)
+    std::fprintf(stderr, "throng run: %lld agents: locomotion off above %lld agents (--animate turns it on; see docs/render.md for its cost)\n",
+                 static_cast<long long>(n), static_cast<long long>(kAnimateUpTo));
+  std::function<std::string()> finish_render;  // ends the video; returns what it wrote
+  if (animate) {
+    LocomotionStageOptions lo;
+    lo.locomotion.lod_thresholds = o.lod_thresholds;
+    const Camera lod_camera = scenario_camera(*sim);  // the camera that renders is the one LOD measures with
+    lo.camera = [lod_camera](double) { return lod_camera; };
+    lo.lod = !o.no_lod;
+    if (!o.render.empty()) {
+#if defined(THRONG_HAVE_RENDER)
+      render::RecordSpec record;
+      record.output = render::parse_record_output(o.render, "--render");
+      record.folder = dir;
+      record.width = o.width;
+      record.height = o.height;
+      record.fps = o.fps;
+      record.options.mode = render::parse_render_mode(o.render_mode, "--render-mode");
+      record.validate();
+      Camera start = lod_camera;
+      start.width = o.width;
+      start.height = o.height;
+      // --camera, else the scenario's camera.motion, else an orbit.
+      const std::string motion = !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : "orbit");
+      const double period = o.camera_period > 0.0 ? o.camera_period : (spec.camera_period_s > 0.0f ? spec.camera_period_s : 40.0);
+      const auto path = std::make_shared<render::CameraPath>(
+          render::animate_camera(start, render::parse_camera_kind(motion, "--camera"), static_cast<float>(period)));
+      const double speed = o.render_speed;
+      lo.camera = [path, speed](double t) { return path->at(t / speed); };
+      // A video frame every `speed / fps` simulated seconds; the animation
+      // runs at least once a step (feet stay planted in a time-lapse) and
+      // every `per_video`-th frame is drawn.
+      const double frame_time = speed / o.fps;
+      const auto per_video = std::max<std::int64_t>(1, std::llround(frame_time / static_cast<double>(spec.dt)));
+      lo.fps = static_cast<double>(per_video) / frame_time;
+      const double until = o.render_seconds > 0.0 ? o.render_seconds : std::numeric_limits<double>::infinity();
+      auto recorder = std::make_shared<std::unique_ptr<render::Recorder>>();
+      const sim::Simulation* simulation = sim.get();
+      lo.on_frame = [recorder, record, per_video, until, simulation, anim_fps = lo.fps](double t, const Camera* camera, SimulationLocomotion& moved) {
+        if (std::llround(t * anim_fps) % per_video != 0 || t > until + 1e-9) return;
+        ScopedTimer timer("render.frame");
+        if (!*recorder) {
+          *recorder = std::make_unique<render::Recorder>(record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
+          (*recorder)->set_world(simulation->world());
+        }
+        (*recorder)->add_frame(*camera, render::poses_of(moved.animator(), simulation->crowd()));
+      };
+      finish_render = [recorder, record] {
+        if (!*recorder) return std::string();
+        const Index frames = (*recorder)->frames();
+        const std::string wrote = (*recorder)->finish();
+        return fmt::format("{} ({} frames, {}x{} at {:g} fps)", wrote, frames, record.width, record.height, record.fps);
+      };
+      std::fprintf(stderr, "throng run: rendering %s (%s, %dx%d, %g fps, %gx speed) into %s\n", o.render.c_str(), o.render_mode.c_str(), o.width,
+                   o.height, o.fps, speed, dir.c_str());
+#else
+      throw Error("this build has no renderer (configured with -DTHRONG_RENDER=OFF)", at_field("--render"));
+#endif
+    }
+    loop.emplace<LocomotionStage>(*sim, std::move(lo));
+  }
+
   Progress progress(max_steps, sim->agent_count(), o.quiet);
   sim::RunControl control;
   control.max_steps = max_steps;
@@ -180,6 +289,10 @@ void run_scenario(const RunOptions& o) {
 
   nlohmann::json stats;
   loop.finish(stats);
+  if (finish_render) {
+    const std::string rendered = finish_render();
+    if (!rendered.empty()) written += (written.empty() ? "" : ", ") + rendered;
+  }
   stats["scenario"] = {{"name", spec.name}, {"description", spec.description}, {"source", loaded.source.file}, {"groups", nlohmann::json::array()}};
   for (const sim::GroupSpec& g : spec.groups) stats["scenario"]["groups"].push_back({{"name", g.name}, {"count", g.count}});
   if (spec.outputs.stats) {
@@ -214,7 +327,38 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-trajectories", o.no_trajectories, "Do not write trajectories.csv");
   cmd->add_flag("--quiet", o.quiet, "No progress display");
-  cmd->callback([&g] {
+  auto* no_animate = cmd->add_flag("--no-animate", o.no_animate, "Skip the locomotion stage (agents are not animated)");
+  cmd->add_flag("--animate", o.animate, fmt::format("Animate even above {} agents", kAnimateUpTo))->excludes(no_animate);
+  cmd->add_option("--render", o.render, "Write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames) under the scenario's camera")
+      ->check(CLI::IsMember({"video", "frames"}));
+  cmd->add_flag("--no-lod", o.no_lod, "Synthesise every joint of every agent (no joint LOD)");
+  cmd->add_option("--lod-thresholds", o.lod_thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
+  cmd->add_flag("--no-render", o.no_render, "The demo: do not write its video");
+  cmd->add_option("--render-mode", o.render_mode, "skinned (the mannequin) or joints (a sphere per bone)")
+      ->check(CLI::IsMember({"skinned", "joints"}))
+      ->capture_default_str();
+  cmd->add_option("--width", o.width, "Video width, pixels")->check(CLI::Range(16, 7680))->capture_default_str();
+  cmd->add_option("--height", o.height, "Video height, pixels")->check(CLI::Range(16, 4320))->capture_default_str();
+  cmd->add_option("--fps", o.fps, "Video frames per second")->check(CLI::Range(1.0, 240.0))->capture_default_str();
+  auto* speed = cmd->add_option("--render-speed", o.render_speed, "Simulated seconds per video second (time-lapse above 1)")
+                    ->check(CLI::Range(0.01, 1000.0))
+                    ->capture_default_str();
+  cmd->add_option("--render-seconds", o.render_seconds, "Render the first S simulated seconds only (default: the whole run)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--camera", o.camera, "The scenario's camera kept fixed, orbiting its target, or flying over it (default: the scenario's camera.motion, else orbit)")
+      ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
+  cmd->add_option("--camera-period", o.camera_period, "Video seconds per orbit or fly-over (default: the scenario's, else 40)")
+      ->check(CLI::PositiveNumber);
+  cmd->callback([&g, cmd, speed] {
+    // The built-in demo (no scenario named) writes a short time-lapse video.
+    // (A build without the renderer runs it without a video.)
+    o.demo = cmd->get_option("scenario")->count() == 0;
+#if defined(THRONG_HAVE_RENDER)
+    if (o.demo && o.render.empty() && !o.no_render && !o.no_animate) {
+      o.render = "video";
+      if (speed->count() == 0) o.render_speed = kDemoRenderSpeed;
+    }
+#endif
     apply_global_options(g);
     run_scenario(o);
   });

@@ -1,27 +1,173 @@
-// throng view: the interactive viewer (render/viewer.h).
+// throng view [SCENARIO|NAME]: the interactive viewer (render/viewer.h), or
+// with --headless a video or screenshot of the same, on characters animated
+// by the locomotion stage: a scenario run by the crowd simulation (a file or
+// a built-in, as `throng run` takes them), or the formation of `throng
+// animate` (`formation`, or an animate file).
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "app/commands.h"
+#include "app/formation.h"
 #include "core/error.h"
+#include "io/scenario_yaml.h"
 
 #if defined(THRONG_HAVE_RENDER)
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <optional>
+
+#include "app/sim_locomotion.h"
+#include "core/ground.h"
+#include "render/renderer.h"
 #include "render/viewer.h"
+#include "sim/simulation.h"
 #endif
 
 namespace throng::app {
+
+#if defined(THRONG_HAVE_RENDER)
+namespace {
+
+// A formation walking (rings or a grid), pillars around it, the rings as paths.
+class FormationScene final : public render::ViewerScene {
+ public:
+  FormationScene(io::AnimateSpec spec, const std::filesystem::path& folder) : crowd_(std::move(spec), folder) {}
+  std::string title() const override { return "throng: " + crowd_.spec().name; }
+  anim::CrowdAnimator& animator() override { return crowd_.animator(); }
+  void advance(double dt, const Camera& camera) override { crowd_.advance(static_cast<float>(dt), crowd_.spec().lod ? &camera : nullptr); }
+  glm::vec3 centre() const override { return glm::vec3(0.0f); }
+  float extent() const override { return crowd_.formation().extent; }
+  std::string status() const override { return fmt::format("formation, {:.1f} s", crowd_.time()); }
+  void decorate(render::Renderer& renderer) const override {
+    const float extent = crowd_.formation().extent;
+    std::vector<sim::Circle> pillars;
+    for (int k = 0; k < 8; ++k) {
+      const float a = 6.2831853f * static_cast<float>(k) / 8.0f;
+      pillars.push_back({(extent + 4.0f) * glm::vec2(std::cos(a), std::sin(a)), 1.2f});
+    }
+    renderer.set_obstacles({}, pillars, render::ObstacleStyle{});
+    const io::AnimateSpec& s = crowd_.spec();
+    if (s.shape != io::AnimateSpec::Shape::Circle) return;
+    std::vector<render::MapPolyline> rings;
+    for (float r = s.radius; r <= extent + 1e-3f; r += s.ring_spacing) {
+      render::MapPolyline ring;
+      for (int k = 0; k <= 96; ++k) {
+        const float a = 6.2831853f * static_cast<float>(k) / 96.0f;
+        ring.push_back(r * glm::vec2(std::cos(a), std::sin(a)));
+      }
+      rings.push_back(ring);
+    }
+    renderer.set_paths(rings);
+  }
+
+ private:
+  FormationCrowd crowd_;
+};
+
+// A scenario run by the crowd simulation, one step of dt whenever the
+// shown time passes it, agents interpolated between steps and animated by
+// the locomotion stage as `throng run` animates them (app/sim_locomotion.h).
+class SimulationScene final : public render::ViewerScene {
+ public:
+  SimulationScene(const io::LoadedScenario& loaded, const std::vector<float>& lod_thresholds)
+      : sim_(io::build_simulation(loaded)), locomotion_(*sim_, locomotion_options(lod_thresholds)), camera_(scenario_camera(*sim_)) {
+    max_steps_ = sim_->spec().step_count();
+    sim::Aabb box = sim_->world().bounds();
+    for (const glm::vec2& p : sim_->positions()) box.add(p);
+    if (box.empty()) box.add(glm::vec2(0.0f));
+    centre_ = world_from_ground(0.5f * (box.min + box.max));
+    extent_ = std::max(5.0f, 0.5f * glm::length(box.max - box.min));
+  }
+  std::string title() const override { return "throng: " + sim_->spec().name; }
+  anim::CrowdAnimator& animator() override { return locomotion_.animator(); }
+  std::optional<Camera> camera() const override { return camera_; }
+  float bin_size() const override { return sim_->bins().cell_size(); }
+  glm::vec3 centre() const override { return centre_; }
+  float extent() const override { return extent_; }
+  std::string status() const override {
+    return fmt::format("{}: step {}, {:.1f} s simulated, arrived {}/{}{}", sim_->spec().name, sim_->steps_done(), sim_->time(),
+                       sim_->arrived_count(), sim_->agent_count(), finished_ ? " (ended)" : "");
+  }
+  render::CharacterPoses poses() override { return render::poses_of(locomotion_.animator(), sim_->crowd()); }
+  void decorate(render::Renderer& renderer) const override { render::show_world(renderer, sim_->world()); }
+  void advance(double dt, const Camera& camera) override {
+    const double step = static_cast<double>(sim_->spec().dt);
+    shown_ += dt;
+    while (!finished_ && sim_->time() < shown_) {
+      locomotion_.remember(*sim_);
+      sim_->step();
+      finished_ = sim_->steps_done() >= max_steps_ || (sim_->spec().stop_when_arrived && sim_->all_arrived());
+    }
+    if (finished_) shown_ = std::min(shown_, sim_->time());
+    const double alpha = std::clamp(1.0 - (sim_->time() - shown_) / step, 0.0, 1.0);
+    locomotion_.animate(*sim_, static_cast<float>(alpha), static_cast<float>(dt), &camera, !finished_);
+  }
+
+ private:
+  static LocomotionOptions locomotion_options(const std::vector<float>& thresholds) {
+    LocomotionOptions o;
+    o.lod_thresholds = thresholds;
+    o.skating_agents = 0;  // measured by throng run, not here
+    return o;
+  }
+
+  std::unique_ptr<sim::Simulation> sim_;
+  SimulationLocomotion locomotion_;
+  Camera camera_;
+  std::int64_t max_steps_ = 0;
+  bool finished_ = false;
+  double shown_ = 0.0;  // simulated seconds on screen
+  glm::vec3 centre_{0.0f};
+  float extent_ = 10.0f;
+};
+
+// An animate scenario (a formation) rather than a simulation scenario: the
+// built-in `formation`, or a file whose top level has a `formation` key.
+bool is_formation(const std::string& what) {
+  for (const std::string& name : io::builtin_animate_specs())
+    if (what == name) return true;
+  std::ifstream in(what);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("formation:", 0) == 0) return true;
+  return false;
+}
+
+}  // namespace
+#endif
 
 void add_view_command(CLI::App& app, const GlobalOptions& g) {
   auto* cmd = app.add_subcommand("view", "Open the viewer: the crowd in a window, orbit/pan/zoom, LOD panel");
 #if defined(THRONG_HAVE_RENDER)
   static render::ViewerOptions o;
-  static std::string layout = "ring";
-  static Index agents = 400;
-  cmd->add_option("--agents", agents, "Characters in the demo crowd")->check(CLI::Range(Index{0}, Index{1} << 24));
-  cmd->add_option("--layout", layout, "Demo crowd layout: ring (walking round rings) or grid")->check(CLI::IsMember({"ring", "grid"}));
-  cmd->add_option("--seed", o.crowd.seed, "Seed of the demo crowd");
+  static std::string scenario = "circle";
+  static std::string layout;
+  static std::string mode = "skinned";
+  static Index agents = 0;
+  static std::vector<float> thresholds;
+  static bool headless = false;
+  static std::string render_output;
+  static std::string out_dir = "out/view";
+  static double fps = 30.0;
+  static std::string camera_kind;  // empty: the scenario's camera.motion, else orbit
+  static float camera_period = 0.0f;
+  std::string names;
+  for (const std::string& n : io::builtin_scenario_names()) names += n + ", ";
+  cmd->add_option("scenario", scenario, "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
+      ->capture_default_str();
+  cmd->add_option("--agents", agents, "How many agents (groups keep their proportions)")->check(CLI::Range(Index{1}, Index{1} << 24));
+  cmd->add_option("--layout", layout, "For formation: ring (walking round rings) or grid")
+      ->check(CLI::IsMember({"ring", "grid"}));
+  cmd->add_option("--mode", mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")->check(CLI::IsMember({"skinned", "joints"}));
+  cmd->add_flag("!--no-lod-colours", o.lod_colours, "Clothing colours instead of joint-LOD levels (L toggles)");
   cmd->add_option("--width", o.width, "Window width, pixels");
   cmd->add_option("--height", o.height, "Window height, pixels");
   cmd->add_option("--frames", o.frames, "Quit after this many frames, at 1/30 s each (0 = when closed)");
@@ -29,15 +175,66 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--speed", o.speed, "Animation speed factor");
   cmd->add_flag("--paused", o.paused, "Start paused (space toggles, period steps)");
   cmd->add_flag("!--no-panel", o.panel, "Hide the ImGui panel");
-  cmd->add_flag("--bins", o.bins, "Show agents per 4 m cell as a heat map");
-  cmd->add_option("--lod-thresholds", o.lod_thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")
-      ->delimiter(',');
+  cmd->add_flag("--bins", o.bins, "Show agents per cell (the simulation's bins; 4 m for the formation) as a heat map");
+  cmd->add_flag("--headless", headless, "No window: render --frames frames offscreen (EGL), for videos and screenshots");
+  cmd->add_option("--render", render_output, "With --headless: write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames)")
+      ->check(CLI::IsMember({"video", "frames"}));
+  cmd->add_option("--out", out_dir, "Folder for --render (default out/view)");
+  cmd->add_option("--fps", fps, "With --headless: frames per second of the video")->check(CLI::Range(1.0, 240.0));
+  cmd->add_option("--camera", camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over (default: the scenario's camera.motion, else orbit)")
+      ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
+  cmd->add_option("--camera-period", camera_period, "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")->check(CLI::PositiveNumber);
+  cmd->add_option("--lod-thresholds", thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
   cmd->callback([&g] {
-    apply_global_options(g);
-    o.crowd.characters = agents;
-    o.crowd.layout = render::parse_demo_layout(layout, "--layout");
     if (!o.screenshot.empty() && o.frames == 0) throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
-    const render::ViewerResult r = render::run_viewer(o);
+    if (headless && o.frames == 0) throw Error("--headless needs --frames N", at_field("--frames"));
+    for (std::size_t i = 0; i < thresholds.size(); ++i)
+      if (!(thresholds[i] > 0.0f) || !std::isfinite(thresholds[i]) || (i > 0 && !(thresholds[i] < thresholds[i - 1])))
+        throw Error("thresholds must be positive and decreasing", at_field("--lod-thresholds"));
+    if (!render_output.empty() && !headless) throw Error("--render needs --headless", at_field("--render"));
+    if (headless && render_output.empty() && o.screenshot.empty())
+      throw Error("--headless writes nothing without --render or --screenshot", at_field("--headless"));
+    o.mode = render::parse_render_mode(mode, "--mode");
+    // A bad name or file fails before any window opens.
+    std::unique_ptr<render::ViewerScene> scene;
+    if (is_formation(scenario)) {
+      std::filesystem::path folder;
+      io::AnimateSpec spec = load_animate_spec(scenario, folder);
+      if (agents > 0) spec.characters = agents;
+      if (!layout.empty()) spec.shape = layout == "grid" ? io::AnimateSpec::Shape::Grid : io::AnimateSpec::Shape::Circle;
+      if (!thresholds.empty()) spec.lod_thresholds = thresholds;
+      apply_global_options(g);
+      scene = std::make_unique<FormationScene>(std::move(spec), folder);
+    } else {
+      if (!layout.empty()) throw Error("--layout is for the formation", at_field("--layout"));
+      io::LoadedScenario loaded = io::load_scenario(scenario);
+      if (agents > 0) sim::scale_agent_counts(loaded.spec, agents);
+      apply_global_options(g);
+      scene = std::make_unique<SimulationScene>(loaded, thresholds);
+      if (camera_kind.empty()) camera_kind = loaded.spec.camera_motion;
+      if (!(camera_period > 0.0f)) camera_period = loaded.spec.camera_period_s;
+    }
+    if (headless) {
+      render::HeadlessViewOptions h;
+      h.record.output = render_output.empty() ? render::RecordOutput::None : render::parse_record_output(render_output, "--render");
+      h.record.folder = out_dir;
+      h.record.width = o.width;
+      h.record.height = o.height;
+      h.record.fps = fps;
+      h.record.options.mode = o.mode;
+      h.record.options.lod_colours = o.lod_colours;
+      h.record.options.bins = false;
+      h.frames = o.frames;
+      h.screenshot = o.screenshot;
+      h.speed = o.speed;
+      h.camera_kind = render::parse_camera_kind(camera_kind.empty() ? "orbit" : camera_kind, "--camera");
+      h.camera_period = camera_period > 0.0f ? camera_period : 60.0f;
+      const render::HeadlessViewResult r = render::record_view(*scene, h);
+      if (!r.output.empty()) std::printf("view: %lld frames in %s\n", static_cast<long long>(r.frames), r.output.c_str());
+      if (!h.screenshot.empty()) std::printf("view: screenshot %s\n", h.screenshot.c_str());
+      return;
+    }
+    const render::ViewerResult r = render::run_viewer(*scene, o);
     if (!o.screenshot.empty()) spdlog::info("view: {} frames, screenshot {}", r.frames, o.screenshot);
   });
 #else

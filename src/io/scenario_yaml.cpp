@@ -451,7 +451,7 @@ class Reader {
   }
 
   Camera camera(const YAML::Node& n, const std::string& path) {
-    expect_map(n, path, {"position", "target", "fov_degrees", "width", "height", "near", "far"});
+    expect_map(n, path, {"position", "target", "fov_degrees", "width", "height", "near", "far", "motion", "period"});
     Camera c;
     const glm::vec3 eye = point3(required(n, path, "position"), child(path, "position"));
     const glm::vec3 target = point3(required(n, path, "target"), child(path, "target"));
@@ -517,7 +517,12 @@ class Reader {
       if (agents > limits_.scenario.max_agents)
         fail(groups[i], item("groups", i), fmt::format("the scenario has more than {} agents", limits_.scenario.max_agents));
     }
-    if (root["camera"]) s.camera = camera(root["camera"], "camera");
+    if (root["camera"]) {
+      s.camera = camera(root["camera"], "camera");
+      const YAML::Node& c = root["camera"];
+      if (c["motion"]) s.camera_motion = word(c["motion"], "camera.motion", {"fixed", "orbit", "flyover"});
+      if (c["period"]) s.camera_period_s = real_in(c["period"], "camera.period", 0.1, 1e6);
+    }
     if (const YAML::Node m = root["measurement"]) {
       const Region r = region(m, "measurement");
       if (r.kind != Region::Kind::rect) fail(m, "measurement", "the measurement area is a rect");

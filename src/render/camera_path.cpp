@@ -41,7 +41,9 @@ void CameraPath::validate() const {
     return;
   }
   Camera probe = lens;
-  probe.position = probe.target + glm::vec3(0.0f, 0.0f, 1.0f);
+  // Away from the target across `up`, so that only the lens is checked.
+  const glm::vec3 across = std::abs(glm::normalize(probe.up).z) < 0.9f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
+  probe.position = probe.target + across;
   probe.validate();  // everything but the placement
   if (kind == Kind::Orbit) {
     const CameraOrbit& o = orbit;
@@ -100,6 +102,41 @@ CameraPath framing_orbit(glm::vec3 centre, float extent, const Camera& lens, flo
   p.orbit.target_height = 0.5f;
   p.orbit.angular_speed = period > 0.0f ? 6.2831853f / period : 0.0f;
   p.orbit.start_angle = 0.6f;
+  return p;
+}
+
+CameraPath animate_camera(const Camera& camera, CameraPath::Kind kind, float period) {
+  camera.validate();
+  if (kind != CameraPath::Kind::Fixed && !(period > 0.0f && std::isfinite(period)))
+    throw Error("must be positive seconds", at_field("camera.period"));
+  CameraPath p;
+  p.kind = kind;
+  p.lens = camera;
+  if (kind == CameraPath::Kind::Fixed) return p;
+  const glm::vec3 centre(camera.target.x, 0.0f, camera.target.z);
+  glm::vec2 offset(camera.position.x - centre.x, camera.position.z - centre.z);
+  const float drop = std::abs(camera.position.y - camera.target.y);
+  if (glm::length(offset) < 0.02f * drop) {
+    // Straight down: tilt towards the image's bottom edge (-up), 2% of the height.
+    const glm::vec2 down(-camera.up.x, -camera.up.z);
+    offset = 0.02f * drop * (glm::length(down) > 0.0f ? glm::normalize(down) : glm::vec2(0.0f, 1.0f));
+  }
+  if (kind == CameraPath::Kind::Orbit) {
+    p.lens.up = glm::vec3(0.0f, 1.0f, 0.0f);  // what orbit_camera uses
+    p.orbit.centre = centre;
+    p.orbit.radius = glm::length(offset);
+    p.orbit.height = camera.position.y;
+    p.orbit.target_height = camera.target.y;
+    p.orbit.angular_speed = 6.2831853f / period;
+    p.orbit.start_angle = std::atan2(-offset.y, offset.x);  // core/camera.h: angle a at (cos a, -sin a)
+    return p;
+  }
+  const glm::vec3 start = centre + glm::vec3(offset.x, camera.position.y, offset.y);
+  const glm::vec3 across = centre + glm::vec3(-offset.x, camera.position.y, -offset.y);
+  const glm::vec3 over = centre + glm::vec3(0.0f, camera.position.y * 1.2f + 2.0f, 0.0f);
+  p.keys = {{0.0f, start, camera.target},
+            {0.5f * period, over + 0.25f * (start - centre) * glm::vec3(1, 0, 1), camera.target - 0.5f * (start - centre) * glm::vec3(1, 0, 1)},
+            {period, across, camera.target}};
   return p;
 }
 

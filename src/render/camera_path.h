@@ -33,6 +33,15 @@ CameraPath::Kind parse_camera_kind(const std::string& text, const std::string& f
 // from above at about 35 degrees, one turn every `period` seconds.
 CameraPath framing_orbit(glm::vec3 centre, float extent, const Camera& lens, float period = 40.0f);
 
+// A scenario's camera (core::Camera, e.g. converted from map coordinates
+// with core/ground.h) set in motion: Fixed keeps it; Orbit circles the
+// ground point under its target at its distance and height, starting where
+// it stands, one turn per `period` seconds (a camera looking straight down
+// is tilted a little, as an orbit needs a horizontal offset); Flyover goes
+// from where it stands over its target to the mirrored point in `period`
+// seconds. At time 0 every kind shows the scenario's camera.
+CameraPath animate_camera(const Camera& camera, CameraPath::Kind kind, float period);
+
 // A fly-over: from one side of the disc, low, over its middle and out high
 // on the other side, in `duration` seconds.
 CameraPath framing_flyover(glm::vec3 centre, float extent, const Camera& lens, float duration = 10.0f);

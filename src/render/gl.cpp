@@ -89,7 +89,8 @@ GlTexture make_texture() {
   return GlTexture(id);
 }
 
-GlProgram make_program(std::string_view name, std::string_view vertex_source, std::string_view fragment_source) {
+GlProgram make_program(std::string_view name, std::string_view vertex_source, std::string_view fragment_source,
+                       std::initializer_list<const char*> feedback) {
   const GLuint vs = compile_shader(name, GL_VERTEX_SHADER, vertex_source);
   GLuint fs = 0;
   try {
@@ -101,6 +102,8 @@ GlProgram make_program(std::string_view name, std::string_view vertex_source, st
   GlProgram program(glCreateProgram());
   glAttachShader(program.get(), vs);
   glAttachShader(program.get(), fs);
+  if (feedback.size() > 0)
+    glTransformFeedbackVaryings(program.get(), static_cast<GLsizei>(feedback.size()), feedback.begin(), GL_INTERLEAVED_ATTRIBS);
   glLinkProgram(program.get());
   glDeleteShader(vs);
   glDeleteShader(fs);

@@ -11,6 +11,7 @@
 #endif
 #include <GL/glcorearb.h>
 
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -78,7 +79,9 @@ GlTexture make_texture();
 
 // Compiles and links a vertex + fragment program; a compile or link error
 // throws Error with the driver's log, naming the program ("render.joints").
-GlProgram make_program(std::string_view name, std::string_view vertex_source, std::string_view fragment_source);
+// `feedback`: vertex outputs captured by transform feedback (interleaved).
+GlProgram make_program(std::string_view name, std::string_view vertex_source, std::string_view fragment_source,
+                       std::initializer_list<const char*> feedback = {});
 
 // Grows `buffer` (GL_DYNAMIC_DRAW) to at least `bytes`; capacity in bytes is
 // kept in `capacity`. Contents are not kept when it grows.

@@ -10,7 +10,14 @@
 
 namespace throng::render {
 
-const char* to_string(RecordOutput o) { return o == RecordOutput::Video ? "video" : "frames"; }
+const char* to_string(RecordOutput o) {
+  switch (o) {
+    case RecordOutput::Video: return "video";
+    case RecordOutput::Frames: return "frames";
+    case RecordOutput::None: return "none";
+  }
+  return "?";
+}
 
 RecordOutput parse_record_output(const std::string& text, const std::string& field) {
   if (text == "video") return RecordOutput::Video;
@@ -19,7 +26,7 @@ RecordOutput parse_record_output(const std::string& text, const std::string& fie
 }
 
 void RecordSpec::validate() const {
-  if (folder.empty()) throw Error("no output folder", at_field("render.folder"));
+  if (folder.empty() && output != RecordOutput::None) throw Error("no output folder", at_field("render.folder"));
   if (output == RecordOutput::Video) {
     VideoSpec v;
     v.path = folder + "/" + video_name;
@@ -39,6 +46,7 @@ void RecordSpec::validate() const {
     throw Error(fmt::format("{}x{} is outside 1..16384", width, height), at_field("render.width"));
   }
   if (samples < 0 || samples > 16) throw Error("must be within 0..16", at_field("render.samples"));
+  options.validate();
 }
 
 struct Recorder::State {
@@ -49,16 +57,18 @@ struct Recorder::State {
   std::unique_ptr<VideoWriter> video;
   Image frame;
   Index frames = 0;
-  State(const RecordSpec& s, const JointRig& rig)
-      : spec(s), context(s.context), target(s.width, s.height, s.samples), renderer(rig) {}
+  State(const RecordSpec& s, const CrowdRigs& rigs)
+      : spec(s), context(s.context), target(s.width, s.height, s.samples), renderer(rigs) {}
 };
 
-Recorder::Recorder(const RecordSpec& spec, const JointRig& rig) {
+Recorder::Recorder(const RecordSpec& spec, const JointRig& rig) : Recorder(spec, CrowdRigs{rig, {}}) {}
+
+Recorder::Recorder(const RecordSpec& spec, const CrowdRigs& rigs) {
   spec.validate();
   std::error_code ec;
-  std::filesystem::create_directories(spec.folder, ec);
+  if (spec.output != RecordOutput::None) std::filesystem::create_directories(spec.folder, ec);
   if (ec) throw Error(fmt::format("cannot create the folder: {}", ec.message()), at_field(spec.folder));
-  s_ = std::make_unique<State>(spec, rig);
+  s_ = std::make_unique<State>(spec, rigs);
   if (spec.output == RecordOutput::Video) {
     VideoSpec v;
     v.path = (std::filesystem::path(spec.folder) / spec.video_name).string();
@@ -77,6 +87,22 @@ const HeadlessContext& Recorder::context() const { return s_->context; }
 const Image& Recorder::last_frame() const { return s_->frame; }
 Index Recorder::frames() const { return s_->frames; }
 
+void show_world(Renderer& renderer, const sim::World& world, const ObstacleStyle& style) {
+  renderer.set_obstacles(world.polygons(), world.circles(), style);
+  if (world.has_walkable()) {
+    MapPolyline boundary(world.walkable().outer.begin(), world.walkable().outer.end());
+    if (!boundary.empty()) boundary.push_back(boundary.front());
+    renderer.set_paths({boundary});
+  }
+}
+
+void Recorder::set_world(const sim::World& world, const ObstacleStyle& style) {
+  s_->context.make_current();
+  show_world(s_->renderer, world, style);
+}
+
+RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses) { return add_frame(camera, poses, s_->spec.options); }
+
 RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options) {
   State& s = *s_;
   s.context.make_current();
@@ -88,7 +114,7 @@ RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& pose
   s.target.read_into(s.frame);
   if (s.video) {
     s.video->write(s.frame);
-  } else {
+  } else if (s.spec.output == RecordOutput::Frames) {
     const auto path = std::filesystem::path(s.spec.folder) / fmt::format("{}{:05d}.png", s.spec.frame_prefix, s.frames);
     write_png(path.string(), s.frame);
   }
@@ -101,7 +127,7 @@ std::string Recorder::finish() {
     s_->video->finish();
     return s_->video->spec().path;
   }
-  return s_->spec.folder;
+  return s_->spec.output == RecordOutput::Frames ? s_->spec.folder : std::string();
 }
 
 }  // namespace throng::render

@@ -5,8 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "anim/locomotion.h"
 #include "anim/lod.h"
+#include "anim/rig.h"
+#include "anim/stream_crowd.h"
 #include "core/error.h"
+#include "sim/crowd.h"
 
 namespace throng::render {
 
@@ -95,19 +99,217 @@ JointRig make_joint_rig(const motion::Skeleton& s) {
   return rig;
 }
 
-void CharacterPoses::validate(const JointRig& rig) const {
-  if (joint_count != rig.joint_count)
-    throw Error(fmt::format("{} joints, the rig has {}", joint_count, rig.joint_count), at_field("poses.joint_count"));
-  if (joint_positions.size() % joint_count != 0)
-    throw Error(fmt::format("{} positions is not a whole number of {}-joint characters", joint_positions.size(), joint_count),
-                at_field("poses.joint_positions"));
-  const Index n = character_count();
-  if (joint_rotations.size() != n * joint_count)
-    throw Error(fmt::format("{} rotations for {} characters of {} joints", joint_rotations.size(), n, joint_count),
-                at_field("poses.joint_rotations"));
+void SkinRig::validate() const {
+  if (joint_count <= 0 || joint_count > anim::kMaxRigJoints)
+    throw Error(fmt::format("joint count {} is outside 1..{}", joint_count, anim::kMaxRigJoints), at_field("skin.joint_count"));
+  if (inverse_bind.size() != static_cast<std::size_t>(joint_count)) throw Error("one matrix per joint", at_field("skin.inverse_bind"));
+  if (bind_positions.size() != static_cast<std::size_t>(joint_count)) throw Error("one position per joint", at_field("skin.bind_positions"));
+  for (int t = 0; t < kDrawTiers; ++t) {
+    const anim::SkinnedMesh& m = meshes[static_cast<std::size_t>(t)];
+    const std::string field = fmt::format("skin.meshes[{}]", t);
+    if (m.joint_count != joint_count) throw Error(fmt::format("bound to {} joints, the rig has {}", m.joint_count, joint_count), at_field(field));
+    const bool lines = t + 1 == kDrawTiers;
+    try {
+      if (lines) {  // SkinnedMesh checks triangles: check the vertices, then the lines here
+        anim::SkinnedMesh vertices = m;
+        vertices.indices.clear();
+        vertices.validate();
+      } else {
+        m.validate();
+      }
+    } catch (const Error& e) {
+      throw Error(e.message(), at_field(field + "." + e.location().field));
+    }
+    if (lines && m.indices.size() % 2 != 0) throw Error("not whole lines", at_field(field + ".indices"));
+    for (std::uint32_t i : m.indices)
+      if (i >= static_cast<std::uint32_t>(m.vertex_count())) throw Error("vertex index out of range", at_field(field + ".indices"));
+    const auto V = static_cast<std::size_t>(m.vertex_count());
+    if (parts[static_cast<std::size_t>(t)].size() != V) throw Error("one part per vertex", at_field(fmt::format("skin.parts[{}]", t)));
+    if (materials[static_cast<std::size_t>(t)].size() != V)
+      throw Error("one material per vertex", at_field(fmt::format("skin.materials[{}]", t)));
+    for (std::uint8_t p : parts[static_cast<std::size_t>(t)])
+      if (p >= anim::kBodyPartCount) throw Error("body part out of range", at_field(fmt::format("skin.parts[{}]", t)));
+  }
+  if (!(bounding_radius > 0.0f) || !std::isfinite(bounding_radius))
+    throw Error("must be positive and finite", at_field("skin.bounding_radius"));
+}
+
+namespace {
+
+// A line per bone (parent to child joint, joint to end site), each end
+// bound rigidly to the joint that carries the bone: the far tier.
+anim::SkinnedMesh bone_lines(const anim::Rig& rig) {
+  const motion::Skeleton& s = rig.skeleton;
+  anim::SkinnedMesh m;
+  m.joint_count = rig.joint_count();
+  const auto add = [&](std::int32_t joint, glm::vec3 p) {
+    m.positions.push_back(p);
+    m.normals.emplace_back(0.0f, 1.0f, 0.0f);
+    m.joints.emplace_back(static_cast<std::uint16_t>(joint), 0, 0, 0);
+    m.weights.emplace_back(1.0f, 0.0f, 0.0f, 0.0f);
+  };
+  for (std::int32_t j = 0; j < rig.joint_count(); ++j) {
+    const auto J = static_cast<std::size_t>(j);
+    const std::int32_t p = s.parents[J];
+    if (p >= 0) {
+      m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+      add(p, rig.bind_positions[static_cast<std::size_t>(p)]);
+      m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+      add(p, rig.bind_positions[J]);
+    }
+    if (s.has_end_site[J] && glm::length(s.end_sites[J]) > 0.0f) {
+      m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+      add(j, rig.bind_positions[J]);
+      m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+      add(j, rig.bind_positions[J] + rig.bind_rotations[J] * s.end_sites[J]);
+    }
+  }
+  return m;
+}
+
+// Is `joint` the joint of one of `roles`, or below one?
+bool at_or_below(const motion::Skeleton& s, std::int32_t joint, std::initializer_list<motion::Role> roles) {
+  for (std::int32_t j = joint; j >= 0; j = s.parents[static_cast<std::size_t>(j)])
+    for (motion::Role r : roles)
+      if (s.role(r) == j) return true;
+  return false;
+}
+
+}  // namespace
+
+SkinRig make_skin_rig(const anim::Rig& rig) {
+  using motion::Role;
+  const motion::Skeleton& s = rig.skeleton;
+  const std::int32_t J = rig.joint_count();
+  SkinRig out;
+  out.name = rig.name;
+  out.joint_count = J;
+  out.inverse_bind = rig.inverse_bind;
+  out.bind_positions = rig.bind_positions;
+  anim::MannequinOptions coarse;
+  coarse.sides = 6;
+  coarse.body_rings = 2;
+  coarse.cap_rings = 1;
+  out.meshes = {rig.mesh, anim::make_mannequin(s, coarse), bone_lines(rig)};
+
+  std::vector<std::uint8_t> part_of(static_cast<std::size_t>(J), static_cast<std::uint8_t>(anim::BodyPart::Torso));
+  try {
+    part_of = anim::make_body_parts(s).part_of;
+  } catch (const Error&) {
+    // No limb roles: one part.
+  }
+  std::vector<std::uint8_t> material(static_cast<std::size_t>(J), kShirt);
+  for (std::int32_t j = 0; j < J; ++j) {
+    const auto part = static_cast<anim::BodyPart>(part_of[static_cast<std::size_t>(j)]);
+    if (part == anim::BodyPart::LeftLeg || part == anim::BodyPart::RightLeg) material[static_cast<std::size_t>(j)] = kTrousers;
+    if (at_or_below(s, j, {Role::Neck, Role::Head, Role::LeftWrist, Role::RightWrist})) material[static_cast<std::size_t>(j)] = kSkin;
+  }
+  // Chain length from the root to every joint in the bind pose.
+  std::vector<float> reach(static_cast<std::size_t>(J), 0.0f);
+  for (std::int32_t j = 1; j < J; ++j) {
+    const std::int32_t p = s.parents[static_cast<std::size_t>(j)];
+    reach[static_cast<std::size_t>(j)] =
+        reach[static_cast<std::size_t>(p)] + glm::distance(rig.bind_positions[static_cast<std::size_t>(p)], rig.bind_positions[static_cast<std::size_t>(j)]);
+  }
+  float radius = 0.0f;
+  for (int t = 0; t < kDrawTiers; ++t) {
+    const anim::SkinnedMesh& m = out.meshes[static_cast<std::size_t>(t)];
+    for (std::int32_t v = 0; v < m.vertex_count(); ++v) {
+      const auto V = static_cast<std::size_t>(v);
+      int dominant = 0;
+      for (int k = 0; k < 4; ++k) {
+        if (m.weights[V][k] > m.weights[V][dominant]) dominant = k;
+        if (m.weights[V][k] <= 0.0f) continue;
+        const auto j = static_cast<std::size_t>(m.joints[V][k]);
+        radius = std::max(radius, reach[j] + glm::distance(m.positions[V], rig.bind_positions[j]));
+      }
+      const auto j = static_cast<std::size_t>(m.joints[V][dominant]);
+      out.parts[static_cast<std::size_t>(t)].push_back(part_of[j]);
+      out.materials[static_cast<std::size_t>(t)].push_back(material[j]);
+    }
+  }
+  out.bounding_radius = radius * 1.001f + 1e-3f;
+  out.validate();
+  return out;
+}
+
+CrowdRigs make_crowd_rigs(const motion::Skeleton& skeleton) {
+  CrowdRigs rigs;
+  rigs.joints = make_joint_rig(skeleton);
+  rigs.skins.push_back(make_skin_rig(anim::make_rig("mannequin", skeleton)));
+  return rigs;
+}
+
+CrowdRigs make_crowd_rigs(const anim::StreamCrowd& crowd) {
+  CrowdRigs rigs;
+  for (std::int32_t r = 0; r < crowd.rig_count(); ++r) rigs.skins.push_back(make_skin_rig(crowd.rig(r)));
+  return rigs;
+}
+
+void CharacterPoses::validate(const CrowdRigs& crowd, RenderMode mode) const {
+  Index n = 0;
+  if (joint_count > 0) {
+    if (!palettes.empty() || !palette_offsets.empty())
+      throw Error("give joint frames or palettes, not both", at_field("poses.palettes"));
+    if (!rigs.empty()) throw Error("joint frames are of one rig: leave rigs empty", at_field("poses.rigs"));
+    if (joint_positions.size() % joint_count != 0)
+      throw Error(fmt::format("{} positions is not a whole number of {}-joint characters", joint_positions.size(), joint_count),
+                  at_field("poses.joint_positions"));
+    n = character_count();
+    if (joint_rotations.size() != n * joint_count)
+      throw Error(fmt::format("{} rotations for {} characters of {} joints", joint_rotations.size(), n, joint_count),
+                  at_field("poses.joint_rotations"));
+    if (!scales.empty() && scales.size() != n)
+      throw Error(fmt::format("{} scales for {} characters", scales.size(), n), at_field("poses.scales"));
+    const std::int32_t rig_joints =
+        mode == RenderMode::Joints ? crowd.joints.joint_count : (crowd.skins.empty() ? 0 : crowd.skins.front().joint_count);
+    if (mode == RenderMode::Joints && rig_joints == 0) throw Error("the renderer has no joint rig", at_field("render.mode"));
+    if (mode == RenderMode::Skinned && crowd.skins.empty()) throw Error("the renderer has no skinned mesh", at_field("render.mode"));
+    if (rig_joints != joint_count)
+      throw Error(fmt::format("{} joints, the rig has {}", joint_count, rig_joints), at_field("poses.joint_count"));
+  } else if (!palette_offsets.empty() || !palettes.empty()) {
+    if (mode != RenderMode::Skinned) throw Error("palettes are drawn in skinned mode only", at_field("render.mode"));
+    if (crowd.skins.empty()) throw Error("the renderer has no skinned mesh", at_field("render.mode"));
+    if (!joint_positions.empty() || !joint_rotations.empty())
+      throw Error("joint frames need joint_count > 0", at_field("poses.joint_count"));
+    n = character_count();
+    if (!rigs.empty() && rigs.size() != n)
+      throw Error(fmt::format("{} rigs for {} characters (want 0 or {})", rigs.size(), n, n), at_field("poses.rigs"));
+    if (!scales.empty()) throw Error("palettes hold their own scale: leave scales empty", at_field("poses.scales"));
+  } else if (joint_count < 0 || !joint_positions.empty() || !joint_rotations.empty()) {
+    throw Error("joint frames need joint_count > 0", at_field("poses.joint_count"));
+  }
   if (!lod_levels.empty() && lod_levels.size() != n && lod_levels.size() != n * anim::kBodyPartCount)
     throw Error(fmt::format("{} levels for {} characters (want 0, {} or {})", lod_levels.size(), n, n, n * anim::kBodyPartCount),
                 at_field("poses.lod_levels"));
+  if (!flags.empty() && flags.size() != n) throw Error(fmt::format("{} flags for {} characters", flags.size(), n), at_field("poses.flags"));
+}
+
+CharacterPoses poses_of(const anim::CrowdAnimator& crowd) {
+  CharacterPoses p;
+  p.joint_count = crowd.joint_count();
+  p.joint_positions = crowd.joint_positions();
+  p.joint_rotations = crowd.joint_rotations();
+  p.scales = crowd.scales();
+  if (crowd.last_frame().lod) p.lod_levels = crowd.lod_levels();  // levels of the last animate()
+  return p;
+}
+
+CharacterPoses poses_of(const anim::CrowdAnimator& crowd, const sim::CrowdState& agents) {
+  CharacterPoses p = poses_of(crowd);
+  p.flags = agents.flags.span();
+  p.visible_bits = sim::kAgentActive;
+  return p;
+}
+
+CharacterPoses poses_of(const anim::StreamCrowd& crowd, Span<const anim::Mat3x4> palettes) {
+  if (palettes.size() != crowd.palette_size())
+    throw Error(fmt::format("{} matrices, the crowd needs {}", palettes.size(), crowd.palette_size()), at_field("poses.palettes"));
+  CharacterPoses p;
+  p.palettes = palettes;
+  p.palette_offsets = crowd.palette_offsets();
+  p.rigs = crowd.agent_rigs();
+  return p;
 }
 
 void BinsOverlay::validate() const {

@@ -1,14 +1,14 @@
 // What the renderer draws, as plain data: the renderer does not care who
 // produced the pose (forward kinematics of a clip, locomotion synthesis,
-// animation streams), only that it gets world-space joint frames.
+// animation streams), only that it gets world-space joint frames or
+// skinning palettes.
 //
-//   JointRig rig = make_joint_rig(skeleton);     // once per skeleton
-//   CharacterPoses poses;                        // every frame
-//   poses.joint_count = rig.joint_count;
-//   poses.joint_positions = ...;  poses.joint_rotations = ...;  poses.lod_levels = ...;
+//   CrowdRigs rigs = make_crowd_rigs(skeleton);  // once: joint rig + mannequin
+//   CharacterPoses poses = poses_of(animator);   // every frame (or fill the spans)
 //   renderer.render(camera, poses, options);
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec2.hpp>
@@ -17,14 +17,25 @@
 #include <vector>
 
 #include "anim/lod_spheres.h"
+#include "anim/mannequin.h"
+#include "anim/pose.h"
 #include "core/span.h"
 #include "motion/skeleton.h"
+
+namespace throng::anim {
+class CrowdAnimator;
+class StreamCrowd;
+struct Rig;
+}  // namespace throng::anim
+namespace throng::sim {
+struct CrowdState;
+}  // namespace throng::sim
 
 namespace throng::render {
 
 enum class RenderMode : std::uint8_t {
   Joints,   // one squashed sphere per bone, as in the 2019 paper
-  Skinned,  // the mannequin skinned in the vertex shader (not built yet)
+  Skinned,  // a mesh (the mannequin) skinned in the vertex shader
 };
 const char* to_string(RenderMode m);
 // "joints" | "skinned"; throws Error naming `field` otherwise.
@@ -67,19 +78,88 @@ struct JointRig {
 // skeleton's roles allow, else everything is torso.
 JointRig make_joint_rig(const motion::Skeleton& skeleton);
 
-// Per-frame pose of N characters, world space, in current_memory().
+// Draw tiers by image size: near characters get the finest mesh, the
+// smallest (a few pixels tall) are drawn as lines (render/cull.h).
+inline constexpr int kDrawTiers = 3;
+
+// What skinned mode draws for one rig (an anim::Rig: a skeleton and the mesh
+// bound to it): a mesh per draw tier, all bound to the same joints.
+struct SkinRig {
+  std::string name;
+  std::int32_t joint_count = 0;
+  // Fine and coarse: triangle meshes; far: line segments (two indices a
+  // line), drawn with GL_LINES through the same skinning.
+  std::array<anim::SkinnedMesh, kDrawTiers> meshes;
+  // What each vertex is coloured by, per mesh and vertex: its body part
+  // (anim::BodyPart, for LOD colours) and its material (kSkin, kShirt, kTrousers).
+  std::array<std::vector<std::uint8_t>, kDrawTiers> parts, materials;
+  std::vector<anim::Mat3x4> inverse_bind;  // per joint: skinning from world joint frames
+  std::vector<glm::vec3> bind_positions;   // per joint, model space
+  // A sphere about the root joint that holds every vertex in any pose (the
+  // longest bone chain to a vertex's joint plus the vertex's distance from
+  // it, over all influences), for culling; times the character's scale.
+  float bounding_radius = 1.0f;
+
+  // Throws Error naming the field ("skin.meshes[2].joints").
+  void validate() const;
+};
+inline constexpr std::uint8_t kShirt = 0, kTrousers = 1, kSkin = 2;
+
+// The rig's own mesh (fine) and two generated mannequins of the skeleton,
+// coarser (6 sides, 1-ring caps) and far (a line per bone).
+SkinRig make_skin_rig(const anim::Rig& rig);
+
+// Everything the renderer can draw a crowd with. Joint mode needs `joints`
+// (a skeleton's rig); skinned mode one SkinRig per rig index of the poses.
+struct CrowdRigs {
+  JointRig joints;              // joint_count 0: joint mode unavailable
+  std::vector<SkinRig> skins;
+};
+// The joint rig and the mannequin of one skeleton (anim::make_rig).
+CrowdRigs make_crowd_rigs(const motion::Skeleton& skeleton);
+// The skin rigs of every rig of a stream crowd, in its rig order.
+CrowdRigs make_crowd_rigs(const anim::StreamCrowd& crowd);
+
+// Per-frame pose of N characters, world space, in current_memory(). Either
+// world joint frames (joint mode and skinned mode; the locomotion stage's
+// output) or skinning palettes (skinned mode only; the animation streams'
+// output).
 struct CharacterPoses {
   std::int32_t joint_count = 0;
-  Span<const glm::vec3> joint_positions;  // characters * joint_count, character-major
+  // World joint frames, character-major [c * joint_count + j].
+  Span<const glm::vec3> joint_positions;  // characters * joint_count
   Span<const glm::quat> joint_rotations;  // characters * joint_count (end sites hang off them)
+  Span<const float> scales;               // per character (skinning from frames); empty = 1
+  // Or palettes, as anim::StreamCrowd::resolve writes them: character c's
+  // joint j is palettes[palette_offsets[c] + j] = world * model_j *
+  // inverse_bind_j, its rig rigs[c] (empty = all rig 0), joint_count = 0.
+  Span<const anim::Mat3x4> palettes;
+  Span<const Index> palette_offsets;
+  Span<const std::int32_t> rigs;
   // Joint-LOD levels, 0 = finest: empty (all 0), one per character, or one
   // per character and body part (characters * 5, as anim::LodJob writes).
   Span<const std::uint8_t> lod_levels;
+  // Which characters are drawn: those whose flags hold every bit of
+  // visible_bits (the simulation's flags and kAgentActive: despawned agents
+  // vanish); empty = all.
+  Span<const std::uint8_t> flags;
+  std::uint8_t visible_bits = 0;
 
-  Index character_count() const { return joint_count > 0 ? joint_positions.size() / joint_count : 0; }
-  // Throws Error naming the span whose size disagrees.
-  void validate(const JointRig& rig) const;
+  bool from_palettes() const { return joint_positions.empty() && !palette_offsets.empty(); }
+  Index character_count() const {
+    if (joint_count > 0) return joint_positions.size() / joint_count;
+    return palette_offsets.size();
+  }
+  // Throws Error naming the span whose size disagrees with the rigs.
+  void validate(const CrowdRigs& rigs, RenderMode mode) const;
 };
+
+// The locomotion stage's output: world joint frames, scales, LOD levels.
+CharacterPoses poses_of(const anim::CrowdAnimator& crowd);
+// The same for the simulation's agents: despawned ones are not drawn.
+CharacterPoses poses_of(const anim::CrowdAnimator& crowd, const sim::CrowdState& agents);
+// A stream crowd's palettes (resolved with world positions and yaws).
+CharacterPoses poses_of(const anim::StreamCrowd& crowd, Span<const anim::Mat3x4> palettes);
 
 // Obstacles of the simulation's map (x, y metres, z up), drawn extruded.
 struct ObstacleStyle {

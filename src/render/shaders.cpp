@@ -79,6 +79,66 @@ void main() {
 }
 )";
 
+// Skinned mode: one instance per visible character of a draw group; its
+// palette is three vec4 rows per joint (anim::Mat3x4), as
+// anim::skin_vertex computes it on the CPU.
+const char* const kSkinnedVertex = R"(#version 430 core
+layout(location = 0) in vec3 a_position;  // bind pose, model space
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in uvec4 a_joints;
+layout(location = 3) in vec4 a_weights;
+layout(location = 4) in uvec2 a_style;    // body part, material (shirt, trousers, skin)
+layout(std430, binding = 0) readonly buffer Palettes { vec4 palette_rows[]; };
+layout(std430, binding = 1) readonly buffer Tags { uvec2 tags[]; };  // character id, 4 bits of LOD level per part
+uniform mat4 u_view_projection;
+uniform int u_slot_base;    // the group's first slot
+uniform int u_row_base;     // the first palette row (vec4) of the draw's first instance
+uniform int u_joint_count;
+uniform int u_colour_by_lod;
+uniform vec3 u_lod_palette[16];
+uniform vec3 u_clothes[8];
+uniform vec3 u_trousers[4];
+uniform vec3 u_skin[4];
+out vec3 v_world;
+out vec3 v_normal;
+flat out vec3 v_albedo;
+void main() {
+  int base = u_row_base + 3 * gl_InstanceID * u_joint_count;
+  vec4 p = vec4(a_position, 1.0);
+  vec4 n = vec4(a_normal, 0.0);
+  vec3 sp = vec3(0.0);
+  vec3 sn = vec3(0.0);
+  for (int k = 0; k < 4; ++k) {
+    float w = a_weights[k];
+    if (w == 0.0) continue;
+    int m = base + 3 * int(a_joints[k]);
+    vec4 r0 = palette_rows[m];
+    vec4 r1 = palette_rows[m + 1];
+    vec4 r2 = palette_rows[m + 2];
+    sp += w * vec3(dot(r0, p), dot(r1, p), dot(r2, p));
+    sn += w * vec3(dot(r0, n), dot(r1, n), dot(r2, n));
+  }
+  float len = length(sn);
+  v_world = sp;
+  v_normal = len > 0.0 ? sn / len : vec3(0.0, 1.0, 0.0);
+  uvec2 tag = tags[u_slot_base + gl_InstanceID];
+  if (u_colour_by_lod != 0) {
+    v_albedo = u_lod_palette[(tag.y >> (4u * a_style.x)) & 15u];
+  } else {
+    uint h = tag.x;  // the character id, hashed (lowbias32) into its outfit
+    h ^= h >> 16;
+    h *= 0x7feb352du;
+    h ^= h >> 15;
+    h *= 0x846ca68bu;
+    h ^= h >> 16;
+    if (a_style.y == 0u) v_albedo = u_clothes[h & 7u];
+    else if (a_style.y == 1u) v_albedo = u_trousers[(h >> 8) & 3u];
+    else v_albedo = u_skin[(h >> 16) & 3u];
+  }
+  gl_Position = u_view_projection * vec4(v_world, 1.0);
+}
+)";
+
 const char* const kLitFragment = "#version 430 core\n"
                                   "in vec3 v_world;\n"
                                   "in vec3 v_normal;\n"

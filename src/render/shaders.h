@@ -10,6 +10,9 @@ extern const char* const kLitFragment;
 // Joint mode for the smallest characters: one line per (slot, bone) from
 // gl_VertexID alone, no vertex attributes.
 extern const char* const kJointLinesVertex;
+// Skinned mode: a mesh instanced per visible character, skinned from its
+// palette (shader storage, three vec4 rows per joint); lit by kLitFragment.
+extern const char* const kSkinnedVertex;
 // Obstacle walls: positions and normals from vertex attributes.
 extern const char* const kStaticVertex;
 // Ground plane with a metre grid (analytic, antialiased lines).

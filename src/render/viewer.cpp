@@ -15,6 +15,7 @@
 #include <cmath>
 #include <memory>
 
+#include "anim/locomotion.h"
 #include "anim/lod.h"
 #include "core/buffer.h"
 #include "core/error.h"
@@ -27,14 +28,10 @@
 namespace throng::render {
 
 void ViewerOptions::validate() const {
-  crowd.validate();
   if (width < 64 || width > 8192) throw Error(fmt::format("{} is outside 64..8192", width), at_field("--width"));
   if (height < 64 || height > 8192) throw Error(fmt::format("{} is outside 64..8192", height), at_field("--height"));
   if (frames < 0) throw Error("must be >= 0", at_field("--frames"));
   if (!(speed >= 0.0 && speed <= 100.0)) throw Error("must be within 0..100", at_field("--speed"));
-  for (std::size_t i = 0; i < lod_thresholds.size(); ++i)
-    if (!(lod_thresholds[i] > 0.0f) || !std::isfinite(lod_thresholds[i]) || (i > 0 && !(lod_thresholds[i] < lod_thresholds[i - 1])))
-      throw Error("thresholds must be positive and decreasing", at_field("--lod-thresholds"));
 }
 
 namespace {
@@ -72,6 +69,7 @@ struct InputState {
   bool step = false;
   double speed = 1.0;
   bool lod_colours = true;
+  RenderMode mode = RenderMode::Skinned;
   double last_x = 0.0, last_y = 0.0;
   bool dragging_orbit = false, dragging_pan = false;
 };
@@ -92,6 +90,7 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
     case GLFW_KEY_MINUS:
     case GLFW_KEY_KP_SUBTRACT: in.speed = std::max(in.speed / 1.5, 0.01); break;
     case GLFW_KEY_L: in.lod_colours = !in.lod_colours; break;
+    case GLFW_KEY_M: in.mode = in.mode == RenderMode::Joints ? RenderMode::Skinned : RenderMode::Joints; break;
     default: break;
   }
 }
@@ -145,7 +144,7 @@ Image read_window(std::int32_t width, std::int32_t height) {
 
 }  // namespace
 
-ViewerResult run_viewer(const ViewerOptions& options) {
+ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
   options.validate();
   GlfwSession glfw;
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
@@ -170,38 +169,12 @@ ViewerResult run_viewer(const ViewerOptions& options) {
   result.gl = gl_description();
   spdlog::info("viewer: {}", result.gl);
 
-  DemoCrowd crowd(options.crowd);
-  Renderer renderer(make_joint_rig(crowd.skeleton()));
-  // Pillars outside the crowd and the rings it walks, to show obstacles and paths.
-  const float extent = crowd.extent();
-  std::vector<sim::Circle> pillars;
-  for (int k = 0; k < 8; ++k) {
-    const float a = 6.2831853f * static_cast<float>(k) / 8.0f;
-    pillars.push_back({(extent + 4.0f) * glm::vec2(std::cos(a), std::sin(a)), 1.2f});
-  }
-  renderer.set_obstacles({}, pillars, ObstacleStyle{});
-  if (options.crowd.layout == DemoLayout::Ring) {
-    std::vector<MapPolyline> rings;
-    for (float r = 1.5f * options.crowd.spacing; r <= extent; r += 1.5f * options.crowd.spacing) {
-      MapPolyline ring;
-      for (int k = 0; k <= 96; ++k) {
-        const float a = 6.2831853f * static_cast<float>(k) / 96.0f;
-        ring.push_back(r * glm::vec2(std::cos(a), std::sin(a)));
-      }
-      rings.push_back(ring);
-    }
-    renderer.set_paths(rings);
-  }
-
-  // Joint LOD, driven by the rendering camera.
-  const anim::BodyParts parts = anim::make_body_parts(crowd.skeleton());
-  std::vector<float> thresholds = options.lod_thresholds.empty() ? anim::default_lod_thresholds() : options.lod_thresholds;
-  anim::LodConfig lod_config = anim::make_lod_config(parts, thresholds);
-  anim::LodTables lod_tables(lod_config);
-  const Index n = crowd.character_count();
-  const std::int32_t words = anim::mask_word_count(crowd.joint_count());
-  Buffer<std::uint8_t> levels(n * anim::kBodyPartCount, current_memory());
-  Buffer<std::uint32_t> masks(n * words, current_memory());
+  anim::CrowdAnimator& animator = scene.animator();
+  Renderer renderer(make_crowd_rigs(animator.blend_space().skeleton()));
+  scene.decorate(renderer);
+  const float extent = scene.extent();
+  const Index n = animator.count();
+  std::vector<float> thresholds = animator.config().lod_thresholds;
 
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
@@ -217,12 +190,22 @@ ViewerResult run_viewer(const ViewerOptions& options) {
   } imgui_shutdown;
 
   OrbitControl orbit;
-  orbit.target = crowd.centre() + glm::vec3(0.0f, 1.0f, 0.0f);
+  orbit.target = scene.centre() + glm::vec3(0.0f, 1.0f, 0.0f);
   orbit.distance = std::max(8.0f, 1.05f * extent / std::tan(0.5f * Camera{}.fov_y));
+  if (const std::optional<Camera> own = scene.camera()) {
+    // Start where the scene's camera stands.
+    const glm::vec3 d = own->position - own->target;
+    orbit.target = own->target;
+    orbit.distance = std::clamp(glm::length(d), 1.5f, 5000.0f);
+    orbit.pitch = std::clamp(std::asin(d.y / glm::length(d)), 0.05f, 1.5f);
+    orbit.yaw = std::atan2(d.x, d.z);
+  }
   InputState input;
   input.orbit = &orbit;
   input.paused = options.paused;
   input.speed = options.speed;
+  input.mode = options.mode;
+  input.lod_colours = options.lod_colours;
   glfwSetWindowUserPointer(window.get(), &input);
   // ImGui's GLFW backend chains to callbacks installed before it; ours
   // are installed after, so they call it themselves via ImGui's handlers.
@@ -245,8 +228,6 @@ ViewerResult run_viewer(const ViewerOptions& options) {
 
   RenderOptions render_options;
   render_options.bins = options.bins;
-  int mode_index = 0;
-  bool show_lod = true;
   double t = 0.0;
   auto last = std::chrono::steady_clock::now();
   double frame_ms = 0.0;
@@ -261,7 +242,8 @@ ViewerResult run_viewer(const ViewerOptions& options) {
     const double wall = std::chrono::duration<double>(now - last).count();
     last = now;
     frame_ms = 0.9 * frame_ms + 0.1 * wall * 1000.0;
-    if (!input.paused || input.step) t += (scripted ? 1.0 / 30.0 : std::min(wall, 0.1)) * input.speed;
+    const double dt = !input.paused || input.step ? (scripted ? 1.0 / 30.0 : std::min(wall, 0.1)) * input.speed : 0.0;
+    t += dt;
     input.step = false;
 
     std::int32_t fb_width = 0, fb_height = 0;
@@ -273,34 +255,31 @@ ViewerResult run_viewer(const ViewerOptions& options) {
     lens.far_plane = std::max(1000.0f, 4.0f * orbit.distance);
     const Camera camera = orbit.camera(lens);
 
-    // LOD from last frame's root transforms (the pose does not move them).
-    anim::LodJob lod;
-    lod.camera = make_camera_view(camera);
-    lod.set_tables(lod_tables);
-    lod.root_positions = crowd.ground_positions();
-    lod.root_headings = crowd.yaws();
-    lod.template_spheres = parts.rest_spheres;
-    lod.levels = levels.span();
-    lod.joint_masks = masks.span();
-    lod.run();
-    histogram = anim::lod_histogram(levels.span(), masks.span(), lod_config.level_count, lod_config.joint_count);
-    crowd.update(t, masks.span());
+    // Locomotion, LOD (for this camera), cache and pose.
+    scene.advance(dt, camera);
+    const anim::FrameStats& animated = animator.last_frame();
+    if (animated.lod) histogram = *animated.lod;
 
+    const CharacterPoses poses = scene.poses();
     if (render_options.bins) {
-      // Agents per 4 m cell over the crowd's square: the bins overlay.
-      const float cell = 4.0f;
-      const auto side = static_cast<std::int32_t>(std::ceil(2.0f * extent / cell));
+      // Agents per cell (the simulation's bin size), cells aligned with its bins.
+      const float cell = scene.bin_size();
+      const glm::vec2 corner = glm::floor((ground_from_world(scene.centre()) - glm::vec2(extent)) / cell) * cell;
+      const auto side = std::min<std::int32_t>(4096, static_cast<std::int32_t>(std::ceil(2.0f * extent / cell)) + 1);
       std::vector<glm::vec3> ground(static_cast<std::size_t>(n));
+      std::vector<std::uint8_t> flags(static_cast<std::size_t>(poses.flags.size()));
       if (n > 0)
-        throng::detail::copy_bytes(ground.data(), Memory::Host, crowd.ground_positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
+        throng::detail::copy_bytes(ground.data(), Memory::Host, animator.positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
+      if (!flags.empty()) throng::detail::copy_bytes(flags.data(), Memory::Host, poses.flags.data(), current_memory(), flags.size());
       bin_counts.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side), 0);
-      for (const glm::vec3& p : ground) {
-        const glm::vec2 m = (ground_from_world(p) + glm::vec2(extent)) / cell;
+      for (std::size_t i = 0; i < ground.size(); ++i) {
+        if (!flags.empty() && (flags[i] & poses.visible_bits) != poses.visible_bits) continue;
+        const glm::vec2 m = (ground_from_world(ground[i]) - corner) / cell;
         const auto x = static_cast<std::int32_t>(std::floor(m.x)), y = static_cast<std::int32_t>(std::floor(m.y));
         if (x >= 0 && x < side && y >= 0 && y < side) ++bin_counts[static_cast<std::size_t>(y * side + x)];
       }
       BinsOverlay bins;
-      bins.min = glm::vec2(-extent);
+      bins.min = corner;
       bins.cell_size = cell;
       bins.columns = side;
       bins.rows = side;
@@ -308,9 +287,8 @@ ViewerResult run_viewer(const ViewerOptions& options) {
       bins.saturate_at = 12;
       renderer.set_bins(bins);
     }
-    CharacterPoses poses = crowd.poses();
-    poses.lod_levels = levels.span();
-    render_options.lod_colours = input.lod_colours && show_lod;
+    render_options.lod_colours = input.lod_colours;
+    render_options.mode = input.mode;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     stats = renderer.render(camera, poses, render_options);
 
@@ -320,7 +298,9 @@ ViewerResult run_viewer(const ViewerOptions& options) {
     if (options.panel) {
       ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
       ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
-      ImGui::Begin("throng");
+      ImGui::Begin(scene.title().c_str());
+      const std::string status = scene.status();
+      if (!status.empty()) ImGui::TextUnformatted(status.c_str());
       ImGui::Text("agents %lld, visible %lld (%lld near)", static_cast<long long>(stats.characters), static_cast<long long>(stats.visible),
                   static_cast<long long>(stats.fine));
       ImGui::Text("frame %.1f ms, time %.1f s, %.1fM triangles", frame_ms, t, static_cast<double>(stats.triangles) / 1e6);
@@ -329,8 +309,9 @@ ViewerResult run_viewer(const ViewerOptions& options) {
       if (ImGui::Button("step")) input.step = true;
       float speed = static_cast<float>(input.speed);
       if (ImGui::SliderFloat("speed", &speed, 0.0f, 4.0f, "%.2fx")) input.speed = speed;
-      const char* modes[] = {"joints", "skinned (not built yet)"};
-      ImGui::Combo("mode", &mode_index, modes, 1);
+      const char* modes[] = {"joints", "skinned"};
+      int mode_index = input.mode == RenderMode::Joints ? 0 : 1;
+      if (ImGui::Combo("mode (M)", &mode_index, modes, 2)) input.mode = mode_index == 0 ? RenderMode::Joints : RenderMode::Skinned;
       ImGui::Checkbox("LOD colours", &input.lod_colours);
       ImGui::SameLine();
       ImGui::Checkbox("grid", &render_options.grid);
@@ -349,10 +330,7 @@ ViewerResult run_viewer(const ViewerOptions& options) {
           changed |= ImGui::SliderFloat(fmt::format("L{} from px^2", l).c_str(), &thresholds[l], lo, std::max(lo, hi), "%.0f",
                                         ImGuiSliderFlags_Logarithmic);
         }
-        if (changed) {
-          lod_config = anim::make_lod_config(parts, thresholds);
-          lod_tables = anim::LodTables(lod_config);
-        }
+        if (changed) animator.set_lod_thresholds(thresholds);
         for (std::int32_t l = 0; l < histogram.level_count; ++l) {
           Index count = 0;
           for (int p = 0; p < anim::kBodyPartCount; ++p) count += histogram.at_level(static_cast<anim::BodyPart>(p), l);
@@ -362,8 +340,12 @@ ViewerResult run_viewer(const ViewerOptions& options) {
           const float share = n > 0 ? static_cast<float>(count) / static_cast<float>(n * anim::kBodyPartCount) : 0.0f;
           ImGui::ProgressBar(share, ImVec2(-1, 0), fmt::format("level {}: {:.0f}% of body parts", l, 100.0f * share).c_str());
         }
-        ImGui::Text("joints synthesised: %.1f of %d per agent", histogram.mean_joints_synthesised(), crowd.joint_count());
-        ImGui::TextDisabled("cache hit rate: when locomotion lands");
+        ImGui::Text("joints synthesised: %.1f of %d per agent", histogram.mean_joints_synthesised(), animator.joint_count());
+        if (animator.cache() != nullptr)
+          ImGui::Text("motion cache: %.1f%% hits, %lld cycles, %lld read it this frame", 100.0 * animated.cache.hit_rate(),
+                      static_cast<long long>(animated.cache.entries), static_cast<long long>(animated.from_cache));
+        else
+          ImGui::TextDisabled("motion cache off");
       }
       if (ImGui::CollapsingHeader("Stages (median ms)", ImGuiTreeNodeFlags_DefaultOpen)) {
         const std::vector<KernelStat> kernels = KernelTimings::global().stats();  // largest total first

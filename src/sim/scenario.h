@@ -131,6 +131,11 @@ struct ScenarioSpec {
   // map coordinates of the file with core/ground.h); nullopt = an overview
   // chosen from the scene's extent (overview_camera).
   std::optional<Camera> camera;
+  // How videos move that camera (camera.motion, camera.period): "fixed",
+  // "orbit" or "flyover" (render/camera_path.h), one turn or pass per
+  // period seconds of video; empty / 0 = the command's defaults.
+  std::string camera_motion;
+  float camera_period_s = 0.0f;
   // Where density and speed are measured for the fundamental diagram
   // (map coordinates); nullopt = a 10 m square at the centre of the scene.
   std::optional<Aabb> measurement;

@@ -151,6 +151,67 @@ TEST_F(RunCommand, TheDefaultDemoRunsTheCircleToTheEnd) {
   EXPECT_NE(o.out.find("arrived " + n + "/" + n), std::string::npos) << o.out;
   const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "stats.json"));
   EXPECT_TRUE(stats["run"]["all_arrived"].get<bool>());
+  EXPECT_TRUE(stats.contains("locomotion"));
+  // A build with the renderer writes the demo's video and says where.
+  if (o.out.find("rendering video") != std::string::npos) {
+    EXPECT_NE(o.out.find((dir_ / "crowd.mp4").string()), std::string::npos) << o.out;
+    EXPECT_GT(fs::file_size(dir_ / "crowd.mp4"), 1000u);
+  }
+}
+
+// The locomotion stage: every agent animated from its simulated velocity and
+// heading; stats.json's "locomotion" section holds the stage's timings, the
+// joint-LOD histogram, the cache counters and foot skating, which stays
+// under 2 cm per contact on the circle; the same on 1 and 2 threads.
+TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) {
+  const std::string agents = sanitized() ? "120" : "400";
+  const auto run_with = [&](const std::string& threads) {
+    const fs::path out = dir_ / ("threads_" + threads);
+    const Outcome o = run({"--threads", threads, "run", "circle", "--agents", agents, "--seconds", "12", "--no-trajectories", "--out", out.string()});
+    EXPECT_EQ(o.code, 0) << o.out;
+    EXPECT_NE(o.out.find("foot skating: mean"), std::string::npos) << o.out;
+    return nlohmann::json::parse(slurp(out / "stats.json"));
+  };
+  const nlohmann::json one = run_with("1");
+  ASSERT_TRUE(one.contains("locomotion")) << one.dump(1);
+  const nlohmann::json& l = one["locomotion"];
+  EXPECT_EQ(l["characters"].get<long>(), std::stol(agents));
+  EXPECT_EQ(l["frames"].get<long>(), 121);  // the initial state and 120 steps
+  EXPECT_GT(l["frame_ms"]["median"].get<double>(), 0.0);
+  EXPECT_TRUE(l["kernels"].contains("anim.locomote") || l["kernels"].contains("anim.from_map")) << l["kernels"].dump();
+  EXPECT_TRUE(l["kernels"].contains("anim.pose")) << l["kernels"].dump();
+  // Joint-LOD histogram: characters per count of joints synthesised, summing to agents x frames.
+  long histogram = 0;
+  for (const auto& c : l["lod"]["joints_synthesised_histogram"]) histogram += c.get<long>();
+  EXPECT_EQ(histogram, 121 * std::stol(agents));
+  for (const char* key : {"hits", "misses", "evictions", "bytes"}) EXPECT_TRUE(l["cache"].contains(key)) << key;
+  EXPECT_GT(l["cache"]["hits"].get<long>() + l["cache"]["misses"].get<long>(), 0);
+  const auto& skate = l["foot_skating_cm"];
+  EXPECT_GT(skate["contacts"].get<int>(), 50);
+  EXPECT_LT(skate["mean"].get<double>(), 2.0) << skate.dump();
+  EXPECT_GE(skate["p95"].get<double>(), skate["mean"].get<double>());
+  EXPECT_TRUE(one["timings"]["stages"].contains("anim.locomotion"));
+
+  // Every joint synthesised (no LOD): the feet that skate are all measured.
+  const Outcome full = run({"run", "circle", "--agents", agents, "--seconds", "12", "--no-lod", "--no-trajectories", "--out", (dir_ / "full").string()});
+  ASSERT_EQ(full.code, 0) << full.out;
+  const nlohmann::json all = nlohmann::json::parse(slurp(dir_ / "full" / "stats.json"))["locomotion"];
+  EXPECT_EQ(all["joints_synthesised_per_character"].get<double>(), all["joints"].get<double>());
+  EXPECT_GT(all["foot_skating_cm"]["contacts"].get<int>(), skate["contacts"].get<int>());
+  EXPECT_LT(all["foot_skating_cm"]["mean"].get<double>(), 2.0) << all["foot_skating_cm"].dump();
+
+  const nlohmann::json two = run_with("2");
+  for (const char* key : {"lod", "cache", "foot_skating_cm", "joints_synthesised_per_character"})
+    EXPECT_EQ(one["locomotion"][key], two["locomotion"][key]) << key;
+}
+
+TEST_F(RunCommand, NoAnimateSkipsTheLocomotionStage) {
+  const Outcome o = run({"run", "circle", "--agents", "50", "--seconds", "1", "--no-animate", "--out", dir_.string()});
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_FALSE(nlohmann::json::parse(slurp(dir_ / "stats.json")).contains("locomotion"));
+  const Outcome both = run({"run", "circle", "--no-animate", "--render", "video", "--out", dir_.string()});
+  EXPECT_EQ(both.code, 1) << both.out;
+  EXPECT_NE(both.out.find("throng: error:"), std::string::npos) << both.out;
 }
 
 TEST_F(RunCommand, ABadScenarioFileIsOneLineWithItsPosition) {

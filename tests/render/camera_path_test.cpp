@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/ground.h"
 
 namespace throng::render {
 namespace {
@@ -42,6 +43,53 @@ TEST(CameraPath, FlyoverPassesThroughItsKeysSmoothly) {
   const glm::vec3 before = (p.at(t).position - p.at(t - h).position) / h;
   const glm::vec3 after = (p.at(t + h).position - p.at(t).position) / h;
   EXPECT_LT(glm::length(before - after), 0.05f * glm::length(before) + 1e-3f);
+}
+
+// A scenario's camera, given on the map (x, y, z up) as scenario files do.
+Camera scenario_camera(glm::vec3 map_eye, glm::vec3 map_target) {
+  Camera c;
+  c.position = world_from_map(map_eye);
+  c.target = world_from_map(map_target);
+  return c;
+}
+
+TEST(CameraPath, AScenarioCameraSetInMotionStartsAsGiven) {
+  const Camera given = scenario_camera({-20.0f, -30.0f, 25.0f}, {5.0f, 2.0f, 0.0f});
+  for (CameraPath::Kind kind : {CameraPath::Kind::Fixed, CameraPath::Kind::Orbit, CameraPath::Kind::Flyover}) {
+    const CameraPath p = animate_camera(given, kind, 20.0f);
+    p.validate();
+    const Camera c = p.at(0.0);
+    EXPECT_LT(glm::length(c.position - given.position), 1e-4f) << to_string(kind);
+    EXPECT_LT(glm::length(c.target - given.target), 1e-4f) << to_string(kind);
+    EXPECT_EQ(c.width, given.width);
+    EXPECT_EQ(c.fov_y, given.fov_y);
+  }
+  // Orbit: same height and distance from the target's ground point all the
+  // way round; half a period later on the opposite side.
+  const CameraPath orbit = animate_camera(given, CameraPath::Kind::Orbit, 20.0f);
+  const glm::vec3 ground(given.target.x, 0.0f, given.target.z);
+  const auto horizontal = [](glm::vec3 v) { return glm::length(glm::vec2(v.x, v.z)); };
+  for (double t : {3.0, 10.0, 17.5}) {
+    const Camera c = orbit.at(t);
+    EXPECT_NEAR(c.position.y, given.position.y, 1e-4f);
+    EXPECT_NEAR(horizontal(c.position - ground), horizontal(given.position - ground), 1e-3f);
+    EXPECT_LT(glm::length(c.target - given.target), 1e-4f);
+  }
+  const glm::vec3 half = orbit.at(10.0).position - ground, start = given.position - ground;
+  EXPECT_LT(glm::length(glm::vec2(half.x + start.x, half.z + start.z)), 1e-3f);
+  // Fly-over: ends mirrored through the target, having passed over it.
+  const CameraPath fly = animate_camera(given, CameraPath::Kind::Flyover, 20.0f);
+  const glm::vec3 end = fly.at(20.0).position - ground;
+  EXPECT_LT(glm::length(glm::vec2(end.x + start.x, end.z + start.z)), 1e-3f);
+  EXPECT_GT(fly.at(10.0).position.y, given.position.y);
+  // Straight down (north up): an orbit still works, barely tilted.
+  Camera down = scenario_camera({0.0f, 0.0f, 50.0f}, {0.0f, 0.0f, 0.0f});
+  down.up = world_from_map(glm::vec3(0.0f, 1.0f, 0.0f));
+  const CameraPath top = animate_camera(down, CameraPath::Kind::Orbit, 30.0f);
+  top.validate();
+  top.at(7.0).validate();
+  EXPECT_LT(glm::length(top.at(0.0).position - down.position), 1.5f);
+  EXPECT_THROW(animate_camera(given, CameraPath::Kind::Orbit, 0.0f), Error);
 }
 
 TEST(CameraPath, InvalidPathsNameTheField) {

@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 
+#include "anim/rig.h"
 #include "core/buffer.h"
 #include "core/error.h"
 #include "core/exec.h"
@@ -46,12 +48,12 @@ Culled cull(const TPoseCrowd& c, const JointRig& rig, const Camera& cam, float f
   Buffer<std::uint32_t> flags(kDrawTiers * n), slots(kDrawTiers * n);
   CullJob job;
   job.camera = make_camera_view(cam);
+  job.rigs.rig[0] = {rig.bounding_radius, glm::vec3(0.0f), rig.joint_count};
   job.joint_count = rig.joint_count;
-  job.bounding_radius = rig.bounding_radius;
   job.fine_min_pixels = fine_px;
   job.lines_max_pixels = lines_px;
   job.joint_positions = c.positions;
-  job.tier_flags = flags.span();
+  job.group_flags = flags.span();
   job.run();
   Culled out;
   out.visible = exclusive_scan<std::uint32_t>("test.slots", flags.span(), slots.span());
@@ -150,7 +152,7 @@ TEST(Pack, MatchesABruteForceAndIsThreadIndependent) {
     job.joint_positions = c.positions;
     job.joint_rotations = c.rotations;
     job.lod_levels = c.levels;
-    job.tier_flags = r.flags;
+    job.group_flags = r.flags;
     job.slots = r.slots;
     job.out_points = out;
     job.run();
@@ -192,7 +194,7 @@ TEST(Pack, PerPartLevelsColourEachPoint) {
   job.joint_positions = c.positions;
   job.joint_rotations = c.rotations;
   job.lod_levels = levels;
-  job.tier_flags = r.flags;
+  job.group_flags = r.flags;
   job.slots = r.slots;
   job.out_points = out;
   job.run();
@@ -202,13 +204,152 @@ TEST(Pack, PerPartLevelsColourEachPoint) {
   EXPECT_THROW(job.run(), Error);
 }
 
+// Palettes of a T-posed crowd straight from its placement: T(at) R(yaw) S(scale).
+std::vector<anim::Mat3x4> rigid_palettes(const TPoseCrowd& c) {
+  std::vector<anim::Mat3x4> out;
+  for (std::int32_t i = 0; i < c.count(); ++i) {
+    const auto I = static_cast<std::size_t>(i);
+    anim::Mat3x4 m = anim::mat3x4_from(glm::angleAxis(c.yaws[I], glm::vec3(0, 1, 0)), c.places[I]);
+    for (glm::vec4* r : {&m.r0, &m.r1, &m.r2}) *r = glm::vec4(glm::vec3(*r) * c.scales[I], r->w);
+    for (std::int32_t j = 0; j < c.skeleton.joint_count(); ++j) out.push_back(m);
+  }
+  return out;
+}
+
+TEST(PalettePack, JointFramesTimesInverseBindGiveEachCharactersTransformAndThreadsAgree) {
+  TPoseCrowd c;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> x(-30.0f, 30.0f), yaw(-3.14f, 3.14f), scale(0.8f, 1.25f);
+  for (int i = 0; i < 300; ++i) c.add({x(rng), 0.0f, x(rng) - 30.0f}, yaw(rng), static_cast<std::uint8_t>(i % 3), scale(rng));
+  const SkinRig skin = make_skin_rig(anim::make_rig("humanoid", c.skeleton));
+  const Index n = c.count();
+  const std::int32_t J = skin.joint_count;
+  const std::vector<anim::Mat3x4> want = rigid_palettes(c);
+  std::vector<std::vector<anim::Mat3x4>> results;
+  for (int threads : {1, 2, 3}) {
+    ScopedExecution exec(Backend::Cpu, threads);
+    Buffer<std::uint32_t> flags(kDrawTiers * n), slots(kDrawTiers * n);
+    CullJob cull;
+    cull.camera = make_camera_view(test_camera());
+    cull.rigs.rig[0] = {skin.bounding_radius, skin.bind_positions[0], J};
+    cull.joint_count = J;
+    cull.joint_positions = c.positions;
+    cull.scales = c.scales;
+    cull.group_flags = flags.span();
+    cull.run();
+    const Index visible = exclusive_scan<std::uint32_t>("test.slots", flags.span(), slots.span());
+    ASSERT_GT(visible, 20);
+    ASSERT_LT(visible, n);
+    PalettePackJob pack;
+    pack.groups = draw_groups(cull, slots.span(), visible);
+    EXPECT_EQ(pack.groups.visible(), visible);
+    std::vector<anim::Mat3x4> out(static_cast<std::size_t>(pack.groups.matrices()));
+    std::vector<glm::uvec2> tags(static_cast<std::size_t>(visible));
+    pack.joint_count = J;
+    pack.joint_positions = c.positions;
+    pack.joint_rotations = c.rotations;
+    pack.scales = c.scales;
+    pack.inverse_bind = skin.inverse_bind;
+    pack.lod_levels = c.levels;
+    pack.group_flags = flags.span();
+    pack.slots = slots.span();
+    pack.out_palettes = out;
+    pack.out_tags = tags;
+    pack.run();
+    // Slots in group order, characters in order within a group.
+    const std::vector<std::uint32_t> f = flags.to_vector();
+    Index slot = 0;
+    for (int g = 0; g < kDrawTiers; ++g)
+      for (Index i = 0; i < n; ++i) {
+        if (f[static_cast<std::size_t>(g * n + i)] == 0u) continue;
+        EXPECT_EQ(tags[static_cast<std::size_t>(slot)].x, static_cast<std::uint32_t>(i));
+        EXPECT_EQ(tags[static_cast<std::size_t>(slot)].y, 0x11111u * c.levels[static_cast<std::size_t>(i)]);  // one level, every part
+        for (std::int32_t j = 0; j < J; ++j) {
+          const anim::Mat3x4& got = out[static_cast<std::size_t>(slot * J + j)];
+          const anim::Mat3x4& w = want[static_cast<std::size_t>(i * J + j)];
+          for (int r = 0; r < 3; ++r)
+            ASSERT_LT(glm::length((&got.r0)[r] - (&w.r0)[r]), 2e-5f * (1.0f + glm::length((&w.r0)[r]))) << i << " " << j;
+        }
+        ++slot;
+      }
+    EXPECT_EQ(slot, visible);
+    results.push_back(out);
+  }
+  EXPECT_EQ(std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(anim::Mat3x4)), 0);
+  EXPECT_EQ(std::memcmp(results[0].data(), results[2].data(), results[0].size() * sizeof(anim::Mat3x4)), 0);
+}
+
+TEST(Cull, PalettesPlaceCharactersAsTheirJointFramesDoAndPickTheirRigsGroup) {
+  TPoseCrowd c;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> x(-80.0f, 80.0f), yaw(-3.14f, 3.14f), scale(0.5f, 2.0f);
+  for (int i = 0; i < 400; ++i) c.add({x(rng), 0.0f, x(rng)}, yaw(rng), 0, scale(rng));
+  const SkinRig skin = make_skin_rig(anim::make_rig("humanoid", c.skeleton));
+  const Index n = c.count();
+  const std::int32_t J = skin.joint_count;
+  const std::vector<anim::Mat3x4> palettes = rigid_palettes(c);
+  std::vector<Index> offsets;
+  for (Index i = 0; i < n; ++i) offsets.push_back(i * J);
+  const CullRig rig{skin.bounding_radius, skin.bind_positions[0], J};
+
+  Buffer<std::uint32_t> from_frames(kDrawTiers * n), from_palettes(2 * kDrawTiers * n);
+  CullJob frames;
+  frames.camera = make_camera_view(test_camera());
+  frames.rigs.rig[0] = rig;
+  frames.fine_min_pixels = 30.0f;
+  frames.lines_max_pixels = 10.0f;
+  frames.joint_count = J;
+  frames.joint_positions = c.positions;
+  frames.scales = c.scales;
+  frames.group_flags = from_frames.span();
+  frames.run();
+  // Every other character of rig 1 (the same bounds), and three that cannot be drawn.
+  std::vector<std::int32_t> rigs(static_cast<std::size_t>(n));
+  for (Index i = 0; i < n; ++i) rigs[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(i % 2);
+  CullJob streamed = frames;
+  streamed.rigs.count = 2;
+  streamed.rigs.rig[1] = rig;
+  streamed.joint_count = 0;
+  streamed.joint_positions = {};
+  streamed.scales = {};
+  streamed.palettes = palettes;
+  streamed.palette_offsets = offsets;
+  streamed.character_rigs = rigs;
+  streamed.group_flags = from_palettes.span();
+  std::vector<Index> broken;
+  for (Index i = 0; i < n && broken.size() < 3; ++i)
+    if (from_frames.to_vector()[static_cast<std::size_t>(i)] != 0u) broken.push_back(i);  // visible, fine
+  ASSERT_EQ(broken.size(), 3u);
+  rigs[static_cast<std::size_t>(broken[0])] = 2;                         // no such rig
+  offsets[static_cast<std::size_t>(broken[1])] = n * J - J + 1;            // palette runs past the end
+  offsets[static_cast<std::size_t>(broken[2])] = -1;
+  streamed.run();
+  const std::vector<std::uint32_t> a = from_frames.to_vector(), b = from_palettes.to_vector();
+  Index visible = 0, tiers_seen[kDrawTiers] = {0, 0, 0};
+  for (Index i = 0; i < n; ++i) {
+    const bool is_broken = std::find(broken.begin(), broken.end(), i) != broken.end();
+    const Index r = i % 2;
+    for (int t = 0; t < kDrawTiers; ++t) {
+      const std::uint32_t want = is_broken ? 0u : a[static_cast<std::size_t>(t * n + i)];
+      EXPECT_EQ(b[static_cast<std::size_t>((r * kDrawTiers + t) * n + i)], want) << i << " tier " << t;
+      EXPECT_EQ(b[static_cast<std::size_t>(((1 - r) * kDrawTiers + t) * n + i)], 0u) << i;
+      visible += want;
+      tiers_seen[t] += want;
+    }
+  }
+  EXPECT_GT(visible, 20);
+  EXPECT_GT(tiers_seen[0], 0);
+  EXPECT_GT(tiers_seen[1], 0);
+  EXPECT_GT(tiers_seen[2], 0);
+}
+
 TEST(Cull, BadSpansNameTheField) {
   const TPoseCrowd c = scattered(4, 1);
   Buffer<std::uint32_t> flags(kDrawTiers * 5);
   CullJob job;
   job.joint_count = c.skeleton.joint_count();
   job.joint_positions = c.positions;
-  job.tier_flags = flags.span();
+  job.group_flags = flags.span();
   try {
     job.run();
     FAIL();

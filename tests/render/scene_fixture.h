@@ -18,9 +18,13 @@ struct TPoseCrowd {
   std::vector<glm::vec3> positions;
   std::vector<glm::quat> rotations;
   std::vector<std::uint8_t> levels;  // one per character
+  std::vector<float> scales;         // one per character
+  std::vector<glm::vec3> places;     // `at` of each character
+  std::vector<float> yaws;
 
-  // A character standing at world ground point `at`, turned by `yaw` about +Y.
-  void add(glm::vec3 at, float yaw = 0.0f, std::uint8_t level = 0) {
+  // A character standing at world ground point `at`, turned by `yaw` about
+  // +Y, scaled by `scale` about `at`: its skinning palette is T(at) R(yaw) S(scale).
+  void add(glm::vec3 at, float yaw = 0.0f, std::uint8_t level = 0, float scale = 1.0f) {
     const std::int32_t J = skeleton.joint_count();
     std::vector<glm::quat> local(static_cast<std::size_t>(J), glm::quat(1, 0, 0, 0));
     std::vector<glm::vec3> p(static_cast<std::size_t>(J));
@@ -29,10 +33,13 @@ struct TPoseCrowd {
                     q.data());
     const glm::quat turn = glm::angleAxis(yaw, glm::vec3(0, 1, 0));
     for (std::int32_t j = 0; j < J; ++j) {
-      positions.push_back(at + turn * p[static_cast<std::size_t>(j)]);
+      positions.push_back(at + turn * (scale * p[static_cast<std::size_t>(j)]));
       rotations.push_back(turn * q[static_cast<std::size_t>(j)]);
     }
     levels.push_back(level);
+    scales.push_back(scale);
+    places.push_back(at);
+    yaws.push_back(yaw);
   }
   CharacterPoses poses() const {
     CharacterPoses out;

@@ -88,7 +88,7 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
   std::filesystem::remove(shot);
   std::string out;
   const int code = run("DISPLAY=" + x.display() + " " + THRONG_EXE +
-                           " --threads 2 view --agents 150 --layout grid --bins --frames 12 --width 480 --height 270 --screenshot " + shot,
+                           " --threads 2 view bottleneck --agents 150 --bins --frames 12 --width 480 --height 270 --screenshot " + shot,
                        out);
   ASSERT_EQ(code, 0) << out;
   EXPECT_NE(out.find("12 frames"), std::string::npos) << out;
@@ -101,6 +101,37 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
   for (std::size_t i = 0; i < im.rgba.size(); i += 4)
     colours.insert(static_cast<std::uint32_t>(im.rgba[i]) << 16 | static_cast<std::uint32_t>(im.rgba[i + 1]) << 8 | im.rgba[i + 2]);
   EXPECT_GT(colours.size(), 200u);
+}
+
+// Without a window: a scenario simulated and animated, written as PNG
+// frames under its camera set in motion; the formation of throng animate
+// as a screenshot.
+TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
+  const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_headless";
+  std::filesystem::remove_all(dir);
+  std::string out;
+  ASSERT_EQ(run(std::string(THRONG_EXE) + " --threads 2 view corridor --agents 120 --headless --render frames --frames 3 --width 160 --height 90 "
+                    "--camera flyover --out " + dir.string(),
+                out),
+            0)
+      << out;
+  EXPECT_NE(out.find("3 frames"), std::string::npos) << out;
+  for (int f = 0; f < 3; ++f) {
+    const Image im = read_png((dir / ("frame_0000" + std::to_string(f) + ".png")).string());
+    EXPECT_EQ(im.width, 160);
+    EXPECT_EQ(im.height, 90);
+  }
+  const std::string shot = (dir / "formation.png").string();
+  out.clear();
+  ASSERT_EQ(run(std::string(THRONG_EXE) + " view formation --layout grid --agents 50 --headless --frames 2 --width 160 --height 90 --screenshot " + shot,
+                out),
+            0)
+      << out;
+  EXPECT_EQ(read_png(shot).width, 160);
+  out.clear();
+  EXPECT_EQ(run(std::string(THRONG_EXE) + " view corridor --layout grid --headless --frames 2 --screenshot " + shot, out), 1) << out;
+  EXPECT_NE(out.find("--layout"), std::string::npos) << out;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Viewer, NoDisplayIsAClearError) {

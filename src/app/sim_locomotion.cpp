@@ -1,0 +1,189 @@
+#include "app/sim_locomotion.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+
+#include "anim/between_steps.h"
+#include "app/locomotion_stats.h"
+#include "core/error.h"
+#include "core/ground.h"
+#include "core/timing.h"
+#include "sim/scenario.h"
+
+namespace throng::app {
+
+namespace {
+
+// Frames of foot tracking pooled at a time: the probe keeps every tracked
+// joint of every frame, so long runs are measured in windows (a contact cut
+// by a window's end counts as two shorter ones).
+constexpr std::int32_t kSkatingWindow = 600;
+
+std::vector<Index> tracked_agents(Index n, Index wanted) {
+  std::vector<Index> out;
+  const Index k = std::min(n, wanted);
+  for (Index i = 0; i < k; ++i) out.push_back(i * n / k);
+  return out;
+}
+
+void copy_device(void* to, const void* from, std::size_t bytes) {
+  if (bytes > 0) throng::detail::copy_bytes(to, current_memory(), from, current_memory(), bytes);
+}
+
+}  // namespace
+
+Camera scenario_camera(const sim::Simulation& sim) {
+  if (sim.spec().camera) return *sim.spec().camera;
+  sim::Aabb box = sim.world().bounds();
+  for (const glm::vec2& p : sim.positions()) box.add(p);
+  if (box.empty()) box.add(glm::vec2(0.0f));
+  return sim::overview_camera(box);
+}
+
+SimulationLocomotion::SimulationLocomotion(const sim::Simulation& sim, const LocomotionOptions& options)
+    : space_(motion::make_default_blend_space()), thresholds_(options.lod_thresholds) {
+  const Index n = sim.agent_count();
+  anim::CrowdAnimatorConfig config;
+  if (!thresholds_.empty()) config.lod_thresholds = thresholds_;
+  thresholds_ = config.lod_thresholds;
+  crowd_ = std::make_unique<anim::CrowdAnimator>(space_, n, config);
+  // Gait phases drawn from the scenario's seed, so neighbours do not step in unison.
+  std::mt19937 rng(static_cast<std::uint32_t>(sim.spec().seed));
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  const std::vector<glm::vec2> at = sim.positions();
+  const std::vector<float> headings = sim.headings();
+  std::vector<glm::vec3> positions(static_cast<std::size_t>(n));
+  std::vector<float> yaws(static_cast<std::size_t>(n)), phases(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    positions[i] = world_from_ground(at[i]);
+    yaws[i] = yaw_from_heading(headings[i]);
+    phases[i] = unit(rng);
+  }
+  crowd_->place(positions, yaws, {}, phases);
+  tracked_ = options.skating_agents;
+  const Memory m = current_memory();
+  previous_positions_ = Buffer<glm::vec2>(n, m);
+  shown_positions_ = Buffer<glm::vec2>(n, m);
+  previous_headings_ = Buffer<float>(n, m);
+  shown_headings_ = Buffer<float>(n, m);
+  still_ = Buffer<glm::vec2>::zeros(n, m);
+  moved_ = Buffer<glm::vec2>(n, m);
+  remember(sim);
+}
+
+void SimulationLocomotion::remember(const sim::Simulation& sim) {
+  const auto n = static_cast<std::size_t>(sim.agent_count());
+  copy_device(previous_positions_.data(), sim.crowd().position.data(), n * sizeof(glm::vec2));
+  copy_device(previous_headings_.data(), sim.crowd().heading.data(), n * sizeof(float));
+}
+
+const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera, bool moving) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const sim::CrowdState& c = sim.crowd();
+  // Agents between the steps, moving at their displacement over the step.
+  anim::InterpolateAgentsJob between;
+  between.alpha = alpha;
+  between.previous_positions = previous_positions_.span();
+  between.positions = c.position.span();
+  between.previous_headings = previous_headings_.span();
+  between.headings = c.heading.span();
+  between.out_positions = shown_positions_.span();
+  between.out_headings = shown_headings_.span();
+  between.step_seconds = sim.spec().dt;
+  between.out_velocities = moved_.span();
+  between.run();
+  crowd_->drive_from_map(shown_positions_.span(), moving ? moved_.span() : still_.span(), shown_headings_.span());
+  const anim::FrameStats& s = crowd_->animate({dt, camera, false});
+  tally_.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  // Foot tracking starts with the first frame that moves time on, in windows.
+  if (dt > 0.0f && tracked_ > 0 && (skating_frames_ == 0 || skating_frames_ >= kSkatingWindow)) {
+    if (skating_frames_ > 0) {
+      const motion::FootSkatingReport r = crowd_->foot_skating();
+      slides_cm_.insert(slides_cm_.end(), r.slides_cm.begin(), r.slides_cm.end());
+    }
+    crowd_->track(tracked_agents(crowd_->count(), tracked_));
+    skating_frames_ = 0;
+  }
+  if (skating_frames_ > 0 || (dt > 0.0f && tracked_ > 0)) ++skating_frames_;
+  return s;
+}
+
+nlohmann::json SimulationLocomotion::stats() const {
+  nlohmann::json out;
+  const anim::CrowdAnimator& crowd = *crowd_;
+  const std::int64_t frames = tally_.frames;
+  out["characters"] = crowd.count();
+  out["joints"] = crowd.joint_count();
+  out["frames"] = frames;
+  out["frame_ms"] = tally_.frame_ms_json();
+  // The stage's kernels (anim.*): milliseconds per frame.
+  nlohmann::json kernels = nlohmann::json::object();
+  for (const KernelStat& k : KernelTimings::global().stats())
+    if (k.name.rfind("anim.", 0) == 0)
+      kernels[k.name] = {{"count", k.count}, {"total_ms", k.total_ms}, {"median_ms", k.median_ms},
+                         {"ms_per_frame", frames > 0 ? k.total_ms / static_cast<double>(frames) : 0.0}};
+  out["kernels"] = kernels;
+  out["joints_synthesised_per_character"] =
+      tally_.character_frames() > 0.0 ? static_cast<double>(tally_.joints_synthesised) / tally_.character_frames() : 0.0;
+  if (nlohmann::json lod = tally_.lod_json(crowd, thresholds_); !lod.is_null()) out["lod"] = lod;
+  if (nlohmann::json cache = tally_.cache_json(crowd); !cache.is_null()) out["cache"] = cache;
+  std::vector<double> slides = slides_cm_;
+  if (skating_frames_ > 0) {
+    const motion::FootSkatingReport r = crowd.foot_skating();
+    slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
+  }
+  const motion::FootSkatingReport skate = motion::summarise_foot_skating(std::move(slides));
+  out["foot_skating_cm"] = {{"mean", skate.mean_cm},
+                            {"p95", skate.p95_cm},
+                            {"max", skate.max_cm},
+                            {"contacts", skate.contacts},
+                            {"agents", std::min(crowd.count(), tracked_)}};
+  return out;
+}
+
+LocomotionStage::LocomotionStage(const sim::Simulation& sim, LocomotionStageOptions options)
+    : options_(std::move(options)), locomotion_(sim, options_.locomotion) {
+  if (!(options_.fps >= 0.0) || !std::isfinite(options_.fps)) throw Error("must be >= 0", at_field("locomotion.fps"));
+}
+
+void LocomotionStage::frame_at(const sim::Simulation& sim, double time, float alpha, float dt) {
+  std::optional<Camera> camera;
+  if (options_.camera) camera = options_.camera(time);
+  locomotion_.animate(sim, alpha, dt, camera && options_.lod ? &*camera : nullptr);
+  if (options_.on_frame) options_.on_frame(time, camera ? &*camera : nullptr, locomotion_);
+}
+
+void LocomotionStage::start(const sim::Simulation& sim, const sim::FrameInfo& frame) {
+  locomotion_.remember(sim);
+  frame_at(sim, frame.time, 1.0f, 0.0f);
+  video_frames_ = 1;
+  last_time_ = frame.time;
+}
+
+void LocomotionStage::after_step(const sim::Simulation& sim, const sim::FrameInfo& frame) {
+  const double step = static_cast<double>(sim.spec().dt);
+  if (options_.fps <= 0.0) {
+    frame_at(sim, frame.time, 1.0f, static_cast<float>(frame.time - last_time_));
+  } else {
+    // Every video frame whose time falls in (previous step, this step].
+    const double frame_dt = 1.0 / options_.fps;
+    for (;;) {
+      const double t = static_cast<double>(video_frames_) * frame_dt;
+      if (t > frame.time + 1e-9) break;
+      const double alpha = std::clamp(1.0 - (frame.time - t) / step, 0.0, 1.0);
+      frame_at(sim, t, static_cast<float>(alpha), static_cast<float>(frame_dt));
+      ++video_frames_;
+    }
+  }
+  last_time_ = frame.time;
+  locomotion_.remember(sim);  // the start of the next step's interpolation
+}
+
+void LocomotionStage::finish(const sim::Simulation& sim, nlohmann::json& stats) {
+  stats["locomotion"] = locomotion_.stats();
+  stats["locomotion"]["fps"] = options_.fps > 0.0 ? options_.fps : 1.0 / static_cast<double>(sim.spec().dt);
+}
+
+}  // namespace throng::app

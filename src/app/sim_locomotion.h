@@ -1,0 +1,108 @@
+// The locomotion stage driven by the crowd simulation: every agent animated
+// from its simulated velocity and heading (anim::CrowdAnimator::drive_from_map:
+// speed -> w, heading -> orientation, phase advanced by the blended cadence),
+// with joint LOD under the scenario's camera, the motion cache, and foot
+// skating measured on some agents.
+//
+// One mechanism for every caller: `throng run` (LocomotionStage, a
+// sim::FrameStage, with a frame per step, or per video frame with --render)
+// and `throng view` / `throng view --headless` (cmd_view.cpp's
+// SimulationScene) all animate through SimulationLocomotion::animate().
+// Between two simulation steps agents are interpolated
+// (anim::InterpolateAgentsJob), so frames faster than the steps stay smooth.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "anim/locomotion.h"
+#include "app/locomotion_stats.h"
+#include "core/buffer.h"
+#include "core/camera.h"
+#include "motion/locomotion.h"
+#include "sim/frame_loop.h"
+#include "sim/simulation.h"
+
+namespace throng::app {
+
+struct LocomotionOptions {
+  std::vector<float> lod_thresholds;  // square pixels, decreasing; empty = anim's defaults
+  Index skating_agents = 64;          // agents, evenly spread over the crowd, whose foot skating is measured
+};
+
+// The scenario's camera, the one that renders and drives the LOD: its own,
+// else an overview of the world and the crowd (sim::overview_camera).
+Camera scenario_camera(const sim::Simulation& sim);
+
+class SimulationLocomotion {
+ public:
+  SimulationLocomotion(const sim::Simulation& sim, const LocomotionOptions& options = {});
+  SimulationLocomotion(const SimulationLocomotion&) = delete;
+  SimulationLocomotion& operator=(const SimulationLocomotion&) = delete;
+
+  anim::CrowdAnimator& animator() { return *crowd_; }
+  const anim::CrowdAnimator& animator() const { return *crowd_; }
+
+  // Where the agents stand now: the start of the next interpolation. Call
+  // before each simulation step (or after it, for the step that follows).
+  void remember(const sim::Simulation& sim);
+  // One frame: agents `alpha` of the way from the remembered step to the
+  // current state (1 = the current state), walking at their displacement
+  // over that step (what the root moves, so strides match it), dt seconds
+  // after the previous frame, joint LOD for `camera` (null: every joint).
+  // moving = false shows everyone standing (a finished simulation).
+  const anim::FrameStats& animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera, bool moving = true);
+
+  std::int64_t frames() const { return tally_.frames; }
+  // stats.json's "locomotion" section: frame timings, kernels (anim.*),
+  // joint-LOD histogram, cache counters, foot skating (cm: mean, p95).
+  nlohmann::json stats() const;
+
+ private:
+  motion::BlendSpace1D space_;
+  std::unique_ptr<anim::CrowdAnimator> crowd_;
+  std::vector<float> thresholds_;
+  Index tracked_ = 0;
+  Buffer<glm::vec2> previous_positions_, shown_positions_, moved_, still_;
+  Buffer<float> previous_headings_, shown_headings_;
+  LocomotionTally tally_;  // over the frames
+  std::int32_t skating_frames_ = 0;  // frames in the current foot-tracking window
+  std::vector<double> slides_cm_;    // contacts of the windows closed so far
+};
+
+// `throng run`'s locomotion stage ("anim.locomotion"). Frames: one per
+// simulation step, or `fps` per simulated second (the frames of a video,
+// agents interpolated between steps). After every frame `on_frame` is
+// called (rendering); the camera at a time drives the LOD.
+struct LocomotionStageOptions {
+  LocomotionOptions locomotion;
+  double fps = 0.0;  // 0: a frame per step
+  std::function<Camera(double time)> camera;  // the camera of each frame (rendering and LOD)
+  bool lod = true;                            // false or no camera: every joint synthesised
+  std::function<void(double time, const Camera* camera, SimulationLocomotion& animated)> on_frame;
+};
+
+class LocomotionStage final : public sim::FrameStage {
+ public:
+  LocomotionStage(const sim::Simulation& sim, LocomotionStageOptions options);
+  std::string name() const override { return "anim.locomotion"; }
+  void start(const sim::Simulation& sim, const sim::FrameInfo& frame) override;
+  void after_step(const sim::Simulation& sim, const sim::FrameInfo& frame) override;
+  void finish(const sim::Simulation& sim, nlohmann::json& stats) override;
+  SimulationLocomotion& locomotion() { return locomotion_; }
+
+ private:
+  void frame_at(const sim::Simulation& sim, double time, float alpha, float dt);
+
+  LocomotionStageOptions options_;
+  SimulationLocomotion locomotion_;
+  std::int64_t video_frames_ = 0;  // with fps: frames shown so far
+  double last_time_ = 0.0;
+};
+
+}  // namespace throng::app
