@@ -207,6 +207,27 @@ std::int32_t FreeSpace::component_of(glm::vec2 p) const {
   return -1;
 }
 
+bool FreeSpace::contains(glm::vec2 p) const {
+  if (!bounds_.contains(p)) return false;
+  const sim::GridView g = grid_.host_view();
+  const std::int32_t cy = sim::cell_coord(p.y, cell_);
+  const std::int32_t x_end = sim::cell_coord(bounds_.max.x, cell_);
+  bool inside = false;
+  // Each crossing is counted in the one cell of the row that holds it (an
+  // edge is registered in every cell its pieces' boxes touch).
+  for (std::int32_t x = sim::cell_coord(p.x, cell_); x <= x_end; ++x) {
+    const Index slot = g.find(x, cy);
+    if (slot < 0) continue;
+    for (std::int32_t i = 0; i < g.count[slot]; ++i) {
+      const sim::Segment& e = boundary_[static_cast<std::size_t>(g.items[g.start[slot] + i])];
+      if ((e.a.y > p.y) == (e.b.y > p.y)) continue;
+      const float cross_x = e.a.x + (p.y - e.a.y) * (e.b.x - e.a.x) / (e.b.y - e.a.y);
+      if (cross_x > p.x && sim::cell_coord(cross_x, cell_) == x) inside = !inside;
+    }
+  }
+  return inside;
+}
+
 float FreeSpace::boundary_distance(glm::vec2 p) const {
   if (boundary_.empty()) return INFINITY;
   const sim::GridView g = grid_.host_view();
