@@ -237,8 +237,8 @@ outputs:
   EXPECT_EQ(s.outputs.every, 4);
   EXPECT_FALSE(s.outputs.trajectories);
   // Every key's position is known.
-  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 40);
-  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 49);
+  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 41);
+  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 50);
   // And it all builds and runs.
   const auto sim = build_simulation(l);
   EXPECT_EQ(sim->agent_count(), 24);
