@@ -5,14 +5,21 @@
 // or more between start and goal), resampled at the machine's spacing and
 // cut into segments of k = 64 points; items/s counts (segment, motion) pairs.
 #include <algorithm>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/registry.h"
+#include "io/scenario_yaml.h"
 #include "io/state_machine_yaml.h"
 #include "motion/default_set.h"
 #include "path/match.h"
 #include "path/pipeline.h"
 #include "path/planner.h"
+#include "path/route_planner.h"
+#include "sim/crowd.h"
 
 namespace throng::bench {
 
@@ -56,6 +63,68 @@ path::CurveSet curves_of(Index n) {
   const auto count = static_cast<std::size_t>(std::min<Index>(n, static_cast<Index>(s.paths.size())));
   return path::cut_paths(std::span<const path::ResampledPath>(s.paths.data(), count), s.machine,
                          std::span<const float>(s.speeds.data(), count));
+}
+
+// The routes of `throng run` (path::RoadmapRoutePlanner): n agents' start
+// and goal points in a world, with the planner's free space and roadmap
+// already built (the "path/roadmap" row's cost), so the rows time the
+// queries: a straight-line check per agent, then A* and shortcuts for the
+// blocked ones. Worlds: the 60 x 40 m field of the rows above (random
+// (start, goal) pairs 15 m or more apart: nearly all routed), the built-in
+// maze (every agent routed through the walls) and the built-in crossing
+// (every straight line clear: what planning adds where it is not needed).
+struct RouteScene {
+  sim::World world;
+  std::vector<glm::vec2> starts, goals;
+  float radius = 0.25f;
+  path::RoadmapRoutePlanner planner;
+};
+
+std::unique_ptr<RouteScene> builtin_route_scene(const char* name, Index n) {
+  auto scene = std::make_unique<RouteScene>();
+  io::LoadedScenario l = io::load_builtin_scenario(name);
+  sim::scale_agent_counts(l.spec, n);
+  scene->world = sim::World::build(l.spec.world, l.spec.model.query_radius());
+  const sim::CrowdHost crowd = sim::spawn_crowd(l.spec, scene->world);
+  scene->starts = crowd.position;
+  for (std::size_t i = 0; i < crowd.position.size(); ++i)
+    scene->goals.push_back(crowd.waypoints[static_cast<std::size_t>(crowd.waypoint_begin[i] + crowd.waypoint_goal[i])]);
+  scene->radius = l.spec.groups.front().radius;
+  return scene;
+}
+
+std::unique_ptr<RouteScene> field_route_scene(Index n) {
+  auto scene = std::make_unique<RouteScene>();
+  scene->world = path::random_obstacle_world({});
+  path::PlanOptions po;
+  po.radius = scene->radius;
+  const path::Planner planner = path::Planner::build(scene->world, po);
+  for (const path::PathQuery& q : path::random_queries(planner, n, 11)) {
+    scene->starts.push_back(q.start);
+    scene->goals.push_back(q.goal);
+  }
+  return scene;
+}
+
+const RouteScene& route_scene(const std::string& name, Index n) {
+  static std::map<std::pair<std::string, Index>, std::unique_ptr<RouteScene>> cache;
+  auto& slot = cache[{name, n}];
+  if (!slot) {
+    ScopedExecution cpu(Backend::Cpu, 0);
+    slot = name == "field" ? field_route_scene(n) : builtin_route_scene(name.c_str(), n);
+    slot->planner.plan(slot->world, slot->starts, slot->goals, slot->radius);  // builds the free space and roadmap
+  }
+  return *slot;
+}
+
+Body route_plan(const char* scene_name) {
+  return [scene_name](benchmark::State& state, Index n) {
+    const RouteScene& s = route_scene(scene_name, n);
+    for (auto _ : state) benchmark::DoNotOptimize(s.planner.plan(s.world, s.starts, s.goals, s.radius));
+    state.SetItemsProcessed(state.iterations() * n);
+    const path::RoutePlannerStats st = s.planner.stats();
+    state.counters["routed_fraction"] = static_cast<double>(st.planned) / static_cast<double>(std::max<std::int64_t>(1, st.queries));
+  };
 }
 
 void register_path(const Options& options) {
@@ -105,6 +174,11 @@ void register_path(const Options& options) {
                   state.SetItemsProcessed(state.iterations() * n);
                 },
                 false, true});
+
+  // Routes for n agents (see RouteScene).
+  add(options, {"path/route_plan/field", {1000, 10000}, route_plan("field")});
+  add(options, {"path/route_plan/maze", {100}, route_plan("maze")});
+  add(options, {"path/route_plan/crossing", {10000}, route_plan("crossing")});
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "io/scenario_yaml.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
@@ -15,6 +16,7 @@
 
 #include "core/ground.h"
 #include "io/embedded.h"
+#include "path/route_planner.h"
 
 namespace throng::io {
 
@@ -493,13 +495,15 @@ class Reader {
 
   sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name) {
     expect_map(root, "",
-               {"name", "description", "seed", "scheduler", "dt", "duration", "steps", "stop_when_arrived", "model", "world", "groups",
+               {"name", "description", "seed", "scheduler", "planning", "dt", "duration", "steps", "stop_when_arrived", "model", "world", "groups",
                 "camera", "measurement", "outputs"});
     sim::ScenarioSpec s;
     s.name = root["name"] ? text(root["name"], "name") : default_name;
     if (root["description"]) s.description = text(root["description"], "description");
     if (root["seed"]) s.seed = static_cast<std::uint64_t>(integer(root["seed"], "seed", 0, std::int64_t{1} << 53));
     if (root["scheduler"]) s.scheduler = sim::parse_scheduler(word(root["scheduler"], "scheduler", {"double_buffer", "four_colour", "four_color"}), "scheduler");
+    if (root["planning"])
+      s.planning = word(root["planning"], "planning", {"roadmap", "none"}) == "none" ? sim::PlanningKind::None : sim::PlanningKind::Roadmap;
     if (root["dt"]) s.dt = real_in(root["dt"], "dt", 1e-4, 10.0);
     if (root["duration"]) s.duration = real_in(root["duration"], "duration", 1e-3, 1e9);
     if (root["steps"]) s.steps = integer(root["steps"], "steps", 1, limits_.scenario.max_steps);
@@ -633,7 +637,24 @@ LoadedScenario load_scenario(const std::string& name_or_path, const ScenarioRead
 
 std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario, const sim::SimulationOptions& options) {
   try {
-    return std::make_unique<sim::Simulation>(scenario.spec, options);
+    // `planning: roadmap` (the default): routes over the Voronoi roadmap for
+    // groups with a goal and no waypoints (or the caller's planner);
+    // `planning: none`: straight to the goal.
+    if (scenario.spec.planning == sim::PlanningKind::None) {
+      sim::SimulationOptions straight = options;
+      straight.planner = nullptr;
+      return std::make_unique<sim::Simulation>(scenario.spec, straight);
+    }
+    if (options.planner != nullptr) return std::make_unique<sim::Simulation>(scenario.spec, options);
+    const path::RoadmapRoutePlanner planner;
+    sim::SimulationOptions planned = options;
+    planned.planner = &planner;
+    auto simulation = std::make_unique<sim::Simulation>(scenario.spec, planned);
+    if (const path::RoutePlannerStats st = planner.stats(); st.queries > 0)
+      spdlog::info("planning: {} of {} agents routed over the roadmap, {} straight, {} without a route ({} roadmap(s) in {:.2f} s, "
+                   "queries {:.2f} s)",
+                   st.planned, st.queries, st.straight, st.fallback, st.roadmaps, st.build_seconds, st.plan_seconds);
+    return simulation;
   } catch (const Error& e) {
     throw scenario.source.located(e);
   }

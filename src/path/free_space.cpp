@@ -207,23 +207,38 @@ std::int32_t FreeSpace::component_of(glm::vec2 p) const {
   return -1;
 }
 
+bool FreeSpace::contains(glm::vec2 p) const {
+  if (!bounds_.contains(p)) return false;
+  const sim::GridView g = grid_.host_view();
+  const std::int32_t cy = sim::cell_coord(p.y, cell_);
+  const std::int32_t x_end = sim::cell_coord(bounds_.max.x, cell_);
+  bool inside = false;
+  // Each crossing is counted in the one cell of the row that holds it (an
+  // edge is registered in every cell its pieces' boxes touch).
+  for (std::int32_t x = sim::cell_coord(p.x, cell_); x <= x_end; ++x) {
+    const Index slot = g.find(x, cy);
+    if (slot < 0) continue;
+    for (std::int32_t i = 0; i < g.count[slot]; ++i) {
+      const sim::Segment& e = boundary_[static_cast<std::size_t>(g.items[g.start[slot] + i])];
+      if ((e.a.y > p.y) == (e.b.y > p.y)) continue;
+      const float cross_x = e.a.x + (p.y - e.a.y) * (e.b.x - e.a.x) / (e.b.y - e.a.y);
+      if (cross_x > p.x && sim::cell_coord(cross_x, cell_) == x) inside = !inside;
+    }
+  }
+  return inside;
+}
+
 float FreeSpace::boundary_distance(glm::vec2 p) const {
   if (boundary_.empty()) return INFINITY;
   const sim::GridView g = grid_.host_view();
   const std::int32_t cx = sim::cell_coord(p.x, cell_), cy = sim::cell_coord(p.y, cell_);
   // Rings of cells around p's cell; ring k covers every point within k cell
   // sides of p, so once the best distance is below that, it is final.
-  const glm::vec2 size = bounds_.size();
-  const glm::vec2 inside(std::clamp(p.x, bounds_.min.x, bounds_.max.x), std::clamp(p.y, bounds_.min.y, bounds_.max.y));
-  const float far = sim::length_of(p - inside);
-  const std::int32_t max_ring = static_cast<std::int32_t>(std::ceil((far + size.x + size.y) / cell_)) + 1;
-  if (max_ring > 48) {  // far away or a sparse index: plain scan
-    float best = INFINITY;
-    for (const sim::Segment& s : boundary_) best = std::min(best, sim::distance_to_segment(p, s.a, s.b));
-    return best;
-  }
+  // Up to 48 rings; a point that has no boundary that near (far outside,
+  // or a sparse index) takes a plain scan.
+  constexpr std::int32_t kMaxRing = 48;
   float best = INFINITY;
-  for (std::int32_t k = 0; k <= max_ring; ++k) {
+  for (std::int32_t k = 0; k <= kMaxRing; ++k) {
     for (std::int32_t dy = -k; dy <= k; ++dy)
       for (std::int32_t dx = -k; dx <= k; ++dx) {
         if (std::max(std::abs(dx), std::abs(dy)) != k) continue;
@@ -234,8 +249,9 @@ float FreeSpace::boundary_distance(glm::vec2 p) const {
           best = std::min(best, sim::distance_to_segment(p, seg.a, seg.b));
         }
       }
-    if (best <= static_cast<float>(k) * cell_) break;
+    if (best <= static_cast<float>(k) * cell_) return best;
   }
+  for (const sim::Segment& s : boundary_) best = std::min(best, sim::distance_to_segment(p, s.a, s.b));
   return best;
 }
 
@@ -252,8 +268,26 @@ void FreeSpace::for_cells_near_segment(glm::vec2 a, glm::vec2 b, float reach, Fn
   const std::int32_t x0 = sim::cell_coord(std::min(a.x, b.x) - grow, cell_), x1 = sim::cell_coord(std::max(a.x, b.x) + grow, cell_);
   const std::int32_t y0 = sim::cell_coord(std::min(a.y, b.y) - grow, cell_), y1 = sim::cell_coord(std::max(a.y, b.y) + grow, cell_);
   const float keep = reach + cell_ * 0.7072f;
-  for (std::int32_t y = y0; y <= y1; ++y)
-    for (std::int32_t x = x0; x <= x1; ++x) {
+  // Row by row, only the cells of the band around the part of [a, b] within
+  // `grow` of the row (a long diagonal segment would otherwise visit its
+  // whole bounding box).
+  const glm::vec2 d = b - a;
+  for (std::int32_t y = y0; y <= y1; ++y) {
+    const float y_lo = static_cast<float>(y) * cell_ - grow, y_hi = static_cast<float>(y + 1) * cell_ + grow;
+    float t0 = 0.0f, t1 = 1.0f;
+    if (std::fabs(d.y) > 1e-12f) {
+      float ta = (y_lo - a.y) / d.y, tb = (y_hi - a.y) / d.y;
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(0.0f, ta);
+      t1 = std::min(1.0f, tb);
+      if (t0 > t1) continue;
+    } else if (a.y < y_lo || a.y > y_hi) {
+      continue;
+    }
+    const float xa = a.x + t0 * d.x, xb = a.x + t1 * d.x;
+    const std::int32_t row_x0 = std::max(x0, sim::cell_coord(std::min(xa, xb) - grow, cell_));
+    const std::int32_t row_x1 = std::min(x1, sim::cell_coord(std::max(xa, xb) + grow, cell_));
+    for (std::int32_t x = row_x0; x <= row_x1; ++x) {
       const glm::vec2 centre((static_cast<float>(x) + 0.5f) * cell_, (static_cast<float>(y) + 0.5f) * cell_);
       if (sim::distance_to_segment(centre, a, b) > keep) continue;
       const Index s = g.find(x, y);
@@ -261,6 +295,7 @@ void FreeSpace::for_cells_near_segment(glm::vec2 a, glm::vec2 b, float reach, Fn
       for (std::int32_t i = 0; i < g.count[s]; ++i)
         if (!fn(boundary_[static_cast<std::size_t>(g.items[g.start[s] + i])])) return;
     }
+  }
 }
 
 bool FreeSpace::segment_clear(glm::vec2 a, glm::vec2 b, float r) const {

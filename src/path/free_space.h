@@ -63,7 +63,11 @@ class FreeSpace {
 
   // Index of the component containing p, or -1 (in an obstacle or outside).
   std::int32_t component_of(glm::vec2 p) const;
-  bool contains(glm::vec2 p) const { return component_of(p) >= 0; }
+  // p lies in free space (some component): parity of the boundary edges a
+  // ray from p to +x crosses, walking only the index cells of p's row (the
+  // components of a large world have thousands of holes: a plain
+  // point-in-polygon test per query would visit every vertex).
+  bool contains(glm::vec2 p) const;
   // Distance from p to the nearest boundary edge (inside or outside).
   float boundary_distance(glm::vec2 p) const;
   // Clearance of p: its distance to the boundary when p is in free space, else 0.

@@ -322,7 +322,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     // points in between.
     std::vector<std::vector<glm::vec2>> planned;
     if (planner != nullptr && W == 0 && !chosen.empty()) {
-      planned = planner->plan(chosen, resolved, r);
+      planned = planner->plan(world, chosen, resolved, r);
       if (planned.size() != chosen.size())
         throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()), at_field(field + ".goal"));
     }

@@ -53,12 +53,13 @@ struct CrowdHost {
 };
 
 // Path planning plugs in here: for every group with a goal and no waypoints,
-// plan() gets the agents' start and goal points and returns, per agent, the
-// points to walk through in between (empty = straight to the goal).
+// plan() gets the world, the agents' start and goal points and returns, per
+// agent, the points to walk through in between (empty = straight to the
+// goal). path/route_planner.h is the roadmap planner `throng run` uses.
 class RoutePlanner {
  public:
   virtual ~RoutePlanner() = default;
-  virtual std::vector<std::vector<glm::vec2>> plan(std::span<const glm::vec2> starts, std::span<const glm::vec2> goals,
+  virtual std::vector<std::vector<glm::vec2>> plan(const World& world, std::span<const glm::vec2> starts, std::span<const glm::vec2> goals,
                                                    float agent_radius) const = 0;
 };
 

@@ -35,8 +35,13 @@ struct ModelParams {
 
 enum class ArrivalBehaviour : std::uint8_t { Stop, Despawn, Loop };
 enum class SchedulerKind : std::uint8_t { DoubleBuffer, FourColour };
+// How groups with a goal and no waypoints find their way: routes planned on
+// the roadmap of free space (path/route_planner.h; io::build_simulation
+// supplies the planner), or straight to the goal.
+enum class PlanningKind : std::uint8_t { Roadmap, None };
 const char* to_string(ArrivalBehaviour a);
 const char* to_string(SchedulerKind s);
+const char* to_string(PlanningKind p);
 // "double_buffer" | "four_colour"; throws Error on anything else.
 SchedulerKind parse_scheduler(const std::string& text, const std::string& field);
 
@@ -124,6 +129,7 @@ struct ScenarioSpec {
   bool stop_when_arrived = true;  // end the run early once every agent has arrived
   std::uint64_t seed = 1;
   SchedulerKind scheduler = SchedulerKind::DoubleBuffer;
+  PlanningKind planning = PlanningKind::Roadmap;  // used where the world has obstacles or walls
   ModelParams model;
   WorldSpec world;
   std::vector<GroupSpec> groups;

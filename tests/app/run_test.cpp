@@ -234,7 +234,7 @@ TEST_F(RunCommand, ABadScenarioFileIsOneLineWithItsPosition) {
 TEST_F(RunCommand, UnknownNamesAndBadOptionsAreErrors) {
   Outcome o = run({"run", "circel"});
   EXPECT_EQ(o.code, 1);
-  EXPECT_NE(o.out.find("no built-in scenario 'circel' (built-ins: bottleneck, circle, corridor, crossing, plaza)"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("no built-in scenario 'circel' (built-ins: bottleneck, circle, corridor, crossing, maze, plaza)"), std::string::npos) << o.out;
   o = run({"run", "circle", "--steps", "5", "--seconds", "3"});
   EXPECT_NE(o.code, 0);
   EXPECT_NE(o.out.find("error"), std::string::npos);

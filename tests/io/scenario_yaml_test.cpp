@@ -110,6 +110,7 @@ TEST(ScenarioYaml, EveryKeyOfTheSchema) {
 description: every key once
 seed: 42
 scheduler: four_colour
+planning: none
 dt: 0.05
 steps: 120
 stop_when_arrived: false
@@ -178,6 +179,7 @@ outputs:
   EXPECT_EQ(s.description, "every key once");
   EXPECT_EQ(s.seed, 42u);
   EXPECT_EQ(s.scheduler, sim::SchedulerKind::FourColour);
+  EXPECT_EQ(s.planning, sim::PlanningKind::None);
   EXPECT_FLOAT_EQ(s.dt, 0.05f);
   EXPECT_EQ(s.step_count(), 120);
   EXPECT_FALSE(s.stop_when_arrived);
@@ -235,8 +237,8 @@ outputs:
   EXPECT_EQ(s.outputs.every, 4);
   EXPECT_FALSE(s.outputs.trajectories);
   // Every key's position is known.
-  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 40);
-  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 49);
+  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 41);
+  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 50);
   // And it all builds and runs.
   const auto sim = build_simulation(l);
   EXPECT_EQ(sim->agent_count(), 24);

@@ -91,6 +91,46 @@ TEST(PathsYaml, ReadsPathsAndRejectsBadOnes) {
   EXPECT_NE(error("speed: 3\npaths: []\n").find("unknown key 'speed'"), std::string::npos);
 }
 
+// Every prefix of the shipped files (a truncated download) and many
+// single-byte changes either read or give an Error that says where (file
+// position or key); none
+// crashes or hangs (the seeds of fuzz/io/fuzz_state_machine_yaml.cpp and
+// fuzz_paths_yaml.cpp, run as a test).
+template <class Read>
+void truncations_and_flips(const std::string& text, std::size_t prefix_stride, std::size_t flip_stride, Read&& read) {
+  auto attempt = [&](const std::string& t) {
+    try {
+      read(t);
+    } catch (const Error& e) {
+      EXPECT_TRUE(e.location().line > 0 || !e.location().file.empty() || !e.location().field.empty()) << e.what();
+    }
+  };
+  for (std::size_t n = 0; n < text.size(); n += prefix_stride) attempt(text.substr(0, n));
+  std::string flipped = text;
+  for (std::size_t i = 0; i < text.size(); i += flip_stride) {
+    for (char c : {'\0', ':', '9', '\n'}) {
+      flipped[i] = c;
+      attempt(flipped);
+    }
+    flipped[i] = text[i];
+  }
+}
+
+TEST(StateMachineYaml, TruncationsAndByteFlipsNeverCrash) {
+  const std::string text(default_state_machine_yaml());
+  truncations_and_flips(text, 211, 149, [](const std::string& t) {
+    path::StateMachine::build(parse_state_machine(t, "m.yaml"), motion::default_skeleton());
+  });
+}
+
+TEST(PathsYaml, TruncationsAndByteFlipsNeverCrash) {
+  std::ifstream in(fs::path(__FILE__).parent_path().parent_path().parent_path() / "examples" / "match" / "paths.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  ASSERT_FALSE(ss.str().empty());
+  truncations_and_flips(ss.str(), 5, 3, [](const std::string& t) { parse_paths(t, "p.yaml"); });
+}
+
 // ---- the command ------------------------------------------------------------------
 
 // The command's output, appended to `out`; returns the exit code.

@@ -151,7 +151,8 @@ TEST(Spawn, ClearErrorsForSpawnRegionsGoalsAndParameters) {
 // fixed point above the obstacle.
 class DetourPlanner : public RoutePlanner {
  public:
-  std::vector<std::vector<glm::vec2>> plan(std::span<const glm::vec2> starts, std::span<const glm::vec2> goals, float) const override {
+  std::vector<std::vector<glm::vec2>> plan(const World&, std::span<const glm::vec2> starts, std::span<const glm::vec2> goals,
+                                           float) const override {
     std::vector<std::vector<glm::vec2>> routes;
     for (std::size_t i = 0; i < starts.size(); ++i) routes.push_back({glm::vec2(0.0f, 6.0f), glm::vec2(goals[i].x, 6.0f)});
     return routes;
