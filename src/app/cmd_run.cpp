@@ -235,13 +235,20 @@ void run_scenario(const RunOptions& o) {
       Camera start = lod_camera;
       start.width = o.width;
       start.height = o.height;
-      // --camera, else the scenario's camera.motion, else an orbit.
-      const std::string motion = !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : "orbit");
-      const double period = o.camera_period > 0.0 ? o.camera_period : (spec.camera_period_s > 0.0f ? spec.camera_period_s : 40.0);
-      const auto path = std::make_shared<render::CameraPath>(
-          render::animate_camera(start, render::parse_camera_kind(motion, "--camera"), static_cast<float>(period)));
+      // --camera, else the scenario's camera.motion, else an orbit (the demo follows the crowd).
+      const std::string motion =
+          !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : (o.demo ? "follow" : "orbit"));
       const double speed = o.render_speed;
-      lo.camera = [path, speed](double t) { return path->at(t / speed); };
+      const sim::Simulation* simulation = sim.get();
+      if (motion == "follow") {
+        const auto follow = std::make_shared<FollowCamera>(start, 0.5 * speed);  // eases over half a video second
+        lo.camera = [follow, simulation](double t) { return follow->at(*simulation, t); };
+      } else {
+        const double period = o.camera_period > 0.0 ? o.camera_period : (spec.camera_period_s > 0.0f ? spec.camera_period_s : 40.0);
+        const auto path = std::make_shared<render::CameraPath>(
+            render::animate_camera(start, render::parse_camera_kind(motion, "--camera"), static_cast<float>(period)));
+        lo.camera = [path, speed](double t) { return path->at(t / speed); };
+      }
       // A video frame every `speed / fps` simulated seconds; the animation
       // runs at least once a step (feet stay planted in a time-lapse) and
       // every `per_video`-th frame is drawn.
@@ -250,7 +257,6 @@ void run_scenario(const RunOptions& o) {
       lo.fps = static_cast<double>(per_video) / frame_time;
       const double until = o.render_seconds > 0.0 ? o.render_seconds : std::numeric_limits<double>::infinity();
       auto recorder = std::make_shared<std::unique_ptr<render::Recorder>>();
-      const sim::Simulation* simulation = sim.get();
       lo.on_frame = [recorder, record, per_video, until, simulation, anim_fps = lo.fps](double t, const Camera* camera, SimulationLocomotion& moved) {
         if (std::llround(t * anim_fps) % per_video != 0 || t > until + 1e-9) return;
         ScopedTimer timer("render.frame");
@@ -345,8 +351,10 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
                     ->capture_default_str();
   cmd->add_option("--render-seconds", o.render_seconds, "Render the first S simulated seconds only (default: the whole run)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--camera", o.camera, "The scenario's camera kept fixed, orbiting its target, or flying over it (default: the scenario's camera.motion, else orbit)")
-      ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
+  cmd->add_option("--camera", o.camera,
+                  "The scenario's camera kept fixed, orbiting its target, flying over it, or following the crowd from its direction "
+                  "(default: the scenario's camera.motion, else orbit; the demo follows)")
+      ->check(CLI::IsMember({"fixed", "orbit", "flyover", "follow"}));
   cmd->add_option("--camera-period", o.camera_period, "Video seconds per orbit or fly-over (default: the scenario's, else 40)")
       ->check(CLI::PositiveNumber);
   cmd->callback([&g, cmd, speed] {

@@ -42,6 +42,63 @@ Camera scenario_camera(const sim::Simulation& sim) {
   return sim::overview_camera(box);
 }
 
+FollowCamera::FollowCamera(const Camera& view, double ease_seconds) : view_(view), ease_seconds_(ease_seconds) {
+  if (!(ease_seconds > 0.0) || !std::isfinite(ease_seconds)) throw Error("must be positive seconds", at_field("camera.ease"));
+  const glm::vec3 d = view.position - view.target;
+  const float length = glm::length(d);
+  if (!(length > 0.0f) || !std::isfinite(length)) throw Error("the camera's position equals its target", at_field("camera"));
+  direction_ = d / length;
+}
+
+Camera FollowCamera::at(const sim::Simulation& sim, double t) {
+  const std::vector<glm::vec2> positions = sim.positions();
+  const std::vector<std::uint8_t> flags = sim.flags();
+  // The box of the middle 80% of the active agents along each axis, so a few
+  // stragglers do not pull the camera away from where the crowd is.
+  std::vector<float> xs, ys;
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    if (flags[i] & sim::kAgentActive) {
+      xs.push_back(positions[i].x);
+      ys.push_back(positions[i].y);
+    }
+  sim::Aabb box;
+  if (!xs.empty()) {
+    const auto quantile = [](std::vector<float>& v, double q) {
+      const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+      std::nth_element(v.begin(), v.begin() + k, v.end());
+      return v[static_cast<std::size_t>(k)];
+    };
+    box.add(glm::vec2(quantile(xs, 0.1), quantile(ys, 0.1)));
+    box.add(glm::vec2(quantile(xs, 0.9), quantile(ys, 0.9)));
+  }
+  if (box.empty()) {  // nobody left: hold the last framing
+    if (!started_) return view_;
+  } else {
+    // A sphere holding the agents (and a character's height) fits the
+    // narrower field of view; never closer than 8 m, so a lone agent is framed whole.
+    const float reach = std::max(0.5f * glm::length(box.size()) + 1.0f, 4.0f);
+    const float half_fov = 0.5f * std::min(view_.fov_y, 2.0f * std::atan(std::tan(0.5f * view_.fov_y) * aspect_ratio(view_)));
+    const float distance = std::max(reach / std::sin(half_fov), 8.0f);
+    const glm::vec3 target = world_from_ground(0.5f * (box.min + box.max), 0.9f);
+    if (!started_) {
+      target_ = target;
+      distance_ = distance;
+      started_ = true;
+    } else {
+      const float a = static_cast<float>(1.0 - std::exp(-std::max(0.0, t - last_t_) / ease_seconds_));
+      target_ += a * (target - target_);
+      distance_ += a * (distance - distance_);
+    }
+  }
+  last_t_ = t;
+  Camera c = view_;
+  c.target = target_;
+  c.position = target_ + distance_ * direction_;
+  c.near_plane = std::max(0.1f, 0.01f * distance_);
+  c.far_plane = std::max(view_.far_plane, 4.0f * distance_);
+  return c;
+}
+
 SimulationLocomotion::SimulationLocomotion(const sim::Simulation& sim, const LocomotionOptions& options)
     : space_(motion::make_default_blend_space()), thresholds_(options.lod_thresholds) {
   const Index n = sim.agent_count();

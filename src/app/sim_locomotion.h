@@ -39,6 +39,28 @@ struct LocomotionOptions {
 // else an overview of the world and the crowd (sim::overview_camera).
 Camera scenario_camera(const sim::Simulation& sim);
 
+// A camera that keeps the scenario camera's viewing direction and field of
+// view but aims at the active agents and comes just close enough to frame
+// them, eased so the view glides rather than jumps. The demo's video uses it:
+// the circle's 300 m ring seen whole leaves each character a few pixels
+// tall, while the crowd converging at the centre fills the frame. As the
+// camera of the locomotion stage it is also what joint LOD measures with.
+class FollowCamera {
+ public:
+  // ease_seconds: simulated seconds to close about 63% of the way to a new framing.
+  FollowCamera(const Camera& view, double ease_seconds);
+  Camera at(const sim::Simulation& sim, double t);
+
+ private:
+  Camera view_;
+  glm::vec3 direction_{0.0f, 0.0f, 1.0f};  // from the target towards the camera, unit
+  double ease_seconds_ = 1.0;
+  bool started_ = false;
+  double last_t_ = 0.0;
+  glm::vec3 target_{0.0f};
+  float distance_ = 10.0f;
+};
+
 class SimulationLocomotion {
  public:
   SimulationLocomotion(const sim::Simulation& sim, const LocomotionOptions& options = {});

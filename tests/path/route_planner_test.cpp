@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/exec.h"
+#include "core/random.h"
 #include "sim/world.h"
 #include "tests/path/path_worlds.h"
 
@@ -114,7 +115,7 @@ float visibility_shortest(glm::vec2 a, glm::vec2 b, const Shapes& s, float radiu
 
 // Random free (start, goal) pairs with room for the disc at both ends.
 void random_queries(const Shapes& s, float radius, std::uint64_t seed, int count, std::vector<glm::vec2>& starts, std::vector<glm::vec2>& goals) {
-  sim::Rng rng(seed);
+  Rng rng(seed);
   auto free_point = [&] {
     for (;;) {
       const glm::vec2 p(static_cast<float>(rng.uniform(0.5, 39.5)), static_cast<float>(rng.uniform(0.5, 29.5)));
