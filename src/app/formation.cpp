@@ -1,5 +1,6 @@
 #include "app/formation.h"
 
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -23,12 +24,9 @@ io::AnimateSpec load_animate_spec(const std::string& what, fs::path& folder) {
     folder = fs::path(what).parent_path();
     return io::read_animate_spec(what);
   }
-  std::string list;
-  for (const std::string& name : io::builtin_animate_specs()) {
-    if (what == name) return io::builtin_animate_spec(name);
-    list += (list.empty() ? "" : ", ") + name;
-  }
-  throw Error("no such file or built-in scenario '" + what + "' (built-in: " + list + ")", at_field("scenario"));
+  const std::vector<std::string> names = io::builtin_animate_specs();
+  if (std::find(names.begin(), names.end(), what) != names.end()) return io::builtin_animate_spec(what);
+  throw Error(fmt::format("no such file or built-in scenario '{}' (built-in: {})", what, fmt::join(names, ", ")), at_field("scenario"));
 }
 
 motion::BlendSpace1D load_blend_space(const io::AnimateSpec& spec, const fs::path& folder) {

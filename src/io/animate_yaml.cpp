@@ -1,5 +1,6 @@
 #include "io/animate_yaml.h"
 
+#include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -226,9 +227,8 @@ std::vector<std::string> builtin_animate_specs() { return kBuiltinAnimateScenari
 AnimateSpec builtin_animate_spec(std::string_view name) {
   const auto text = kBuiltinAnimateScenarios.find(name);
   if (!text) {
-    std::string list;
-    for (const auto& n : kBuiltinAnimateScenarios.names()) list += (list.empty() ? "" : ", ") + n;
-    throw Error("no built-in animate scenario '" + std::string(name) + "' (built-in: " + list + ")", at_field("scenario"));
+    throw Error(fmt::format("no built-in animate scenario '{}' (built-in: {})", name, fmt::join(kBuiltinAnimateScenarios.names(), ", ")),
+                at_field("scenario"));
   }
   AnimateSpec s = parse_animate_spec(std::string(*text), "built-in:" + std::string(name));
   s.source = "built-in";

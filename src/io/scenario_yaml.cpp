@@ -1,5 +1,6 @@
 #include "io/scenario_yaml.h"
 
+#include <fmt/ranges.h>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/depthguard.h>
@@ -618,9 +619,7 @@ std::optional<std::string_view> builtin_scenario_text(std::string_view name) { r
 LoadedScenario load_builtin_scenario(std::string_view name, const ScenarioReadLimits& limits) {
   const auto text = builtin_scenario_text(name);
   if (!text) {
-    std::string list;
-    for (const std::string& n : builtin_scenario_names()) list += (list.empty() ? "" : ", ") + n;
-    throw Error(fmt::format("no built-in scenario '{}' (built-ins: {})", name, list), at_field("scenario"));
+    throw Error(fmt::format("no built-in scenario '{}' (built-ins: {})", name, fmt::join(builtin_scenario_names(), ", ")), at_field("scenario"));
   }
   LoadedScenario s = parse_scenario(*text, "builtin:" + std::string(name), limits);
   return s;
