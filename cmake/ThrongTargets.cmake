@@ -4,7 +4,7 @@ set(THRONG_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wconversion-null -Wno-unu
 if(THRONG_WERROR)
   list(APPEND THRONG_WARNINGS -Werror)
 endif()
-set(THRONG_SANITIZER_FLAGS -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+set(THRONG_SANITIZER_FLAGS -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)
 
 # throng_setup_target(target): warnings, sanitizers and include path.
 function(throng_setup_target target)
@@ -33,6 +33,9 @@ function(throng_test name)
   cmake_parse_arguments(T "" "" "LIBS" ${ARGN})
   add_executable(${name} ${T_UNPARSED_ARGUMENTS})
   target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
+  # Test data is found from the source folder, never from __FILE__ (which is
+  # relative when the compiler is given relative paths, e.g. under ccache).
+  target_compile_definitions(${name} PRIVATE THRONG_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   throng_setup_target(${name})
   gtest_discover_tests(${name}
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR}

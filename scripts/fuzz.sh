@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
-# Builds every libFuzzer target (clang, ASan+UBSan) and runs each for a
-# bounded time on a copy of its seed corpus. Fails on the first crash.
+# Builds every libFuzzer target (clang, ASan+UBSan, every sanitizer finding
+# fatal) and runs each for a bounded time on a copy of its seed corpus.
+# Each target's whole log goes to $build_dir/fuzz-logs/<target>.log and any
+# crashing, leaking or slow input to $build_dir/fuzz-crashes/<target>/; a
+# failing target prints its whole log and the inputs kept. Every target
+# runs; the script fails if any found something.
 #   FUZZ_SECONDS=60 bash scripts/fuzz.sh
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -16,17 +20,35 @@ cmake --build "$build_dir" -j "${JOBS:-$(nproc)}" -- --quiet
 shopt -s nullglob
 targets=("$build_dir"/fuzz/fuzz_*)
 if ((${#targets[@]} == 0)); then
-  echo "fuzz: no fuzz targets"
-  exit 0
+  echo "fuzz: no fuzz targets were built" >&2
+  exit 1
 fi
+logs="$root/$build_dir/fuzz-logs"
+crashes="$root/$build_dir/fuzz-crashes"
+mkdir -p "$logs"
+failed=()
 for t in "${targets[@]}"; do
   name=$(basename "$t")
   seeds=$(find fuzz -type d -name "corpus_${name#fuzz_}" | head -n 1)
   work=$(mktemp -d)
   [ -n "$seeds" ] && cp -r "$seeds"/. "$work"/
+  mkdir -p "$crashes/$name"
   echo "fuzz: $name for ${seconds}s (seeds: ${seeds:-none})"
-  (cd "$work" && "$root/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
-     -print_final_stats=1 "$work" 2>&1 | tail -n 12)
+  if (cd "$work" && "$root/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+        -artifact_prefix="$crashes/$name/" -print_final_stats=1 "$work" >"$logs/$name.log" 2>&1); then
+    grep -E '^(#[0-9]+.*DONE|stat::number_of_executed_units|stat::peak_rss_mb|Done [0-9]+ runs)' "$logs/$name.log" | sed 's/^/  /' || true
+  else
+    echo "fuzz: $name FAILED; its whole log ($logs/$name.log):" >&2
+    cat "$logs/$name.log" >&2
+    echo "fuzz: inputs kept in $crashes/$name/:" >&2
+    ls -l "$crashes/$name" >&2
+    failed+=("$name")
+  fi
   rm -rf "$work"
+  rmdir "$crashes/$name" 2>/dev/null || true  # empty: nothing found
 done
-echo "fuzz: all targets ran clean"
+if ((${#failed[@]})); then
+  echo "fuzz: ${#failed[@]} target(s) failed: ${failed[*]} (inputs under $crashes)" >&2
+  exit 1
+fi
+echo "fuzz: all ${#targets[@]} targets ran clean"

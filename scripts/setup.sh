@@ -4,6 +4,7 @@
 #   bash scripts/setup.sh            # deps + build/release
 #   bash scripts/setup.sh --deps     # deps only
 #   BUILD_DIR=build/x CMAKE_ARGS="-DTHRONG_SANITIZE=ON" bash scripts/setup.sh
+#   BUILD_TARGETS="throng gpu_tests" bash scripts/setup.sh   # only these targets
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -32,5 +33,7 @@ extra+=(${CMAKE_ARGS:-})
 if [ ! -f "$build_dir/build.ninja" ]; then
   cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" "${extra[@]}" >/dev/null
 fi
-echo "setup: building $build_dir"
-cmake --build "$build_dir" -j "$jobs" -- --quiet
+targets=()
+for t in ${BUILD_TARGETS:-}; do targets+=(--target "$t"); done
+echo "setup: building $build_dir${BUILD_TARGETS:+ (targets: $BUILD_TARGETS)}"
+cmake --build "$build_dir" -j "$jobs" "${targets[@]}" -- --quiet

@@ -148,8 +148,7 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
                 static_cast<double>(stats["cache"]["bytes"]) / (1024.0 * 1024.0), static_cast<long long>(stats["cache"]["evictions"]),
                 static_cast<double>(stats["cache"]["quantisation_error_deg"]["max"]),
                 static_cast<double>(stats["cache"]["quantisation_error_deg"]["mean"]));
-  std::printf("  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts of %zu characters\n", skate.mean_cm, skate.p95_cm, skate.contacts,
-              tracked.size());
+  std::printf("  foot skating: %s of %zu characters\n", motion::describe(skate).c_str(), tracked.size());
   if (spec.shape == io::AnimateSpec::Shape::Circle) std::printf("  formation: largest drift from a ring %.2g m\n", drift);
   std::printf("  wrote %s\n", json_path.string().c_str());
 }

@@ -166,8 +166,12 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
     std::printf("  locomotion: %lld frames, median %.3f ms per frame; joints synthesised %.1f of %d per agent", l["frames"].get<long long>(),
                 l["frame_ms"]["median"].get<double>(), l["joints_synthesised_per_character"].get<double>(), l["joints"].get<int>());
     if (l.contains("cache")) std::printf("; cache hits %.1f%%", 100.0 * l["cache"]["hit_rate"].get<double>());
-    std::printf("\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts\n", l["foot_skating_cm"]["mean"].get<double>(),
-                l["foot_skating_cm"]["p95"].get<double>(), l["foot_skating_cm"]["contacts"].get<int>());
+    const auto& skate = l["foot_skating_cm"];
+    if (skate["contacts"].get<int>() > 0)
+      std::printf("\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts\n", skate["mean"].get<double>(), skate["p95"].get<double>(),
+                  skate["contacts"].get<int>());
+    else
+      std::printf("\n  foot skating: no contacts measured\n");
   }
   if (!written.empty()) std::printf("  wrote %s\n", written.c_str());
 }

@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "core/error.h"
 
 namespace throng::motion {
@@ -62,6 +64,11 @@ FootSkatingReport summarise_foot_skating(std::vector<double> slides_cm) {
   r.p95_cm = sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
   r.max_cm = sorted.back();
   return r;
+}
+
+std::string describe(const FootSkatingReport& r) {
+  if (!r.measured()) return "no contacts measured";
+  return fmt::format("mean {:.2f} cm, p95 {:.2f} cm over {} contacts", r.mean_cm, r.p95_cm, r.contacts);
 }
 
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpaceClip& posed, double frame_time,

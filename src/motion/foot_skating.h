@@ -8,7 +8,9 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
@@ -21,13 +23,21 @@
 
 namespace throng::motion {
 
+// With no contact measured the figures are NaN, not zero: nothing was
+// measured, so no bound on them can hold by accident (NaN < x is false), and
+// JSON writes them as null.
 struct FootSkatingReport {
   std::int32_t contacts = 0;
-  double mean_cm = 0.0;
-  double p95_cm = 0.0;  // nearest-rank 95th percentile over contacts
-  double max_cm = 0.0;
+  double mean_cm = std::numeric_limits<double>::quiet_NaN();
+  double p95_cm = std::numeric_limits<double>::quiet_NaN();  // nearest-rank 95th percentile over contacts
+  double max_cm = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> slides_cm;  // per contact: left foot's, then right's
+
+  bool measured() const { return contacts > 0; }
 };
+
+// "mean 0.42 cm, p95 0.90 cm over 120 contacts", or "no contacts measured".
+std::string describe(const FootSkatingReport& r);
 
 FootSkatingReport measure_foot_skating(const ModelSpaceClip& model, const ContactReport& contacts, const FeetJoints& feet);
 

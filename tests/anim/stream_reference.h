@@ -147,11 +147,4 @@ inline AnimClip wiggle_clip(int joints, int frames, float frame_time, const std:
   return c;
 }
 
-inline std::string shared_bvh(const std::string& file) {
-  const char* dir = std::getenv("THRONG_SHARED_DIR");
-  if (dir == nullptr) return {};
-  const std::filesystem::path p = std::filesystem::path(dir) / "data" / "bvh" / file;
-  return std::filesystem::exists(p) ? p.string() : std::string();
-}
-
 }  // namespace throng::anim::testing

@@ -54,12 +54,12 @@ TEST(Buffer, OutOfRangeIsAnErrorInCheckedBuilds) {
 }
 #endif
 
-TEST(Buffer, DeviceMemoryWithoutGpuIsAClearError) {
-  if (cuda::device_count() > 0) GTEST_SKIP() << "a GPU is present; covered by DeviceRoundTrip";
+TEST(Buffer, CudaDeviceMemoryWithoutGpuIsAClearError) {
+  if (cuda::device_count() > 0) GTEST_SKIP() << "a GPU is present; covered by CudaDeviceRoundTrip";
   EXPECT_THROW(Buffer<int>(10, Memory::Device), Error);
 }
 
-TEST(Buffer, DeviceRoundTrip) {
+TEST(Buffer, CudaDeviceRoundTrip) {
   if (cuda::device_count() == 0) GTEST_SKIP() << "no usable GPU on this machine: " << cuda::runtime_error_text();
   std::vector<float> v(4097);
   std::iota(v.begin(), v.end(), 0.5f);

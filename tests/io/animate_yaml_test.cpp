@@ -23,7 +23,7 @@ std::string error_of(const std::string& yaml) {
 
 TEST(AnimateYaml, TheExampleIsTheBuiltInAndTheDefaults) {
   const std::filesystem::path example =
-      std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "examples" / "animate" / "formation.yaml";
+      std::filesystem::path(THRONG_SOURCE_DIR) / "examples" / "animate" / "formation.yaml";
   AnimateSpec file = read_animate_spec(example.string());
   AnimateSpec builtin = builtin_animate_spec("formation");
   EXPECT_EQ(file.source, example.string());

@@ -14,7 +14,7 @@
 namespace throng::io {
 namespace {
 
-const std::filesystem::path kCorpus = std::filesystem::path(__FILE__).parent_path().parent_path() / "data" / "bvh_bad";
+const std::filesystem::path kCorpus = std::filesystem::path(THRONG_SOURCE_DIR) / "tests" / "data" / "bvh_bad";
 
 struct Expectation {
   std::string file;

@@ -19,6 +19,7 @@
 #include "io/bvh_reader.h"
 #include "motion/fk.h"
 #include "tests/io/throng_exe.h"
+#include "tests/shared_data.h"
 
 namespace throng::io {
 namespace {
@@ -29,17 +30,10 @@ using testing::find_throng;
 using testing::Result;
 using testing::run;
 
-std::optional<fs::path> shared_bvh_dir() {
-  const char* dir = std::getenv("THRONG_SHARED_DIR");
-  if (dir == nullptr || !fs::is_directory(fs::path(dir) / "data" / "bvh")) return std::nullopt;
-  return fs::path(dir) / "data" / "bvh";
-}
-
 #define REQUIRE_EXE_AND_SHARED(exe, dir)                                                       \
   const auto exe = find_throng();                                                              \
   if (!exe) GTEST_SKIP() << "throng executable not found near this test (build target throng)"; \
-  const auto dir = shared_bvh_dir();                                                           \
-  if (!dir) GTEST_SKIP() << "../shared not found: THRONG_SHARED_DIR is unset or has no data/bvh"
+  THRONG_NEED_SHARED_BVH(dir)
 
 // Header facts read without the reader.
 struct Header {
@@ -133,7 +127,7 @@ std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::c
 TEST(BvhCli, ErrorsAreOneLineWithNonZeroExit) {
   const auto exe = find_throng();
   if (!exe) GTEST_SKIP() << "throng executable not found near this test (build target throng)";
-  const fs::path bad = fs::path(__FILE__).parent_path().parent_path() / "data" / "bvh_bad" / "nan_value.bvh";
+  const fs::path bad = fs::path(THRONG_SOURCE_DIR) / "tests" / "data" / "bvh_bad" / "nan_value.bvh";
   const fs::path tmp = fs::temp_directory_path() / "throng_bvh_cli_out.bvh";
   const std::vector<std::string> cases = {"info /nonexistent/x.bvh", "info " + bad.string(), "info README.md",
                                   "convert " + bad.string() + " " + tmp.string(), "convert a.bvh b.bvh --order QQQ",

@@ -18,16 +18,13 @@
 #include "io/bvh_reader.h"
 #include "io/bvh_writer.h"
 #include "motion/fk.h"
-#include "tests/io/shared_data.h"
+#include "tests/shared_data.h"
 
 namespace throng::io {
 namespace {
 
 namespace fs = std::filesystem;
 
-#define REQUIRE_SHARED_BVH(dir)                                                                                  \
-  const auto dir = shared_bvh_dir();                                                                             \
-  if (!dir) GTEST_SKIP() << "../shared not found: THRONG_SHARED_DIR is unset or has no data/bvh (ctest sets it)"
 
 std::vector<fs::path> shared_files(const fs::path& dir) {
   std::vector<fs::path> out;
@@ -76,7 +73,7 @@ bool is_daz(const fs::path& p) { return p.filename().string().find("_daz") != st
 bool is_max(const fs::path& p) { return p.filename().string().find("_max") != std::string::npos; }
 
 TEST(BvhShared, EveryFileLoadsAndMatchesItsHeader) {
-  REQUIRE_SHARED_BVH(dir);
+  THRONG_NEED_SHARED_BVH(dir);
   const auto files = shared_files(*dir);
   ASSERT_FALSE(files.empty());
   for (const auto& path : files) {
@@ -117,7 +114,7 @@ std::string role_name(const motion::Skeleton& s, motion::Role r) {
 }
 
 TEST(BvhShared, RolesOfEveryFile) {
-  REQUIRE_SHARED_BVH(dir);
+  THRONG_NEED_SHARED_BVH(dir);
   using motion::Role;
   for (const auto& path : shared_files(*dir)) {
     SCOPED_TRACE(path.filename().string());
@@ -175,7 +172,7 @@ double max_joint_distance(const BvhFile& a, const BvhFile& b) {
 }
 
 TEST(BvhShared, RoundTripWithinATenthOfAMillimetre) {
-  REQUIRE_SHARED_BVH(dir);
+  THRONG_NEED_SHARED_BVH(dir);
   const motion::LengthUnit units[] = {motion::LengthUnit::Centimetre, motion::LengthUnit::Metre, motion::LengthUnit::Inch};
   std::size_t k = 0;
   for (const auto& path : shared_files(*dir)) {

@@ -10,7 +10,7 @@
 
 #include "io/bvh_reader.h"
 #include "motion/locomotion.h"
-#include "tests/io/shared_data.h"
+#include "tests/shared_data.h"
 
 namespace throng::io {
 namespace {
@@ -24,7 +24,7 @@ struct Subject16 {
 
 const Subject16* subject16() {
   static const std::optional<Subject16> loaded = []() -> std::optional<Subject16> {
-    const auto dir = shared_bvh_dir();
+    const auto dir = ::throng::test::shared_bvh_dir();
     if (!dir) return std::nullopt;
     Subject16 s;
     s.walk = read_bvh((*dir / "cmu_16_15_walk_daz.bvh").string());
@@ -42,7 +42,7 @@ const Subject16* subject16() {
 
 TEST(LocomotionOnSharedFiles, WalkAndJogOfOneSubjectFormABlendSpace) {
   const Subject16* s = subject16();
-  if (s == nullptr) GTEST_SKIP() << "../shared not found: THRONG_SHARED_DIR is unset or has no data/bvh (ctest sets it)";
+  THRONG_REQUIRE_SHARED_DATA(s != nullptr);
   // Same subject, same skeleton: the jog's clip plays on the walk's skeleton.
   ASSERT_EQ(s->walk.skeleton.joint_count(), s->jog.skeleton.joint_count());
   for (std::size_t j = 0; j < s->walk.skeleton.offsets.size(); ++j)
@@ -74,7 +74,7 @@ TEST(LocomotionOnSharedFiles, WalkAndJogOfOneSubjectFormABlendSpace) {
 // ten speeds from the walk's to the jog's, foot skating below 2 cm per contact.
 TEST(LocomotionOnSharedFiles, FootSkatingOfWalkJogBlendsBelowTwoCentimetres) {
   const Subject16* s = subject16();
-  if (s == nullptr) GTEST_SKIP() << "../shared not found: THRONG_SHARED_DIR is unset or has no data/bvh (ctest sets it)";
+  THRONG_REQUIRE_SHARED_DATA(s != nullptr);
   const motion::BlendSpace1D& space = *s->space;
   motion::LocomotionStep step;
   step.dt = 1.0f / 120.0f;  // the files' rate
@@ -89,6 +89,7 @@ TEST(LocomotionOnSharedFiles, FootSkatingOfWalkJogBlendsBelowTwoCentimetres) {
   // For scale: the raw walk take slides several centimetres per contact.
   const motion::FootSkatingReport raw = motion::measure_foot_skating(s->walk.skeleton, s->walk.clip);
   std::printf("raw 16_15 take: mean %.2f cm, p95 %.2f cm over %d contacts\n", raw.mean_cm, raw.p95_cm, raw.contacts);
+  EXPECT_GE(raw.contacts, 4);  // the take holds several steps of each foot
 }
 
 }  // namespace

@@ -16,7 +16,7 @@
 namespace throng::io {
 namespace {
 
-const std::filesystem::path kRoot = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
+const std::filesystem::path kRoot = std::filesystem::path(THRONG_SOURCE_DIR);
 const std::filesystem::path kCorpus = kRoot / "tests" / "data" / "scenario_bad";
 
 std::string slurp(const std::filesystem::path& p) {

@@ -43,7 +43,7 @@ TEST(StateMachineYaml, DefaultMachineHasTheRequiredStates) {
   EXPECT_TRUE(m.allowed(s("run_left"), s("walk_forward")));
   EXPECT_TRUE(m.allowed(s("idle"), s("walk_forward")));
   // The shipped file is the one compiled in.
-  const fs::path file = fs::path(__FILE__).parent_path().parent_path().parent_path() / "data" / "motion" / "default_machine.yaml";
+  const fs::path file = fs::path(THRONG_SOURCE_DIR) / "data" / "motion" / "default_machine.yaml";
   std::ifstream in(file);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -124,7 +124,7 @@ TEST(StateMachineYaml, TruncationsAndByteFlipsNeverCrash) {
 }
 
 TEST(PathsYaml, TruncationsAndByteFlipsNeverCrash) {
-  std::ifstream in(fs::path(__FILE__).parent_path().parent_path().parent_path() / "examples" / "match" / "paths.yaml");
+  std::ifstream in(fs::path(THRONG_SOURCE_DIR) / "examples" / "match" / "paths.yaml");
   std::stringstream ss;
   ss << in.rdbuf();
   ASSERT_FALSE(ss.str().empty());

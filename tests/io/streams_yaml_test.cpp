@@ -11,6 +11,7 @@
 #include "anim/blend_controller.h"
 #include "core/error.h"
 #include "tests/anim/stream_reference.h"
+#include "tests/shared_data.h"
 
 namespace throng::io {
 namespace {
@@ -151,8 +152,9 @@ TEST(StreamsYaml, ErrorsNameLineAndColumn) {
 // Two skeletons side by side: the default humanoid (22 joints) and a real
 // CMU skeleton (31 joints), each with its own streams.
 TEST(StreamsYaml, MixedCrowdWithARealCmuSkeleton) {
-  const std::string bvh = shared_bvh("cmu_02_01_walk_mb.bvh");
-  if (bvh.empty()) GTEST_SKIP() << "../shared not found: THRONG_SHARED_DIR is unset or has no data/bvh (ctest sets it)";
+  const auto found = ::throng::test::shared_bvh("cmu_02_01_walk_mb.bvh");
+  THRONG_REQUIRE_SHARED_DATA(found);
+  const std::string bvh = found->string();
   const std::string yaml = "frame_rate: 30\nrigs:\n  - {name: human, skeleton: default}\n  - {name: cmu, bvh: '" + bvh +
                            "'}\nclips:\n  - {name: walk, rig: human, default: walk, footsteps: true}\n"
                            "  - {name: idle, rig: human, default: idle}\n"

@@ -261,6 +261,22 @@ TEST(FootSkating, MeasuresTheSlideOfThePinnedPoint) {
   EXPECT_NEAR(r.p95_cm, 2.9, 1e-3);
 }
 
+// Nothing measured is not zero skating: with no contact every figure is NaN
+// (so any bound on it fails) and the report says so in words.
+TEST(FootSkating, NoContactsMeansNoFigures) {
+  const FootSkatingReport none = summarise_foot_skating({});
+  EXPECT_FALSE(none.measured());
+  EXPECT_EQ(none.contacts, 0);
+  EXPECT_TRUE(std::isnan(none.mean_cm));
+  EXPECT_TRUE(std::isnan(none.p95_cm));
+  EXPECT_TRUE(std::isnan(none.max_cm));
+  EXPECT_FALSE(none.mean_cm < 2.0);
+  EXPECT_EQ(describe(none), "no contacts measured");
+  const FootSkatingReport some = summarise_foot_skating({1.0, 3.0});
+  EXPECT_TRUE(some.measured());
+  EXPECT_EQ(describe(some), "mean 2.00 cm, p95 3.00 cm over 2 contacts");
+}
+
 TEST(MakeCyclic, LeavesAnExactLoopAloneAndClosesADriftingOne) {
   const Skeleton s = legs_skeleton();
   Synthetic c;

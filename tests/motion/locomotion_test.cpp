@@ -330,9 +330,11 @@ TEST(LocomotionFootSkating, PlantingTheFeetIsWhatKeepsBlendsFromSliding) {
   off.plant_feet = false;
   const BlendSpace1D loose(space.skeleton(), space.clips(), off);
   const float speed = 0.6f;  // idle <-> walk_slow, w = 0.6
-  const double with_ik = locomotion_foot_skating(space, speed, 8.0).mean_cm;
-  const double without = locomotion_foot_skating(loose, speed, 8.0).mean_cm;
-  EXPECT_LT(with_ik, 0.5 * without);
+  const FootSkatingReport with_ik = locomotion_foot_skating(space, speed, 8.0);
+  const FootSkatingReport without = locomotion_foot_skating(loose, speed, 8.0);
+  EXPECT_GE(with_ik.contacts, 10);
+  EXPECT_GE(without.contacts, 10);
+  EXPECT_LT(with_ik.mean_cm, 0.5 * without.mean_cm);
 }
 
 TEST(LocomotionErrors, BadSetsAndClipsAreNamed) {
