@@ -46,8 +46,17 @@ int spawn(const std::vector<std::string>& args, int stdin_fd, int log_fd, int cl
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
   }
   if (close_fd >= 0) posix_spawn_file_actions_addclose(&actions, close_fd);
+  // The child leads a process group of its own: a terminal's Ctrl-C goes to
+  // the foreground group, and must reach throng alone, which then ends the
+  // run after the current frame, closes the pipe and lets the encoder finish
+  // the file. An encoder that got the signal too would stop mid-stream.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attr, 0);
   pid_t pid = -1;
-  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  const int rc = posix_spawnp(&pid, argv[0], &actions, &attr, argv.data(), environ);
+  posix_spawnattr_destroy(&attr);
   posix_spawn_file_actions_destroy(&actions);
   return rc == 0 ? static_cast<int>(pid) : -1;
 }
