@@ -40,15 +40,20 @@ struct ArrivalStats {
 // Host values (arrival time < 0 = not arrived).
 ArrivalStats arrival_stats(const std::vector<float>& arrival_times);
 
-// Fundamental-diagram sample: agents inside a rectangle.
+// Fundamental-diagram sample: agents inside a rectangle. Speed is measured
+// along each agent's desired direction (towards the end of its current leg,
+// `goals`): agents that swirl sideways in a jam move fast and advance slowly,
+// and only the advance carries a flow. |v| is kept apart, labelled.
 struct AreaSample {
-  double area = 0;        // m^2
+  double area = 0;                  // m^2
   Index agents = 0;
-  double density = 0;     // agents / m^2
-  double mean_speed = 0;  // m/s (0 when empty)
-  double flow = 0;        // density * mean_speed, 1/(m s)
+  double density = 0;               // agents / m^2
+  double mean_speed = 0;            // m/s along the desired direction (0 when empty; negative = backwards)
+  double mean_speed_magnitude = 0;  // m/s, mean |v| (0 when empty)
+  double flow = 0;                  // specific flow: density * mean_speed, 1/(m s)
 };
-AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const std::uint8_t> flags, const Aabb& area);
+AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const glm::vec2> goals,
+                        Span<const std::uint8_t> flags, const Aabb& area);
 
 // Mean speed of active agents.
 double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> flags);

@@ -49,6 +49,16 @@ struct CombineCount {
   THRONG_HOST_DEVICE CountPair operator()(const CountPair& a, const CountPair& b) const { return {a.count + b.count, a.sum + b.sum}; }
 };
 
+struct AreaAcc {
+  Index count;
+  double along, magnitude;
+};
+struct CombineArea {
+  THRONG_HOST_DEVICE AreaAcc operator()(const AreaAcc& a, const AreaAcc& b) const {
+    return {a.count + b.count, a.along + b.along, a.magnitude + b.magnitude};
+  }
+};
+
 struct Histogram {
   std::int64_t bins[kDensityBins];
 };
@@ -82,21 +92,27 @@ Index count_obstacle_penetrations(const World& world, Span<const glm::vec2> posi
       THRONG_LAMBDA(Index a, Index b)->Index { return a + b; });
 }
 
-AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const std::uint8_t> flags, const Aabb& area) {
+AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const glm::vec2> goals,
+                        Span<const std::uint8_t> flags, const Aabb& area) {
   const glm::vec2 lo = area.min, hi = area.max;
-  const CountPair c = parallel_reduce(
-      "sim.metrics.area", positions.size(), CountPair{0, 0.0},
-      THRONG_LAMBDA(Index i)->CountPair {
+  const AreaAcc c = parallel_reduce(
+      "sim.metrics.area", positions.size(), AreaAcc{0, 0.0, 0.0},
+      THRONG_LAMBDA(Index i)->AreaAcc {
         const glm::vec2 p = positions[i];
-        if ((flags[i] & kAgentActive) == 0 || p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) return {0, 0.0};
-        return {1, static_cast<double>(length_of(velocities[i]))};
+        if ((flags[i] & kAgentActive) == 0 || p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) return {0, 0.0, 0.0};
+        const glm::vec2 v = velocities[i], to_goal = goals[i] - p;
+        const float d = length_of(to_goal);
+        // An agent standing on its goal has no desired direction: no advance.
+        const float along = d > 1e-6f ? dot2(v, to_goal) / d : 0.0f;
+        return {1, static_cast<double>(along), static_cast<double>(length_of(v))};
       },
-      CombineCount{});
+      CombineArea{});
   AreaSample s;
   s.area = static_cast<double>(area.size().x) * area.size().y;
   s.agents = c.count;
   s.density = s.area > 0 ? static_cast<double>(c.count) / s.area : 0.0;
-  s.mean_speed = c.count > 0 ? c.sum / static_cast<double>(c.count) : 0.0;
+  s.mean_speed = c.count > 0 ? c.along / static_cast<double>(c.count) : 0.0;
+  s.mean_speed_magnitude = c.count > 0 ? c.magnitude / static_cast<double>(c.count) : 0.0;
   s.flow = s.density * s.mean_speed;
   return s;
 }

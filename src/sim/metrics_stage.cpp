@@ -37,7 +37,7 @@ void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame
   s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_tolerance, sim.contact_cell());
   s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), options_.penetration_tolerance);
   s.mean_speed = mean_speed(c.velocity.span(), c.flags.span());
-  s.area = measure_area(c.position.span(), c.velocity.span(), c.flags.span(), options_.measurement);
+  s.area = measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), options_.measurement);
   const DensityHistogram h = density_histogram(c.position.span(), c.flags.span());
   density_.cell = h.cell;
   density_.bin_width = h.bin_width;
@@ -85,16 +85,22 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
   // Fundamental diagram: samples of the measurement area grouped by density.
   struct Bin {
     Index samples = 0;
-    double speed = 0, flow = 0;
+    double speed = 0, speed_magnitude = 0, flow = 0;
   };
   std::map<std::int64_t, Bin> by_density;
   nlohmann::json series = nlohmann::json::array();
   for (const Sample& s : samples_) {
-    series.push_back({{"time", s.time}, {"agents", s.area.agents}, {"density", s.area.density}, {"speed", s.area.mean_speed}, {"flow", s.area.flow}});
+    series.push_back({{"time", s.time},
+                      {"agents", s.area.agents},
+                      {"density", s.area.density},
+                      {"speed", s.area.mean_speed},
+                      {"speed_magnitude", s.area.mean_speed_magnitude},
+                      {"flow", s.area.flow}});
     if (s.area.agents == 0) continue;
     Bin& b = by_density[static_cast<std::int64_t>(std::floor(s.area.density / options_.density_bin_width))];
     ++b.samples;
     b.speed += s.area.mean_speed;
+    b.speed_magnitude += s.area.mean_speed_magnitude;
     b.flow += s.area.flow;
   }
   nlohmann::json diagram = nlohmann::json::array();
@@ -103,9 +109,12 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
                        {"max_density", static_cast<double>(k + 1) * options_.density_bin_width},
                        {"samples", b.samples},
                        {"mean_speed", b.speed / static_cast<double>(b.samples)},
+                       {"mean_speed_magnitude", b.speed_magnitude / static_cast<double>(b.samples)},
                        {"mean_flow", b.flow / static_cast<double>(b.samples)}});
   const Aabb& m = options_.measurement;
   stats["fundamental_diagram"] = {{"area", {{"min", {m.min.x, m.min.y}}, {"max", {m.max.x, m.max.y}}}},
+                                  {"speed", "m/s along each agent's desired direction (towards its current goal); speed_magnitude: mean |v|"},
+                                  {"flow", "specific flow, density x speed, 1/(m s)"},
                                   {"density_bin_width_per_m2", options_.density_bin_width},
                                   {"bins", diagram},
                                   {"samples", series}};

@@ -15,7 +15,7 @@ namespace throng::sim {
 namespace {
 
 struct Crowd {
-  std::vector<glm::vec2> p, v;
+  std::vector<glm::vec2> p, v, goal;
   std::vector<float> r;
   std::vector<std::uint8_t> flags;
 };
@@ -28,6 +28,7 @@ Crowd random_crowd(std::size_t n, float extent, unsigned seed) {
     c.p.push_back({d(rng), d(rng)});
     c.v.push_back({s(rng), s(rng)});
     c.r.push_back(rad(rng));
+    c.goal.push_back({d(rng), d(rng)});
     c.flags.push_back(i % 11 == 0 ? 0 : kAgentActive);
   }
   return c;
@@ -96,18 +97,23 @@ TEST(Metrics, AreaSpeedAndDensityMatchCounting) {
   Aabb area;
   area.add({-5, -2});
   area.add({5, 8});
-  const AreaSample s = measure_area(c.p, c.v, c.flags, area);
+  const AreaSample s = measure_area(c.p, c.v, c.goal, c.flags, area);
   Index n = 0;
-  double speed = 0;
+  double magnitude = 0, along = 0;
   for (std::size_t i = 0; i < c.p.size(); ++i)
     if (c.flags[i] && area.contains(c.p[i])) {
       ++n;
-      speed += std::hypot(c.v[i].x, c.v[i].y);
+      magnitude += std::hypot(c.v[i].x, c.v[i].y);
+      // In double, by angles: |v| cos(angle between v and the way to the goal).
+      const double to_goal = std::atan2(double(c.goal[i].y) - c.p[i].y, double(c.goal[i].x) - c.p[i].x);
+      along += std::hypot(c.v[i].x, c.v[i].y) * std::cos(std::atan2(c.v[i].y, c.v[i].x) - to_goal);
     }
   EXPECT_EQ(s.agents, n);
   EXPECT_DOUBLE_EQ(s.area, 100.0);
   EXPECT_DOUBLE_EQ(s.density, static_cast<double>(n) / 100.0);
-  EXPECT_NEAR(s.mean_speed, speed / static_cast<double>(n), 1e-6);  // float lengths
+  EXPECT_NEAR(s.mean_speed_magnitude, magnitude / static_cast<double>(n), 1e-6);  // float lengths
+  EXPECT_NEAR(s.mean_speed, along / static_cast<double>(n), 1e-5);
+  EXPECT_LT(std::abs(s.mean_speed), 0.5 * s.mean_speed_magnitude);  // random headings: little net advance
   EXPECT_NEAR(s.flow, s.density * s.mean_speed, 1e-12);
 
   double all = 0;
@@ -118,6 +124,23 @@ TEST(Metrics, AreaSpeedAndDensityMatchCounting) {
       ++active;
     }
   EXPECT_NEAR(mean_speed(c.v, c.flags), all / static_cast<double>(active), 1e-6);
+}
+
+// A jam that swirls: agents fast sideways, slow towards their goals. The
+// speed of the fundamental diagram is the advance, not |v|.
+TEST(Metrics, AreaSpeedIsTheAdvanceTowardsTheGoalNotTheSpeed) {
+  const std::vector<glm::vec2> p{{0, 0}, {1, 0}, {2, 0}, {3, 0}};
+  const std::vector<glm::vec2> goal{{0, 10}, {1, 10}, {2, 10}, {3, -10}};
+  const std::vector<glm::vec2> v{{1.2f, 0.1f}, {-1.2f, 0.1f}, {0.0f, 0.0f}, {0.6f, -0.8f}};
+  const std::vector<std::uint8_t> flags(4, kAgentActive);
+  Aabb area;
+  area.add({-1, -1});
+  area.add({4, 1});
+  const AreaSample s = measure_area(p, v, goal, flags, area);
+  EXPECT_EQ(s.agents, 4);
+  EXPECT_NEAR(s.mean_speed, (0.1 + 0.1 + 0.0 + 0.8) / 4.0, 1e-6);
+  EXPECT_NEAR(s.mean_speed_magnitude, (std::hypot(1.2, 0.1) * 2 + 0.0 + 1.0) / 4.0, 1e-6);
+  EXPECT_NEAR(s.flow, 4.0 / 10.0 * s.mean_speed, 1e-9);
 }
 
 TEST(Metrics, DensityHistogramCountsEachActiveAgentOnceInTheBinOfItsCell) {
