@@ -46,8 +46,9 @@ void expect_one_step_matches(const Case& c) {
   // One step from the same spawn: per agent a sense (distances, a
   // time-to-collision, a few divides), the steering force, an integration
   // and 4 contact passes, each tens of FMA-able operations on positions of
-  // up to ~40 m. 1e-4 m is ~25 ulps at 40 m, and 100x the expected
-  // rounding difference of the displacement (~0.1 m) itself.
+  // up to ~40 m. The step moves an agent by ~0.13 m, computed to ~1e-6
+  // relative (a few dozen roundings), and adds it to a position whose ulp
+  // is ~4e-6 m: 1e-4 m (~25 ulps at 40 m) bounds that with a margin.
   // A discrete decision (which force has priority, whether a contact pass
   // touches a pair, whether a move is accepted) flips only for an agent
   // within a rounding of its threshold: allow one such agent.
