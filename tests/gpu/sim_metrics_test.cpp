@@ -3,6 +3,7 @@
 // density_histogram over a random crowd in a built-in scenario's world.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <random>
 #include <vector>
@@ -30,25 +31,26 @@ TEST(CudaMetrics, MatchCpu) {
   constexpr Index kN = 4000;
   std::mt19937 rng(13);
   std::uniform_real_distribution<float> x(-2.0f, 42.0f), y(-7.0f, 27.0f), r(0.18f, 0.3f), v(-1.5f, 1.5f);
-  std::vector<glm::vec2> positions, velocities;
+  std::vector<glm::vec2> positions, velocities, goals;
   std::vector<float> radii;
   std::vector<std::uint8_t> flags;
   for (Index i = 0; i < kN; ++i) {
     positions.emplace_back(x(rng), y(rng));
     velocities.emplace_back(v(rng), v(rng));
+    goals.emplace_back(x(rng), y(rng));
     radii.push_back(r(rng));
     flags.push_back(i % 9 == 0 ? 0 : kAgentActive);
   }
   const Aabb area{{17.0f, 8.0f}, {20.0f, 12.0f}};
   const auto run = [&](Memory m) {
     const World world = World::build(spec.world, spec.model.query_radius(), {}, m);
-    const Buffer<glm::vec2> bp = gpu_test::upload(positions, m), bv = gpu_test::upload(velocities, m);
+    const Buffer<glm::vec2> bp = gpu_test::upload(positions, m), bv = gpu_test::upload(velocities, m), bg = gpu_test::upload(goals, m);
     const Buffer<float> br = gpu_test::upload(radii, m);
     const Buffer<std::uint8_t> bf = gpu_test::upload(flags, m);
     Result out;
     out.overlaps = measure_overlaps(bp.span(), br.span(), bf.span(), 0.01f, 0.6f);
     out.penetrations = count_obstacle_penetrations(world, bp.span(), br.span(), bf.span(), 0.01f);
-    out.area = measure_area(bp.span(), bv.span(), bf.span(), area);
+    out.area = measure_area(bp.span(), bv.span(), bg.span(), bf.span(), area);
     out.speed = mean_speed(bv.span(), bf.span());
     out.density = density_histogram(bp.span(), bf.span(), 2.0f, 0.5f);
     return out;
@@ -78,12 +80,14 @@ TEST(CudaMetrics, MatchCpu) {
   EXPECT_NEAR(gpu.overlaps.min_separation, cpu.overlaps.min_separation, tol);
   // Mean speeds: |v| per agent (FMA-able), summed in double in a fixed
   // order on both: 1e-6 relative per term, so 1e-6 relative in the mean.
-  EXPECT_NEAR(gpu.area.mean_speed, cpu.area.mean_speed, tol * (1.0 + cpu.area.mean_speed));
+  EXPECT_NEAR(gpu.area.mean_speed, cpu.area.mean_speed, tol * (1.0 + std::abs(cpu.area.mean_speed)));
+  EXPECT_NEAR(gpu.area.mean_speed_magnitude, cpu.area.mean_speed_magnitude, tol * (1.0 + cpu.area.mean_speed_magnitude));
   EXPECT_NEAR(gpu.speed, cpu.speed, tol * (1.0 + cpu.speed));
   if (!gpu_test::tolerant()) {
     EXPECT_EQ(gpu.overlaps.max_depth, cpu.overlaps.max_depth);
     EXPECT_EQ(gpu.overlaps.min_separation, cpu.overlaps.min_separation);
     EXPECT_EQ(gpu.area.mean_speed, cpu.area.mean_speed);
+    EXPECT_EQ(gpu.area.mean_speed_magnitude, cpu.area.mean_speed_magnitude);
     EXPECT_EQ(gpu.speed, cpu.speed);
   }
 }
