@@ -114,7 +114,7 @@ void register_render(const Options& options) {
                     cull.joint_positions = poses.joint_positions;
                     cull.group_flags = flags.span();
                     cull.run();
-                    const Index visible = exclusive_scan<std::uint32_t>("render.slots", flags.span(), slots.span());
+                    const Index visible = scan_draw_slots(flags.span(), slots.span());
                     PackJob pack;
                     pack.joint_count = rig.joint_count;
                     pack.points = points.span();
@@ -150,7 +150,7 @@ void register_render(const Options& options) {
                     cull.scales = poses.scales;
                     cull.group_flags = flags.span();
                     cull.run();
-                    const Index visible = exclusive_scan<std::uint32_t>("render.slots", flags.span(), slots.span());
+                    const Index visible = scan_draw_slots(flags.span(), slots.span());
                     PalettePackJob pack;
                     pack.groups = draw_groups(cull, slots.span(), visible);
                     pack.joint_count = poses.joint_count;

@@ -95,6 +95,11 @@ struct DrawGroups {
   Index matrices() const { return count > 0 ? first_matrix[count - 1] + slots[count - 1] * joints[count - 1] : 0; }
 };
 
+// slots[i] = group_flags[0] + ... + group_flags[i-1] (the "render.slots"
+// scan, deterministic); returns the total, the visible characters. Lives in
+// cull_kernels.cpp so that CUDA builds compile the scan for the device.
+Index scan_draw_slots(Span<const std::uint32_t> group_flags, Span<std::uint32_t> slots);
+
 // The groups of a CullJob that ran, from the exclusive scan of its flags
 // (`visible`: the scan's total).
 DrawGroups draw_groups(const CullJob& job, Span<const std::uint32_t> slots, Index visible);

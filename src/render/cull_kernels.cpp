@@ -1,9 +1,14 @@
 #include "anim/lod.h"
 #include "anim/sphere_projection.h"
 #include "core/parallel.h"
+#include "core/reduce.h"
 #include "render/cull.h"
 
 namespace throng::render {
+
+Index scan_draw_slots(Span<const std::uint32_t> group_flags, Span<std::uint32_t> slots) {
+  return exclusive_scan<std::uint32_t>("render.slots", group_flags, slots);
+}
 
 void CullJob::run() const {
   validate();

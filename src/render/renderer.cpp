@@ -271,7 +271,7 @@ DrawGroups Renderer::State::cull(const Camera* camera, const CharacterPoses& pos
   Index visible = 0;
   if (n > 0) {
     job.run();
-    visible = exclusive_scan<std::uint32_t>("render.slots", job.group_flags, slots.span());
+    visible = scan_draw_slots(job.group_flags, slots.span());
   }
   return draw_groups(job, slots.span(), visible);
 }
