@@ -6,12 +6,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 
 #include "core/ground.h"
+#include "sim/metrics.h"
+#include "sim/simulation.h"
 
 namespace throng::io {
 namespace {
@@ -273,7 +277,18 @@ TEST(BuiltinScenarios, EachReadsBuildsAndRuns) {
     EXPECT_EQ(l.source.file, "builtin:" + n);
     if (l.spec.total_agents() > 2000) sim::scale_agent_counts(l.spec, 2000);  // plaza ships with 10^5
     const auto sim = build_simulation(l);
+    const std::vector<glm::vec2> start = sim->positions();
     sim->run(3);
+    // It ran: three steps, every position finite, the crowd under way, nobody
+    // in an obstacle. (Each built-in's outcome run to its end, with
+    // arrivals and overlaps at every step: tests/sim/builtin_outcomes_test.cpp.)
+    EXPECT_EQ(sim->steps_done(), 3);
+    const std::vector<glm::vec2> now = sim->positions();
+    ASSERT_EQ(now.size(), start.size());
+    EXPECT_TRUE(std::all_of(now.begin(), now.end(), [](glm::vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }));
+    EXPECT_NE(now, start);
+    const sim::CrowdState& c = sim->crowd();
+    EXPECT_EQ(sim::count_obstacle_penetrations(sim->world(), c.position.span(), c.radius.span(), c.flags.span(), 1e-3f), 0);
     // A file path reads the same scenario.
     const LoadedScenario from_file = load_scenario((kRoot / "examples" / (n + ".yaml")).string());
     EXPECT_EQ(from_file.spec.total_agents(), load_scenario(n).spec.total_agents());

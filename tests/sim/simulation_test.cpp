@@ -25,12 +25,12 @@ namespace {
 //     of the radius: well inside how far clothing and bodies give in a
 //     dense crowd), and
 //   - pairs overlapping by more than kOverlapTolerance = 5 cm are rare: at
-//     most 0.5% of the agents at any sampled step.
+//     most 0.5% of the agents at any step.
+// Overlaps and penetrations are measured after every step (and at the start).
 constexpr float kOverlapLimit = 0.08f;
 constexpr float kOverlapTolerance = 0.05f;
 constexpr double kDeepPairFraction = 0.005;
 constexpr float kPenetrationTolerance = 1e-3f;  // m: float error against walls
-constexpr int kSampleEvery = 5;                  // steps between metric samples
 
 struct RunRecord {
   std::int64_t steps = 0;
@@ -39,9 +39,10 @@ struct RunRecord {
   float max_overlap_depth = 0.0f;
   Index max_deep_pairs = 0;
   Index max_penetrations = 0;
-  Index deep_pair_samples = 0;  // sum over samples of the pairs deeper than the tolerance
+  Index deep_pair_samples = 0;  // sum over samples (steps) of the pairs deeper than the tolerance
   Index touching_samples = 0;   // sum over samples of the pairs in contact (collisions)
-  Index samples = 0;
+  Index samples = 0;            // the start and every step
+  std::int64_t penetration_steps = 0;  // samples with any agent in an obstacle
 };
 
 RunRecord run_to_arrival(const ScenarioSpec& spec, SchedulerKind scheduler, std::int64_t max_steps) {
@@ -57,15 +58,16 @@ RunRecord run_to_arrival(const ScenarioSpec& spec, SchedulerKind scheduler, std:
     r.deep_pair_samples += o.pairs;
     r.touching_samples += o.touching;
     ++r.samples;
-    r.max_penetrations = std::max(
-        r.max_penetrations, count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), kPenetrationTolerance));
+    const Index penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), kPenetrationTolerance);
+    r.max_penetrations = std::max(r.max_penetrations, penetrations);
+    r.penetration_steps += penetrations > 0 ? 1 : 0;
   };
+  sample();
   while (!sim.all_arrived() && r.steps < max_steps) {
     sim.step();
     ++r.steps;
-    if (r.steps % kSampleEvery == 0) sample();
+    sample();
   }
-  sample();
   r.all_arrived = sim.all_arrived();
   r.arrival_times = sim.arrival_times();
   return r;
@@ -93,7 +95,8 @@ void expect_acceptance(const RunRecord& r, Index agents, const char* what) {
   SCOPED_TRACE(what);
   EXPECT_TRUE(r.all_arrived) << "after " << r.steps << " steps";
   EXPECT_EQ(std::count_if(r.arrival_times.begin(), r.arrival_times.end(), [](float t) { return t >= 0.0f; }), agents);
-  EXPECT_EQ(r.max_penetrations, 0);
+  EXPECT_EQ(r.max_penetrations, 0) << "in " << r.penetration_steps << " steps";
+  EXPECT_EQ(r.samples, r.steps + 1);  // the start and every step were measured
   EXPECT_LT(r.max_overlap_depth, kOverlapLimit);
   EXPECT_LE(static_cast<double>(r.max_deep_pairs), kDeepPairFraction * static_cast<double>(agents));
 }
@@ -125,8 +128,9 @@ void acceptance(const char* name, Index agents, Index sanitized_agents, Schedule
   const ScenarioSpec spec = test::builtin(name, n);
   ASSERT_EQ(spec.total_agents(), n);
   const RunRecord r = run_to_arrival(spec, scheduler, spec.step_count());
-  std::printf("  %s, %lld agents, %s: %lld steps, mean arrival %.1f s, deepest overlap %.3f m\n", name, static_cast<long long>(n),
-              to_string(scheduler), static_cast<long long>(r.steps), mean(r.arrival_times), r.max_overlap_depth);
+  std::printf("  %s, %lld agents, %s: %lld steps, mean arrival %.1f s, deepest overlap %.3f m, pairs deeper than %.2f m at most %lld\n",
+              name, static_cast<long long>(n), to_string(scheduler), static_cast<long long>(r.steps), mean(r.arrival_times), r.max_overlap_depth,
+              static_cast<double>(kOverlapTolerance), static_cast<long long>(r.max_deep_pairs));
   expect_acceptance(r, n, to_string(scheduler));
 }
 
