@@ -27,8 +27,8 @@ Camera test_camera() {
   return cam;
 }
 
-// The exclusive scan of the group flags on the host (the test cannot launch
-// a scan of its own on the CUDA backend: see gpu_test.h).
+// The exclusive scan of the group flags on the host: the reference for
+// scan_draw_slots on either backend.
 Index host_slots(const std::vector<std::uint32_t>& flags, std::vector<std::uint32_t>& slots) {
   slots.resize(flags.size());
   std::uint32_t acc = 0;
@@ -41,6 +41,8 @@ Index host_slots(const std::vector<std::uint32_t>& flags, std::vector<std::uint3
 
 struct Result {
   std::vector<std::uint32_t> flags_joints, flags_palettes;
+  std::vector<std::uint32_t> slots;  // scan_draw_slots of the CPU's flags
+  Index visible = 0;
   std::vector<glm::vec4> points;
   std::vector<anim::Mat3x4> palettes_from_joints, palettes_copied;
   std::vector<glm::uvec2> tags_from_joints, tags_copied;
@@ -114,7 +116,9 @@ TEST(CudaCull, CullAndPackMatchCpu) {
       cpu_flags = r.flags_joints;
       cpu_visible = host_slots(cpu_flags, cpu_slots);
     }
-    Buffer<std::uint32_t> f = gpu_test::upload(cpu_flags, m), s = gpu_test::upload(cpu_slots, m);
+    Buffer<std::uint32_t> f = gpu_test::upload(cpu_flags, m), s(cpu_flags.size(), m);
+    r.visible = scan_draw_slots(f.span(), s.span());
+    r.slots = s.to_vector();
     PackJob pack;
     pack.joint_count = J;
     pack.points = points.span();
@@ -158,6 +162,11 @@ TEST(CudaCull, CullAndPackMatchCpu) {
   const Result gpu = gpu_test::run_on(gpu_test::device_side(), run);
   ASSERT_GT(cpu_visible, 50);
   ASSERT_LT(cpu_visible, n);
+  // The scan of one set of flags: integer sums, bitwise on both backends.
+  EXPECT_EQ(cpu.visible, cpu_visible);
+  EXPECT_EQ(gpu.visible, cpu_visible);
+  EXPECT_EQ(cpu.slots, cpu_slots);
+  EXPECT_EQ(gpu.slots, cpu_slots);
 
   // Visibility and tier are thresholds on a projected radius (a 4x4
   // transform, a divide): a character within a few roundings of a frustum
