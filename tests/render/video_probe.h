@@ -1,0 +1,67 @@
+// What ffprobe finds in a video file: the first video stream's codec, pixel
+// format, size and decoded frame count, and the container's duration. The
+// one helper for every test that checks a video (tests/render/video_test.cpp,
+// tests/app/run_test.cpp); header-only, so tests built without the renderer
+// can use it too.
+#pragma once
+
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <string>
+
+namespace throng::testing {
+
+struct VideoProbe {
+  std::string codec;       // e.g. "h264"; empty when ffprobe found no video stream
+  std::string pix_fmt;     // e.g. "yuv420p"
+  int width = 0;
+  int height = 0;
+  long frames = -1;        // frames decoded (nb_read_frames); -1 when unknown
+  double duration = -1.0;  // seconds, the container's; -1 when unknown
+  std::string text;        // what ffprobe printed, for failure messages
+};
+
+inline std::ostream& operator<<(std::ostream& os, const VideoProbe& p) { return os << "ffprobe said:\n" << p.text; }
+
+// Runs `ffprobe -count_frames` (it decodes every frame) on `path`.
+inline VideoProbe probe_video(const std::string& path) {
+  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                          "stream=codec_name,pix_fmt,width,height,nb_read_frames:format=duration -of json '" +
+                          path + "' 2>&1";
+  VideoProbe p;
+  {
+    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+    char buf[256];
+    while (pipe && fgets(buf, sizeof buf, pipe.get()) != nullptr) p.text += buf;
+  }
+  // The JSON starts at a line "{"; error lines may come before it.
+  const std::size_t start = p.text.rfind('{', 0) == 0 ? 0 : p.text.find("\n{");
+  if (start == std::string::npos) return p;
+  const nlohmann::json j = nlohmann::json::parse(p.text.substr(start), nullptr, false);
+  if (j.is_discarded()) return p;
+  // ffprobe writes some numbers as strings ("nb_read_frames": "25").
+  const auto number = [](const nlohmann::json& v, double otherwise) {
+    if (v.is_number()) return v.get<double>();
+    if (v.is_string()) {
+      try {
+        return std::stod(v.get<std::string>());
+      } catch (const std::exception&) {
+      }
+    }
+    return otherwise;
+  };
+  if (j.contains("streams") && j["streams"].is_array() && !j["streams"].empty()) {
+    const nlohmann::json& s = j["streams"][0];
+    p.codec = s.value("codec_name", "");
+    p.pix_fmt = s.value("pix_fmt", "");
+    p.width = static_cast<int>(number(s.value("width", nlohmann::json()), 0.0));
+    p.height = static_cast<int>(number(s.value("height", nlohmann::json()), 0.0));
+    p.frames = static_cast<long>(number(s.value("nb_read_frames", nlohmann::json()), -1.0));
+  }
+  if (j.contains("format")) p.duration = number(j["format"].value("duration", nlohmann::json()), -1.0);
+  return p;
+}
+
+}  // namespace throng::testing
