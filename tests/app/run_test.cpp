@@ -191,6 +191,13 @@ TEST_F(RunCommand, TheDefaultDemoRunsTheCircleToTheEnd) {
   EXPECT_GT(p.frames, 0) << p;
   EXPECT_EQ(p.frames, expected) << p;
   EXPECT_NEAR(p.duration, static_cast<double>(expected) / fps, 1.5 / fps) << p;
+  // The first and the last frame are pictures of the scene, not a cleared
+  // (or black) frame buffer.
+  for (const long frame : {0L, expected - 1}) {
+    const std::vector<std::uint8_t> rgb = throng::testing::decode_frame_rgb(video.string(), frame);
+    EXPECT_EQ(rgb.size(), 3u * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) << "frame " << frame;
+    EXPECT_GT(throng::testing::distinct_colours_rgb(rgb), 200u) << "frame " << frame;
+  }
 #else
   EXPECT_FALSE(fs::exists(video)) << o.out;
 #endif

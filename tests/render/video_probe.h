@@ -1,15 +1,19 @@
 // What ffprobe finds in a video file: the first video stream's codec, pixel
-// format, size and decoded frame count, and the container's duration. The
-// one helper for every test that checks a video (tests/render/video_test.cpp,
-// tests/app/run_test.cpp); header-only, so tests built without the renderer
-// can use it too.
+// format, size and decoded frame count, and the container's duration; and
+// one frame decoded by ffmpeg. The one helper for every test that checks a
+// video (tests/render/video_test.cpp, tests/app/run_test.cpp); header-only,
+// so tests built without the renderer can use it too.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <set>
 #include <string>
+#include <vector>
 
 namespace throng::testing {
 
@@ -62,6 +66,27 @@ inline VideoProbe probe_video(const std::string& path) {
   }
   if (j.contains("format")) p.duration = number(j["format"].value("duration", nlohmann::json()), -1.0);
   return p;
+}
+
+// Frame `index` (0 = the first) of the first video stream, decoded to RGB:
+// 3 bytes a pixel, rows top to bottom; empty when there is no such frame.
+inline std::vector<std::uint8_t> decode_frame_rgb(const std::string& path, long index) {
+  const std::string cmd = "ffmpeg -v error -i '" + path + "' -vf 'select=eq(n\\," + std::to_string(index) +
+                          ")' -frames:v 1 -f rawvideo -pix_fmt rgb24 - 2>/dev/null";
+  std::vector<std::uint8_t> rgb;
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::array<std::uint8_t, 65536> buf;
+  std::size_t n;
+  while (pipe && (n = fread(buf.data(), 1, buf.size(), pipe.get())) > 0) rgb.insert(rgb.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+  return rgb;
+}
+
+// Distinct colours in RGB pixels: a drawn scene has hundreds, a cleared or black picture a handful.
+inline std::size_t distinct_colours_rgb(const std::vector<std::uint8_t>& rgb) {
+  std::set<std::uint32_t> colours;
+  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
+    colours.insert(static_cast<std::uint32_t>(rgb[i]) << 16 | static_cast<std::uint32_t>(rgb[i + 1]) << 8 | rgb[i + 2]);
+  return colours.size();
 }
 
 }  // namespace throng::testing
