@@ -48,12 +48,23 @@ TEST(Cli, VersionAndHelp) {
   }
 }
 
+// A command line CLI11 rejects exits with 2 (src/app/main.cpp), naming the
+// option or value; a crash (128 + signal, or -1 here) does not pass.
 TEST(Cli, BadArgumentsGiveOneLineErrorAndNonZeroExit) {
-  for (const char* args : {"frobnicate", "--backend gpu info", "--threads -3 info", "bench --no-such-flag", ""}) {
-    const auto r = run(args);
-    EXPECT_NE(r.code, 0) << args;
-    EXPECT_EQ(lines(r.out), 1u) << "'" << args << "' printed:\n" << r.out;
+  struct Case {
+    const char* args;
+    const char* names;
+  };
+  for (const Case& c : {Case{"frobnicate", "A subcommand is required"}, Case{"--backend gpu info", "--backend: gpu not in {auto,cpu,cuda}"},
+                        Case{"--threads -3 info", "--threads: Value -3 not in range"},
+                        Case{"bench --no-such-flag", "not expected: --no-such-flag"}, Case{"", "A subcommand is required"}}) {
+    const auto r = run(c.args);
+    EXPECT_NE(r.code, 0) << c.args;
+    EXPECT_EQ(r.code, 2) << "'" << c.args << "' printed:\n" << r.out;
+    EXPECT_EQ(lines(r.out), 1u) << "'" << c.args << "' printed:\n" << r.out;
     EXPECT_NE(r.out.find("error"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.rfind("throng: error: ", 0), 0u) << r.out;
+    EXPECT_NE(r.out.find(c.names), std::string::npos) << "'" << c.args << "' printed:\n" << r.out;
   }
 }
 
@@ -108,6 +119,8 @@ TEST(Cli, AnimateWritesStatsJson) {
 TEST(Cli, AnimateRejectsUnknownScenarios) {
   const Result r = run("animate no_such_scenario");
   EXPECT_NE(r.code, 0);
+  EXPECT_EQ(r.code, 1) << r.out;  // throng::Error
+  EXPECT_NE(r.out.find("no such file or built-in scenario 'no_such_scenario'"), std::string::npos) << r.out;
   EXPECT_EQ(lines(r.out), 1u) << r.out;
   EXPECT_NE(r.out.find("throng: error:"), std::string::npos) << r.out;
 }

@@ -1,6 +1,6 @@
 // `throng info FILE.bvh --json` and `throng convert` run as a user runs them.
-// The executable is looked up next to this test's build folder; the tests
-// skip when it is absent (build the `throng` target) or ../shared is.
+// The executable is the build's (THRONG_EXE, built before this test); the
+// tests skip when ../shared is absent.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,13 +26,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using testing::find_throng;
 using testing::Result;
 using testing::run;
+using testing::throng_exe;
 
 #define REQUIRE_EXE_AND_SHARED(exe, dir)                                                       \
-  const auto exe = find_throng();                                                              \
-  if (!exe) GTEST_SKIP() << "throng executable not found near this test (build target throng)"; \
+  const fs::path exe = throng_exe();                                                           \
   THRONG_NEED_SHARED_BVH(dir)
 
 // Header facts read without the reader.
@@ -66,7 +65,7 @@ TEST(BvhCli, InfoJsonMatchesEveryHeader) {
   for (const auto& e : fs::directory_iterator(*dir)) {
     if (e.path().extension() != ".bvh") continue;
     ++files;
-    const Result r = run(*exe, "info " + e.path().string() + " --json", false);
+    const Result r = run(exe, "info " + e.path().string() + " --json", false);
     ASSERT_EQ(r.code, 0) << r.out;
     const auto j = nlohmann::json::parse(r.out);
     const Header h = read_header(e.path());
@@ -89,11 +88,11 @@ TEST(BvhCli, InfoJsonMatchesEveryHeader) {
 TEST(BvhCli, InfoTextAndOptions) {
   REQUIRE_EXE_AND_SHARED(exe, dir);
   const std::string file = (*dir / "cmu_02_01_walk_mb.bvh").string();
-  Result r = run(*exe, "info " + file);
+  Result r = run(exe, "info " + file);
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("joints       31 (7 end sites), 96 channels"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("cmu (detected)"), std::string::npos) << r.out;
-  r = run(*exe, "info " + file + " --json --units cm --role left_knee=LeftFoot", false);
+  r = run(exe, "info " + file + " --json --units cm --role left_knee=LeftFoot", false);
   ASSERT_EQ(r.code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["units"]["unit"], "cm");
@@ -105,7 +104,7 @@ TEST(BvhCli, ConvertRoundTripsAndNormalises) {
   REQUIRE_EXE_AND_SHARED(exe, dir);
   const fs::path in = *dir / "cmu_131_02_start_walk_stop_max.bvh";  // mixed orders, CMU units
   const fs::path out = fs::temp_directory_path() / "throng_bvh_cli_convert.bvh";
-  const Result r = run(*exe, "convert " + in.string() + " " + out.string() + " --order YXZ --units m");
+  const Result r = run(exe, "convert " + in.string() + " " + out.string() + " --order YXZ --units m");
   ASSERT_EQ(r.code, 0) << r.out;
   const BvhFile a = read_bvh(in.string());
   BvhReadOptions metres;
@@ -125,21 +124,35 @@ TEST(BvhCli, ConvertRoundTripsAndNormalises) {
 std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
 
 TEST(BvhCli, ErrorsAreOneLineWithNonZeroExit) {
-  const auto exe = find_throng();
-  if (!exe) GTEST_SKIP() << "throng executable not found near this test (build target throng)";
+  const fs::path exe = throng_exe();
   const fs::path bad = fs::path(THRONG_SOURCE_DIR) / "tests" / "data" / "bvh_bad" / "nan_value.bvh";
   const fs::path tmp = fs::temp_directory_path() / "throng_bvh_cli_out.bvh";
-  const std::vector<std::string> cases = {"info /nonexistent/x.bvh", "info " + bad.string(), "info README.md",
-                                  "convert " + bad.string() + " " + tmp.string(), "convert a.bvh b.bvh --order QQQ",
-                                  "convert a.bvh b.bvh --units parsec", "info x.bvh --units furlong", "info x.bvh --role elbow=X",
-                                  "convert onlyone.bvh"};
-  for (const std::string& args : cases) {
-    const Result r = run(*exe, args);
-    EXPECT_NE(r.code, 0) << args;
-    EXPECT_EQ(lines(r.out), 1u) << args << " printed:\n" << r.out;
+  // Exit status 1 for a bad file or value (throng::Error), 2 for a bad
+  // command line (CLI11); the message names what is wrong.
+  struct Case {
+    std::string args;
+    int code;
+    std::string names;
+  };
+  const std::vector<Case> cases = {{"info /nonexistent/x.bvh", 1, "/nonexistent/x.bvh: cannot read"},
+                                   {"info " + bad.string(), 1, "nan_value.bvh:26:"},
+                                   {"info README.md", 1, "README.md: cannot describe this file type"},
+                                   {"convert " + bad.string() + " " + tmp.string(), 1, "nan_value.bvh:26:"},
+                                   {"convert a.bvh b.bvh --order QQQ", 1, "--order: unknown rotation order 'QQQ'"},
+                                   {"convert a.bvh b.bvh --units parsec", 1, "--units: unknown unit 'parsec'"},
+                                   {"info x.bvh --units furlong", 1, "--units: unknown unit 'furlong'"},
+                                   {"info x.bvh --role elbow=X", 1, "--role: expected ROLE=JOINT"},
+                                   {"convert onlyone.bvh", 2, "output is required"}};
+  for (const Case& c : cases) {
+    const Result r = run(exe, c.args);
+    EXPECT_NE(r.code, 0) << c.args;
+    EXPECT_EQ(r.code, c.code) << c.args << " printed:\n" << r.out;
+    EXPECT_EQ(lines(r.out), 1u) << c.args << " printed:\n" << r.out;
     EXPECT_NE(r.out.find("error"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.rfind("throng: error: ", 0), 0u) << r.out;
+    EXPECT_NE(r.out.find(c.names), std::string::npos) << c.args << " printed:\n" << r.out;
   }
-  const Result r = run(*exe, "info " + bad.string());
+  const Result r = run(exe, "info " + bad.string());
   EXPECT_NE(r.out.find("nan_value.bvh:26:"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(tmp));
 }

@@ -141,12 +141,11 @@ int run(const fs::path& exe, const std::string& args, std::string& out) {
 }
 
 TEST(MatchCommand, RandomPathsAndAPathsFile) {
-  const auto exe = testing::find_throng();
-  if (!exe) GTEST_SKIP() << "build the throng target to run this test";
+  const fs::path exe = testing::throng_exe();
   const fs::path dir = fs::temp_directory_path() / ("throng_match_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::string out;
-  ASSERT_EQ(run(*exe, "match --random 6 --seed 3 --bvh 1 --out " + dir.string(), out), 0) << out;
+  ASSERT_EQ(run(exe, "match --random 6 --seed 3 --bvh 1 --out " + dir.string(), out), 0) << out;
   EXPECT_NE(out.find("dynamic program"), std::string::npos) << out;
   std::ifstream in(dir / "match.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -161,18 +160,24 @@ TEST(MatchCommand, RandomPathsAndAPathsFile) {
                           "paths:\n  - {name: around, from: [2, 10], to: [28, 10], speed: 1.35}\n"
                           "  - {name: line, points: [[0, 0], [12, 0]], speed: 2.7}\n";
   out.clear();
-  ASSERT_EQ(run(*exe, "match " + paths.string() + " --out " + dir.string(), out), 0) << out;
+  ASSERT_EQ(run(exe, "match " + paths.string() + " --out " + dir.string(), out), 0) << out;
   std::ifstream in2(dir / "match.json");
   const nlohmann::json k = nlohmann::json::parse(in2);
   ASSERT_EQ(k["paths"].size(), 2u);
   EXPECT_GT(k["paths"][0]["length_m"].get<double>(), 26.0);  // goes around the disc
   out.clear();
   std::ofstream(paths) << "paths:\n  - {name: bad, points: [[0, 0]]}\n";
-  EXPECT_NE(run(*exe, "match " + paths.string() + " --out " + dir.string(), out), 0);
+  const int bad_path = run(exe, "match " + paths.string() + " --out " + dir.string(), out);
+  EXPECT_NE(bad_path, 0);
+  EXPECT_EQ(bad_path, 1) << out;  // throng::Error, not a crash
   EXPECT_NE(out.find("paths.yaml:2:"), std::string::npos) << out;
+  EXPECT_NE(out.find("needs at least 2 points"), std::string::npos) << out;
   out.clear();
-  EXPECT_NE(run(*exe, "match --out " + dir.string(), out), 0);
+  const int nothing = run(exe, "match --out " + dir.string(), out);
+  EXPECT_NE(nothing, 0);
+  EXPECT_EQ(nothing, 1) << out;
   EXPECT_NE(out.find("throng: error:"), std::string::npos) << out;
+  EXPECT_NE(out.find("give a paths file or --random N"), std::string::npos) << out;
   fs::remove_all(dir);
 }
 

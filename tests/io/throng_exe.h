@@ -1,4 +1,6 @@
 // Running the built `throng` executable from a test, as a user runs it.
+// THRONG_EXE is its path, given by the build (tests/CMakeLists.txt), which
+// also builds it before this test: a missing executable is a failure.
 #pragma once
 
 #include <sys/wait.h>
@@ -6,23 +8,18 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
-#include <optional>
 #include <string>
+
+#ifndef THRONG_EXE
+#error "THRONG_EXE (the path of the throng executable) is set by tests/CMakeLists.txt"
+#endif
 
 namespace throng::io::testing {
 
-// The executable, looked up next to this test's build folder.
-inline std::optional<std::filesystem::path> find_throng() {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
-  for (int up = 0; up < 3 && !ec; ++up, dir = dir.parent_path())
-    if (fs::is_regular_file(dir / "throng")) return dir / "throng";
-  return std::nullopt;
-}
+inline std::filesystem::path throng_exe() { return THRONG_EXE; }
 
 struct Result {
-  int code;
+  int code;  // exit status; -1 when killed by a signal
   std::string out;
 };
 // Runs `throng --backend cpu --log-level warn ARGS`; stdout (and stderr unless told not to).

@@ -2,45 +2,37 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
+#include <sys/wait.h>
+#include <vector>
 
 #include "anim/locomotion.h"
 #include "core/error.h"
 #include "motion/locomotion.h"
 #include "render/camera_path.h"
+#include "render/image.h"
 #include "render/recorder.h"
 #include "sim/world.h"
+#include "tests/render/video_probe.h"
 
 namespace throng::render {
 namespace {
+
+using throng::testing::probe_video;
+using throng::testing::VideoProbe;
 
 std::string temp_dir(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / ("throng_video_test_" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
-}
-
-// ffprobe's answer for the first video stream: "width,height,nb_read_frames,duration".
-std::string probe(const std::string& path) {
-  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                          "stream=width,height,nb_read_frames,codec_name,pix_fmt:format=duration -of default=noprint_wrappers=1 '" +
-                          path + "' 2>&1";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  char buf[256];
-  while (pipe && fgets(buf, sizeof buf, pipe.get()) != nullptr) out += buf;
-  return out;
-}
-
-std::string field(const std::string& text, const std::string& key) {
-  const auto at = text.find(key + "=");
-  if (at == std::string::npos) return "";
-  const auto end = text.find('\n', at);
-  return text.substr(at + key.size() + 1, end - at - key.size() - 1);
 }
 
 Image solid(std::int32_t w, std::int32_t h, std::uint8_t shade) {
@@ -69,13 +61,13 @@ TEST_F(VideoTest, WritesAPlayableMp4) {
     EXPECT_EQ(w.frames_written(), 50);
     w.finish();
   }
-  const std::string p = probe(spec.path);
-  EXPECT_EQ(field(p, "codec_name"), "h264") << p;
-  EXPECT_EQ(field(p, "pix_fmt"), "yuv420p") << p;
-  EXPECT_EQ(field(p, "width"), "64") << p;
-  EXPECT_EQ(field(p, "height"), "48") << p;
-  EXPECT_EQ(field(p, "nb_read_frames"), "50") << p;
-  EXPECT_NEAR(std::stod(field(p, "duration")), 2.0, 0.05) << p;
+  const VideoProbe p = probe_video(spec.path);
+  EXPECT_EQ(p.codec, "h264") << p;
+  EXPECT_EQ(p.pix_fmt, "yuv420p") << p;
+  EXPECT_EQ(p.width, 64) << p;
+  EXPECT_EQ(p.height, 48) << p;
+  EXPECT_EQ(p.frames, 50) << p;
+  EXPECT_NEAR(p.duration, 2.0, 0.05) << p;
 }
 
 TEST_F(VideoTest, BadSpecsAndFramesAreErrors) {
@@ -158,11 +150,11 @@ TEST_F(VideoTest, RecorderWritesVideoOfAWalkingCrowdWithTheWorldsObstacles) {
   }
   const std::string file = rec.finish();
   EXPECT_EQ(file, spec.folder + "/crowd.mp4");
-  const std::string p = probe(file);
-  EXPECT_EQ(field(p, "width"), "160") << p;
-  EXPECT_EQ(field(p, "height"), "90") << p;
-  EXPECT_EQ(field(p, "nb_read_frames"), "15") << p;
-  EXPECT_NEAR(std::stod(field(p, "duration")), 1.5, 0.05) << p;
+  const VideoProbe p = probe_video(file);
+  EXPECT_EQ(p.width, 160) << p;
+  EXPECT_EQ(p.height, 90) << p;
+  EXPECT_EQ(p.frames, 15) << p;
+  EXPECT_NEAR(p.duration, 1.5, 0.05) << p;
 }
 
 TEST_F(VideoTest, RecorderWritesNumberedPngFrames) {
@@ -207,12 +199,94 @@ TEST_F(VideoTest, ThrongRunRendersTheCircleAsAVideo) {
   while (pipe && fgets(buf, sizeof buf, pipe.get()) != nullptr) out += buf;
   ASSERT_EQ(pclose(pipe.release()), 0) << out;
   EXPECT_NE(out.find(dir + "/crowd.mp4 (25 frames, 160x90 at 12 fps)"), std::string::npos) << out;
-  const std::string p = probe(dir + "/crowd.mp4");
-  EXPECT_EQ(field(p, "codec_name"), "h264") << p;
-  EXPECT_EQ(field(p, "width"), "160") << p;
-  EXPECT_EQ(field(p, "height"), "90") << p;
-  EXPECT_EQ(field(p, "nb_read_frames"), "25") << p;
-  EXPECT_NEAR(std::stod(field(p, "duration")), 25.0 / 12.0, 0.05) << p;
+  const VideoProbe p = probe_video(dir + "/crowd.mp4");
+  EXPECT_EQ(p.codec, "h264") << p;
+  EXPECT_EQ(p.width, 160) << p;
+  EXPECT_EQ(p.height, 90) << p;
+  EXPECT_EQ(p.frames, 25) << p;
+  EXPECT_NEAR(p.duration, 25.0 / 12.0, 0.05) << p;
+}
+
+// `throng ARGS`, stdout and stderr into `out`; the exit status, -1 when killed.
+int run_throng(const std::string& args, std::string& out) {
+  const std::string cmd = std::string(THRONG_EXE) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return -1;
+  char buf[512];
+  while (fgets(buf, sizeof buf, pipe) != nullptr) out += buf;
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Where the characters are in a frame: the pixels that differ between two
+// drawings of it, one with every agent at the finest joint LOD and one with
+// every agent at the coarsest (LOD colours; nothing else depends on LOD).
+struct Crowd {
+  std::int64_t pixels = 0;
+  double x = 0.0, y = 0.0;  // their centroid, pixels from the top left
+};
+Crowd crowd_in(const Image& fine, const Image& coarse) {
+  EXPECT_EQ(fine.width, coarse.width);
+  EXPECT_EQ(fine.height, coarse.height);
+  Crowd c;
+  for (std::int32_t y = 0; y < std::min(fine.height, coarse.height); ++y)
+    for (std::int32_t x = 0; x < std::min(fine.width, coarse.width); ++x)
+      if (colour_distance(fine, x, y, coarse.pixel(x, y)) > 16) {
+        ++c.pixels;
+        c.x += x;
+        c.y += y;
+      }
+  if (c.pixels > 0) {
+    c.x /= static_cast<double>(c.pixels);
+    c.y /= static_cast<double>(c.pixels);
+  }
+  return c;
+}
+
+// `throng run --camera follow`: the scenario camera's direction, aimed at the
+// crowd and close enough to frame it. A small group walking far from the
+// target of the scenario camera, drawn under that camera kept fixed and
+// under follow: under follow the characters are in the middle of every
+// frame and cover many more pixels than under the fixed camera.
+TEST(ThrongRunCamera, FollowKeepsTheCrowdInTheMiddleOfTheFrame) {
+  const std::string dir = temp_dir("follow");
+  const std::string scenario = dir + "/aside.yaml";
+  std::ofstream(scenario) << "name: aside\nseed: 3\ndt: 0.1\nduration: 2\n"
+                             "world:\n  walkable: {rect: {min: [-40, -30], max: [40, 30]}}\n"
+                             "groups:\n  - name: walkers\n    count: 12\n    radius: 0.25\n"
+                             "    speed: {mean: 1.3, stddev: 0.1, min: 1.0, max: 1.6}\n"
+                             "    spawn: {rect: {min: [22, 6], max: [28, 12]}}\n    goal: {offset: [8, 0]}\n"
+                             "camera:\n  position: [0, -45, 40]\n  target: [0, 0, 0]\n  fov_degrees: 50\n";
+  constexpr int kFrames = 5;  // 2 simulated seconds at 2 fps, the first frame included
+  const auto frames = [&](const std::string& camera, const std::string& lod) {
+    const std::string out_dir = dir + "/" + camera + "_" + lod;
+    std::string out;
+    const int code = run_throng("--backend cpu --threads 2 run '" + scenario + "' --seconds 2 --render frames --width 160 --height 90 --fps 2 "
+                                "--no-trajectories --quiet --camera " + camera + " --lod-thresholds " +
+                                    (lod == "fine" ? "0.002,0.001" : "100000000,10000000") + " --out '" + out_dir + "'",
+                                out);
+    EXPECT_EQ(code, 0) << out;
+    std::vector<Image> images;
+    for (int f = 0; f < kFrames; ++f) images.push_back(read_png(out_dir + "/frame_0000" + std::to_string(f) + ".png"));
+    EXPECT_FALSE(std::filesystem::exists(out_dir + "/frame_0000" + std::to_string(kFrames) + ".png"));
+    return images;
+  };
+  const std::vector<Image> follow_fine = frames("follow", "fine"), follow_coarse = frames("follow", "coarse");
+  const std::vector<Image> fixed_fine = frames("fixed", "fine"), fixed_coarse = frames("fixed", "coarse");
+  for (int f = 0; f < kFrames; ++f) {
+    const auto i = static_cast<std::size_t>(f);
+    const Crowd follow = crowd_in(follow_fine[i], follow_coarse[i]);
+    const Crowd fixed = crowd_in(fixed_fine[i], fixed_coarse[i]);
+    const double w = follow_fine[i].width, h = follow_fine[i].height;
+    EXPECT_GT(fixed.pixels, 0) << "frame " << f;  // seen, small, by the scenario camera
+    EXPECT_GT(follow.pixels, static_cast<std::int64_t>(w * h / 50)) << "frame " << f;
+    EXPECT_GT(follow.pixels, 5 * fixed.pixels) << "frame " << f;
+    EXPECT_LT(std::abs(follow.x - 0.5 * w), 0.15 * w) << "frame " << f << ": the crowd's centre at x " << follow.x;
+    EXPECT_LT(std::abs(follow.y - 0.5 * h), 0.2 * h) << "frame " << f << ": the crowd's centre at y " << follow.y;
+    // The scenario camera sees the group off to the side.
+    EXPECT_GT(std::abs(fixed.x - 0.5 * w), 0.15 * w) << "frame " << f << ": the crowd's centre at x " << fixed.x;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -72,6 +74,22 @@ class VirtualDisplay {
   std::string display_;
 };
 
+// Colours (RGB) in a picture: a real scene has many, a cleared one a few.
+std::size_t distinct_colours(const Image& im) {
+  std::set<std::uint32_t> colours;
+  for (std::size_t i = 0; i < im.rgba.size(); i += 4)
+    colours.insert(static_cast<std::uint32_t>(im.rgba[i]) << 16 | static_cast<std::uint32_t>(im.rgba[i + 1]) << 8 | im.rgba[i + 2]);
+  return colours.size();
+}
+
+// Pixels that differ between a picture with joint-LOD colours and the same
+// with clothing colours (--no-lod-colours): those of characters, as
+// everything else (sky, ground, obstacles) is drawn the same in both.
+std::int64_t character_pixels(const Image& lod, const Image& clothes) {
+  const ImageDifference d = compare_images(lod, clothes);
+  return std::llround(d.fraction_differing * static_cast<double>(lod.width) * static_cast<double>(lod.height));
+}
+
 int run(const std::string& command, std::string& output) {
   FILE* pipe = popen((command + " 2>&1").c_str(), "r");
   if (pipe == nullptr) return -1;
@@ -97,37 +115,50 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
   EXPECT_EQ(im.width, 480);
   EXPECT_EQ(im.height, 270);
   // A real picture: the panel, the ground, characters in LOD colours.
-  std::set<std::uint32_t> colours;
-  for (std::size_t i = 0; i < im.rgba.size(); i += 4)
-    colours.insert(static_cast<std::uint32_t>(im.rgba[i]) << 16 | static_cast<std::uint32_t>(im.rgba[i + 1]) << 8 | im.rgba[i + 2]);
-  EXPECT_GT(colours.size(), 200u);
+  EXPECT_GT(distinct_colours(im), 200u);
 }
 
 // Without a window: a scenario simulated and animated, written as PNG
 // frames under its camera set in motion; the formation of throng animate
-// as a screenshot.
+// as a screenshot. Each is drawn twice, in joint-LOD colours and in
+// clothing colours, so the pixels that differ are the characters': a
+// picture of the ground alone, or a cleared one, fails.
 TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_headless";
   std::filesystem::remove_all(dir);
   std::string out;
-  ASSERT_EQ(run(std::string(THRONG_EXE) + " --threads 2 view corridor --agents 120 --headless --render frames --frames 3 --width 160 --height 90 "
-                    "--camera flyover --out " + dir.string(),
-                out),
-            0)
-      << out;
+  const std::string frames = std::string(THRONG_EXE) + " --threads 2 view corridor --agents 120 --headless --render frames --frames 3 --width 160 --height 90 "
+                             "--camera flyover --out ";
+  ASSERT_EQ(run(frames + dir.string(), out), 0) << out;
   EXPECT_NE(out.find("3 frames"), std::string::npos) << out;
+  out.clear();
+  ASSERT_EQ(run(frames + (dir / "clothes").string() + " --no-lod-colours", out), 0) << out;
   for (int f = 0; f < 3; ++f) {
-    const Image im = read_png((dir / ("frame_0000" + std::to_string(f) + ".png")).string());
+    const std::string name = "frame_0000" + std::to_string(f) + ".png";
+    const Image im = read_png((dir / name).string());
     EXPECT_EQ(im.width, 160);
     EXPECT_EQ(im.height, 90);
+    EXPECT_GT(distinct_colours(im), 100u) << name;  // sky, lit ground, grid, characters
+    const Image clothes = read_png((dir / "clothes" / name).string());
+    ASSERT_EQ(clothes.width, im.width);
+    ASSERT_EQ(clothes.height, im.height);
+    // 120 characters on a 100 m corridor seen whole: a few pixels each
+    // (about 3% of the picture).
+    EXPECT_GT(character_pixels(im, clothes), im.width * im.height / 70) << name;
   }
   const std::string shot = (dir / "formation.png").string();
+  const std::string clothes_shot = (dir / "formation_clothes.png").string();
+  const std::string formation = std::string(THRONG_EXE) + " view formation --layout grid --agents 50 --headless --frames 2 --width 160 --height 90 ";
   out.clear();
-  ASSERT_EQ(run(std::string(THRONG_EXE) + " view formation --layout grid --agents 50 --headless --frames 2 --width 160 --height 90 --screenshot " + shot,
-                out),
-            0)
-      << out;
-  EXPECT_EQ(read_png(shot).width, 160);
+  ASSERT_EQ(run(formation + "--screenshot " + shot, out), 0) << out;
+  out.clear();
+  ASSERT_EQ(run(formation + "--no-lod-colours --screenshot " + clothes_shot, out), 0) << out;
+  const Image im = read_png(shot);
+  EXPECT_EQ(im.width, 160);
+  EXPECT_EQ(im.height, 90);
+  EXPECT_GT(distinct_colours(im), 100u);
+  // 50 characters framed whole: about 6% of the picture is theirs.
+  EXPECT_GT(character_pixels(im, read_png(clothes_shot)), im.width * im.height / 40);
   out.clear();
   EXPECT_EQ(run(std::string(THRONG_EXE) + " view corridor --layout grid --headless --frames 2 --screenshot " + shot, out), 1) << out;
   EXPECT_NE(out.find("--layout"), std::string::npos) << out;
@@ -143,11 +174,16 @@ TEST(Viewer, NoDisplayIsAClearError) {
 
 TEST(Viewer, BadOptionsAreErrors) {
   std::string out;
-  EXPECT_NE(run(std::string(THRONG_EXE) + " view --screenshot x.png", out), 0);
+  int code = run(std::string(THRONG_EXE) + " view --screenshot x.png", out);
+  EXPECT_NE(code, 0);
+  EXPECT_EQ(code, 1) << out;  // throng::Error, not a crash
   EXPECT_NE(out.find("--frames"), std::string::npos) << out;
   out.clear();
-  EXPECT_NE(run(std::string(THRONG_EXE) + " view --lod-thresholds 10,100 --frames 1", out), 0);
+  code = run(std::string(THRONG_EXE) + " view --lod-thresholds 10,100 --frames 1", out);
+  EXPECT_NE(code, 0);
+  EXPECT_EQ(code, 1) << out;
   EXPECT_NE(out.find("--lod-thresholds"), std::string::npos) << out;
+  EXPECT_NE(out.find("positive and decreasing"), std::string::npos) << out;
 }
 
 }  // namespace
