@@ -163,8 +163,8 @@ void add_animate_command(CLI::App& app, const GlobalOptions& g) {
   static std::int64_t characters = 0;
   cmd->add_option("scenario", scenario, "Scenario YAML file or built-in name (formation)");
   cmd->add_option("--out", out_dir, "Folder for stats.json (default: the scenario's output)");
-  cmd->add_option("--duration", duration, "Seconds to animate (overrides the scenario)")->check(CLI::PositiveNumber);
-  cmd->add_option("--characters", characters, "How many characters (overrides the scenario)")->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));
+  cmd->add_option("--duration", duration, "Seconds to animate (overrides the scenario)")->check(greater_than(0));
+  cmd->add_option("--characters", characters, "How many characters (overrides the scenario)")->check(between(1, 1e7));
   cmd->callback([&g] {
     fs::path folder;
     io::AnimateSpec spec = load_animate_spec(scenario, folder);  // a bad name fails before any backend talk

@@ -326,15 +326,15 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
   std::string names;
   for (const std::string& n : io::builtin_scenario_names()) names += (names.empty() ? "" : ", ") + n;
   cmd->add_option("scenario", o.scenario, "Scenario file, or a built-in: " + names)->capture_default_str();
-  cmd->add_option("--agents", o.agents, "Total agents (groups keep their proportions)")->check(CLI::PositiveNumber);
-  auto* steps = cmd->add_option("--steps", o.steps, "Steps to run (default: the scenario's duration)")->check(CLI::PositiveNumber);
-  cmd->add_option("--seconds", o.seconds, "Simulated seconds to run")->check(CLI::PositiveNumber)->excludes(steps);
+  cmd->add_option("--agents", o.agents, "Total agents (groups keep their proportions)")->check(at_least(1));
+  auto* steps = cmd->add_option("--steps", o.steps, "Steps to run (default: the scenario's duration)")->check(at_least(1));
+  cmd->add_option("--seconds", o.seconds, "Simulated seconds to run")->check(greater_than(0))->excludes(steps);
   cmd->add_option("--seed", o.seed, "Random seed (spawn positions, speeds, random goals)");
   cmd->add_option("--scheduler", o.scheduler, "double_buffer or four_colour (default: the scenario's)")
       ->check(CLI::IsMember({"double_buffer", "four_colour", "four_color"}));
   cmd->add_option("--out", o.out, "Output folder (default: the scenario's, else out/<name>)");
   cmd->add_option("--every", o.every, "Write trajectories every K-th frame (default: the scenario's, else once a simulated second)")
-      ->check(CLI::PositiveNumber);
+      ->check(at_least(1));
   cmd->add_flag("--no-trajectories", o.no_trajectories, "Do not write trajectories.csv");
   cmd->add_flag("--quiet", o.quiet, "No progress display");
   auto* no_animate = cmd->add_flag("--no-animate", o.no_animate, "Skip the locomotion stage (agents are not animated)");
@@ -347,20 +347,20 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--render-mode", o.render_mode, "skinned (the mannequin) or joints (a sphere per bone)")
       ->check(CLI::IsMember({"skinned", "joints"}))
       ->capture_default_str();
-  cmd->add_option("--width", o.width, "Video width, pixels")->check(CLI::Range(16, 7680))->capture_default_str();
-  cmd->add_option("--height", o.height, "Video height, pixels")->check(CLI::Range(16, 4320))->capture_default_str();
-  cmd->add_option("--fps", o.fps, "Video frames per second")->check(CLI::Range(1.0, 240.0))->capture_default_str();
+  cmd->add_option("--width", o.width, "Video width, pixels")->check(between(16, 7680))->capture_default_str();
+  cmd->add_option("--height", o.height, "Video height, pixels")->check(between(16, 4320))->capture_default_str();
+  cmd->add_option("--fps", o.fps, "Video frames per second")->check(between(1, 240))->capture_default_str();
   auto* speed = cmd->add_option("--render-speed", o.render_speed, "Simulated seconds per video second (time-lapse above 1)")
-                    ->check(CLI::Range(0.01, 1000.0))
+                    ->check(between(0.01, 1000))
                     ->capture_default_str();
   cmd->add_option("--render-seconds", o.render_seconds, "Render the first S simulated seconds only (default: the whole run)")
-      ->check(CLI::PositiveNumber);
+      ->check(greater_than(0));
   cmd->add_option("--camera", o.camera,
                   "The scenario's camera kept fixed, orbiting its target, flying over it, or following the crowd from its direction "
                   "(default: the scenario's camera.motion, else orbit; the demo follows)")
       ->check(CLI::IsMember({"fixed", "orbit", "flyover", "follow"}));
   cmd->add_option("--camera-period", o.camera_period, "Video seconds per orbit or fly-over (default: the scenario's, else 40)")
-      ->check(CLI::PositiveNumber);
+      ->check(greater_than(0));
   cmd->callback([&g, cmd, speed] {
     // The built-in demo (no scenario named) writes a short time-lapse video.
     // (A build without the renderer runs it without a video.)
@@ -371,6 +371,12 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
       if (speed->count() == 0) o.render_speed = kDemoRenderSpeed;
     }
 #endif
+    // Options that only shape the video or frames are refused without them
+    // rather than ignored (the demo renders unless --no-render).
+    refuse_unless(*cmd, !o.render.empty(),
+                  {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera", "--camera-period"},
+                  "--render video|frames");
+    check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");
     apply_global_options(g);
     run_scenario(o);
   });

@@ -163,7 +163,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   for (const std::string& n : io::builtin_scenario_names()) names += n + ", ";
   cmd->add_option("scenario", scenario, "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
       ->capture_default_str();
-  cmd->add_option("--agents", agents, "How many agents (groups keep their proportions)")->check(CLI::Range(Index{1}, Index{1} << 24));
+  cmd->add_option("--agents", agents, "How many agents (groups keep their proportions)")->check(between(1, static_cast<double>(Index{1} << 24)));
   cmd->add_option("--layout", layout, "For formation: ring (walking round rings) or grid")
       ->check(CLI::IsMember({"ring", "grid"}));
   cmd->add_option("--mode", mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")->check(CLI::IsMember({"skinned", "joints"}));
@@ -180,17 +180,18 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--render", render_output, "With --headless: write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames)")
       ->check(CLI::IsMember({"video", "frames"}));
   cmd->add_option("--out", out_dir, "Folder for --render (default out/view)");
-  cmd->add_option("--fps", fps, "With --headless: frames per second of the video")->check(CLI::Range(1.0, 240.0));
+  cmd->add_option("--fps", fps, "With --headless: frames per second of the video")->check(between(1, 240));
   cmd->add_option("--camera", camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over (default: the scenario's camera.motion, else orbit)")
       ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
-  cmd->add_option("--camera-period", camera_period, "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")->check(CLI::PositiveNumber);
+  cmd->add_option("--camera-period", camera_period, "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")->check(greater_than(0));
   cmd->add_option("--lod-thresholds", thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
-  cmd->callback([&g] {
+  cmd->callback([&g, cmd] {
+    // Options of the offscreen recording are refused in a window, not ignored.
+    refuse_unless(*cmd, headless, {"--fps", "--camera", "--camera-period"}, "--headless (with --render video|frames or --screenshot)");
+    refuse_unless(*cmd, !render_output.empty(), {"--out"}, "--render video|frames");
     if (!o.screenshot.empty() && o.frames == 0) throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
     if (headless && o.frames == 0) throw Error("--headless needs --frames N", at_field("--frames"));
-    for (std::size_t i = 0; i < thresholds.size(); ++i)
-      if (!(thresholds[i] > 0.0f) || !std::isfinite(thresholds[i]) || (i > 0 && !(thresholds[i] < thresholds[i - 1])))
-        throw Error("thresholds must be positive and decreasing", at_field("--lod-thresholds"));
+    check_lod_thresholds(thresholds, "--lod-thresholds");
     if (!render_output.empty() && !headless) throw Error("--render needs --headless", at_field("--render"));
     if (headless && render_output.empty() && o.screenshot.empty())
       throw Error("--headless writes nothing without --render or --screenshot", at_field("--headless"));

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 namespace throng::app {
 
@@ -15,6 +16,30 @@ struct GlobalOptions {
 
 // Applies --backend/--threads/--log-level; throws Error on bad values.
 void apply_global_options(const GlobalOptions& g);
+
+// Adds --backend/--threads/--log-level to `app`, bound to `g`. main() adds
+// them to the top level and to every subcommand, so they may be given
+// before or after the subcommand's name.
+void add_global_options(CLI::App& app, GlobalOptions& g);
+
+// Range checks whose errors read "--agents: must be at least 1, got 0"
+// (CLI11's own print the bounds of the type, a 309-digit number for double).
+CLI::Validator at_least(double min);
+CLI::Validator greater_than(double min);
+CLI::Validator between(double lo, double hi);
+
+// --lod-thresholds: positive, finite, decreasing, at most kMaxLodLevels - 1;
+// errors name `flag`.
+void check_lod_thresholds(const std::vector<float>& thresholds, const std::string& flag);
+
+// Throws Error "OPTION: needs NEEDS" for the first of `options` given on
+// `cmd` when `given` is false (options that only matter with another one).
+void refuse_unless(const CLI::App& cmd, bool given, const std::vector<std::string>& options, const std::string& needs);
+
+// Edit distance (insert, delete, substitute, swap neighbours), and the name
+// in `names` closest to `word` when close enough to suggest; empty if none.
+std::size_t edit_distance(const std::string& a, const std::string& b);
+std::string closest_name(const std::string& word, const std::vector<std::string>& names);
 
 void add_run_command(CLI::App& app, const GlobalOptions& g);
 void add_animate_command(CLI::App& app, const GlobalOptions& g);
