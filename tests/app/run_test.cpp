@@ -30,10 +30,14 @@ struct Outcome {
   std::string out;
 };
 
-// Starts `throng args...` with stdout and stderr into `log`; returns the pid.
+// Starts `throng args...` with stdout and stderr into `log`, leading a new
+// process group (pgid = pid); returns the pid.
 pid_t start(const std::vector<std::string>& args, const fs::path& log) {
   const pid_t pid = fork();
   if (pid == 0) {
+    // A process group of its own, as a shell gives a foreground job: a
+    // test can signal the whole group the way a terminal's Ctrl-C does.
+    setpgid(0, 0);
     std::FILE* f = std::fopen(log.c_str(), "w");
     if (f != nullptr) {
       dup2(fileno(f), STDOUT_FILENO);
@@ -294,7 +298,7 @@ TEST_F(RunCommand, UnknownNamesAndBadOptionsAreErrors) {
   o = run({"run", "circle", "--agents", "0"});
   EXPECT_NE(o.code, 0);
   EXPECT_EQ(o.code, 2) << o.out;
-  EXPECT_NE(o.out.find("--agents: Value 0"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("--agents: must be at least 1, got 0"), std::string::npos) << o.out;
 }
 
 // Ctrl-C: the run ends after the current frame, the CSV ends on a complete
@@ -325,6 +329,43 @@ TEST_F(RunCommand, InterruptLeavesCompleteFiles) {
   EXPECT_FALSE(stats["run"]["all_arrived"].get<bool>());
   EXPECT_EQ(stats["run"]["steps"].get<long>(), rows.rbegin()->first);
   EXPECT_FALSE(fs::exists(out / "stats.json.tmp"));
+}
+
+// A terminal's Ctrl-C signals the whole foreground process group: throng
+// and the encoder it feeds. The encoder must not die of it: throng ends the
+// run after the frame, closes the pipe, the encoder finishes the file, and
+// every output is complete, with exit status 130.
+TEST_F(RunCommand, CtrlCToTheProcessGroupDuringAVideoRunKeepsEveryFile) {
+#if !defined(THRONG_HAVE_RENDER)
+  GTEST_SKIP() << "this build has no renderer: no video to interrupt";
+#else
+  const fs::path log = dir_ / "log.txt";
+  const fs::path out = dir_ / "out";
+  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "200", "--render", "video", "--width", "160", "--height", "90",
+                           "--out", out.string(), "--quiet"},
+                          log);
+  // Wait until the encoder has written part of the file.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::error_code ec;
+    if (fs::file_size(out / "crowd.mp4", ec) > 0 && !ec && fs::file_size(out / "trajectories.csv", ec) > 200 * 40 * 3 && !ec) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(kill(-pid, SIGINT), 0);  // the group, as a terminal does
+  const Outcome o = finish(pid, log);
+  ASSERT_EQ(o.code, 130) << o.out;
+  EXPECT_NE(o.out.find("(interrupted)"), std::string::npos) << o.out;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out / "stats.json"));
+  EXPECT_TRUE(stats["run"]["interrupted"].get<bool>());
+  EXPECT_FALSE(fs::exists(out / "stats.json.tmp"));
+  const std::map<long, int> rows = read_trajectories(out / "trajectories.csv", 200);
+  ASSERT_GE(rows.size(), 2u);
+  for (const auto& [frame, n] : rows) EXPECT_EQ(n, 200) << "frame " << frame;
+  const throng::testing::VideoProbe v = throng::testing::probe_video((out / "crowd.mp4").string());
+  EXPECT_EQ(v.codec, "h264") << v;
+  EXPECT_GT(v.frames, 0) << v;
+  EXPECT_GT(v.duration, 0.0) << v;
+#endif
 }
 
 }  // namespace
