@@ -1,6 +1,5 @@
 // Shared pieces of the command line (app/commands.h): readable range checks,
-// the joint-LOD thresholds flag, options that need another option, and the
-// closest command name for a mistyped one.
+// the joint-LOD thresholds flag, options that need another option.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -71,35 +70,6 @@ void refuse_unless(const CLI::App& cmd, bool given, const std::vector<std::strin
   if (given) return;
   for (const std::string& name : options)
     if (cmd.count(name) > 0) throw Error("needs " + needs, at_field(name));
-}
-
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  // Optimal string alignment: insertions, deletions, substitutions and
-  // swaps of neighbours ("rnu" is one step from "run").
-  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1, 0));
-  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  }
-  return d[a.size()][b.size()];
-}
-
-std::string closest_name(const std::string& word, const std::vector<std::string>& names) {
-  std::string best;
-  std::size_t best_distance = 3;  // at most two edits...
-  for (const std::string& name : names) {
-    const std::size_t d = edit_distance(word, name);
-    if (d < best_distance && 2 * d < name.size()) {  // ...and fewer than half the name's letters
-      best = name;
-      best_distance = d;
-    }
-  }
-  return best;
 }
 
 }  // namespace throng::app

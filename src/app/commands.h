@@ -36,10 +36,6 @@ void check_lod_thresholds(const std::vector<float>& thresholds, const std::strin
 // `cmd` when `given` is false (options that only matter with another one).
 void refuse_unless(const CLI::App& cmd, bool given, const std::vector<std::string>& options, const std::string& needs);
 
-// Edit distance (insert, delete, substitute, swap neighbours), and the name
-// in `names` closest to `word` when close enough to suggest; empty if none.
-std::size_t edit_distance(const std::string& a, const std::string& b);
-std::string closest_name(const std::string& word, const std::vector<std::string>& names);
 
 void add_run_command(CLI::App& app, const GlobalOptions& g);
 void add_animate_command(CLI::App& app, const GlobalOptions& g);

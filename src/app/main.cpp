@@ -1,4 +1,6 @@
 // throng: simulate and animate massive crowds.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -12,6 +14,7 @@
 #include "app/version.h"
 #include "core/error.h"
 #include "core/exec.h"
+#include "core/spelling.h"
 
 namespace throng::app {
 
@@ -68,11 +71,9 @@ void check_command_word(const CLI::App& app, int argc, char** argv) {
   for (const std::string& name : names)
     if (name == *word) return;
   std::string message = "unknown command '" + *word + "'";
-  const std::string close = throng::app::closest_name(*word, names);
+  const std::string close = throng::closest_name(*word, names);
   if (!close.empty()) message += " (did you mean '" + close + "'?)";
-  message += "; the commands are";
-  for (std::size_t i = 0; i < names.size(); ++i) message += (i == 0 ? " " : ", ") + names[i];
-  throw UnknownCommand(message);
+  throw UnknownCommand(fmt::format("{}; the commands are {}", message, fmt::join(names, ", ")));
 }
 
 }  // namespace

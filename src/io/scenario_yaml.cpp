@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "core/ground.h"
+#include "core/spelling.h"
 #include "io/embedded.h"
 #include "path/route_planner.h"
 
@@ -27,21 +28,6 @@ using sim::GoalSpec;
 using sim::Region;
 
 constexpr double kDegrees = 0.017453292519943295;
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
 
 std::string shown(std::string_view s) {
   constexpr std::size_t kShown = 40;
@@ -91,13 +77,8 @@ class Reader {
       const std::string& k = key.Scalar();
       const std::string where = child(path, k);
       if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
-        std::string hint;
-        std::size_t best = 3;
-        for (std::string_view a : allowed)
-          if (const std::size_t d = edit_distance(k, a); d < best) {
-            best = d;
-            hint = fmt::format(" (did you mean '{}'?)", a);
-          }
+        const std::string close = closest_name(k, allowed);
+        const std::string hint = close.empty() ? "" : fmt::format(" (did you mean '{}'?)", close);
         fail_at(key.Mark(), where, fmt::format("unknown key {}{}; expected one of {}", shown(k), hint, join(allowed)));
       }
       if (std::find(keys.begin(), keys.end(), k) != keys.end()) fail_at(key.Mark(), where, fmt::format("duplicate key {}", shown(k)));

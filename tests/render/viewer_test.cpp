@@ -183,7 +183,7 @@ TEST(Viewer, BadOptionsAreErrors) {
   EXPECT_NE(code, 0);
   EXPECT_EQ(code, 1) << out;
   EXPECT_NE(out.find("--lod-thresholds"), std::string::npos) << out;
-  EXPECT_NE(out.find("positive and decreasing"), std::string::npos) << out;
+  EXPECT_NE(out.find("thresholds must decrease"), std::string::npos) << out;
 }
 
 }  // namespace
