@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/exec.h"
 #include "core/ground.h"
+#include "tests/anim/random_crowd.h"
 
 namespace throng::anim {
 namespace {
@@ -24,33 +25,8 @@ const motion::BlendSpace1D& space() {
   return s;
 }
 
-struct Crowd {
-  std::vector<glm::vec3> positions;
-  std::vector<float> yaws, scales, phases, speeds;
-};
-
-Crowd random_crowd(Index n, std::uint32_t seed, float extent = 40.0f) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  Crowd c;
-  for (Index i = 0; i < n; ++i) {
-    c.positions.emplace_back(extent * (2.0f * u(rng) - 1.0f), 0.0f, extent * (2.0f * u(rng) - 1.0f));
-    c.yaws.push_back(2.0f * kPi * u(rng) - kPi);
-    c.scales.push_back(0.85f + 0.3f * u(rng));
-    c.phases.push_back(u(rng));
-    c.speeds.push_back(5.0f * u(rng));
-  }
-  return c;
-}
-
-Camera test_camera() {
-  Camera cam;
-  cam.position = glm::vec3(0.0f, 12.0f, 45.0f);
-  cam.target = glm::vec3(0.0f, 0.0f, 0.0f);
-  cam.width = 1280;
-  cam.height = 720;
-  return cam;
-}
+using testing::Crowd;
+using testing::random_crowd;
 
 double angle_deg(const glm::quat& a, const glm::quat& b) { return rotation_angle_deg(a, b); }
 
@@ -112,7 +88,7 @@ TEST(CrowdAnimator, MatchesThePerCharacterReference) {
 TEST(CrowdAnimator, IdenticalOutputForOneTwoAndManyThreads) {
   const Index n = 6000;
   const Crowd crowd = random_crowd(n, 12);
-  const Camera cam = test_camera();
+  const Camera cam = testing::crowd_camera();
   struct Result {
     std::vector<glm::vec3> p;
     std::vector<glm::quat> q;
@@ -161,7 +137,7 @@ TEST(CrowdAnimator, IdenticalOutputForOneTwoAndManyThreads) {
 TEST(CrowdAnimator, MaskedJointsAreNotSynthesised) {
   const Index n = 3000;
   const Crowd crowd = random_crowd(n, 13, 60.0f);
-  const Camera cam = test_camera();
+  const Camera cam = testing::crowd_camera();
   CrowdAnimatorConfig config;
   config.cache = false;
   CrowdAnimator masked(space(), n, config);

@@ -8,6 +8,7 @@
 
 #include "anim/locomotion.h"
 #include "core/camera.h"
+#include "tests/anim/random_crowd.h"
 #include "tests/gpu/gpu_test.h"
 
 namespace throng::anim {
@@ -20,33 +21,8 @@ const motion::BlendSpace1D& space() {
   return s;
 }
 
-struct Crowd {
-  std::vector<glm::vec3> positions;
-  std::vector<float> yaws, scales, phases, speeds;
-};
-
-Crowd random_crowd(Index n, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  Crowd c;
-  for (Index i = 0; i < n; ++i) {
-    c.positions.emplace_back(40.0f * (2.0f * u(rng) - 1.0f), 0.0f, 40.0f * (2.0f * u(rng) - 1.0f));
-    c.yaws.push_back(2.0f * kPi * u(rng) - kPi);
-    c.scales.push_back(0.85f + 0.3f * u(rng));
-    c.phases.push_back(u(rng));
-    c.speeds.push_back(5.0f * u(rng));
-  }
-  return c;
-}
-
-Camera test_camera() {
-  Camera cam;
-  cam.position = glm::vec3(0.0f, 12.0f, 45.0f);
-  cam.target = glm::vec3(0.0f, 0.0f, 0.0f);
-  cam.width = 1280;
-  cam.height = 720;
-  return cam;
-}
+using testing::Crowd;
+using testing::random_crowd;
 
 struct Result {
   std::vector<glm::vec3> root_p, joint_p;
@@ -63,7 +39,7 @@ TEST(CudaCrowdAnimator, FramesMatchCpu) {
   THRONG_REQUIRE_GPU();
   constexpr Index kN = 2000;
   const Crowd crowd = random_crowd(kN, 12);
-  const Camera cam = test_camera();
+  const Camera cam = testing::crowd_camera();
   const auto run = [&](Memory m) {
     CrowdAnimatorConfig config;
     config.draw_matrices = true;

@@ -17,16 +17,6 @@ namespace {
 
 using testing::TPoseCrowd;
 
-Camera test_camera() {
-  Camera cam;
-  cam.width = 640;
-  cam.height = 360;
-  cam.position = {0.0f, 1.7f, 0.0f};
-  cam.target = {10.0f, 1.0f, -20.0f};
-  cam.far_plane = 60.0f;
-  return cam;
-}
-
 // The exclusive scan of the group flags on the host: the reference for
 // scan_draw_slots on either backend.
 Index host_slots(const std::vector<std::uint32_t>& flags, std::vector<std::uint32_t>& slots) {
@@ -72,7 +62,7 @@ TEST(CudaCull, CullAndPackMatchCpu) {
     palettes.insert(palettes.end(), static_cast<std::size_t>(J), m);
     rigs.push_back(i % 3 == 0 ? 1 : 0);
   }
-  const CameraView view = make_camera_view(test_camera());
+  const CameraView view = make_camera_view(testing::street_camera());
   // Pack jobs read the CPU's flags and slots on both sides, so they are
   // compared on the same visible set whatever the cull decided.
   std::vector<std::uint32_t> cpu_flags, cpu_slots;

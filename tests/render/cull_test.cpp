@@ -28,16 +28,6 @@ TPoseCrowd scattered(int n, std::uint32_t seed) {
   return c;
 }
 
-Camera test_camera() {
-  Camera cam;
-  cam.width = 640;
-  cam.height = 360;
-  cam.position = {0.0f, 1.7f, 0.0f};
-  cam.target = {10.0f, 1.0f, -20.0f};
-  cam.far_plane = 60.0f;
-  return cam;
-}
-
 struct Culled {
   std::vector<std::uint32_t> flags, slots;
   Index visible = 0;
@@ -65,7 +55,7 @@ Culled cull(const TPoseCrowd& c, const JointRig& rig, const Camera& cam, float f
 TEST(Cull, KeepsEveryCharacterWithAPointInViewAndDropsThoseFarOutside) {
   const TPoseCrowd c = scattered(600, 7);
   const JointRig rig = make_joint_rig(c.skeleton);
-  const Camera cam = test_camera();
+  const Camera cam = testing::street_camera();
   const Culled r = cull(c, rig, cam);
   const Index n = c.count();
   const CameraView view = make_camera_view(cam);
@@ -106,7 +96,7 @@ TEST(Cull, KeepsEveryCharacterWithAPointInViewAndDropsThoseFarOutside) {
 }
 
 TEST(Cull, TiersFollowImageSize) {
-  Camera cam = test_camera();
+  Camera cam = testing::street_camera();
   cam.width = 160;
   cam.height = 90;
   cam.far_plane = 500.0f;
@@ -144,7 +134,7 @@ TEST(Pack, MatchesABruteForceAndIsThreadIndependent) {
   std::vector<std::vector<glm::vec4>> results;
   for (int threads : {1, 2, 3}) {
     ScopedExecution exec(Backend::Cpu, threads);
-    const Culled r = cull(c, rig, test_camera());
+    const Culled r = cull(c, rig, testing::street_camera());
     std::vector<glm::vec4> out(static_cast<std::size_t>(r.visible * P));
     PackJob job;
     job.joint_count = rig.joint_count;
@@ -185,7 +175,7 @@ TEST(Pack, PerPartLevelsColourEachPoint) {
   c.add({0.0f, 0.0f, -10.0f});
   std::vector<std::uint8_t> levels = {1, 2, 3, 4, 5};  // left arm, right arm, torso, left leg, right leg
   const JointRig rig = make_joint_rig(c.skeleton);
-  const Culled r = cull(c, rig, test_camera());
+  const Culled r = cull(c, rig, testing::street_camera());
   ASSERT_EQ(r.visible, 1);
   std::vector<glm::vec4> out(static_cast<std::size_t>(rig.point_count()));
   PackJob job;
@@ -230,7 +220,7 @@ TEST(PalettePack, JointFramesTimesInverseBindGiveEachCharactersTransformAndThrea
     ScopedExecution exec(Backend::Cpu, threads);
     Buffer<std::uint32_t> flags(kDrawTiers * n), slots(kDrawTiers * n);
     CullJob cull;
-    cull.camera = make_camera_view(test_camera());
+    cull.camera = make_camera_view(testing::street_camera());
     cull.rigs.rig[0] = {skin.bounding_radius, skin.bind_positions[0], J};
     cull.joint_count = J;
     cull.joint_positions = c.positions;
@@ -294,7 +284,7 @@ TEST(Cull, PalettesPlaceCharactersAsTheirJointFramesDoAndPickTheirRigsGroup) {
 
   Buffer<std::uint32_t> from_frames(kDrawTiers * n), from_palettes(2 * kDrawTiers * n);
   CullJob frames;
-  frames.camera = make_camera_view(test_camera());
+  frames.camera = make_camera_view(testing::street_camera());
   frames.rigs.rig[0] = rig;
   frames.fine_min_pixels = 30.0f;
   frames.lines_max_pixels = 10.0f;

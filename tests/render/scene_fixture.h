@@ -6,6 +6,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/ground.h"
 #include "motion/default_set.h"
 #include "motion/fk.h"
@@ -51,5 +52,17 @@ struct TPoseCrowd {
   }
   std::int32_t count() const { return static_cast<std::int32_t>(levels.size()); }
 };
+
+// A pedestrian's eye (1.7 m) looking down a street into the crowd, 640x360,
+// far plane at 60 m: the cull tests' camera, so frustum and distance both cut.
+inline Camera street_camera() {
+  Camera cam;
+  cam.width = 640;
+  cam.height = 360;
+  cam.position = {0.0f, 1.7f, 0.0f};
+  cam.target = {10.0f, 1.0f, -20.0f};
+  cam.far_plane = 60.0f;
+  return cam;
+}
 
 }  // namespace throng::render::testing
