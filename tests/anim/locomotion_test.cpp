@@ -13,20 +13,15 @@
 #include "core/error.h"
 #include "core/exec.h"
 #include "core/ground.h"
-#include "tests/anim/random_crowd.h"
+#include "tests/anim/crowd_fixture.h"
 
 namespace throng::anim {
 namespace {
 
-constexpr float kPi = 3.14159265f;
-
-const motion::BlendSpace1D& space() {
-  static const motion::BlendSpace1D s = motion::make_default_blend_space();
-  return s;
-}
-
 using testing::Crowd;
+using testing::kPi;
 using testing::random_crowd;
+const motion::BlendSpace1D& space() { return testing::default_space(); }
 
 double angle_deg(const glm::quat& a, const glm::quat& b) { return rotation_angle_deg(a, b); }
 

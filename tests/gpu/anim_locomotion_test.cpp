@@ -8,21 +8,16 @@
 
 #include "anim/locomotion.h"
 #include "core/camera.h"
-#include "tests/anim/random_crowd.h"
+#include "tests/anim/crowd_fixture.h"
 #include "tests/gpu/gpu_test.h"
 
 namespace throng::anim {
 namespace {
 
-constexpr float kPi = 3.14159265f;
-
-const motion::BlendSpace1D& space() {
-  static const motion::BlendSpace1D s = motion::make_default_blend_space();
-  return s;
-}
-
 using testing::Crowd;
+using testing::kPi;
 using testing::random_crowd;
+const motion::BlendSpace1D& space() { return testing::default_space(); }
 
 struct Result {
   std::vector<glm::vec3> root_p, joint_p;

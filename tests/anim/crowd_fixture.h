@@ -1,7 +1,7 @@
-// A random crowd of characters for the locomotion tests (tests/anim and the
-// CUDA comparison in tests/gpu): positions on the ground within +-extent m,
-// yaws, scales 0.85-1.15, phases and speeds 0-5 m/s; and the camera they
-// are seen from.
+// Shared by the locomotion tests (tests/anim and the CUDA comparison in
+// tests/gpu): the default blend space built once, a random crowd of
+// characters (positions on the ground within +-extent m, yaws, scales
+// 0.85-1.15, phases and speeds 0-5 m/s) and the camera they are seen from.
 #pragma once
 
 #include <cstdint>
@@ -13,8 +13,17 @@
 
 #include "core/camera.h"
 #include "core/config.h"
+#include "motion/locomotion.h"
 
 namespace throng::anim::testing {
+
+inline constexpr float kPi = std::numbers::pi_v<float>;
+
+// Built once per test program: the space's tables take a while.
+inline const motion::BlendSpace1D& default_space() {
+  static const motion::BlendSpace1D s = motion::make_default_blend_space();
+  return s;
+}
 
 struct Crowd {
   std::vector<glm::vec3> positions;
@@ -22,7 +31,6 @@ struct Crowd {
 };
 
 inline Crowd random_crowd(Index n, std::uint32_t seed, float extent = 40.0f) {
-  constexpr float kPi = std::numbers::pi_v<float>;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   Crowd c;
