@@ -16,6 +16,7 @@ function(throng_family name)
   target_include_directories(throng_${name} PUBLIC
     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<INSTALL_INTERFACE:include/throng>)
   target_link_libraries(throng_${name} PUBLIC ${F_DEPENDS})
+  target_compile_features(throng_${name} PUBLIC cxx_std_20)
   throng_setup_target(throng_${name})
   # Installed as throng::<name> (cmake/ThrongInstall.cmake).
   set_target_properties(throng_${name} PROPERTIES EXPORT_NAME ${name})
