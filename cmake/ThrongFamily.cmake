@@ -11,9 +11,16 @@ function(throng_family name)
     throng_kernel_sources(${kernels})
   endif()
   add_library(throng_${name} ${sources})
-  target_include_directories(throng_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  # Headers include each other as "core/buffer.h": installed under
+  # include/throng/<family>/, with include/throng on the consumer's path.
+  target_include_directories(throng_${name} PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src> $<INSTALL_INTERFACE:include/throng>)
   target_link_libraries(throng_${name} PUBLIC ${F_DEPENDS})
+  target_compile_features(throng_${name} PUBLIC cxx_std_20)
   throng_setup_target(throng_${name})
+  # Installed as throng::<name> (cmake/ThrongInstall.cmake).
+  set_target_properties(throng_${name} PROPERTIES EXPORT_NAME ${name})
+  set_property(GLOBAL APPEND PROPERTY THRONG_LIBRARIES throng_${name})
 
   file(GLOB tests CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/tests/${name}/*_test.cpp)
   if(tests AND THRONG_TESTS)

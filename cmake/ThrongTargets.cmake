@@ -15,7 +15,14 @@ function(throng_setup_target target)
   endif()
   if(THRONG_SANITIZE)
     target_compile_options(${target} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:${THRONG_SANITIZER_FLAGS}>)
-    target_link_options(${target} PRIVATE ${THRONG_SANITIZER_FLAGS})
+    # A sanitized static library needs the sanitizer runtimes wherever it is
+    # linked: consumers of a library (also the installed package) get the flags.
+    get_target_property(type ${target} TYPE)
+    if(type STREQUAL "STATIC_LIBRARY")
+      target_link_options(${target} PUBLIC ${THRONG_SANITIZER_FLAGS})
+    else()
+      target_link_options(${target} PRIVATE ${THRONG_SANITIZER_FLAGS})
+    endif()
   endif()
 endfunction()
 
