@@ -1,6 +1,8 @@
 // throng convert IN.bvh OUT.bvh: rewrites a file through the reader and the
 // writer, with one rotation order for every joint and the chosen unit. The
 // writer is chosen by OUT's extension; BVH is the only one so far.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -39,11 +41,12 @@ const std::vector<MotionWriter>& motion_writers() {
 const MotionWriter& writer_for(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  std::string supported;
+  std::vector<std::string> extensions;
   for (const MotionWriter& w : motion_writers()) {
     if (ext == w.extension) return w;
-    supported += (supported.empty() ? "" : ", ") + std::string(w.extension);
+    extensions.emplace_back(w.extension);
   }
+  const std::string supported = fmt::format("{}", fmt::join(extensions, ", "));
   Location where;
   where.file = path;
   if (ext.empty()) throw Error("no extension to choose the output format by (supported: " + supported + ")", where);
