@@ -335,21 +335,52 @@ class Reader {
     return s;
   }
 
+  // `type` picks the model; the other keys are that model's parameters or
+  // those every model shares. A parameter of another model is an error that
+  // says which type it belongs to.
   sim::ModelParams model(const YAML::Node& n, const std::string& path) {
-    expect_map(n, path,
-               {"pred_time", "max_speed", "max_force", "personal_space", "lane_half_width", "relaxation_time", "probe_margin",
-                "contact_iterations"});
+    static const std::vector<std::string_view> shared = {"type", "max_speed", "contact_iterations"};
+    static const std::vector<std::string_view> priority = {"pred_time", "max_force", "personal_space", "lane_half_width", "relaxation_time",
+                                                           "probe_margin"};
+    static const std::vector<std::string_view> cfs = {"time_gap",       "neighbour_strength", "neighbour_range", "wall_strength",
+                                                      "wall_range",     "avoid_strength",     "avoid_time",      "side_margin",
+                                                      "turn_time"};
+    visit(n, path);
+    if (!n.IsMap()) fail(n, path, "expected a map (model.type and its parameters), got " + kind(n));
     sim::ModelParams m;
+    if (n["type"]) m.kind = sim::parse_model_kind(word(n["type"], child(path, "type"), {"collision_free_speed", "priority"}), child(path, "type"));
+    const std::vector<std::string_view>& own = m.kind == sim::ModelKind::Priority ? priority : cfs;
+    const std::vector<std::string_view>& other = m.kind == sim::ModelKind::Priority ? cfs : priority;
+    std::vector<std::string_view> allowed = shared;
+    allowed.insert(allowed.end(), own.begin(), own.end());
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const YAML::Node key = it->first;
+      if (!key.IsScalar() || std::find(other.begin(), other.end(), key.Scalar()) == other.end()) continue;
+      const sim::ModelKind owner = m.kind == sim::ModelKind::Priority ? sim::ModelKind::CollisionFreeSpeed : sim::ModelKind::Priority;
+      fail_at(key.Mark(), child(path, key.Scalar()),
+              fmt::format("'{}' is a parameter of the {} model, and this scenario's model.type is {}", key.Scalar(), to_string(owner),
+                          to_string(m.kind)));
+    }
+    keys_of(n, path, allowed);
     auto opt = [&](const char* key, float& out) {
       if (n[key]) out = real(n[key], child(path, key));
     };
-    opt("pred_time", m.pred_time);
     opt("max_speed", m.max_speed);
+    opt("pred_time", m.pred_time);
     opt("max_force", m.max_force);
     opt("personal_space", m.personal_space);
     opt("lane_half_width", m.lane_half_width);
     opt("relaxation_time", m.relaxation_time);
     opt("probe_margin", m.probe_margin);
+    opt("time_gap", m.cfs.time_gap);
+    opt("neighbour_strength", m.cfs.neighbour_strength);
+    opt("neighbour_range", m.cfs.neighbour_range);
+    opt("wall_strength", m.cfs.wall_strength);
+    opt("wall_range", m.cfs.wall_range);
+    opt("avoid_strength", m.cfs.avoid_strength);
+    opt("avoid_time", m.cfs.avoid_time);
+    opt("side_margin", m.cfs.side_margin);
+    opt("turn_time", m.cfs.turn_time);
     if (n["contact_iterations"]) m.contact_iterations = static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
     return m;
   }

@@ -115,8 +115,10 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
                               "through walls: lower dt or max_speed",
                               step, 0.9f * G.radius),
                   at_field(field + ".radius"));
-    if (2.0f * G.radius + 2.0f * step > cell || G.radius > spec.model.pred_time * spec.model.max_speed)
-      throw Error(fmt::format("radius {} m is too large for the bins of side {} m (2 * model.pred_time * model.max_speed)", G.radius, cell),
+    if (2.0f * G.radius + 2.0f * step > cell || G.radius > spec.model.max_radius())
+      throw Error(fmt::format("radius {} m is too large for the {} model (at most {:.3g} m, and 2 * radius + 2 * dt * max_speed within its "
+                              "bins of side {:.3g} m)",
+                              G.radius, to_string(spec.model.kind), spec.model.max_radius(), cell),
                   at_field(field + ".radius"));
     const SpeedSpec& S = G.speed;
     if (!std::isfinite(S.mean) || !(S.mean > 0)) throw Error(fmt::format("mean speed must be > 0 (got {})", S.mean), at_field(field + ".speed.mean"));

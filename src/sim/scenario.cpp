@@ -29,6 +29,23 @@ void ModelParams::validate() const {
   check_range(probe_margin, 0.0f, 100.0f, true, "model.probe_margin", "probe margin (m)");
   if (contact_iterations < 0 || contact_iterations > 64)
     throw Error(fmt::format("contact iterations must be in [0, 64] (got {})", contact_iterations), at_field("model.contact_iterations"));
+  check_range(cfs.time_gap, 0.0f, 100.0f, false, "model.time_gap", "time gap (s)");
+  check_range(cfs.neighbour_strength, 0.0f, 1000.0f, true, "model.neighbour_strength", "neighbour repulsion strength");
+  check_range(cfs.neighbour_range, 0.001f, 10.0f, true, "model.neighbour_range", "neighbour repulsion range (m)");
+  check_range(cfs.wall_strength, 0.0f, 1000.0f, true, "model.wall_strength", "wall repulsion strength");
+  check_range(cfs.wall_range, 0.001f, 10.0f, true, "model.wall_range", "wall repulsion range (m)");
+  check_range(cfs.avoid_strength, 0.0f, 100.0f, true, "model.avoid_strength", "anticipation strength");
+  check_range(cfs.avoid_time, 0.0f, 100.0f, false, "model.avoid_time", "anticipation time (s)");
+  check_range(cfs.side_margin, 0.0f, 10.0f, true, "model.side_margin", "anticipation side margin (m)");
+  check_range(cfs.turn_time, 0.0f, 10.0f, true, "model.turn_time", "turn time (s)");
+}
+
+const char* to_string(ModelKind k) { return k == ModelKind::Priority ? "priority" : "collision_free_speed"; }
+
+ModelKind parse_model_kind(const std::string& text, const std::string& field) {
+  if (text == "collision_free_speed") return ModelKind::CollisionFreeSpeed;
+  if (text == "priority") return ModelKind::Priority;
+  throw Error("unknown model type '" + text + "' (collision_free_speed or priority)", at_field(field));
 }
 
 const char* to_string(ArrivalBehaviour a) {

@@ -17,17 +17,59 @@
 
 namespace throng::sim {
 
-// Parameters of the paper's priority-force model and of the move stage.
+// Which steering model turns neighbours, walls and the goal into motion
+// (docs/simulation.md has the equations and the source of every default).
+enum class ModelKind : std::uint8_t {
+  CollisionFreeSpeed,  // Tordeux, Chraibi, Seyfried 2016, with anticipation (collision_free_speed.h)
+  Priority,            // the paper's three forces by priority (steering.h)
+};
+const char* to_string(ModelKind k);
+// "collision_free_speed" | "priority"; throws Error naming `field` otherwise.
+ModelKind parse_model_kind(const std::string& text, const std::string& field);
+
+// Parameters of the collision-free speed model (collision_free_speed.h).
+// Defaults: a, D, b, Dw as JuPedSim's CollisionFreeSpeedModel (8, 0.1 m,
+// 5, 0.02 m); T fitted to Weidmann's fundamental diagram (docs/simulation.md;
+// the published calibration is about 1 s); the anticipation and turn terms
+// are this engine's.
+struct CollisionFreeSpeedParams {
+  float time_gap = 0.75f;           // s: T, the time gap kept to the agent ahead
+  float neighbour_strength = 8.0f;  // a: neighbour repulsion at contact, relative to the goal direction
+  float neighbour_range = 0.1f;     // m: D, its decay length
+  float wall_strength = 5.0f;       // b: wall repulsion at contact
+  float wall_range = 0.02f;         // m: Dw
+  float avoid_strength = 1.0f;      // k: sideways push from an oncoming neighbour about to meet us (0 = off)
+  float avoid_time = 2.0f;          // s: how far ahead oncoming neighbours are anticipated
+  float side_margin = 0.2f;         // m: an oncoming neighbour counts when its centre is within l + this of our line
+  float turn_time = 0.3f;           // s: the walking direction turns towards the wanted one over about this
+};
+
+// The steering model and its parameters, and those of the move stage.
 struct ModelParams {
+  ModelKind kind = ModelKind::Priority;
+  CollisionFreeSpeedParams cfs;
+  // The priority model (the paper's):
   float pred_time = 1.0f;          // s: prediction horizon (predTime)
-  float max_speed = 2.0f;          // m/s: maxVelocity; query radius = 2 * pred_time * max_speed
   float max_force = 4.0f;          // m/s^2: largest steering acceleration
   float personal_space = 0.15f;    // m: observation radius = radius + personal_space
   float lane_half_width = 0.5f;    // m: path following steers back beyond this
   float relaxation_time = 0.5f;    // s: path following reaches the desired velocity in about this
   float probe_margin = 0.1f;       // m: probe half-width = radius + probe_margin
+  // Every model:
+  float max_speed = 2.0f;          // m/s: no agent is faster (maxVelocity)
   std::int32_t contact_iterations = 4;  // contact/obstacle projection passes per step (the added constraint)
-  THRONG_HOST_DEVICE float query_radius() const { return 2.0f * pred_time * max_speed; }
+  // Side of the steering bins: every neighbour the model looks at lies
+  // within it. Priority: 2 * pred_time * max_speed (the paper's). Collision-
+  // free speed: the gap that allows max_speed (T * max_speed) plus two of
+  // the largest radius (kCfsMaxRadius), at least the anticipation reach.
+  THRONG_HOST_DEVICE float query_radius() const {
+    if (kind == ModelKind::Priority) return 2.0f * pred_time * max_speed;
+    const float gap = cfs.time_gap * max_speed, anticipate = 0.5f * cfs.avoid_time * max_speed;
+    return 2.0f * kCfsMaxRadius + (gap > anticipate ? gap : anticipate);
+  }
+  // The largest agent radius the bins allow.
+  THRONG_HOST_DEVICE float max_radius() const { return kind == ModelKind::Priority ? pred_time * max_speed : kCfsMaxRadius; }
+  static constexpr float kCfsMaxRadius = 0.5f;  // m
   // Throws Error naming the field ("model.pred_time") for NaN, negative or
   // out-of-range values.
   void validate() const;

@@ -3,6 +3,7 @@
 // neighbour threat), plus the projections of the move stage. Host+device.
 #pragma once
 
+#include "sim/collision_free_speed.h"
 #include "sim/crowd.h"
 #include "sim/grid.h"
 #include "sim/steering.h"
@@ -86,6 +87,53 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec
   const float query2 = m.query_radius() * m.query_radius();
   for (Index j = 0; j < n.position.size(); ++j) consider_neighbour(best, j, self, p, v, forward, radius, n, m, query2);
   return best;
+}
+
+// ---- collision-free speed -------------------------------------------------------
+
+// The new velocity of agent `self` under the collision-free speed model
+// (collision_free_speed.h). `for_each_candidate(fn)` calls fn(j) for every
+// agent that may be a neighbour, in a fixed order (the 3x3 bins, or all
+// agents for the reference); those beyond the query radius, inactive or
+// `self` are skipped here. Walls and circles come from the agent's cell of
+// the world's halo grids (everything within one cell side).
+template <class ForEachCandidate>
+THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, Index self, const CfsAgent& me, float v0, float dt,
+                                                            const NeighbourArrays& n, const ModelParams& m,
+                                                            const ForEachCandidate& for_each_candidate) {
+  const CollisionFreeSpeedParams& c = m.cfs;
+  const float query2 = m.query_radius() * m.query_radius();
+  auto is_neighbour = [&](Index j) {
+    return j != self && (n.flags[j] & kAgentActive) != 0 && length2(n.position[j] - me.p) < query2;
+  };
+  // Walls first: they may slide e0 along them before the pushes are summed.
+  const float reach = me.radius + cfs_wall_reach(c);
+  glm::vec2 e0 = me.e0, walls(0.0f);
+  auto wall_point = [&](glm::vec2 q) {
+    const glm::vec2 d = me.p - q;
+    const float d2 = length2(d);
+    if (d2 >= reach * reach || d2 <= 1e-12f) return;
+    e0 = cfs_slide_along_wall(e0, d * (1.0f / sqrtf(d2)));
+    walls += cfs_wall_push(me, q, c);
+  };
+  for_each_obstacle(
+      w, obstacle_cell(w, me.p), [&](const Segment& s) { wall_point(closest_point_on_segment(me.p, s.a, s.b)); },
+      [&](const Circle& k) {
+        const glm::vec2 d = me.p - k.center;
+        const float dist = length_of(d);
+        if (dist > 1e-6f) wall_point(k.center + d * (k.radius / dist));
+      });
+  glm::vec2 sum = e0 + walls;
+  for_each_candidate([&](Index j) {
+    if (is_neighbour(j)) sum += cfs_neighbour_push(me, n.position[j], n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
+  });
+  const glm::vec2 e = cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
+  if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
+  float gap = INFINITY;
+  for_each_candidate([&](Index j) {
+    if (is_neighbour(j)) gap = fminf(gap, cfs_gap_ahead(me.p, me.radius, e, n.position[j], n.radius[j]));
+  });
+  return e * cfs_speed(gap, v0, c.time_gap);
 }
 
 // Deterministic unit direction for two agents at exactly the same point.

@@ -13,14 +13,40 @@ constexpr float kWallTolerance = 1e-4f;   // m: accepted float error against wal
 constexpr float kMaxStepFraction = 0.9f;  // of the radius: displacement cap in a contact pass
 constexpr float kAcceptFraction = 0.95f;  // of the radius: largest accepted displacement per step
 
+// Under the collision-free speed model an intermediate waypoint (a door, a
+// corner of a route) also counts as reached once the agent has crossed the
+// line through it square to its leg, within kWaypointHalfWidth of it: a
+// crowd streams through a door side by side, and an agent the crowd pushed
+// past the point must not turn back against the stream to touch it.
+constexpr float kWaypointHalfWidth = 1.5f;  // m
+THRONG_HOST_DEVICE inline bool passed_waypoint(glm::vec2 p, glm::vec2 leg_start, glm::vec2 waypoint, float arrival_radius) {
+  const glm::vec2 along = normalize_or(waypoint - leg_start, glm::vec2(0.0f));
+  if (length2(along) == 0.0f || dot2(p - waypoint, along) <= 0.0f) return false;
+  const float half = arrival_radius > kWaypointHalfWidth ? arrival_radius : kWaypointHalfWidth;
+  return fabsf(dot2(p - waypoint, perp_left(along))) <= half;
+}
+
+// Where the collision-free speed model heads for an intermediate waypoint:
+// the nearest point of the same gate (the segment through the waypoint
+// square to its leg, kWaypointHalfWidth each side), so agents stream
+// through a door side by side in lanes instead of converging on one point
+// in single file. A gate end inside a wall is harmless: the model slides
+// the agent along the wall.
+THRONG_HOST_DEVICE inline glm::vec2 waypoint_aim(glm::vec2 p, glm::vec2 leg_start, glm::vec2 waypoint) {
+  const glm::vec2 along = normalize_or(waypoint - leg_start, glm::vec2(0.0f));
+  const glm::vec2 across = perp_left(along);
+  const float offset = dot2(p - waypoint, across);
+  return waypoint + across * fminf(fmaxf(offset, -kWaypointHalfWidth), kWaypointHalfWidth);
+}
+
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) { return (flags & kAgentActive) != 0 && (flags & kAgentStopped) == 0; }
 
-// Sense: the higher-priority force of one agent, obstacle avoidance or else
-// agent avoidance (zero when neither applies). `neighbours(p, v, forward,
-// radius)` finds the most urgent threat: from the 3x3 bins, or all pairs.
+// Sense under the priority model: the higher-priority force of one agent,
+// obstacle avoidance or else agent avoidance (zero when neither applies).
+// `neighbours(p, v, forward, radius)` finds the most urgent threat: from the
+// 3x3 bins, or all pairs.
 template <class Neighbours>
-THRONG_HOST_DEVICE inline glm::vec2 sense_agent(const StepContext& ctx, const AgentArrays& a, Index i, const Neighbours& neighbours) {
-  if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
+THRONG_HOST_DEVICE inline glm::vec2 sense_priority(const StepContext& ctx, const AgentArrays& a, Index i, const Neighbours& neighbours) {
   const ModelParams& m = ctx.model;
   const glm::vec2 p = a.position[i], v = a.velocity[i];
   const float r = a.radius[i];
@@ -31,15 +57,38 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_agent(const StepContext& ctx, const Ag
   return avoidance_force(probe.forward, neighbours(p, v, probe.forward, r), m.max_force);
 }
 
-// Neighbours from the 3x3 bins around (cx, cy), the agent's cell.
-THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy) {
+// Sense under the collision-free speed model: the agent's new velocity.
+// `for_each_candidate(fn)` visits the candidate neighbours.
+template <class ForEachCandidate>
+THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx, const AgentArrays& a, Index i,
+                                                         const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-  return sense_agent(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
+  const glm::vec2 p = a.position[i];
+  const bool final_goal = a.waypoint_cursor[i] == a.waypoint_goal[i];
+  const glm::vec2 aim = final_goal ? a.goal[i] : waypoint_aim(p, a.path_start[i], a.goal[i]);
+  const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f))};
+  return collision_free_velocity(ctx.world, i, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
+}
+
+// Sense: what the model makes of the agent's surroundings, zero for agents
+// that do not steer. Priority: the avoidance force (zero when nothing is
+// sensed); collision-free speed: the new velocity. Neighbours come from the
+// 3x3 bins around (cx, cy), the agent's cell.
+THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy) {
+  if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
+  if (ctx.model.kind == ModelKind::CollisionFreeSpeed) {
+    const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
+    return sense_collision_free(ctx, a, i, [&](const auto& fn) { for_each_in_cells(ctx.bins, cells, fn); });
+  }
+  const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+  return sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
     return sense_neighbours(ctx.bins, cx, cy, i, p, v, forward, r, n, ctx.model, ctx.bin_slack);
   });
 }
 
-// Steer: path following when the sensed force is zero, then integration.
+// Steer: integrates what was sensed. Priority: path following when the
+// sensed force is zero, else that force; collision-free speed: the sensed
+// velocity as it is (a first-order model).
 THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentArrays& a, Index i, glm::vec2 sensed, glm::vec2& out_p,
                                            glm::vec2& out_v) {
   const glm::vec2 p = a.position[i], v = a.velocity[i];
@@ -49,11 +98,15 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
     return;
   }
   const ModelParams& m = ctx.model;
-  // Priority: path following only when no avoidance force was sensed.
-  const glm::vec2 force =
-      length2(sensed) > 1e-12f ? sensed : path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
-  // Forces turn and brake; none makes an agent walk faster than it prefers.
-  out_v = clamp_length(v + force * ctx.dt, a.pref_speed[i]);
+  if (m.kind == ModelKind::CollisionFreeSpeed) {
+    out_v = sensed;
+  } else {
+    // Priority: path following only when no avoidance force was sensed.
+    const glm::vec2 force =
+        length2(sensed) > 1e-12f ? sensed : path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
+    // Forces turn and brake; none makes an agent walk faster than it prefers.
+    out_v = clamp_length(v + force * ctx.dt, a.pref_speed[i]);
+  }
   out_p = p + out_v * ctx.dt;
 }
 
@@ -90,9 +143,20 @@ struct SenseAllPairs {
   AgentArrays a;
   Span<glm::vec2> sensed;
   THRONG_HOST_DEVICE void operator()(Index i) const {
+    if (!is_steering(a.flags[i])) {
+      sensed[i] = glm::vec2(0.0f);
+      return;
+    }
+    if (ctx.model.kind == ModelKind::CollisionFreeSpeed) {
+      const Index count = a.position.size();
+      sensed[i] = sense_collision_free(ctx, a, i, [&](const auto& fn) {
+        for (Index j = 0; j < count; ++j) fn(j);
+      });
+      return;
+    }
     const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
     const ModelParams m = ctx.model;
-    sensed[i] = sense_agent(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
+    sensed[i] = sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
       return sense_neighbours_all_pairs(i, p, v, forward, r, n, m);
     });
   }
@@ -195,8 +259,11 @@ struct Finalize {
     if ((flags & kAgentStopped) == 0) {
       const GroupRuntime g = a.groups[a.group[i]];
       const glm::vec2 goal = a.goal[i];
-      if (length2(goal - p) <= g.arrival_radius * g.arrival_radius) {
-        const std::int32_t cursor = a.waypoint_cursor[i];
+      const std::int32_t cursor = a.waypoint_cursor[i];
+      // (The priority model keeps the paper's point waypoints.)
+      const bool through = ctx.model.kind == ModelKind::CollisionFreeSpeed && cursor != a.waypoint_goal[i] &&
+                           passed_waypoint(p, a.path_start[i], goal, g.arrival_radius);
+      if (through || length2(goal - p) <= g.arrival_radius * g.arrival_radius) {
         const std::int32_t begin = a.waypoint_begin[i], count = a.waypoint_count[i];
         if (cursor == a.waypoint_goal[i] && a.arrival_time[i] < 0.0f) {
           a.arrival_time[i] = ctx.time_after;

@@ -225,7 +225,7 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
   for (const Polygon& p : polygons_) total += cells_in_box(sim::bounds(p), cell);
   if (total > static_cast<double>(limits.max_grid_items))
     throw Error(fmt::format("obstacles would need about {:.0f} grid cells at cell size {} m (limit {}): use fewer or smaller obstacles "
-                            "or a larger model.pred_time * model.max_speed",
+                            "or a larger model.max_speed (the cell is the model's query radius)",
                             total, cell, limits.max_grid_items),
                 at_field("world.obstacles"));
 

@@ -1,0 +1,145 @@
+// The collision-free speed model (Tordeux, Chraibi, Seyfried 2016,
+// "Collision-free speed model for pedestrian dynamics", Traffic and
+// Granular Flow '15, pp. 225-232; JuPedSim's default model), with an
+// anticipation term for oncoming neighbours. A first-order model: each step
+// an agent picks a direction, then the largest speed that keeps a time gap T
+// to whoever stands ahead of it in that direction:
+//
+//   e_i = normalize(e0_i + sum_j R_ij + sum_w W_iw + sum_j A_ij)
+//   v_i = e_i * clamp((s_i - 0) / T, 0, v0_i)
+//
+//   e0_i   unit direction towards the current goal;
+//   R_ij = -a exp((l_ij - d_ij) / D) (x_j - x_i)/d_ij, l_ij = r_i + r_j: the
+//          neighbour repulsion, felt only within a few D of contact;
+//   W_iw = -b exp((r_i - d_iw) / Dw) (q_w - x_i)/d_iw, q_w the nearest point
+//          of wall (or circle) w: the wall repulsion, by the agent's own
+//          radius (no probe wider than the body);
+//   s_i    the smallest gap d_ij - l_ij to a neighbour in front (e_i .
+//          (x_j - x_i) >= 0) inside the corridor of the agent's body
+//          (|e_i^perp . (x_j - x_i)| <= l_ij); +inf when there is none.
+//
+// Speed falls with the gap ahead, so the model brakes in a dense crowd and
+// its flow follows the fundamental diagram instead of collapsing.
+//
+// The anticipation term A_ij (this engine's addition; the published model
+// has no lateral avoidance, so two agents head-on on one line stop nose to
+// nose for ever): a neighbour ahead whose path will come within l_ij +
+// side_margin of the agent's own line, and who closes in at relative speed
+// c > 0, pushes the agent sideways, away from the side the neighbour is on,
+// with strength k (1 - tau / avoid_time) for time to contact tau =
+// (d_ij - l_ij) / c < avoid_time. A neighbour dead ahead is passed on the
+// right: every agent keeps right, which breaks head-on and circle
+// symmetries deterministically (the same bits for any thread count; no
+// random draw) and lets counterflows sort into lanes.
+//
+// Host+device; the kernels (simulation_kernels.cpp) feed neighbours from the
+// 3x3 bins, tests call these functions on hand-computed cases.
+#pragma once
+
+#include <cmath>
+
+#include "sim/geometry.h"
+#include "sim/scenario.h"
+
+namespace throng::sim {
+
+// m/s: a neighbour walking towards the agent at least this fast is oncoming.
+inline constexpr float kCfsOncoming = 0.05f;
+
+// The agent being steered: position, velocity, radius and e0.
+struct CfsAgent {
+  glm::vec2 p{0.0f};
+  glm::vec2 v{0.0f};
+  float radius = 0.2f;
+  glm::vec2 e0{1.0f, 0.0f};
+};
+
+// R_ij + A_ij of neighbour j at q with velocity w and radius rj; `parked`:
+// j stands at its goal for good.
+THRONG_HOST_DEVICE inline glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj, bool parked,
+                                                       const CollisionFreeSpeedParams& m) {
+  const glm::vec2 d = q - i.p;
+  const float dist = length_of(d);
+  if (dist <= 1e-6f) return glm::vec2(0.0f);  // coincident: the contact passes separate them
+  const float l = i.radius + rj;
+  const glm::vec2 u = d * (1.0f / dist);
+  glm::vec2 f = u * (-m.neighbour_strength * expf((l - dist) / m.neighbour_range));
+  // Anticipation: only neighbours ahead, closing in, soon, near our line,
+  // and walking towards us (or parked for good). A slower walker ahead in
+  // the same direction is followed at the time gap, not dodged: dodging
+  // every slower neighbour spreads a queue sideways and chokes a door.
+  const float ahead = dot2(d, i.e0);
+  const float closing = -dot2(w - i.v, u);
+  const bool coming = parked || -dot2(w, u) > kCfsOncoming;
+  if (m.avoid_strength > 0.0f && coming && ahead > 0.0f && closing > 1e-3f) {
+    const float tau = fmaxf(dist - l, 0.0f) / closing;
+    const glm::vec2 left = perp_left(i.e0);
+    const float lateral = dot2(d, left);
+    const float band = l + m.side_margin;
+    if (tau < m.avoid_time && fabsf(lateral) < band) {
+      const float strength = m.avoid_strength * (1.0f - tau / m.avoid_time) * (1.0f - fabsf(lateral) / band);
+      // Away from the neighbour's side; dead ahead (within 1 cm), to the right.
+      f += (lateral > 0.01f ? -left : (lateral < -0.01f ? left : -left)) * strength;
+    }
+  }
+  return f;
+}
+
+// W_iw of a wall point q (the nearest point of a segment or circle).
+// A centre on the wall itself gets no push: the move stage's projection
+// puts it back on its side.
+THRONG_HOST_DEVICE inline glm::vec2 cfs_wall_push(const CfsAgent& i, glm::vec2 q, const CollisionFreeSpeedParams& m) {
+  const glm::vec2 d = i.p - q;
+  const float dist = length_of(d);
+  if (dist <= 1e-6f) return glm::vec2(0.0f);
+  return d * (m.wall_strength * expf((i.radius - dist) / m.wall_range) / dist);
+}
+
+// The gap to neighbour j if it is in front of the agent along e inside the
+// agent's corridor, else +inf.
+THRONG_HOST_DEVICE inline float cfs_gap_ahead(glm::vec2 p, float ri, glm::vec2 e, glm::vec2 q, float rj) {
+  const glm::vec2 d = q - p;
+  if (dot2(d, e) < 0.0f) return INFINITY;
+  const float l = ri + rj;
+  if (fabsf(dot2(d, perp_left(e))) > l) return INFINITY;
+  return length_of(d) - l;
+}
+
+// The optimal-velocity function: the speed that keeps time gap T to the gap
+// s ahead, within [0, v0].
+THRONG_HOST_DEVICE inline float cfs_speed(float gap, float v0, float time_gap) {
+  const float v = gap / time_gap;
+  return v < 0.0f ? 0.0f : (v > v0 ? v0 : v);
+}
+
+// e0 slid along a wall the agent touches (nearest point q within the
+// agent's radius + wall reach, outward normal n = (p - q)/|p - q|): the part
+// of e0 into the wall is removed, so an agent pushed against a wall with its
+// goal beyond the wall's end walks along it round the corner instead of
+// standing still. Head-on into the wall (nothing left), it follows the wall
+// to its right: a deterministic choice, like keeping right.
+THRONG_HOST_DEVICE inline glm::vec2 cfs_slide_along_wall(glm::vec2 e0, glm::vec2 n) {
+  const float into = dot2(e0, n);
+  if (into >= 0.0f) return e0;
+  const glm::vec2 along = e0 - n * into;
+  if (length2(along) > 0.05f * 0.05f) return normalize_or(along, along);
+  return glm::vec2(n.y, -n.x);  // the wall tangent to the right of walking into it (-n)
+}
+
+// The direction actually walked: the previous one turned towards the new one
+// by dt / turn_time (at once when turn_time <= dt or the agent stood). A
+// first-order model otherwise turns instantly, and agents pressed between
+// neighbours flip direction every step; people and their animation cannot.
+THRONG_HOST_DEVICE inline glm::vec2 cfs_turn(glm::vec2 previous, glm::vec2 wanted, float dt, float turn_time) {
+  if (length2(previous) == 0.0f || turn_time <= dt) return wanted;
+  const float a = dt / turn_time;
+  return normalize_or(previous * (1.0f - a) + wanted * a, wanted);
+}
+
+// Walls (and circles) are sensed within this distance of the agent's
+// surface: beyond it exp((r - d) / Dw) is below 1e-4 of the strength.
+THRONG_HOST_DEVICE inline float cfs_wall_reach(const CollisionFreeSpeedParams& m) { return 9.2f * m.wall_range; }
+// Neighbours repel within this gap (exp(-9.2) ~ 1e-4 of the strength).
+THRONG_HOST_DEVICE inline float cfs_neighbour_reach(const CollisionFreeSpeedParams& m) { return 9.2f * m.neighbour_range; }
+
+}  // namespace throng::sim
