@@ -31,6 +31,9 @@ Aabb region_bounds(const Region& r) {
       b.add(r.center + glm::vec2(r.radius));
       break;
     case Region::Kind::polygon: b = bounds(r.polygon); break;
+    case Region::Kind::points:
+      for (glm::vec2 p : r.points) b.add(p);
+      break;
   }
   return b;
 }
@@ -41,6 +44,7 @@ bool region_contains(const Region& r, glm::vec2 p) {
     case Region::Kind::disc: return length2(p - r.center) <= r.radius * r.radius;
     case Region::Kind::ring: return false;
     case Region::Kind::polygon: return point_in_polygon(p, r.polygon);
+    case Region::Kind::points: return false;
   }
   return false;
 }
@@ -65,29 +69,42 @@ void check_region(const Region& r, const std::string& field, float max_extent) {
         if (!finite(p)) throw Error("polygon vertices must be finite numbers within the extent limit", at_field(field + ".polygon"));
       if (find_self_intersection(r.polygon.outer)) throw Error("spawn polygon is self-intersecting", at_field(field + ".polygon"));
       break;
+    case Region::Kind::points:
+      for (std::size_t i = 0; i < r.points.size(); ++i)
+        if (!finite(r.points[i]))
+          throw Error("a point must be finite numbers within the extent limit", at_field(fmt::format("{}.points[{}]", field, i)));
+      break;
   }
 }
 
-// Agents already placed, for overlap tests across groups.
+// Agents already placed, for overlap tests across groups. The cell must be
+// at least the largest r + rq + gap asked about.
 class Occupancy {
  public:
   explicit Occupancy(float cell) : cell_(cell) {}
-  bool overlaps(glm::vec2 p, float r, float gap) const {
+  // The id of an agent closer than r + rq + gap to p, or -1.
+  std::int64_t find(glm::vec2 p, float r, float gap) const {
     const std::int32_t cx = cell_coord(p.x, cell_), cy = cell_coord(p.y, cell_);
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
         auto it = cells_.find(cell_key(cx + dx, cy + dy));
         if (it == cells_.end()) continue;
-        for (const auto& [q, rq] : it->second)
-          if (length2(q - p) < (r + rq + gap) * (r + rq + gap)) return true;
+        for (const Entry& e : it->second)
+          if (length2(e.p - p) < (r + e.r + gap) * (r + e.r + gap)) return e.id;
       }
-    return false;
+    return -1;
   }
-  void add(glm::vec2 p, float r) { cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r}); }
+  bool overlaps(glm::vec2 p, float r, float gap) const { return find(p, r, gap) >= 0; }
+  void add(glm::vec2 p, float r, std::int64_t id) { cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r, id}); }
 
  private:
+  struct Entry {
+    glm::vec2 p;
+    float r;
+    std::int64_t id;
+  };
   float cell_;
-  std::unordered_map<std::uint64_t, std::vector<std::pair<glm::vec2, float>>> cells_;
+  std::unordered_map<std::uint64_t, std::vector<Entry>> cells_;
 };
 
 // Hexagonal lattice sites of spacing a over the box b (rows a * sqrt(3) / 2
@@ -129,7 +146,8 @@ double region_area(const Region& r) {
     case Region::Kind::rect: return static_cast<double>(r.max.x - r.min.x) * static_cast<double>(r.max.y - r.min.y);
     case Region::Kind::disc: return kPi * static_cast<double>(r.radius) * r.radius;
     case Region::Kind::polygon: return area(r.polygon);
-    case Region::Kind::ring: return 0.0;
+    case Region::Kind::ring:
+    case Region::Kind::points: return 0.0;
   }
   return 0.0;
 }
@@ -174,6 +192,9 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     if (static_cast<std::int64_t>(G.waypoints.size()) > limits.max_waypoints)
       throw Error(fmt::format("more than {} waypoints", limits.max_waypoints), at_field(field + ".waypoints"));
     check_region(G.spawn, field + ".spawn", limits.max_extent);
+    if (G.spawn.kind == Region::Kind::points && static_cast<std::int64_t>(G.spawn.points.size()) != G.count)
+      throw Error(fmt::format("{} points for a count of {}: give one point per agent", G.spawn.points.size(), G.count),
+                  at_field(field + ".spawn.points"));
     auto check_goal = [&](const GoalSpec& goal, const std::string& gf) {
       if (!std::isfinite(goal.value.x) || !std::isfinite(goal.value.y) || std::fabs(goal.value.x) > limits.max_extent ||
           std::fabs(goal.value.y) > limits.max_extent)
@@ -181,6 +202,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
       if (goal.kind == GoalSpec::Kind::Random) {
         check_region(goal.region, gf + ".random", limits.max_extent);
         if (goal.region.kind == Region::Kind::ring) throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
+        if (goal.region.kind == Region::Kind::points) throw Error("a list of points is not an area to draw goals from", at_field(gf + ".random"));
       }
     };
     for (std::size_t w = 0; w < G.waypoints.size(); ++w) check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w));
@@ -257,6 +279,31 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
                       at_field(field + ".spawn"));
         }
         if (placed.overlaps(p, r, gap)) throw Error(fmt::format("agent {} at {} overlaps an agent of an earlier group", k, point_text(p)), at_field(field + ".spawn"));
+        chosen.push_back(p);
+      }
+    } else if (G.spawn.kind == Region::Kind::points) {
+      // Exact positions: each must be free and apart from every agent so far
+      // (discs may touch); the group's own points are checked among themselves.
+      Occupancy own(std::max(2.0f * r * 1.2f, 0.1f));
+      for (std::size_t k = 0; k < G.spawn.points.size(); ++k) {
+        const glm::vec2 p = G.spawn.points[k];
+        const std::string pf = fmt::format("{}.spawn.points[{}]", field, k);
+        if (!world.disc_fits(p, wall_clearance)) {
+          const std::string blocked = world.what_blocks(p);
+          throw Error(fmt::format("an agent of radius {} m at {} does not fit: {}", r, point_text(p),
+                                  blocked.empty() ? fmt::format("closer than {:.3g} m to a wall", wall_clearance) : "it lies " + blocked),
+                      at_field(pf));
+        }
+        if (const std::int64_t other = own.find(p, r, 0.0f); other >= 0)
+          throw Error(fmt::format("an agent at {} overlaps the one at points[{}] {}: centres {:.3g} m apart, less than 2 * radius = {:.3g} m",
+                                  point_text(p), other, point_text(G.spawn.points[static_cast<std::size_t>(other)]),
+                                  length_of(p - G.spawn.points[static_cast<std::size_t>(other)]), 2.0f * r),
+                      at_field(pf));
+        if (const std::int64_t other = placed.find(p, r, 0.0f); other >= 0)
+          throw Error(fmt::format("an agent at {} overlaps agent {} of groups[{}] at {}", point_text(p), other,
+                                  out.group[static_cast<std::size_t>(other)], point_text(out.position[static_cast<std::size_t>(other)])),
+                      at_field(pf));
+        own.add(p, r, static_cast<std::int64_t>(k));
         chosen.push_back(p);
       }
     } else {
@@ -336,7 +383,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     for (std::size_t k = 0; k < chosen.size(); ++k) {
       const glm::vec2 p = chosen[k];
       const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
-      placed.add(p, r);
+      placed.add(p, r, agent);
       Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
       const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
                                       static_cast<double>(G.speed.min), static_cast<double>(G.speed.max));

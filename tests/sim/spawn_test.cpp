@@ -1,5 +1,6 @@
-// Spawning in areas: hexagonal lattice, dense up to about 6.5 agents per m^2
-// at r = 0.2 m, random-looking when sparse, deterministic from the seed.
+// Spawning in areas (hexagonal lattice, dense up to about 6.5 agents per m^2
+// at r = 0.2 m, random-looking when sparse, deterministic from the seed) and
+// at exact points.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -157,6 +158,66 @@ TEST(SpawnRandomness, DeterministicForASeedAndDifferentForAnother) {
     for (std::size_t i = 0; i < a.position.size(); ++i) same += a.position[i] == c.position[i] ? 1 : 0;
     EXPECT_LT(same, a.position.size() / 2);
   }
+}
+
+ScenarioSpec at_points(std::vector<glm::vec2> points) {
+  ScenarioSpec s = field(static_cast<std::int64_t>(points.size()), {0, 0}, {1, 1}, 0.25f);
+  s.dt = 0.1f;
+  s.groups[0].spawn.kind = Region::Kind::points;
+  s.groups[0].spawn.points = std::move(points);
+  return s;
+}
+
+TEST(SpawnPoints, AgentsStartExactlyAtThePointsInOrder) {
+  const std::vector<glm::vec2> points = {{3.5f, 1.25f}, {0, 0}, {0.5f, 0}, {-7.125f, 2}};  // the two at 0.5 m touch
+  const CrowdHost h = spawn(at_points(points));
+  EXPECT_EQ(h.position, points);
+  ASSERT_EQ(h.waypoints.size(), 4u);
+  EXPECT_EQ(h.waypoints[0], points[0] + glm::vec2(10, 0));
+}
+
+TEST(SpawnPoints, ErrorsNameThePoint) {
+  ScenarioSpec overlap = at_points({{0, 0}, {5, 0}, {5.3f, 0.1f}});
+  std::string e = spawn_error(overlap);
+  EXPECT_TRUE(contains(e, "groups[0].spawn.points[2]")) << e;
+  EXPECT_TRUE(contains(e, "overlaps the one at points[1]")) << e;
+
+  ScenarioSpec in_wall = at_points({{0, 0}, {5, 0}});
+  in_wall.world.polygons.push_back({rect_ring({4, -1}, {6, 1}), {}});
+  in_wall.world.polygon_fields.push_back("world.obstacles[0]");
+  e = spawn_error(in_wall);
+  EXPECT_TRUE(contains(e, "groups[0].spawn.points[1]")) << e;
+  EXPECT_TRUE(contains(e, "inside obstacle world.obstacles[0]")) << e;
+
+  ScenarioSpec near_wall = at_points({{0, 0}, {3.9f, 0}});
+  near_wall.world.polygons = in_wall.world.polygons;
+  near_wall.world.polygon_fields = in_wall.world.polygon_fields;
+  e = spawn_error(near_wall);
+  EXPECT_TRUE(contains(e, "groups[0].spawn.points[1]")) << e;
+  EXPECT_TRUE(contains(e, "to a wall")) << e;
+
+  // A later group's point on an agent of an earlier group.
+  ScenarioSpec two = at_points({{0, 0}});
+  GroupSpec second = two.groups[0];
+  second.spawn.points = {{20, 0}, {0.2f, 0.2f}};
+  second.count = 2;
+  two.groups.push_back(second);
+  e = spawn_error(two);
+  EXPECT_TRUE(contains(e, "groups[1].spawn.points[1]")) << e;
+  EXPECT_TRUE(contains(e, "overlaps agent 0 of groups[0]")) << e;
+
+  ScenarioSpec mismatch = at_points({{0, 0}, {5, 0}});
+  mismatch.groups[0].count = 3;
+  e = spawn_error(mismatch);
+  EXPECT_TRUE(contains(e, "groups[0].spawn.points")) << e;
+  EXPECT_TRUE(contains(e, "2 points for a count of 3")) << e;
+
+  ScenarioSpec far = at_points({{0, 0}, {2e7f, 0}});
+  e = spawn_error(far);
+  EXPECT_TRUE(contains(e, "groups[0].spawn.points[1]")) << e;
+
+  ScenarioSpec resized = at_points({{0, 0}, {5, 0}});
+  EXPECT_THROW(scale_agent_counts(resized, 10), Error);
 }
 
 }  // namespace
