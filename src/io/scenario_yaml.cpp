@@ -241,6 +241,26 @@ class Reader {
     return r;
   }
 
+  // Spawn points [[x, y], ...]: each item's position is kept in the compact
+  // per-list table (a file may list a million of them), so errors found
+  // when the crowd is placed ("groups[0].spawn.points[3]") get its line.
+  std::vector<glm::vec2> points(const YAML::Node& n, const std::string& path) {
+    expect_list(n, path, 1, static_cast<std::size_t>(limits_.scenario.max_agents), "points [x, y]");
+    std::vector<glm::vec2> out;
+    out.reserve(n.size());
+    std::vector<std::pair<int, int>>& marks = source_.item_marks[path];
+    marks.clear();
+    marks.reserve(n.size());
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      ++nodes_;
+      const YAML::Node p = n[i];
+      out.push_back(coordinates(p, [&] { return item(path, i); }));
+      const YAML::Mark m = p.Mark();
+      marks.emplace_back(m.is_null() ? 0 : m.line + 1, m.is_null() ? 0 : m.column + 1);
+    }
+    return out;
+  }
+
   std::vector<sim::Ring> holes(const YAML::Node& n, const std::string& path) {
     expect_list(n, path, 0, static_cast<std::size_t>(limits_.scenario.max_obstacles), "holes");
     std::vector<sim::Ring> out;
@@ -273,7 +293,7 @@ class Reader {
   }
 
   Region region(const YAML::Node& n, const std::string& path) {
-    const std::string k = one_of(n, path, {"rect", "disc", "ring", "polygon"});
+    const std::string k = one_of(n, path, {"rect", "disc", "ring", "polygon", "points"});
     const std::string sub = child(path, k);
     const YAML::Node v = n[k];
     Region r;
@@ -294,6 +314,9 @@ class Reader {
       if (v["radius"].IsDefined() == v["spacing"].IsDefined()) fail(v, sub, "a ring needs one of 'radius' or 'spacing'");
       if (v["radius"]) r.radius = real(v["radius"], child(sub, "radius"));
       if (v["spacing"]) r.spacing = real(v["spacing"], child(sub, "spacing"));
+    } else if (k == "points") {
+      r.kind = Region::Kind::points;
+      r.points = points(v, sub);
     } else {
       r.kind = Region::Kind::polygon;
       r.polygon.outer = ring(v, sub);
@@ -443,14 +466,24 @@ class Reader {
     expect_map(n, path, {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius"});
     sim::GroupSpec g;
     if (n["name"]) g.name = text(n["name"], child(path, "name"));
-    g.count = integer(required(n, path, "count"), child(path, "count"), 0, limits_.scenario.max_agents);
+    // count may be left out when the group spawns at points: one agent per point.
+    const YAML::Node spawn = required(n, path, "spawn");
+    const bool at_points = spawn.IsMap() && spawn["points"];
+    if (n["count"] || !at_points) g.count = integer(required(n, path, "count"), child(path, "count"), 0, limits_.scenario.max_agents);
     if (n["radius"]) g.radius = real(n["radius"], child(path, "radius"));
     // Unless given, speeds stay within the model's maximum.
     g.speed.max = std::min(g.speed.max, model.max_speed);
     g.speed.min = std::min(g.speed.min, g.speed.max);
     g.speed.mean = std::min(g.speed.mean, g.speed.max);
     if (n["speed"]) g.speed = speed(n["speed"], child(path, "speed"), g.speed);
-    g.spawn = region(required(n, path, "spawn"), child(path, "spawn"));
+    g.spawn = region(spawn, child(path, "spawn"));
+    if (g.spawn.kind == Region::Kind::points) {
+      const auto given = static_cast<std::int64_t>(g.spawn.points.size());
+      if (!n["count"]) g.count = given;
+      if (g.count != given)
+        fail(spawn["points"], child(path, "spawn.points"),
+             fmt::format("{} points for a count of {}: give one point per agent (or leave count out)", given, g.count));
+    }
     if (const YAML::Node list = n["waypoints"]) {
       const std::string lp = child(path, "waypoints");
       expect_list(list, lp, 0, static_cast<std::size_t>(limits_.scenario.max_waypoints), "waypoints");
@@ -572,6 +605,15 @@ Location ScenarioSource::locate(const std::string& field) const {
   // Drop trailing parts ("[3]", ".radius", " (shape 5)") until a recorded key remains.
   while (!key.empty()) {
     if (const auto it = marks.find(key); it != marks.end()) return Location{file, it->second.first, it->second.second, field};
+    if (key.back() == ']') {
+      const std::size_t open = key.rfind('[');
+      if (const auto it = item_marks.find(std::string_view(key).substr(0, open)); open != std::string::npos && it != item_marks.end()) {
+        std::size_t i = 0;
+        const auto [end, ec] = std::from_chars(key.data() + open + 1, key.data() + key.size() - 1, i);
+        if (ec == std::errc() && end == key.data() + key.size() - 1 && i < it->second.size() && it->second[i].first > 0)
+          return Location{file, it->second[i].first, it->second[i].second, field};
+      }
+    }
     const std::size_t cut = key.find_last_of(".[ ");
     if (cut == std::string::npos || cut == 0) break;
     key.resize(cut);

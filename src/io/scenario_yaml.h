@@ -40,6 +40,9 @@ struct ScenarioReadLimits {
 struct ScenarioSource {
   std::string file;  // the path, or "builtin:<name>"
   std::map<std::string, std::pair<int, int>, std::less<>> marks;  // key path -> 1-based (line, column)
+  // Long lists kept compact: list path -> (line, column) of item i, for
+  // "path[i]" (spawn points).
+  std::map<std::string, std::vector<std::pair<int, int>>, std::less<>> item_marks;
   // The location of `field` or of its closest recorded parent
   // ("groups[0].goal.point[1]" -> "groups[0].goal" when only that is known).
   Location locate(const std::string& field) const;

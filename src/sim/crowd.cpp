@@ -31,6 +31,9 @@ Aabb region_bounds(const Region& r) {
       b.add(r.center + glm::vec2(r.radius));
       break;
     case Region::Kind::polygon: b = bounds(r.polygon); break;
+    case Region::Kind::points:
+      for (glm::vec2 p : r.points) b.add(p);
+      break;
   }
   return b;
 }
@@ -41,6 +44,7 @@ bool region_contains(const Region& r, glm::vec2 p) {
     case Region::Kind::disc: return length2(p - r.center) <= r.radius * r.radius;
     case Region::Kind::ring: return false;
     case Region::Kind::polygon: return point_in_polygon(p, r.polygon);
+    case Region::Kind::points: return false;
   }
   return false;
 }
@@ -65,30 +69,88 @@ void check_region(const Region& r, const std::string& field, float max_extent) {
         if (!finite(p)) throw Error("polygon vertices must be finite numbers within the extent limit", at_field(field + ".polygon"));
       if (find_self_intersection(r.polygon.outer)) throw Error("spawn polygon is self-intersecting", at_field(field + ".polygon"));
       break;
+    case Region::Kind::points:
+      for (std::size_t i = 0; i < r.points.size(); ++i)
+        if (!finite(r.points[i]))
+          throw Error("a point must be finite numbers within the extent limit", at_field(fmt::format("{}.points[{}]", field, i)));
+      break;
   }
 }
 
-// Agents already placed, for overlap tests across groups.
+// Agents already placed, for overlap tests across groups. The cell must be
+// at least the largest r + rq + gap asked about.
 class Occupancy {
  public:
   explicit Occupancy(float cell) : cell_(cell) {}
-  bool overlaps(glm::vec2 p, float r, float gap) const {
+  // The id of an agent closer than r + rq + gap to p, or -1.
+  std::int64_t find(glm::vec2 p, float r, float gap) const {
     const std::int32_t cx = cell_coord(p.x, cell_), cy = cell_coord(p.y, cell_);
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
         auto it = cells_.find(cell_key(cx + dx, cy + dy));
         if (it == cells_.end()) continue;
-        for (const auto& [q, rq] : it->second)
-          if (length2(q - p) < (r + rq + gap) * (r + rq + gap)) return true;
+        for (const Entry& e : it->second)
+          if (length2(e.p - p) < (r + e.r + gap) * (r + e.r + gap)) return e.id;
       }
-    return false;
+    return -1;
   }
-  void add(glm::vec2 p, float r) { cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r}); }
+  bool overlaps(glm::vec2 p, float r, float gap) const { return find(p, r, gap) >= 0; }
+  void add(glm::vec2 p, float r, std::int64_t id) { cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r, id}); }
 
  private:
+  struct Entry {
+    glm::vec2 p;
+    float r;
+    std::int64_t id;
+  };
   float cell_;
-  std::unordered_map<std::uint64_t, std::vector<std::pair<glm::vec2, float>>> cells_;
+  std::unordered_map<std::uint64_t, std::vector<Entry>> cells_;
 };
+
+// Hexagonal lattice sites of spacing a over the box b (rows a * sqrt(3) / 2
+// apart, odd rows shifted by a / 2, the whole centred in the box), in row
+// order, each moved uniformly within a disc of radius `jitter`; `keep` is
+// called with every site. Returns the number of sites.
+template <class Keep>
+std::int64_t hex_sites(const Aabb& b, double a, double jitter, Rng& rng, const Keep& keep) {
+  const double w = b.size().x, h = b.size().y, row = a * 0.5 * std::sqrt(3.0);
+  const auto nx = static_cast<std::int64_t>(std::floor(w / a)) + 1, ny = static_cast<std::int64_t>(std::floor(h / row)) + 1;
+  const double x0 = b.min.x + (w - static_cast<double>(nx - 1) * a) * 0.5, y0 = b.min.y + (h - static_cast<double>(ny - 1) * row) * 0.5;
+  std::int64_t sites = 0;
+  for (std::int64_t j = 0; j < ny; ++j) {
+    const bool odd = (j & 1) != 0;
+    for (std::int64_t i = 0; i < nx - (odd ? 1 : 0); ++i, ++sites) {
+      double x = x0 + (static_cast<double>(i) + (odd ? 0.5 : 0.0)) * a, y = y0 + static_cast<double>(j) * row;
+      if (jitter > 0) {
+        const double rho = jitter * std::sqrt(rng.uniform()), phi = 2.0 * kPi * rng.uniform();
+        x += rho * std::cos(phi);
+        y += rho * std::sin(phi);
+      }
+      keep(glm::vec2(static_cast<float>(x), static_cast<float>(y)));
+    }
+  }
+  return sites;
+}
+
+// How many sites hex_sites makes for spacing a (nx per even row, nx - 1 per odd row).
+double hex_site_count(const Aabb& b, double a) {
+  const double nx = std::floor(b.size().x / a) + 1, ny = std::floor(b.size().y / (a * 0.5 * std::sqrt(3.0))) + 1;
+  return nx * ny - std::floor(ny / 2);
+}
+
+// The hexagonal lattice spacing with `density` sites per m^2.
+double hex_spacing(double density) { return std::sqrt(2.0 / (std::sqrt(3.0) * density)); }
+
+double region_area(const Region& r) {
+  switch (r.kind) {
+    case Region::Kind::rect: return static_cast<double>(r.max.x - r.min.x) * static_cast<double>(r.max.y - r.min.y);
+    case Region::Kind::disc: return kPi * static_cast<double>(r.radius) * r.radius;
+    case Region::Kind::polygon: return area(r.polygon);
+    case Region::Kind::ring:
+    case Region::Kind::points: return 0.0;
+  }
+  return 0.0;
+}
 
 std::string point_text(glm::vec2 p) { return fmt::format("({:.3g}, {:.3g})", p.x, p.y); }
 
@@ -132,6 +194,9 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     if (static_cast<std::int64_t>(G.waypoints.size()) > limits.max_waypoints)
       throw Error(fmt::format("more than {} waypoints", limits.max_waypoints), at_field(field + ".waypoints"));
     check_region(G.spawn, field + ".spawn", limits.max_extent);
+    if (G.spawn.kind == Region::Kind::points && static_cast<std::int64_t>(G.spawn.points.size()) != G.count)
+      throw Error(fmt::format("{} points for a count of {}: give one point per agent", G.spawn.points.size(), G.count),
+                  at_field(field + ".spawn.points"));
     auto check_goal = [&](const GoalSpec& goal, const std::string& gf) {
       if (!std::isfinite(goal.value.x) || !std::isfinite(goal.value.y) || std::fabs(goal.value.x) > limits.max_extent ||
           std::fabs(goal.value.y) > limits.max_extent)
@@ -139,6 +204,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
       if (goal.kind == GoalSpec::Kind::Random) {
         check_region(goal.region, gf + ".random", limits.max_extent);
         if (goal.region.kind == Region::Kind::ring) throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
+        if (goal.region.kind == Region::Kind::points) throw Error("a list of points is not an area to draw goals from", at_field(gf + ".random"));
       }
     };
     for (std::size_t w = 0; w < G.waypoints.size(); ++w) check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w));
@@ -217,32 +283,73 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
         if (placed.overlaps(p, r, gap)) throw Error(fmt::format("agent {} at {} overlaps an agent of an earlier group", k, point_text(p)), at_field(field + ".spawn"));
         chosen.push_back(p);
       }
+    } else if (G.spawn.kind == Region::Kind::points) {
+      // Exact positions: each must be free and apart from every agent so far
+      // (discs may touch); the group's own points are checked among themselves.
+      Occupancy own(std::max(2.0f * r * 1.2f, 0.1f));
+      for (std::size_t k = 0; k < G.spawn.points.size(); ++k) {
+        const glm::vec2 p = G.spawn.points[k];
+        const std::string pf = fmt::format("{}.spawn.points[{}]", field, k);
+        if (!world.disc_fits(p, wall_clearance)) {
+          const std::string blocked = world.what_blocks(p);
+          throw Error(fmt::format("an agent of radius {} m at {} does not fit: {}", r, point_text(p),
+                                  blocked.empty() ? fmt::format("closer than {:.3g} m to a wall", wall_clearance) : "it lies " + blocked),
+                      at_field(pf));
+        }
+        if (const std::int64_t other = own.find(p, r, 0.0f); other >= 0)
+          throw Error(fmt::format("an agent at {} overlaps the one at points[{}] {}: centres {:.3g} m apart, less than 2 * radius = {:.3g} m",
+                                  point_text(p), other, point_text(G.spawn.points[static_cast<std::size_t>(other)]),
+                                  length_of(p - G.spawn.points[static_cast<std::size_t>(other)]), 2.0f * r),
+                      at_field(pf));
+        if (const std::int64_t other = placed.find(p, r, 0.0f); other >= 0)
+          throw Error(fmt::format("an agent at {} overlaps agent {} of groups[{}] at {}", point_text(p), other,
+                                  out.group[static_cast<std::size_t>(other)], point_text(out.position[static_cast<std::size_t>(other)])),
+                      at_field(pf));
+        own.add(p, r, static_cast<std::int64_t>(k));
+        chosen.push_back(p);
+      }
     } else {
-      // Jittered lattice: spacing d = 2r + gap keeps neighbours apart; a
-      // sparse spawn widens the lattice so it holds about 3 * count points.
+      // Sites of a hexagonal lattice (the densest packing of equal discs),
+      // of which count are chosen at random. Sites of spacing a >= d = 2r +
+      // gap stay d apart when each moves less than (a - d) / 2, so jitter
+      // within that disc never makes an overlap. a is chosen so that the
+      // free part of the region holds about 3 * count sites: the random
+      // choice of a third of them and the jitter make sparse spawns look
+      // random; a dense spawn gets a = d, up to 2 / (sqrt(3) d^2) agents per
+      // m^2 (6.5 at r = 0.2 m; random sequential placement would jam near
+      // 4.3). The free area is not known in advance (obstacles, walls, other
+      // groups): when a lattice holds fewer than count free sites, the next
+      // one is made denser from the free fraction it found, down to a = d.
       const Aabb b = region_bounds(G.spawn);
       const double d = 2.0 * r + gap;
-      const double area = static_cast<double>(b.size().x) * b.size().y;
-      const double s = std::max(d, std::sqrt(area / (3.0 * static_cast<double>(G.count))));
-      const double fnx = std::floor(b.size().x / s) + 1, fny = std::floor(b.size().y / s) + 1;
-      if (fnx * fny > 8.0 * static_cast<double>(G.count) + 4.0e6)
-        throw Error(fmt::format("the spawn region ({:.3g} x {:.3g} m) is too elongated for agents of radius {} m", b.size().x, b.size().y, r),
-                    at_field(field + ".spawn"));
-      const auto nx = static_cast<std::int64_t>(fnx), ny = static_cast<std::int64_t>(fny);
-      if (fnx * fny < static_cast<double>(G.count))
+      const double max_sites = 8.0 * static_cast<double>(G.count) + 4.0e6;
+      if (hex_site_count(b, d) < static_cast<double>(G.count))
         throw Error(fmt::format("{} agents of radius {} m cannot fit in the spawn region ({:.3g} x {:.3g} m)", G.count, r, b.size().x, b.size().y),
                     at_field(field + ".spawn"));
-      const double jitter = (s - d) * 0.5;
-      Rng rng(spec.seed, 0x59a3000000ull + g);
+      const double wanted = 3.0 * static_cast<double>(G.count);
+      const double area = region_area(G.spawn);
+      double a = area > 0 ? std::max(d, hex_spacing(wanted / area)) : d;
+      if (hex_site_count(b, a) > max_sites)
+        throw Error(fmt::format("the spawn region ({:.3g} x {:.3g} m) is too elongated for agents of radius {} m", b.size().x, b.size().y, r),
+                    at_field(field + ".spawn"));
       std::vector<glm::vec2> candidates;
-      for (std::int64_t j = 0; j < ny; ++j)
-        for (std::int64_t i = 0; i < nx; ++i) {
-          const double ox = rng.uniform(-jitter, jitter), oy = rng.uniform(-jitter, jitter);
-          const glm::vec2 p(static_cast<float>(b.min.x + (static_cast<double>(i) + 0.5) * s + ox),
-                            static_cast<float>(b.min.y + (static_cast<double>(j) + 0.5) * s + oy));
-          if (!region_contains(G.spawn, p) || !world.disc_fits(p, wall_clearance) || placed.overlaps(p, r, gap)) continue;
-          candidates.push_back(p);
-        }
+      for (int pass = 0;; ++pass) {
+        Rng rng(spec.seed, 0x59a3000000ull + g + (static_cast<std::uint64_t>(pass) << 32));
+        candidates.clear();
+        // Against earlier groups with 0.99 * gap: a group of the same radius
+        // on the same lattice has its sites exactly d from ours, which
+        // rounding must not reject.
+        const std::int64_t sites = hex_sites(b, a, (a - d) * 0.5, rng, [&](glm::vec2 p) {
+          if (region_contains(G.spawn, p) && world.disc_fits(p, wall_clearance) && !placed.overlaps(p, r, 0.99f * gap)) candidates.push_back(p);
+        });
+        if (static_cast<std::int64_t>(candidates.size()) >= G.count || a <= d) break;
+        // Free area as seen by this lattice; at least a 20 % denser lattice next.
+        const double free_area = static_cast<double>(b.size().x) * b.size().y * static_cast<double>(candidates.size()) / static_cast<double>(sites);
+        double next = free_area > 0 ? hex_spacing(wanted / free_area) : d;
+        next = std::max(d, std::min(next, 0.8 * a));
+        if (hex_site_count(b, next) > max_sites) break;
+        a = next;
+      }
       if (static_cast<std::int64_t>(candidates.size()) < G.count) {
         const glm::vec2 centre = (b.min + b.max) * 0.5f;
         const std::string blocked = world.what_blocks(centre);
@@ -253,6 +360,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
                                 candidates.size(), G.count, r),
                     at_field(field + ".spawn"));
       }
+      Rng rng(spec.seed, 0x5e1ec7000000ull + g);
       // Choose count of them at random, then keep lattice order (neighbours
       // in space get neighbouring indices: better memory locality).
       std::vector<std::uint32_t> order(candidates.size());
@@ -277,7 +385,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     for (std::size_t k = 0; k < chosen.size(); ++k) {
       const glm::vec2 p = chosen[k];
       const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
-      placed.add(p, r);
+      placed.add(p, r, agent);
       Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
       const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
                                       static_cast<double>(G.speed.min), static_cast<double>(G.speed.max));

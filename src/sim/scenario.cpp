@@ -97,6 +97,10 @@ void scale_agent_counts(ScenarioSpec& spec, std::int64_t total) {
   const auto groups = static_cast<std::int64_t>(spec.groups.size());
   if (groups == 0) throw Error("the scenario has no groups to resize", at_field("--agents"));
   if (total < groups) throw Error(fmt::format("need at least one agent per group ({} groups)", groups), at_field("--agents"));
+  for (std::size_t g = 0; g < spec.groups.size(); ++g)
+    if (spec.groups[g].spawn.kind == Region::Kind::points)
+      throw Error(fmt::format("groups[{}] spawns at {} fixed points and cannot be resized", g, spec.groups[g].spawn.points.size()),
+                  at_field("--agents"));
   const std::int64_t old_total = spec.total_agents();
   std::vector<std::int64_t> counts(spec.groups.size(), 1);
   std::vector<std::pair<double, std::size_t>> remainders;

@@ -87,15 +87,17 @@ const char* to_string(PlanningKind p);
 // "double_buffer" | "four_colour"; throws Error on anything else.
 SchedulerKind parse_scheduler(const std::string& text, const std::string& field);
 
-// A region of the plane: rect, disc, ring (points on a circle) or polygon.
+// A region of the plane: rect, disc, ring (points on a circle), polygon, or
+// points (exact spawn positions, one per agent; not an area).
 struct Region {
-  enum class Kind : std::uint8_t { rect, disc, ring, polygon };  // named as in YAML
+  enum class Kind : std::uint8_t { rect, disc, ring, polygon, points };  // named as in YAML
   Kind kind = Kind::rect;
   glm::vec2 min{0.0f}, max{0.0f};  // Rect
   glm::vec2 center{0.0f};          // Disc, Ring
   float radius = 0.0f;             // Disc, Ring (Ring: 0 = from spacing)
   float spacing = 0.0f;            // Ring: arc length between agents when radius is 0
   Polygon polygon;                 // Polygon
+  std::vector<glm::vec2> points;   // Points: agent k starts at points[k]
 };
 
 // One waypoint of a group: the same for every agent, or per agent.
@@ -209,7 +211,8 @@ struct ScenarioLimits {
 Camera overview_camera(const Aabb& extent);
 
 // Resizes group counts so they add up to `total` (largest remainder), keeping
-// their proportions; throws Error when total < number of groups or <= 0.
+// their proportions; throws Error when total < number of groups or <= 0, or
+// when a group spawns at fixed points (its count is the number of points).
 void scale_agent_counts(ScenarioSpec& spec, std::int64_t total);
 
 }  // namespace throng::sim

@@ -162,6 +162,11 @@ groups:
     spawn: {polygon: [[-40, 30], [-35, 30], [-35, 35]]}
     goal: {point: [-10, 40]}
     on_arrival: despawn
+  - spawn:
+      points:
+        - [-20, -20]
+        - [-19.5, -20]
+    goal: {point: [-10, -20]}
 camera:
   position: [0, -30, 20]
   target: [0, 0, 1]
@@ -208,7 +213,7 @@ outputs:
   EXPECT_EQ(s.world.scatters[0].count, 3);
   EXPECT_FLOAT_EQ(s.world.scatters[0].max_size, 2.0f);
   EXPECT_EQ(s.world.scatters[0].seed, 9u);
-  ASSERT_EQ(s.groups.size(), 3u);
+  ASSERT_EQ(s.groups.size(), 4u);
   const sim::GroupSpec& g = s.groups[0];
   EXPECT_EQ(g.name, "first");
   EXPECT_EQ(g.count, 12);
@@ -227,6 +232,9 @@ outputs:
   EXPECT_EQ(s.groups[1].goal.kind, sim::GoalSpec::Kind::Mirror);
   EXPECT_EQ(s.groups[2].spawn.kind, sim::Region::Kind::polygon);
   EXPECT_EQ(s.groups[2].arrival, sim::ArrivalBehaviour::Despawn);
+  EXPECT_EQ(s.groups[3].spawn.kind, sim::Region::Kind::points);  // count left out: one agent per point
+  EXPECT_EQ(s.groups[3].count, 2);
+  EXPECT_EQ(s.groups[3].spawn.points[1], glm::vec2(-19.5f, -20));
   // The camera is given on the map (z up) and kept in the Y-up world.
   ASSERT_TRUE(s.camera.has_value());
   EXPECT_EQ(s.camera->position, world_from_map({0, -30, 20}));
@@ -243,9 +251,14 @@ outputs:
   // Every key's position is known.
   EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 41);
   EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 50);
+  EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").line, 56);  // each point, though not recorded as a key
+  EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").column, 11);
+  EXPECT_EQ(l.source.locate("groups[3].spawn.points[7]").line, 55);  // beyond the list: where the list starts
   // And it all builds and runs.
   const auto sim = build_simulation(l);
-  EXPECT_EQ(sim->agent_count(), 24);
+  EXPECT_EQ(sim->agent_count(), 26);
+  const std::vector<glm::vec2> at = sim->positions();
+  EXPECT_NE(std::find(at.begin(), at.end(), glm::vec2(-19.5f, -20)), at.end());
   sim->run(5);
 }
 
