@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "core/parallel.h"
 #include "sim/crowd.h"
@@ -86,7 +87,7 @@ class NearGrid {
 // neighbour, nearest first. Once a neighbour's bisector (at half its
 // distance) lies beyond the cell's farthest corner, it and every farther one
 // leave the cell unchanged.
-ConvexPolygon cell_of(std::span<const glm::vec2> points, Index i, std::vector<Index>& neighbours, double cutoff) {
+ConvexPolygon cell_of(std::span<const glm::vec2> points, Index i, const std::vector<Index>& neighbours, double cutoff) {
   const glm::dvec2 p(points[static_cast<std::size_t>(i)]);
   ConvexPolygon cell;
   cell.reserve(kVoronoiDiscVertices);
@@ -94,18 +95,16 @@ ConvexPolygon cell_of(std::span<const glm::vec2> points, Index i, std::vector<In
     const double a = 2.0 * std::numbers::pi * k / kVoronoiDiscVertices;
     cell.push_back(p + cutoff * glm::dvec2(std::cos(a), std::sin(a)));
   }
-  auto distance2 = [&](Index j) {
-    const glm::dvec2 d = glm::dvec2(points[static_cast<std::size_t>(j)]) - p;
-    return d.x * d.x + d.y * d.y;
-  };
-  // Ties by index: the same order, so the same rounding, on every run.
-  std::sort(neighbours.begin(), neighbours.end(), [&](Index a, Index b) {
-    const double da = distance2(a), db = distance2(b);
-    return da != db ? da < db : a < b;
-  });
-  double reach2 = cutoff * cutoff;  // squared distance of the cell's farthest corner from p
+  std::vector<std::pair<double, Index>> by_distance;
+  by_distance.reserve(neighbours.size());
   for (Index j : neighbours) {
-    const double d2 = distance2(j);
+    const glm::dvec2 d = glm::dvec2(points[static_cast<std::size_t>(j)]) - p;
+    by_distance.emplace_back(d.x * d.x + d.y * d.y, j);
+  }
+  // Ties by index: the same order, so the same rounding, on every run.
+  std::sort(by_distance.begin(), by_distance.end());
+  double reach2 = cutoff * cutoff;  // squared distance of the cell's farthest corner from p
+  for (const auto& [d2, j] : by_distance) {
     if (d2 <= 0.0) continue;  // two agents on one spot: no bisector; each keeps the other's region
     if (0.25 * d2 >= reach2) break;
     const glm::dvec2 q(points[static_cast<std::size_t>(j)]);
