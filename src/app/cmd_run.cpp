@@ -204,7 +204,7 @@ void run_scenario(const RunOptions& o) {
   sim::FrameLoop loop(*sim);
   sim::MetricsOptions metrics;
   metrics.sample_every = std::max<std::int64_t>(1, std::llround(1.0 / static_cast<double>(spec.dt)));
-  if (spec.measurement) metrics.measurement = *spec.measurement;
+  metrics.measurement = spec.measurement;
   loop.emplace<sim::CrowdMetricsStage>(*sim, metrics);
   std::string written;
   if (spec.outputs.trajectories && !o.no_trajectories) {

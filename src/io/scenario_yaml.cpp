@@ -529,6 +529,68 @@ class Reader {
     return c;
   }
 
+  // {rect: {min, max}} (one area, the older form), or
+  // {areas: [{name, rect}], lines: [{name, from, to}], voronoi_cutoff}.
+  sim::MeasurementSpec measurement(const YAML::Node& n, const std::string& path) {
+    constexpr std::size_t kMaxItems = 1000;
+    sim::MeasurementSpec m;
+    if (!(n.IsMap() && (n["areas"] || n["lines"] || n["voronoi_cutoff"]))) {
+      // A misspelt key is told apart from both forms' keys.
+      if (n.IsMap() && !n["rect"] && !n["disc"] && !n["ring"] && !n["polygon"]) expect_map(n, path, {"rect", "areas", "lines", "voronoi_cutoff"});
+      const Region r = region(n, path);
+      if (r.kind != Region::Kind::rect) fail(n, path, "the measurement area is a rect");
+      sim::Aabb box;
+      box.add(r.min);
+      box.add(r.max);
+      m.areas.push_back({"area", box});
+      return m;
+    }
+    if (n["rect"]) fail(n["rect"], child(path, "rect"), "give either 'rect' (one area) or 'areas' and 'lines', not both");
+    expect_map(n, path, {"areas", "lines", "voronoi_cutoff"});
+    // Names label the results in stats.json: each names one thing.
+    auto name_of = [&](const YAML::Node& item_node, const std::string& ip, std::vector<std::string>& taken, const std::string& fallback) {
+      const YAML::Node given = item_node["name"];
+      const std::string np = child(ip, "name");
+      const std::string name = given ? text(given, np) : fallback;
+      if (name.empty()) fail(given, np, "must not be empty");
+      if (std::find(taken.begin(), taken.end(), name) != taken.end())
+        fail(given ? given : item_node, given ? np : ip, fmt::format("duplicate name {}", shown(name)));
+      taken.push_back(name);
+      return name;
+    };
+    std::vector<std::string> names;
+    if (const YAML::Node list = n["areas"]) {
+      const std::string lp = child(path, "areas");
+      expect_list(list, lp, 0, kMaxItems, "areas");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string ip = item(lp, i);
+        expect_map(list[i], ip, {"name", "rect"});
+        const sim::Polygon p = rect_polygon(required(list[i], ip, "rect"), child(ip, "rect"));
+        sim::Aabb box;
+        box.add(p.outer[0]);
+        box.add(p.outer[2]);
+        m.areas.push_back({name_of(list[i], ip, names, fmt::format("area{}", i)), box});
+      }
+    }
+    names.clear();
+    if (const YAML::Node list = n["lines"]) {
+      const std::string lp = child(path, "lines");
+      expect_list(list, lp, 0, kMaxItems, "lines");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string ip = item(lp, i);
+        expect_map(list[i], ip, {"name", "from", "to"});
+        sim::MeasurementLine l;
+        l.from = point(required(list[i], ip, "from"), child(ip, "from"));
+        l.to = point(required(list[i], ip, "to"), child(ip, "to"));
+        if (!(sim::length_of(l.to - l.from) > 0.0f)) fail(list[i]["to"], child(ip, "to"), "the line has no length: 'to' equals 'from'");
+        l.name = name_of(list[i], ip, names, fmt::format("line{}", i));
+        m.lines.push_back(l);
+      }
+    }
+    if (n["voronoi_cutoff"]) m.voronoi_cutoff = real_in(n["voronoi_cutoff"], child(path, "voronoi_cutoff"), 0.1, 100.0);
+    return m;
+  }
+
   sim::OutputSpec outputs(const YAML::Node& n, const std::string& path) {
     expect_map(n, path, {"dir", "every", "trajectories", "stats"});
     sim::OutputSpec o;
@@ -573,14 +635,7 @@ class Reader {
       if (c["motion"]) s.camera_motion = word(c["motion"], "camera.motion", {"fixed", "orbit", "flyover"});
       if (c["period"]) s.camera_period_s = real_in(c["period"], "camera.period", 0.1, 1e6);
     }
-    if (const YAML::Node m = root["measurement"]) {
-      const Region r = region(m, "measurement");
-      if (r.kind != Region::Kind::rect) fail(m, "measurement", "the measurement area is a rect");
-      sim::Aabb box;
-      box.add(r.min);
-      box.add(r.max);
-      s.measurement = box;
-    }
+    if (const YAML::Node m = root["measurement"]) s.measurement = measurement(m, "measurement");
     if (root["outputs"]) s.outputs = outputs(root["outputs"], "outputs");
     return s;
   }

@@ -1,19 +1,12 @@
-// Host-only parallel loops for work that cannot run as a kernel (A* with its
-// heaps, dynamic programming over std containers): the same oneTBB arena and
-// thread count as parallel_for, timed under `description`, always on the CPU.
-// Each index must write only its own outputs, so results do not depend on
-// the thread count.
+// The path family's host-only parallel loops: core/parallel.h's
+// host_parallel_for (A* with its heaps, dynamic programming over std
+// containers), named in this namespace for the family's callers.
 #pragma once
 
 #include "core/parallel.h"
 
 namespace throng::path {
 
-template <class Fn>
-void host_parallel_for(const char* description, Index n, const Fn& fn, Index grain = 1) {
-  if (n <= 0) return;
-  ScopedTimer timer(description);
-  detail::cpu_parallel_for(n, grain, &detail::run_range<Fn>, &fn);
-}
+using throng::host_parallel_for;
 
 }  // namespace throng::path

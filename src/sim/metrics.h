@@ -1,12 +1,16 @@
 // Crowd metrics as library functions (tests and stats.json use them): pair
 // overlaps, obstacle penetrations, arrivals, speed and density in a
-// measurement area (the fundamental diagram), a local density histogram.
-// Spans in current_memory(); every reduction is deterministic.
+// measurement area (the fundamental diagram, classic and Voronoi), crossings
+// of measurement lines (flow by the N-t curve), a local density histogram.
+// Spans in current_memory() unless said otherwise; every reduction is
+// deterministic.
 #pragma once
 
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <glm/vec2.hpp>
+#include <span>
 #include <vector>
 
 #include "core/span.h"
@@ -54,6 +58,94 @@ struct AreaSample {
 };
 AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const glm::vec2> goals,
                         Span<const std::uint8_t> flags, const Aabb& area);
+
+// Speed of an agent at p along the way to its goal (0 when it stands on it:
+// no desired direction, no advance).
+THRONG_HOST_DEVICE inline float speed_towards(glm::vec2 v, glm::vec2 p, glm::vec2 goal) {
+  const glm::vec2 to_goal = goal - p;
+  const float d = length_of(to_goal);
+  return d > 1e-6f ? dot2(v, to_goal) / d : 0.0f;
+}
+
+// Voronoi density and speed in a rectangle (Steffen & Seyfried 2010; method
+// D of Liao et al. 2014): every point of the area carries the density
+// 1/|cell| and the speed of the agent whose Voronoi cell holds it, averaged
+// over the area:
+//   density = sum_i |cell_i n A| / |cell_i| / |A|,  speed = sum_i v_i |cell_i n A| / |A|.
+// Cells are cut to a disc of radius `cutoff` around their agent (a regular
+// polygon of kVoronoiDiscVertices corners inscribed in the circle), so a
+// lone agent's cell stays finite; where the cells leave part of the area
+// uncovered that part counts as empty (density and speed 0 there). Walls do
+// not cut cells. Host spans; only active agents count.
+inline constexpr int kVoronoiDiscVertices = 64;
+struct VoronoiSample {
+  double density = 0;          // agents / m^2
+  double speed = 0;            // m/s along the desired direction
+  double speed_magnitude = 0;  // m/s, |v|
+  double covered = 0;          // m^2 of the area inside some agent's cell
+};
+VoronoiSample measure_area_voronoi(std::span<const glm::vec2> positions, std::span<const glm::vec2> velocities,
+                                   std::span<const glm::vec2> goals, std::span<const std::uint8_t> flags, const Aabb& area, float cutoff);
+
+// The Voronoi cell of every point among `points` (host), cut to the disc of
+// radius `cutoff`, as a convex polygon counter-clockwise; the building block
+// of measure_area_voronoi, for tests and plots.
+using ConvexPolygon = std::vector<glm::dvec2>;
+std::vector<ConvexPolygon> voronoi_cells(std::span<const glm::vec2> points, float cutoff);
+double polygon_area(const ConvexPolygon& polygon);
+// The part of a convex polygon inside the rectangle.
+ConvexPolygon clip_to_rect(const ConvexPolygon& polygon, const Aabb& rect);
+
+// Crossings of measurement lines by agents, for flow by the N-t curve
+// (method A of Liao et al. 2014). An agent crosses line (a, b) during a step
+// when its straight move from `before` to `after` changes side and passes
+// between a and b. The side is the sign of cross(b - a, p - a): positive
+// (left of a -> b) or not (right, or on the line), so an agent that stops on
+// the line and walks on is counted once. direction +1: right to left (the
+// positive direction), -1: left to right.
+struct LineCrossing {
+  double time = 0;  // s, interpolated along the step
+  Index agent = 0;
+  std::int32_t line = 0;
+  std::int32_t direction = 0;
+};
+// Where the step p0 -> p1 crosses a -> b: the direction, and in *fraction
+// the part of the step done at the crossing; 0 when it does not cross.
+THRONG_HOST_DEVICE inline int step_crossing(glm::vec2 p0, glm::vec2 p1, glm::vec2 a, glm::vec2 b, double* fraction) {
+  // In double: the sides of points close to the line keep their sign.
+  const double ex = static_cast<double>(b.x) - a.x, ey = static_cast<double>(b.y) - a.y;
+  const double d0 = ex * (static_cast<double>(p0.y) - a.y) - ey * (static_cast<double>(p0.x) - a.x);
+  const double d1 = ex * (static_cast<double>(p1.y) - a.y) - ey * (static_cast<double>(p1.x) - a.x);
+  const bool left0 = d0 > 0.0, left1 = d1 > 0.0;
+  if (left0 == left1) return 0;
+  const double s = d0 / (d0 - d1);  // d0 and d1 differ: one is > 0, the other <= 0
+  const double qx = p0.x + s * (static_cast<double>(p1.x) - p0.x), qy = p0.y + s * (static_cast<double>(p1.y) - p0.y);
+  const double u = ((qx - a.x) * ex + (qy - a.y) * ey) / (ex * ex + ey * ey);
+  if (u < 0.0 || u > 1.0) return 0;
+  *fraction = s;
+  return left1 ? 1 : -1;
+}
+// Crossings by agents active both before and after a step from time t0 to
+// t1, ordered by agent, then line: the same list for any thread count or
+// backend. `lines` in current_memory(); `bounds` holds every line (agents
+// whose step stays outside it are skipped).
+std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before, Span<const glm::vec2> after,
+                                         Span<const std::uint8_t> flags_after, Span<const Segment> lines, const Aabb& bounds, double t0,
+                                         double t1);
+
+// Flow through a line by the N-t curve (method A of Liao et al. 2014): of
+// `times`, one direction's crossing times in increasing order, the mean flow
+// between the first and the last crossing, (N - 1) / (t_N - t_1), and per
+// metre of the line's `width`. Not timed (flows 0) with fewer than two
+// crossings or all at one instant.
+struct LineFlow {
+  Index crossings = 0;
+  double first_time = 0, last_time = 0;  // s (0 when none)
+  bool timed = false;
+  double flow = 0;           // persons / s
+  double specific_flow = 0;  // persons / (m s)
+};
+LineFlow line_flow(std::span<const double> times, double width);
 
 // Mean speed of active agents.
 double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> flags);

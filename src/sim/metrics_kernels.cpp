@@ -100,11 +100,8 @@ AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> v
       THRONG_LAMBDA(Index i)->AreaAcc {
         const glm::vec2 p = positions[i];
         if ((flags[i] & kAgentActive) == 0 || p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) return {0, 0.0, 0.0};
-        const glm::vec2 v = velocities[i], to_goal = goals[i] - p;
-        const float d = length_of(to_goal);
-        // An agent standing on its goal has no desired direction: no advance.
-        const float along = d > 1e-6f ? dot2(v, to_goal) / d : 0.0f;
-        return {1, static_cast<double>(along), static_cast<double>(length_of(v))};
+        const glm::vec2 v = velocities[i];
+        return {1, static_cast<double>(speed_towards(v, p, goals[i])), static_cast<double>(length_of(v))};
       },
       CombineArea{});
   AreaSample s;
@@ -115,6 +112,64 @@ AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> v
   s.mean_speed_magnitude = c.count > 0 ? c.magnitude / static_cast<double>(c.count) : 0.0;
   s.flow = s.density * s.mean_speed;
   return s;
+}
+
+namespace {
+// The crossing part of a step, as the kernels fill it in.
+struct CrossingRecord {
+  double fraction;
+  Index agent;
+  std::int32_t line;
+  std::int32_t direction;
+};
+
+// Whether agent i's step may cross a line: active before and after, and
+// the step's box meets the lines' box (most agents are far from every line).
+THRONG_HOST_DEVICE inline bool may_cross(Index i, Span<const glm::vec2> before, Span<const std::uint8_t> flags_before,
+                                         Span<const glm::vec2> after, Span<const std::uint8_t> flags_after, glm::vec2 lo, glm::vec2 hi) {
+  if ((flags_before[i] & kAgentActive) == 0 || (flags_after[i] & kAgentActive) == 0) return false;
+  const glm::vec2 p0 = before[i], p1 = after[i];
+  return !((p0.x < lo.x && p1.x < lo.x) || (p0.x > hi.x && p1.x > hi.x) || (p0.y < lo.y && p1.y < lo.y) || (p0.y > hi.y && p1.y > hi.y));
+}
+}  // namespace
+
+std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before, Span<const glm::vec2> after,
+                                         Span<const std::uint8_t> flags_after, Span<const Segment> lines, const Aabb& bounds, double t0,
+                                         double t1) {
+  const Index n = after.size();
+  if (n == 0 || lines.size() == 0 || bounds.empty()) return {};
+  const glm::vec2 lo = bounds.min, hi = bounds.max;
+  const Index line_count = lines.size();
+  // Two passes so the list comes out in agent order whatever the threads:
+  // count each agent's crossings, place them by a prefix sum, then write.
+  Buffer<Index> offsets(n, current_memory());
+  const Span<Index> count = offsets.span();
+  parallel_for("sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
+    Index c = 0;
+    if (may_cross(i, before, flags_before, after, flags_after, lo, hi)) {
+      double s = 0;
+      for (Index k = 0; k < line_count; ++k) c += step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s) != 0 ? 1 : 0;
+    }
+    count[i] = c;
+  });
+  const Index total = exclusive_scan("sim.metrics.line_crossings", Span<const Index>(count), count);
+  if (total == 0) return {};
+  Buffer<CrossingRecord> records(total, current_memory());
+  const Span<CrossingRecord> out = records.span();
+  const Span<const Index> first = offsets.span();
+  parallel_for("sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
+    if (!may_cross(i, before, flags_before, after, flags_after, lo, hi)) return;
+    Index at = first[i];
+    for (Index k = 0; k < line_count; ++k) {
+      double s = 0;
+      const int d = step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s);
+      if (d != 0) out[at++] = CrossingRecord{s, i, static_cast<std::int32_t>(k), d};
+    }
+  });
+  std::vector<LineCrossing> crossings;
+  crossings.reserve(static_cast<std::size_t>(total));
+  for (const CrossingRecord& r : records.to_vector()) crossings.push_back({t0 + r.fraction * (t1 - t0), r.agent, r.line, r.direction});
+  return crossings;
 }
 
 double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> flags) {
@@ -151,6 +206,19 @@ DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const s
   out.bin_width = bin_width;
   std::copy(h.bins, h.bins + kDensityBins, out.agents.begin());
   return out;
+}
+
+LineFlow line_flow(std::span<const double> times, double width) {
+  LineFlow f;
+  f.crossings = static_cast<Index>(times.size());
+  if (times.empty()) return f;
+  f.first_time = times.front();
+  f.last_time = times.back();
+  f.timed = times.size() >= 2 && f.last_time > f.first_time;
+  if (!f.timed) return f;
+  f.flow = static_cast<double>(times.size() - 1) / (f.last_time - f.first_time);
+  f.specific_flow = width > 0 ? f.flow / width : 0.0;
+  return f;
 }
 
 ArrivalStats arrival_stats(const std::vector<float>& arrival_times) {

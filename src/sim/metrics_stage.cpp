@@ -1,8 +1,11 @@
 #include "sim/metrics_stage.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include "core/error.h"
 
@@ -21,15 +24,60 @@ Aabb default_measurement_area(const Simulation& sim) {
   return a;
 }
 
-CrowdMetricsStage::CrowdMetricsStage(const Simulation& sim, MetricsOptions options) : options_(options) {
+CrowdMetricsStage::CrowdMetricsStage(const Simulation& sim, MetricsOptions options) : options_(std::move(options)) {
   if (options_.sample_every < 1) throw Error("must be >= 1", at_field("metrics.sample_every"));
   if (!(options_.density_bin_width > 0)) throw Error("must be > 0", at_field("metrics.density_bin_width"));
-  if (options_.measurement.empty()) options_.measurement = default_measurement_area(sim);
-  if (!(options_.measurement.size().x > 0 && options_.measurement.size().y > 0))
-    throw Error("the measurement area needs a positive width and height", at_field("measurement"));
+  MeasurementSpec& m = options_.measurement;
+  if (!(m.voronoi_cutoff > 0)) throw Error("must be > 0", at_field("measurement.voronoi_cutoff"));
+  if (m.areas.empty()) m.areas.push_back({"default", default_measurement_area(sim)});
+  for (std::size_t k = 0; k < m.areas.size(); ++k)
+    if (!(m.areas[k].rect.size().x > 0 && m.areas[k].rect.size().y > 0))
+      throw Error("the measurement area needs a positive width and height", at_field(fmt::format("measurement.areas[{}].rect", k)));
+  std::vector<Segment> lines;
+  for (std::size_t k = 0; k < m.lines.size(); ++k) {
+    const MeasurementLine& l = m.lines[k];
+    if (!(length_of(l.to - l.from) > 0))
+      throw Error("the line has no length: 'to' equals 'from'", at_field(fmt::format("measurement.lines[{}].to", k)));
+    lines.push_back({l.from, l.to});
+    line_bounds_.add(l.from);
+    line_bounds_.add(l.to);
+  }
+  lines_ = Buffer<Segment>(std::span<const Segment>(lines), current_memory());
+  line_times_.resize(lines.size());
+}
+
+void CrowdMetricsStage::record_crossings(const Simulation& sim, const FrameInfo& frame) {
+  if (line_times_.empty() || frame.frame == previous_frame_) return;
+  const CrowdState& c = sim.crowd();
+  if (previous_frame_ >= 0) {
+    // Agents added since the frame before have no step to cross with.
+    const Index n = std::min(previous_position_.size(), c.position.size());
+    const std::vector<LineCrossing> found =
+        line_crossings(previous_position_.span().subspan(0, n), previous_flags_.span().subspan(0, n), c.position.span().subspan(0, n),
+                       c.flags.span().subspan(0, n), lines_.span(), line_bounds_, previous_time_, frame.time);
+    // The list is in agent order; sorted by time within the step, every
+    // N-t curve only climbs.
+    std::vector<LineTimes> step(line_times_.size());
+    for (const LineCrossing& x : found) {
+      LineTimes& t = step[static_cast<std::size_t>(x.line)];
+      (x.direction > 0 ? t.positive : t.negative).push_back(x.time);
+    }
+    for (std::size_t k = 0; k < step.size(); ++k) {
+      for (auto [from, to] : {std::pair{&step[k].positive, &line_times_[k].positive}, std::pair{&step[k].negative, &line_times_[k].negative}}) {
+        std::stable_sort(from->begin(), from->end());
+        to->insert(to->end(), from->begin(), from->end());
+      }
+    }
+  }
+  previous_position_ = c.position.to(c.position.memory());
+  previous_flags_ = c.flags.to(c.flags.memory());
+  previous_time_ = frame.time;
+  previous_frame_ = frame.frame;
 }
 
 void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame) {
+  // Crossings need every step; the rest is sampled.
+  record_crossings(sim, frame);
   if (frame.frame % options_.sample_every != 0 && !frame.last) return;
   const CrowdState& c = sim.crowd();
   Sample s;
@@ -37,7 +85,11 @@ void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame
   s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_tolerance, sim.contact_cell());
   s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), options_.penetration_tolerance);
   s.mean_speed = mean_speed(c.velocity.span(), c.flags.span());
-  s.area = measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), options_.measurement);
+  const std::vector<glm::vec2> position = c.position.to_vector(), velocity = c.velocity.to_vector(), goal = c.goal.to_vector();
+  const std::vector<std::uint8_t> flags = c.flags.to_vector();
+  for (const MeasurementArea& a : options_.measurement.areas)
+    s.areas.push_back({measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), a.rect),
+                       measure_area_voronoi(position, velocity, goal, flags, a.rect, options_.measurement.voronoi_cutoff)});
   const DensityHistogram h = density_histogram(c.position.span(), c.flags.span());
   density_.cell = h.cell;
   density_.bin_width = h.bin_width;
@@ -82,42 +134,106 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
                     {"agent_samples", density_.agents[static_cast<std::size_t>(b)]}});
   stats["density_histogram"] = {{"cell_m", density_.cell}, {"bin_width_per_m2", density_.bin_width}, {"bins", bins}};
 
-  // Fundamental diagram: samples of the measurement area grouped by density.
+  // Fundamental diagram: samples of the first measurement area grouped by density.
   struct Bin {
     Index samples = 0;
-    double speed = 0, speed_magnitude = 0, flow = 0;
+    double speed = 0, speed_magnitude = 0, flow = 0, voronoi_density = 0, voronoi_speed = 0;
   };
   std::map<std::int64_t, Bin> by_density;
   nlohmann::json series = nlohmann::json::array();
   for (const Sample& s : samples_) {
-    series.push_back({{"time", s.time},
-                      {"agents", s.area.agents},
-                      {"density", s.area.density},
-                      {"speed", s.area.mean_speed},
-                      {"speed_magnitude", s.area.mean_speed_magnitude},
-                      {"flow", s.area.flow}});
-    if (s.area.agents == 0) continue;
-    Bin& b = by_density[static_cast<std::int64_t>(std::floor(s.area.density / options_.density_bin_width))];
+    const AreaSample& a = s.areas.front().classic;
+    const VoronoiSample& v = s.areas.front().voronoi;
+    series.push_back(area_sample_json(s.time, s.areas.front()));
+    if (a.agents == 0) continue;
+    Bin& b = by_density[static_cast<std::int64_t>(std::floor(a.density / options_.density_bin_width))];
     ++b.samples;
-    b.speed += s.area.mean_speed;
-    b.speed_magnitude += s.area.mean_speed_magnitude;
-    b.flow += s.area.flow;
+    b.speed += a.mean_speed;
+    b.speed_magnitude += a.mean_speed_magnitude;
+    b.flow += a.flow;
+    b.voronoi_density += v.density;
+    b.voronoi_speed += v.speed;
   }
   nlohmann::json diagram = nlohmann::json::array();
-  for (const auto& [k, b] : by_density)
+  for (const auto& [k, b] : by_density) {
+    const double n = static_cast<double>(b.samples);
     diagram.push_back({{"min_density", static_cast<double>(k) * options_.density_bin_width},
                        {"max_density", static_cast<double>(k + 1) * options_.density_bin_width},
                        {"samples", b.samples},
-                       {"mean_speed", b.speed / static_cast<double>(b.samples)},
-                       {"mean_speed_magnitude", b.speed_magnitude / static_cast<double>(b.samples)},
-                       {"mean_flow", b.flow / static_cast<double>(b.samples)}});
-  const Aabb& m = options_.measurement;
+                       {"mean_speed", b.speed / n},
+                       {"mean_speed_magnitude", b.speed_magnitude / n},
+                       {"mean_flow", b.flow / n},
+                       {"mean_voronoi_density", b.voronoi_density / n},
+                       {"mean_voronoi_speed", b.voronoi_speed / n}});
+  }
+  const MeasurementSpec& spec = options_.measurement;
+  const Aabb& m = spec.areas.front().rect;
   stats["fundamental_diagram"] = {{"area", {{"min", {m.min.x, m.min.y}}, {"max", {m.max.x, m.max.y}}}},
                                   {"speed", "m/s along each agent's desired direction (towards its current goal); speed_magnitude: mean |v|"},
                                   {"flow", "specific flow, density x speed, 1/(m s)"},
+                                  {"voronoi_density", "Voronoi density (Steffen & Seyfried 2010), 1/m^2; voronoi_speed: Voronoi-weighted speed along the desired direction, m/s"},
                                   {"density_bin_width_per_m2", options_.density_bin_width},
                                   {"bins", diagram},
                                   {"samples", series}};
+  stats["measurement"] = measurement_section();
+}
+
+nlohmann::json CrowdMetricsStage::area_sample_json(double time, const AreaMeasure& m) {
+  const AreaSample& a = m.classic;
+  const VoronoiSample& v = m.voronoi;
+  // Each classic value beside its Voronoi one; the flows are density x speed.
+  return {{"time", time}, {"agents", a.agents},
+          {"density", a.density}, {"voronoi_density", v.density},
+          {"speed", a.mean_speed}, {"voronoi_speed", v.speed},
+          {"speed_magnitude", a.mean_speed_magnitude}, {"voronoi_speed_magnitude", v.speed_magnitude},
+          {"flow", a.flow}, {"voronoi_flow", v.density * v.speed}};
+}
+
+nlohmann::json CrowdMetricsStage::measurement_section() const {
+  const MeasurementSpec& spec = options_.measurement;
+  nlohmann::json areas = nlohmann::json::array();
+  for (std::size_t k = 0; k < spec.areas.size(); ++k) {
+    nlohmann::json series = nlohmann::json::array();
+    for (const Sample& s : samples_) series.push_back(area_sample_json(s.time, s.areas[k]));
+    // Means of every value but the time over every sample, empty ones
+    // included, as the series shows them.
+    std::map<std::string, double> sums;
+    for (const nlohmann::json& s : series)
+      for (const auto& [key, value] : s.items())
+        if (key != "time") sums[key] += value.get<double>();
+    nlohmann::json mean = nlohmann::json::object();
+    for (const auto& [key, sum] : sums) mean[key] = sum / static_cast<double>(series.size());
+    const Aabb& r = spec.areas[k].rect;
+    areas.push_back({{"name", spec.areas[k].name}, {"min", {r.min.x, r.min.y}}, {"max", {r.max.x, r.max.y}},
+                     {"area_m2", static_cast<double>(r.size().x) * r.size().y}, {"mean", mean}, {"samples", series}});
+  }
+  nlohmann::json lines = nlohmann::json::array();
+  for (std::size_t k = 0; k < spec.lines.size(); ++k) {
+    const MeasurementLine& l = spec.lines[k];
+    const double width = static_cast<double>(length_of(l.to - l.from));
+    auto direction = [width](const std::vector<double>& t) {
+      const std::size_t n = t.size();
+      const LineFlow f = line_flow(t, width);
+      nlohmann::json nt = nlohmann::json::array();
+      const std::size_t stride = (n + kMaxNtPoints - 1) / kMaxNtPoints;
+      for (std::size_t i = 0; i < n; ++i)
+        if (stride <= 1 || i == 0 || i + 1 == n || (i + 1) % stride == 0) nt.push_back({t[i], i + 1});
+      auto or_null = [](bool known, double v) { return known ? nlohmann::json(v) : nlohmann::json(nullptr); };
+      return nlohmann::json{{"crossings", n},
+                            {"first_s", or_null(n > 0, f.first_time)},
+                            {"last_s", or_null(n > 0, f.last_time)},
+                            {"flow_per_s", or_null(f.timed, f.flow)},
+                            {"specific_flow_per_m_s", or_null(f.timed, f.specific_flow)},
+                            {"nt", nt}};
+    };
+    lines.push_back({{"name", l.name},
+                     {"from", {l.from.x, l.from.y}},
+                     {"to", {l.to.x, l.to.y}},
+                     {"width_m", width},
+                     {"positive", direction(line_times_[k].positive)},
+                     {"negative", direction(line_times_[k].negative)}});
+  }
+  return {{"voronoi_cutoff_m", spec.voronoi_cutoff}, {"areas", areas}, {"lines", lines}};
 }
 
 }  // namespace throng::sim

@@ -164,6 +164,25 @@ struct WorldSpec {
   std::vector<std::string> scatter_fields;
 };
 
+// Where the crowd is measured (map coordinates): rectangles for density and
+// speed (the fundamental diagram, classic and Voronoi), lines for flow by
+// the N-t curve. Names label them in stats.json.
+struct MeasurementArea {
+  std::string name;
+  Aabb rect;
+};
+// Walking from `from` to `to`, the positive crossing direction is to the left.
+struct MeasurementLine {
+  std::string name;
+  glm::vec2 from{0.0f};
+  glm::vec2 to{0.0f};
+};
+struct MeasurementSpec {
+  std::vector<MeasurementArea> areas;  // empty = a 10 m square at the centre of the scene
+  std::vector<MeasurementLine> lines;
+  float voronoi_cutoff = 2.0f;  // m: Voronoi cells are clipped to a disc of this radius around their agent
+};
+
 struct ScenarioSpec {
   std::string name = "scenario";
   std::string description;
@@ -186,9 +205,9 @@ struct ScenarioSpec {
   // period seconds of video; empty / 0 = the command's defaults.
   std::string camera_motion;
   float camera_period_s = 0.0f;
-  // Where density and speed are measured for the fundamental diagram
-  // (map coordinates); nullopt = a 10 m square at the centre of the scene.
-  std::optional<Aabb> measurement;
+  // Where density, speed and flow are measured (the fundamental diagram
+  // is drawn for the first area).
+  MeasurementSpec measurement;
   OutputSpec outputs;
   std::int64_t total_agents() const;
   std::int64_t step_count() const;  // steps, or ceil(duration / dt)

@@ -1,6 +1,7 @@
 // sim/metrics on CUDA against the CPU: measure_overlaps,
 // count_obstacle_penetrations, measure_area, mean_speed and
-// density_histogram over a random crowd in a built-in scenario's world.
+// density_histogram over a random crowd in a built-in scenario's world, and
+// line_crossings of a random step.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -89,6 +90,44 @@ TEST(CudaMetrics, MatchCpu) {
     EXPECT_EQ(gpu.area.mean_speed, cpu.area.mean_speed);
     EXPECT_EQ(gpu.area.mean_speed_magnitude, cpu.area.mean_speed_magnitude);
     EXPECT_EQ(gpu.speed, cpu.speed);
+  }
+}
+
+TEST(CudaMetrics, LineCrossingsMatchCpu) {
+  THRONG_REQUIRE_GPU();
+  const std::vector<Segment> lines{{{-10, -10}, {10, 10}}, {{0, -15}, {0, 15}}, {{-5, 3}, {12, 3}}};
+  Aabb bounds;
+  for (const Segment& l : lines) bounds.add(l.a), bounds.add(l.b);
+  // A random step of 20,000 agents, every 9th inactive.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> x(-20.0f, 20.0f), v(-1.5f, 1.5f);
+  std::vector<glm::vec2> before(20000), after(20000);
+  std::vector<std::uint8_t> flags(20000);
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    before[i] = {x(rng), x(rng)};
+    after[i] = before[i] + glm::vec2(v(rng), v(rng));
+    flags[i] = i % 9 == 0 ? 0 : kAgentActive;
+  }
+  const auto run = [&](Memory m) {
+    const Buffer<glm::vec2> b0 = gpu_test::upload(before, m), b1 = gpu_test::upload(after, m);
+    const Buffer<std::uint8_t> bf = gpu_test::upload(flags, m);
+    const Buffer<Segment> bl = gpu_test::upload(lines, m);
+    return line_crossings(b0.span(), bf.span(), b1.span(), bf.span(), bl.span(), bounds, 1.0, 1.1);
+  };
+  const std::vector<LineCrossing> cpu = gpu_test::run_on(gpu_test::cpu_side(), run);
+  const std::vector<LineCrossing> gpu = gpu_test::run_on(gpu_test::device_side(), run);
+  ASSERT_GT(cpu.size(), 500u);
+  // Each decision is two sides in double of float inputs and a position
+  // along the line: it flips only for a step ending within ~1e-15 m of a
+  // line or an end, which these random steps do not. The same list; times
+  // within an FMA's rounding on CUDA.
+  ASSERT_EQ(gpu.size(), cpu.size());
+  const double tol = gpu_test::tolerant() ? 1e-12 : 0.0;
+  for (std::size_t k = 0; k < cpu.size(); ++k) {
+    EXPECT_EQ(gpu[k].agent, cpu[k].agent);
+    EXPECT_EQ(gpu[k].line, cpu[k].line);
+    EXPECT_EQ(gpu[k].direction, cpu[k].direction);
+    EXPECT_NEAR(gpu[k].time, cpu[k].time, tol);
   }
 }
 

@@ -243,8 +243,11 @@ outputs:
   EXPECT_NEAR(s.camera->fov_y, 45.0f * 0.0174532925f, 1e-6f);
   EXPECT_EQ(s.camera->width, 640);
   EXPECT_FLOAT_EQ(s.camera->far_plane, 500.0f);
-  ASSERT_TRUE(s.measurement.has_value());
-  EXPECT_EQ(s.measurement->min, glm::vec2(-5, 10));
+  ASSERT_EQ(s.measurement.areas.size(), 1u);  // the single-rect form
+  EXPECT_EQ(s.measurement.areas[0].name, "area");
+  EXPECT_EQ(s.measurement.areas[0].rect.min, glm::vec2(-5, 10));
+  EXPECT_EQ(s.measurement.areas[0].rect.max, glm::vec2(5, 15));
+  EXPECT_TRUE(s.measurement.lines.empty());
   EXPECT_EQ(s.outputs.dir, "out/all");
   EXPECT_EQ(s.outputs.every, 4);
   EXPECT_FALSE(s.outputs.trajectories);
@@ -260,6 +263,60 @@ outputs:
   const std::vector<glm::vec2> at = sim->positions();
   EXPECT_NE(std::find(at.begin(), at.end(), glm::vec2(-19.5f, -20)), at.end());
   sim->run(5);
+}
+
+constexpr const char* kOneGroup = R"(name: m
+groups:
+  - count: 4
+    spawn: {rect: {min: [0, 0], max: [5, 5]}}
+    goal: {point: [20, 2]}
+)";
+
+TEST(ScenarioYaml, MeasurementAreasAndLines) {
+  const std::string text = std::string(kOneGroup) + R"(measurement:
+  voronoi_cutoff: 1.5
+  areas:
+    - {name: door, rect: {min: [1, 2], max: [3, 4]}}
+    - rect: {min: [-1, -1], max: [0, 0]}
+  lines:
+    - {name: exit, from: [10, 0], to: [10, 5]}
+    - {from: [0, 0], to: [1, 1]}
+)";
+  const sim::MeasurementSpec m = parse_scenario(text, "m.yaml").spec.measurement;
+  EXPECT_FLOAT_EQ(m.voronoi_cutoff, 1.5f);
+  ASSERT_EQ(m.areas.size(), 2u);
+  EXPECT_EQ(m.areas[0].name, "door");
+  EXPECT_EQ(m.areas[0].rect.min, glm::vec2(1, 2));
+  EXPECT_EQ(m.areas[0].rect.max, glm::vec2(3, 4));
+  EXPECT_EQ(m.areas[1].name, "area1");  // unnamed: by position
+  ASSERT_EQ(m.lines.size(), 2u);
+  EXPECT_EQ(m.lines[0].name, "exit");
+  EXPECT_EQ(m.lines[0].from, glm::vec2(10, 0));
+  EXPECT_EQ(m.lines[0].to, glm::vec2(10, 5));
+  EXPECT_EQ(m.lines[1].name, "line1");
+
+  // Only lines: the areas stay to the default (the stage's 10 m square).
+  const sim::MeasurementSpec lines_only =
+      parse_scenario(std::string(kOneGroup) + "measurement: {lines: [{from: [0, 0], to: [0, 1]}]}\n", "l.yaml").spec.measurement;
+  EXPECT_TRUE(lines_only.areas.empty());
+  EXPECT_EQ(lines_only.lines.size(), 1u);
+  EXPECT_FLOAT_EQ(lines_only.voronoi_cutoff, 2.0f);
+}
+
+TEST(ScenarioYaml, MeasurementListsAreBounded) {
+  for (const char* list : {"areas", "lines"}) {
+    std::string text = std::string(kOneGroup) + "measurement:\n  " + list + ":\n";
+    for (int i = 0; i < 1001; ++i)
+      text += std::string(list) == "areas" ? "    - {rect: {min: [0, 0], max: [1, 1]}}\n" : "    - {from: [0, 0], to: [1, 1]}\n";
+    try {
+      parse_scenario(text, "many.yaml");
+      ADD_FAILURE() << list << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.location().field, std::string("measurement.") + list);
+      EXPECT_EQ(e.location().line, 8);  // the list's first item
+      EXPECT_NE(std::string(e.what()).find(std::string("has more than 1000 ") + list), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(ScenarioYaml, CameraLookingStraightDownHasNorthUp) {

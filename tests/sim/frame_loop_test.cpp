@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "sim/metrics_stage.h"
 #include "tests/sim/test_scenarios.h"
 
@@ -109,6 +111,96 @@ TEST(FrameLoop, MetricsStageWritesItsSections) {
   EXPECT_EQ(stats["fundamental_diagram"]["samples"].size(), 7u);
   const Aabb area = default_measurement_area(sim);
   EXPECT_NEAR(area.size().x, 10.0f, 1e-4f);
+}
+
+// Keeps every frame's positions and flags: the reference for the crossings.
+class PositionRecorder : public FrameStage {
+ public:
+  std::string name() const override { return "test.positions"; }
+  void after_step(const Simulation& sim, const FrameInfo& f) override {
+    times.push_back(f.time);
+    positions.push_back(sim.crowd().position.to_vector());
+    flags.push_back(sim.crowd().flags.to_vector());
+  }
+  std::vector<double> times;
+  std::vector<std::vector<glm::vec2>> positions;
+  std::vector<std::vector<std::uint8_t>> flags;
+};
+
+// Lines see every step, though areas are sampled every 10th frame: the
+// circle's walkers cross two lines through the centre, counted as a
+// brute-force segment test of each frame pair counts them.
+TEST(FrameLoop, MetricsStageMeasuresAreasAndEveryStepsLineCrossings) {
+  Simulation sim(test::builtin("circle", 100));
+  FrameLoop loop(sim);
+  MetricsOptions options;
+  options.sample_every = 10;
+  const std::vector<MeasurementLine> lines{{"north_south", {0.37f, -30.0f}, {0.37f, 30.0f}}, {"west_east", {-30.0f, -0.53f}, {30.0f, -0.53f}}};
+  options.measurement.lines = lines;
+  Aabb centre, east;
+  centre.add({-3, -3});
+  centre.add({3, 3});
+  east.add({2, -2});
+  east.add({6, 2});
+  options.measurement.areas = {{"centre", centre}, {"east", east}};
+  const auto& metrics = loop.emplace<CrowdMetricsStage>(sim, options);
+  const auto& recorded = loop.emplace<PositionRecorder>();
+  RunControl control;
+  control.max_steps = 300;
+  loop.run(control);
+
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    SCOPED_TRACE(lines[l].name);
+    std::vector<double> positive, negative;
+    for (std::size_t f = 1; f < recorded.positions.size(); ++f)
+      for (std::size_t i = 0; i < recorded.positions[f].size(); ++i) {
+        const glm::vec2 p0 = recorded.positions[f - 1][i], p1 = recorded.positions[f][i];
+        if (!(recorded.flags[f - 1][i] & kAgentActive) || !(recorded.flags[f][i] & kAgentActive)) continue;
+        if (!segments_intersect(p0, p1, lines[l].from, lines[l].to)) continue;
+        const bool to_left = cross2(lines[l].to - lines[l].from, p1 - lines[l].from) > 0;
+        (to_left ? positive : negative).push_back(recorded.times[f]);
+      }
+    const CrowdMetricsStage::LineTimes& got = metrics.line_times()[l];
+    ASSERT_EQ(got.positive.size(), positive.size());
+    ASSERT_EQ(got.negative.size(), negative.size());
+    EXPECT_GT(positive.size() + negative.size(), 50u);
+    EXPECT_TRUE(std::is_sorted(got.positive.begin(), got.positive.end()));
+    for (std::size_t k = 0; k < positive.size(); ++k) {
+      EXPECT_LE(got.positive[k], positive[k] + 1e-9);  // within the step that ends at the frame
+      EXPECT_GE(got.positive[k], positive[k] - 0.1 - 1e-9);
+    }
+  }
+
+  nlohmann::json stats;
+  loop.finish(stats);
+  const nlohmann::json& m = stats["measurement"];
+  ASSERT_EQ(m["areas"].size(), 2u);
+  EXPECT_EQ(m["areas"][1]["name"], "east");
+  EXPECT_EQ(m["areas"][0]["samples"].size(), metrics.samples().size());
+  EXPECT_DOUBLE_EQ(m["areas"][0]["area_m2"].get<double>(), 36.0);
+  for (const char* key : {"agents", "density", "voronoi_density", "speed", "voronoi_speed", "speed_magnitude", "voronoi_speed_magnitude", "flow",
+                          "voronoi_flow"}) {
+    EXPECT_TRUE(m["areas"][0]["mean"].contains(key)) << key;
+    EXPECT_TRUE(m["areas"][0]["samples"][0].contains(key)) << key;
+  }
+  double densest = 0;  // everyone meets at the centre
+  for (const auto& s : m["areas"][0]["samples"]) densest = std::max(densest, s["voronoi_density"].get<double>());
+  EXPECT_GT(densest, 1.0);
+  ASSERT_EQ(m["lines"].size(), 2u);
+  const nlohmann::json& line = m["lines"][0];
+  EXPECT_EQ(line["name"], "north_south");
+  EXPECT_DOUBLE_EQ(line["width_m"].get<double>(), 60.0);
+  const std::vector<double>& t = metrics.line_times()[0].positive;
+  ASSERT_GE(t.size(), 2u);
+  EXPECT_EQ(line["positive"]["crossings"], t.size());
+  EXPECT_DOUBLE_EQ(line["positive"]["flow_per_s"].get<double>(), static_cast<double>(t.size() - 1) / (t.back() - t.front()));
+  EXPECT_DOUBLE_EQ(line["positive"]["specific_flow_per_m_s"].get<double>(), line["positive"]["flow_per_s"].get<double>() / 60.0);
+  EXPECT_EQ(line["positive"]["nt"].size(), t.size());
+  EXPECT_EQ(line["positive"]["nt"].back()[1], t.size());
+  // The fundamental diagram is the first area's, with its Voronoi values.
+  EXPECT_EQ(stats["fundamental_diagram"]["area"]["min"][0], -3.0);
+  EXPECT_TRUE(stats["fundamental_diagram"]["samples"][0].contains("voronoi_density"));
+  EXPECT_TRUE(stats["fundamental_diagram"]["samples"][0].contains("voronoi_speed"));
 }
 
 }  // namespace
