@@ -123,7 +123,7 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_slide_along_wall(glm::vec2 e0, glm::vec2
   if (into >= 0.0f) return e0;
   const glm::vec2 along = e0 - n * into;
   if (length2(along) > 0.05f * 0.05f) return normalize_or(along, along);
-  return glm::vec2(n.y, -n.x);  // the wall tangent to the right of walking into it (-n)
+  return glm::vec2(-n.y, n.x);  // the wall tangent to the right of walking into it (-n)
 }
 
 // The direction actually walked: the previous one turned towards the new one

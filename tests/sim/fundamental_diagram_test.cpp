@@ -1,0 +1,111 @@
+// The fundamental diagram of the collision-free speed model against
+// Weidmann's curve (Weidmann 1993, v0 1.34 m/s, gamma 1.913 /m^2, rho_max
+// 5.4 /m^2), in the set-up of RiMEA 3.0 test 4: a 10 m wide corridor filled
+// at a given density, everyone walking along it, speed along the corridor
+// and density measured in a 10 m x 10 m area from 10 to 70 s.
+//
+// The corridor is long and open ahead, not periodic: the measurement area
+// sits far enough behind the crowd's front (the rarefaction fan travels
+// back into the crowd at Weidmann's characteristic speed q'(rho)) and ahead
+// of its tail (which walks at v(rho)) that neither reaches it by 70 s.
+//
+// THRONG_FD_CSV=path writes the table (density, speed, Weidmann) for
+// scripts/plot_fundamental_diagram.py, which draws docs/fundamental_diagram.png.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <vector>
+
+#include "sim/metrics.h"
+#include "sim/simulation.h"
+#include "tests/sim/test_scenarios.h"
+
+namespace throng::sim {
+namespace {
+
+double weidmann(double rho) { return 1.34 * (1.0 - std::exp(-1.913 * (1.0 / rho - 1.0 / 5.4))); }
+double weidmann_slope(double rho) { return -1.34 * 1.913 / (rho * rho) * std::exp(-1.913 * (1.0 / rho - 1.0 / 5.4)); }
+
+struct Point {
+  double target = 0, density = 0, speed = 0;
+};
+
+// One density: the crowd fills [0, length] x [0, 10]; the area is centred
+// at x = X, X - 5 beyond where the tail walks by 70 s, and the fan from the
+// front needs longer than 70 s to come back to X + 5.
+Point measure(double rho) {
+  const double v = weidmann(rho), c = v + rho * weidmann_slope(rho);
+  const double X = v * 70.0 + 10.0;
+  const double length = X + 5.0 + std::max(0.0, -c * 70.0) + 10.0;
+  ScenarioSpec s;
+  s.name = "fundamental_diagram";
+  s.model.kind = ModelKind::CollisionFreeSpeed;
+  s.planning = PlanningKind::None;
+  s.dt = 0.05f;
+  s.duration = 70.0f;
+  s.world.has_walkable = true;
+  const float far = static_cast<float>(2.0 * length + 200.0);
+  s.world.walkable.outer = {{-1.0f, 0.0f}, {far, 0.0f}, {far, 10.0f}, {-1.0f, 10.0f}};
+  GroupSpec g;
+  g.count = static_cast<std::int64_t>(length * 10.0 * rho);
+  g.radius = 0.2f;
+  g.speed = {1.34f, 0.26f, 0.5f, 2.0f};  // Weidmann's free speed and its spread
+  g.spawn.kind = Region::Kind::rect;
+  g.spawn.min = {0.2f, 0.2f};
+  g.spawn.max = {static_cast<float>(length), 9.8f};
+  g.goal.kind = GoalSpec::Kind::Offset;
+  g.goal.value = {static_cast<float>(length + 150.0), 0.0f};
+  g.arrival = ArrivalBehaviour::Stop;
+  s.groups = {g};
+  Simulation sim(s);
+  const Aabb area{{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 10.0f}};
+  Point p{rho, 0, 0};
+  int samples = 0;
+  const std::int64_t per_second = static_cast<std::int64_t>(std::lround(1.0 / s.dt));
+  for (std::int64_t k = 1; k <= 70 * per_second; ++k) {
+    sim.step();
+    if (k % per_second != 0 || k < 10 * per_second) continue;
+    const CrowdState& c = sim.crowd();
+    const AreaSample a = measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), area);
+    p.density += a.density;
+    p.speed += a.mean_speed;
+    ++samples;
+  }
+  p.density /= samples;
+  p.speed /= samples;
+  return p;
+}
+
+TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
+  // Under the sanitizers, three densities across the range (same checks).
+  const std::vector<double> targets =
+      test::sanitized() ? std::vector<double>{1.0, 2.5, 4.0} : std::vector<double>{0.5, 1, 1.5, 2, 2.5, 3, 3.5, 4, 4.5, 5};
+  std::vector<Point> points;
+  double squares = 0;
+  for (double rho : targets) {
+    const Point p = measure(rho);
+    points.push_back(p);
+    const double w = weidmann(p.density);
+    squares += (p.speed - w) * (p.speed - w);
+    std::printf("  target %.1f /m2: density %.2f /m2, speed %.3f m/s (Weidmann %.3f)\n", rho, p.density, p.speed, w);
+    EXPECT_NEAR(p.density, rho, 0.15 * rho) << "the corridor was not filled as asked";
+  }
+  const double rms = std::sqrt(squares / static_cast<double>(points.size()));
+  std::printf("  RMS deviation from Weidmann: %.3f m/s over %zu densities\n", rms, points.size());
+  EXPECT_LE(rms, 0.15);
+  for (std::size_t i = 1; i < points.size(); ++i) EXPECT_LT(points[i].speed, points[i - 1].speed) << "speed must fall with density";
+  for (const Point& p : points)
+    if (p.density < 4.5) EXPECT_GT(p.speed, 0.05) << "stopped at " << p.density << " /m2";
+  if (const char* path = std::getenv("THRONG_FD_CSV")) {
+    std::ofstream out(path);
+    out << "target,density,speed,weidmann\n";
+    for (const Point& p : points) out << p.target << ',' << p.density << ',' << p.speed << ',' << weidmann(p.density) << '\n';
+  }
+}
+
+}  // namespace
+}  // namespace throng::sim
