@@ -1,11 +1,13 @@
 // The crowd simulation at scale: one step (bin, sense, steer, move) of the
 // built-in plaza (1200 m x 1200 m, 3000 obstacles) with 10^3 to 10^6 agents,
-// under both schedulers, and the naive O(N^2) reference (every agent senses
-// every other; contacts still binned) up to 10^4 agents. Items are
+// for every steering model under both schedulers, and the naive O(N^2)
+// reference (every agent senses every other; contacts still binned) up to
+// 10^4 agents. Rows: sim/plaza_step/<model>/<scheduler>. Items are
 // agent-steps, so items/s is agent-steps per second and the median ns is
 // the time of one step.
 #include <map>
 #include <memory>
+#include <string>
 #include <tuple>
 
 #include "bench/registry.h"
@@ -22,12 +24,13 @@ enum class Variant { DoubleBuffer, FourColour, AllPairs };
 // Building a plaza of 10^6 agents takes seconds: each size, variant and
 // backend is built once per process and keeps stepping across repetitions
 // (the crowd is in steady motion: agents loop between random places).
-sim::Simulation& plaza(Index n, Variant variant) {
-  static std::map<std::tuple<Index, Variant, Backend>, std::unique_ptr<sim::Simulation>> cache;
-  auto& slot = cache[{n, variant, current_backend()}];
+sim::Simulation& plaza(Index n, sim::ModelKind model, Variant variant) {
+  static std::map<std::tuple<Index, sim::ModelKind, Variant, Backend>, std::unique_ptr<sim::Simulation>> cache;
+  auto& slot = cache[{n, model, variant, current_backend()}];
   if (!slot) {
     io::LoadedScenario s = io::load_builtin_scenario("plaza");
     sim::scale_agent_counts(s.spec, n);
+    s.spec.model.kind = model;
     s.spec.scheduler = variant == Variant::FourColour ? sim::SchedulerKind::FourColour : sim::SchedulerKind::DoubleBuffer;
     sim::SimulationOptions options;
     if (variant == Variant::AllPairs) options.neighbours = sim::NeighbourSearch::AllPairs;
@@ -37,9 +40,9 @@ sim::Simulation& plaza(Index n, Variant variant) {
   return *slot;
 }
 
-Body step(Variant variant) {
-  return [variant](benchmark::State& state, Index n) {
-    sim::Simulation& sim = plaza(n, variant);
+Body step(sim::ModelKind model, Variant variant) {
+  return [model, variant](benchmark::State& state, Index n) {
+    sim::Simulation& sim = plaza(n, model, variant);
     for (auto _ : state) sim.step();
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
   };
@@ -47,9 +50,12 @@ Body step(Variant variant) {
 
 void register_sim(const Options& options) {
   const std::vector<Index> sizes = {1000, 10000, 100000, 1000000};
-  add(options, {"sim/plaza_step/double_buffer", sizes, step(Variant::DoubleBuffer), true});
-  add(options, {"sim/plaza_step/four_colour", sizes, step(Variant::FourColour), true});
-  add(options, {"sim/plaza_step/all_pairs_reference", {1000, 10000}, step(Variant::AllPairs), true});
+  for (const sim::ModelKind model : {sim::ModelKind::Priority, sim::ModelKind::CollisionFreeSpeed}) {
+    const std::string prefix = std::string("sim/plaza_step/") + sim::to_string(model);
+    add(options, {prefix + "/double_buffer", sizes, step(model, Variant::DoubleBuffer), true});
+    add(options, {prefix + "/four_colour", sizes, step(model, Variant::FourColour), true});
+    add(options, {prefix + "/all_pairs_reference", {1000, 10000}, step(model, Variant::AllPairs), true});
+  }
 }
 
 const bool registered = register_suite("sim", &register_sim);

@@ -367,7 +367,7 @@ class Reader {
                                                            "probe_margin"};
     static const std::vector<std::string_view> cfs = {"time_gap",       "neighbour_strength", "neighbour_range", "wall_strength",
                                                       "wall_range",     "avoid_strength",     "avoid_time",      "side_margin",
-                                                      "turn_time"};
+                                                      "turn_time",      "anticipation_time"};
     visit(n, path);
     if (!n.IsMap()) fail(n, path, "expected a map (model.type and its parameters), got " + kind(n));
     sim::ModelParams m;
@@ -404,6 +404,7 @@ class Reader {
     opt("avoid_time", m.cfs.avoid_time);
     opt("side_margin", m.cfs.side_margin);
     opt("turn_time", m.cfs.turn_time);
+    opt("anticipation_time", m.cfs.anticipation_time);
     if (n["contact_iterations"]) m.contact_iterations = static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
     return m;
   }

@@ -38,6 +38,7 @@ void ModelParams::validate() const {
   check_range(cfs.avoid_time, 0.0f, 100.0f, false, "model.avoid_time", "anticipation time (s)");
   check_range(cfs.side_margin, 0.0f, 10.0f, true, "model.side_margin", "anticipation side margin (m)");
   check_range(cfs.turn_time, 0.0f, 10.0f, true, "model.turn_time", "turn time (s)");
+  check_range(cfs.anticipation_time, 0.0f, 10.0f, true, "model.anticipation_time", "anticipation time (s)");
 }
 
 const char* to_string(ModelKind k) { return k == ModelKind::Priority ? "priority" : "collision_free_speed"; }

@@ -42,6 +42,7 @@ struct CollisionFreeSpeedParams {
   float avoid_time = 2.0f;          // s: how far ahead oncoming neighbours are anticipated
   float side_margin = 0.2f;         // m: an oncoming neighbour counts when its centre is within l + this of our line
   float turn_time = 0.3f;           // s: the walking direction turns towards the wanted one over about this
+  float anticipation_time = 0.0f;   // s: the gap ahead is measured to where neighbours will be after this
 };
 
 // The steering model and its parameters, and those of the move stage.

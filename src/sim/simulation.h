@@ -1,9 +1,13 @@
 // One crowd simulation: world, crowd state, bins and the per-step stages of
 // the perception layer, in the order of the frame (../shared/DESIGN.md):
 //   1 bin    agents into uniform bins by a counting sort (grid.h)
-//   2 sense  per agent, the higher-priority force: obstacle avoidance from
-//            the probe, else agent avoidance from the 3x3 bins (sense.h)
-//   3 steer  path following when nothing was sensed, then integration
+//   2 sense  per agent, what the scenario's model (ModelParams::kind) makes
+//            of its neighbours in the 3x3 bins and the walls nearby
+//            (sense.h). Priority: the higher-priority force, obstacle
+//            avoidance from the probe else agent avoidance. Collision-free
+//            speed: the new velocity (collision_free_speed.h).
+//   3 steer  priority: path following when nothing was sensed, then
+//            integration; collision-free speed: the sensed velocity
 //   4 move   contact passes and wall projection, accept or reject the move,
 //            velocity, heading, arrivals and waypoints
 // under one of two schedulers:
@@ -78,8 +82,8 @@ struct StepContext {
 };
 
 // Stages (each one or more parallel_for launches named "sim.<stage>...").
-// Double buffer: the sensed force of every binned (active) agent, then
-// candidate positions.
+// Double buffer: what the model senses for every binned (active) agent (a
+// force, or the collision-free velocity), then candidate positions.
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
 // The naive reference for the sense stage: every agent against every other,
 // O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
