@@ -34,11 +34,14 @@ struct Case {
   Index agents;
   SchedulerKind scheduler;
   NeighbourSearch neighbours;
+  ModelKind model = ModelKind::Priority;
 };
 
 void expect_one_step_matches(const Case& c) {
-  SCOPED_TRACE(std::string(c.scenario) + ", " + to_string(c.scheduler) + (c.neighbours == NeighbourSearch::AllPairs ? ", all pairs" : ""));
-  const ScenarioSpec spec = test::builtin(c.scenario, c.agents);
+  SCOPED_TRACE(std::string(c.scenario) + ", " + to_string(c.scheduler) + (c.neighbours == NeighbourSearch::AllPairs ? ", all pairs" : "") +
+               ", " + to_string(c.model));
+  ScenarioSpec spec = test::builtin(c.scenario, c.agents);
+  spec.model.kind = c.model;
   const auto run = [&](Memory) { return run_steps(spec, c.scheduler, c.neighbours, 1); };
   const State cpu = gpu_test::run_on(gpu_test::cpu_side(), run);
   const State gpu = gpu_test::run_on(gpu_test::device_side(), run);
@@ -76,7 +79,12 @@ TEST(CudaSimulation, OneStepMatchesCpu) {
                         Case{"crossing", 1000, SchedulerKind::FourColour, NeighbourSearch::Bins},
                         Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins},
                         Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins},
-                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs}})
+                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs},
+                        // The collision-free speed model: sums of exponentials over neighbours (expf
+                        // differs by an ulp or two between the backends), the same bounds.
+                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
+                        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
+                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs, ModelKind::CollisionFreeSpeed}})
     expect_one_step_matches(c);
 }
 
