@@ -9,6 +9,12 @@
 // back into the crowd at Weidmann's characteristic speed q'(rho)) and ahead
 // of its tail (which walks at v(rho)) that neither reaches it by 70 s.
 //
+// Single file: the same model in a 0.5 m wide corridor, against the linear
+// relation between headway and speed that Seyfried, Steffen, Klingsch and
+// Boltzmann (2005, "The fundamental diagram of pedestrian movement
+// revisited", J. Stat. Mech. P10002) measured in single-file experiments:
+// d = 0.36 m + 1.06 s * v, for headways d = 1/rho (rho per metre).
+//
 // THRONG_FD_CSV=path writes the table (density, speed, Weidmann) for
 // scripts/plot_fundamental_diagram.py, which draws docs/fundamental_diagram.png.
 #include <gtest/gtest.h>
@@ -105,6 +111,73 @@ TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
     out << "target,density,speed,weidmann\n";
     for (const Point& p : points) out << p.target << ',' << p.density << ',' << p.speed << ',' << weidmann(p.density) << '\n';
   }
+}
+
+// Seyfried et al. 2005: the speed at headway d, within [0, v0].
+double seyfried_single_file(double rho, double v0) { return std::clamp((1.0 / rho - 0.36) / 1.06, 0.0, v0); }
+
+// One line density (per metre): agents exactly `1 / rho` apart along the
+// middle of a 0.5 m corridor, all at 1.34 m/s (in single file the slowest
+// would lead everyone), measured over 10 m from 10 to 70 s; the corridor is
+// sized as above (the fan from the front travels back at most at half the
+// free speed here).
+Point measure_single_file(double rho) {
+  // The tail may walk faster than the relation says: size for the free speed.
+  const double d = 1.0 / rho;
+  const double X = 1.34 * 70.0 + 10.0, length = X + 5.0 + 1.34 * 70.0 * 0.5 + 10.0;
+  ScenarioSpec s;
+  s.name = "single_file";
+  s.model.kind = ModelKind::CollisionFreeSpeed;
+  s.planning = PlanningKind::None;
+  s.dt = 0.05f;
+  s.duration = 70.0f;
+  s.world.has_walkable = true;
+  const float far = static_cast<float>(2.0 * length + 200.0);
+  s.world.walkable.outer = {{-1.0f, 0.0f}, {far, 0.0f}, {far, 0.5f}, {-1.0f, 0.5f}};
+  GroupSpec g;
+  g.radius = 0.2f;
+  g.speed = {1.34f, 0.0f, 1.34f, 1.34f};
+  g.spawn.kind = Region::Kind::points;
+  for (double x = 0.3; x < length; x += d) g.spawn.points.push_back({static_cast<float>(x), 0.25f});
+  g.count = static_cast<std::int64_t>(g.spawn.points.size());
+  g.goal.kind = GoalSpec::Kind::Offset;
+  g.goal.value = {static_cast<float>(length + 150.0), 0.0f};
+  s.groups = {g};
+  Simulation sim(s);
+  const Aabb area{{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 0.5f}};
+  Point p{rho, 0, 0};
+  int samples = 0;
+  for (std::int64_t k = 1; k <= 1400; ++k) {
+    sim.step();
+    if (k % 20 != 0 || k < 200) continue;
+    const CrowdState& c = sim.crowd();
+    const AreaSample a = measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), area);
+    p.density += static_cast<double>(a.agents) / 10.0;  // per metre of corridor
+    p.speed += a.mean_speed;
+    ++samples;
+  }
+  p.density /= samples;
+  p.speed /= samples;
+  return p;
+}
+
+TEST(FundamentalDiagram, CollisionFreeSpeedSingleFileFollowsSeyfried2005) {
+  double squares = 0;
+  int n = 0;
+  double previous = INFINITY;
+  for (double rho : {0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0}) {
+    const Point p = measure_single_file(rho);
+    const double want = seyfried_single_file(p.density, 1.34);
+    squares += (p.speed - want) * (p.speed - want);
+    ++n;
+    std::printf("  %.1f /m: measured %.2f /m, speed %.3f m/s (Seyfried et al. %.3f)\n", rho, p.density, p.speed, want);
+    EXPECT_NEAR(p.density, rho, 0.1 * rho);
+    EXPECT_LT(p.speed, previous + 1e-3) << "speed must not rise with density";
+    previous = p.speed;
+  }
+  const double rms = std::sqrt(squares / n);
+  std::printf("  RMS deviation from the single-file relation: %.3f m/s\n", rms);
+  EXPECT_LE(rms, 0.15);
 }
 
 }  // namespace
