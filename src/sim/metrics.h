@@ -147,6 +147,23 @@ struct LineFlow {
 };
 LineFlow line_flow(std::span<const double> times, double width);
 
+// Lane order of a counterflow along `axis` (unit vector), after Rex and
+// Loewen (2007, Phys. Rev. E 75, 051402): for each active agent j, the
+// active agents within `band` of its line along the axis (|lateral| < band)
+// and within `reach` along it are counted as walking the same way (n_s) or
+// the other way (n_o), by the sign of (goal - position) . axis;
+// phi_j = ((n_s - n_o) / (n_s + n_o))^2, and the order is the mean of phi_j
+// over agents with at least one such neighbour. 1: every agent sees only its
+// own direction in its lane (lanes); a well-mixed crowd gives about
+// 1 / (neighbours in the band). Host values; O(N^2), for measurement areas
+// of a few thousand agents.
+struct LaneOrder {
+  double order = 0;   // mean phi_j (0 when no agent has neighbours in its band)
+  Index counted = 0;  // agents with at least one neighbour in their band
+};
+LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<glm::vec2>& goals, const std::vector<std::uint8_t>& flags,
+                     glm::vec2 axis, float band, float reach);
+
 // Mean speed of active agents.
 double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> flags);
 

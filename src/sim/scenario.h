@@ -38,9 +38,9 @@ struct CollisionFreeSpeedParams {
   float neighbour_range = 0.1f;     // m: D, its decay length
   float wall_strength = 5.0f;       // b: wall repulsion at contact
   float wall_range = 0.02f;         // m: Dw
-  float avoid_strength = 1.0f;      // k: sideways push from an oncoming neighbour about to meet us (0 = off)
-  float avoid_time = 2.0f;          // s: how far ahead oncoming neighbours are anticipated
-  float side_margin = 0.2f;         // m: an oncoming neighbour counts when its centre is within l + this of our line
+  float avoid_strength = 3.0f;      // k: sideways push from an oncoming neighbour about to meet us (0 = off)
+  float avoid_time = 4.0f;          // s: how far ahead oncoming neighbours are anticipated
+  float side_margin = 0.5f;         // m: an oncoming neighbour counts when its centre is within l + this of our line
   float turn_time = 0.3f;           // s: the walking direction turns towards the wanted one over about this
   float anticipation_time = 0.0f;   // s: the gap ahead is measured to where neighbours will be after this
 };

@@ -44,9 +44,9 @@ struct Point {
 // at x = X, X - 5 beyond where the tail walks by 70 s, and the fan from the
 // front needs longer than 70 s to come back to X + 5.
 Point measure(double rho) {
-  const double v = weidmann(rho), c = v + rho * weidmann_slope(rho);
+  const double v = weidmann(rho), fan = v + rho * weidmann_slope(rho);
   const double X = v * 70.0 + 10.0;
-  const double length = X + 5.0 + std::max(0.0, -c * 70.0) + 10.0;
+  const double length = X + 5.0 + std::max(0.0, -fan * 70.0) + 10.0;
   ScenarioSpec s;
   s.name = "fundamental_diagram";
   s.model.kind = ModelKind::CollisionFreeSpeed;
@@ -104,8 +104,9 @@ TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
   std::printf("  RMS deviation from Weidmann: %.3f m/s over %zu densities\n", rms, points.size());
   EXPECT_LE(rms, 0.15);
   for (std::size_t i = 1; i < points.size(); ++i) EXPECT_LT(points[i].speed, points[i - 1].speed) << "speed must fall with density";
-  for (const Point& p : points)
+  for (const Point& p : points) {
     if (p.density < 4.5) EXPECT_GT(p.speed, 0.05) << "stopped at " << p.density << " /m2";
+  }
   if (const char* path = std::getenv("THRONG_FD_CSV")) {
     std::ofstream out(path);
     out << "target,density,speed,weidmann\n";
