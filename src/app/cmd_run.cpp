@@ -157,6 +157,12 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
               100.0 * ov["tolerance_m"].get<double>(), ov["max_pairs"].get<long long>(), 100.0 * ov["max_depth_m"].get<double>(),
               crowd["min_separation_m"].is_null() ? "n/a" : fmt::format("{:.3f} m", crowd["min_separation_m"].get<double>()).c_str(),
               crowd["obstacle_penetrations"]["max"].get<long long>());
+  const auto& stuck = stats["stuck_agents"];
+  std::printf("  stuck agents (at rest over %.0f s with the way ahead free): %lld", stuck["threshold_s"].get<double>(),
+              stuck["agents"].get<long long>());
+  if (stuck["agents"].get<long long>() > 0)
+    std::printf(" (at most %lld at once, first at %.1f s)", stuck["max_at_once"].get<long long>(), stuck["first_time_s"].get<double>());
+  std::printf("\n");
   const bool colour = sim.scheduler() == sim::SchedulerKind::FourColour;
   std::printf("  ms per step: %.3f (bin %.3f, %s %.3f, move %.3f)\n", stats["timings"]["step_ms"].get<double>(), stage_ms(stats, "sim.bin"),
               colour ? "sense+steer" : "sense", colour ? stage_ms(stats, "sim.sense_steer") : stage_ms(stats, "sim.sense"),

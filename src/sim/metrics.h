@@ -1,7 +1,8 @@
 // Crowd metrics as library functions (tests and stats.json use them): pair
 // overlaps, obstacle penetrations, arrivals, speed and density in a
 // measurement area (the fundamental diagram, classic and Voronoi), crossings
-// of measurement lines (flow by the N-t curve), a local density histogram.
+// of measurement lines (flow by the N-t curve), a local density histogram,
+// agents stuck at rest in free space.
 // Spans in current_memory() unless said otherwise; every reduction is
 // deterministic.
 #pragma once
@@ -18,6 +19,8 @@
 #include "sim/world.h"
 
 namespace throng::sim {
+
+class Simulation;
 
 struct OverlapStats {
   Index touching = 0;         // pairs overlapping at all (discs closer than the sum of radii)
@@ -177,5 +180,63 @@ struct DensityHistogram {
   std::array<std::int64_t, kDensityBins> agents{};
 };
 DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, float cell = 2.0f, float bin_width = 0.5f);
+
+// Stuck agents. An agent is stuck when, for more than `threshold_s` of
+// simulated time in a row, it is active, still steering (not kAgentStopped),
+// at rest (|v| below `speed_below`) and the way ahead of it is free: the
+// probe, a disc of the agent's radius r centred at p + (r + gap) * unit(goal
+// - p) (goal: the end of its current leg), overlaps no other active agent's
+// disc and enters no obstacle (disc_is_clear with no tolerance). An agent
+// waiting in a queue has someone in its probe and is not stuck; one frozen
+// in free space (forces that cancel, a wall corner beside a free way to its
+// goal) is. An agent standing on its goal has no way ahead and is not
+// counted. Time at rest is counted in whole steps: with dt 0.1 s an agent is
+// stuck from its 51st step in a row (5.1 s > 5 s).
+struct StuckOptions {
+  double threshold_s = 5.0;
+  double speed_below = 0.1;  // m/s
+  double gap = 0.3;          // m from the agent's centre to the near edge of the probe
+};
+inline constexpr std::size_t kStuckExamples = 10;
+struct StuckExample {
+  Index agent = 0;
+  double time = 0;        // s, when it became stuck the first time
+  glm::vec2 position{};  // where
+};
+struct StuckStats {
+  Index agents = 0;        // distinct agents ever stuck
+  Index now = 0;           // stuck at the last update
+  Index max_at_once = 0;   // most stuck at one update
+  double first_time = -1;  // s, when the first became stuck; -1 while none has
+  std::vector<StuckExample> examples;  // the first kStuckExamples to become stuck, by time, then agent
+};
+// Follows the crowd step by step: update() once after every step. Per-agent
+// counters in current_memory(), updated by parallel_for: the same figures
+// for any thread count or backend. Agents added between updates (a growing
+// crowd) start with no time at rest.
+class StuckTracker {
+ public:
+  explicit StuckTracker(StuckOptions options = {}) : options_(options) {}
+  // The step of length dt that ended at `time`. Spans in current_memory();
+  // `reach` (>= twice the largest radius) sizes the bins of the probe.
+  void update(const World& world, Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> radii,
+              Span<const glm::vec2> goals, Span<const std::uint8_t> flags, float reach, double time, double dt);
+  // The simulation's last step.
+  void update(const Simulation& sim);
+  const StuckOptions& options() const { return options_; }
+  const StuckStats& stats() const { return stats_; }
+  // Steps in a row each agent has been at rest with its way free (host copy).
+  std::vector<std::int32_t> rest_steps() const { return rest_.to_vector(); }
+  // Steps in a row at rest that make an agent stuck: the fewest whose time
+  // exceeds threshold_s.
+  std::int32_t threshold_steps(double dt) const;
+
+ private:
+  StuckOptions options_;
+  AgentGrid bins_;
+  Buffer<std::int32_t> rest_;  // steps in a row at rest with the way free
+  Buffer<std::uint8_t> state_;  // kStuck* bits (metrics_stuck.cpp)
+  StuckStats stats_;
+};
 
 }  // namespace throng::sim

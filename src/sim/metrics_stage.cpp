@@ -24,7 +24,8 @@ Aabb default_measurement_area(const Simulation& sim) {
   return a;
 }
 
-CrowdMetricsStage::CrowdMetricsStage(const Simulation& sim, MetricsOptions options) : options_(std::move(options)) {
+CrowdMetricsStage::CrowdMetricsStage(const Simulation& sim, MetricsOptions options)
+    : options_(std::move(options)), stuck_(options_.stuck) {
   if (options_.sample_every < 1) throw Error("must be >= 1", at_field("metrics.sample_every"));
   if (!(options_.density_bin_width > 0)) throw Error("must be > 0", at_field("metrics.density_bin_width"));
   MeasurementSpec& m = options_.measurement;
@@ -76,8 +77,13 @@ void CrowdMetricsStage::record_crossings(const Simulation& sim, const FrameInfo&
 }
 
 void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame) {
-  // Crossings need every step; the rest is sampled.
+  // Crossings and stuck agents need every step; the rest is sampled.
   record_crossings(sim, frame);
+  // Frame 0 is the initial state: no step, no velocity measured yet.
+  if (frame.frame > stuck_frame_) {
+    stuck_.update(sim);
+    stuck_frame_ = frame.frame;
+  }
   if (frame.frame % options_.sample_every != 0 && !frame.last) return;
   const CrowdState& c = sim.crowd();
   Sample s;
@@ -176,6 +182,22 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
                                   {"bins", diagram},
                                   {"samples", series}};
   stats["measurement"] = measurement_section();
+  stats["stuck_agents"] = stuck_section();
+}
+
+nlohmann::json CrowdMetricsStage::stuck_section() const {
+  const StuckOptions& o = stuck_.options();
+  const StuckStats& s = stuck_.stats();
+  nlohmann::json examples = nlohmann::json::array();
+  for (const StuckExample& e : s.examples) examples.push_back({{"agent", e.agent}, {"time_s", e.time}, {"position", {e.position.x, e.position.y}}});
+  return {{"threshold_s", o.threshold_s},
+          {"speed_below", o.speed_below},
+          {"probe_gap_m", o.gap},
+          {"agents", s.agents},
+          {"at_end", s.now},
+          {"max_at_once", s.max_at_once},
+          {"first_time_s", s.agents > 0 ? nlohmann::json(s.first_time) : nlohmann::json(nullptr)},
+          {"examples", examples}};
 }
 
 nlohmann::json CrowdMetricsStage::area_sample_json(double time, const AreaMeasure& m) {

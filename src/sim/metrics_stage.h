@@ -1,8 +1,8 @@
 // The metrics of a run as a frame stage: samples the crowd every few frames
 // (and at the last frame) with the metric functions of metrics.h, records
-// every crossing of the measurement lines at every step, and writes the
-// "crowd", "density_histogram", "fundamental_diagram" and "measurement"
-// sections of stats.json.
+// every crossing of the measurement lines and the stuck agents at every
+// step, and writes the "crowd", "stuck_agents", "density_histogram",
+// "fundamental_diagram" and "measurement" sections of stats.json.
 #pragma once
 
 #include <cstdint>
@@ -18,6 +18,7 @@ struct MetricsOptions {
   float overlap_tolerance = 0.05f;      // m: pair overlaps deeper than this count
   float penetration_tolerance = 1e-3f;  // m: obstacle penetrations deeper than this count
   MeasurementSpec measurement;          // areas and lines (map); no areas = default_measurement_area
+  StuckOptions stuck;                   // what counts as a stuck agent
   float density_bin_width = 0.25f;      // agents/m^2 per fundamental-diagram bin
 };
 
@@ -54,10 +55,12 @@ class CrowdMetricsStage : public FrameStage {
   const std::vector<Sample>& samples() const { return samples_; }
   const std::vector<MeasurementArea>& areas() const { return options_.measurement.areas; }
   const std::vector<LineTimes>& line_times() const { return line_times_; }
+  const StuckStats& stuck() const { return stuck_.stats(); }
 
  private:
   void record_crossings(const Simulation& sim, const FrameInfo& frame);
   nlohmann::json measurement_section() const;
+  nlohmann::json stuck_section() const;
   // One sample of an area: classic and Voronoi values side by side.
   static nlohmann::json area_sample_json(double time, const AreaMeasure& m);
 
@@ -73,6 +76,9 @@ class CrowdMetricsStage : public FrameStage {
   double previous_time_ = 0;
   std::int64_t previous_frame_ = -1;
   std::vector<LineTimes> line_times_;
+  // Stuck agents need every step too (time at rest is counted in steps).
+  StuckTracker stuck_;
+  std::int64_t stuck_frame_ = 0;
 };
 
 }  // namespace throng::sim

@@ -125,6 +125,7 @@ TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
   EXPECT_NE(o.out.find("circle: 50 agents, 120 steps"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("arrived"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("obstacle penetrations 0"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("stuck agents (at rest over 5 s with the way ahead free): 0"), std::string::npos) << o.out;
 
   const std::map<long, int> rows = read_trajectories(dir_ / "trajectories.csv", 50);
   std::map<long, int> want;
@@ -132,7 +133,7 @@ TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
   EXPECT_EQ(rows, want);
 
   const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "stats.json"));
-  for (const char* section : {"run", "timings", "crowd", "density_histogram", "fundamental_diagram", "trajectories", "scenario"})
+  for (const char* section : {"run", "timings", "crowd", "stuck_agents", "density_histogram", "fundamental_diagram", "trajectories", "scenario"})
     EXPECT_TRUE(stats.contains(section)) << section;
   EXPECT_EQ(stats["run"]["steps"], 120);
   EXPECT_EQ(stats["run"]["agents"], 50);
@@ -140,6 +141,13 @@ TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
   EXPECT_FALSE(stats["run"]["interrupted"].get<bool>());
   EXPECT_EQ(stats["crowd"]["agents"], 50);
   EXPECT_EQ(stats["crowd"]["obstacle_penetrations"]["max"], 0);
+  const nlohmann::json& stuck = stats["stuck_agents"];
+  EXPECT_EQ(stuck["threshold_s"], 5.0);
+  EXPECT_EQ(stuck["speed_below"], 0.1);
+  EXPECT_EQ(stuck["agents"], 0);
+  EXPECT_EQ(stuck["max_at_once"], 0);
+  EXPECT_TRUE(stuck["first_time_s"].is_null());
+  EXPECT_TRUE(stuck["examples"].is_array() && stuck["examples"].empty());
   EXPECT_EQ(stats["trajectories"]["rows"], 13 * 50);
   for (const char* stage : {"sim.bin", "sim.sense", "sim.steer", "sim.move", "emit.trajectories", "sim.metrics"})
     EXPECT_TRUE(stats["timings"]["stages"].contains(stage)) << stage;

@@ -2,9 +2,11 @@
 // runs them: io::load_builtin_scenario + io::build_simulation, so with the
 // route planner where the file asks for it), resized to a few hundred agents
 // and run to the scenario's end. At every step: every position finite, no
-// agent in an obstacle, no overlap beyond the model's bound. At the end:
+// agent in an obstacle, no overlap beyond the model's bound, no agent stuck
+// (StuckTracker: at rest over 5 s with the way ahead free). At the end:
 // measurable progress towards the goals, and where the scenario ends with
 // its agents at their goals, the arrivals.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -120,6 +122,7 @@ struct Outcome {
   double moved = 0;           // mean distance between start and end positions
   double progress_seconds = 0;
   Index expected_active = 0;  // agents that should still be active: all but those arrived in a despawn group
+  StuckStats stuck;
 };
 
 // Each agent's final goal (the waypoint whose arrival counts as arriving).
@@ -175,6 +178,7 @@ Outcome run_builtin(const std::string& name, std::int64_t agents) {
   const std::int64_t steps = l.spec.step_count();
   const auto progress_step = static_cast<std::int64_t>(std::lround(kProgressSeconds / static_cast<double>(l.spec.dt)));
   bool progress_taken = false;
+  StuckTracker stuck;
   while (r.steps < steps && !(l.spec.stop_when_arrived && sim->all_arrived())) {
     sim->step();
     ++r.steps;
@@ -185,6 +189,7 @@ Outcome run_builtin(const std::string& name, std::int64_t agents) {
     const OverlapStats o = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), kOverlapTolerance, sim->contact_cell());
     r.max_overlap_depth = std::max(r.max_overlap_depth, o.max_depth);
     r.max_deep_pairs = std::max(r.max_deep_pairs, o.pairs);
+    stuck.update(*sim);
     if (r.steps == progress_step) {
       progress_now();
       progress_taken = true;
@@ -200,6 +205,7 @@ Outcome run_builtin(const std::string& name, std::int64_t agents) {
     const bool left = (flags[i] & kAgentArrived) != 0 && l.spec.groups[static_cast<std::size_t>(group[i])].arrival == ArrivalBehaviour::Despawn;
     r.expected_active += left ? 0 : 1;
   }
+  r.stuck = stuck.stats();
   r.seconds = sim->time();
   const auto end = sim->positions();
   for (std::size_t i = 0; i < end.size(); ++i) r.moved += static_cast<double>(length_of(end[i] - start[i]));
@@ -224,10 +230,16 @@ TEST_P(BuiltinOutcome, RunsToItsEndWithProgressArrivalsAndNoCollisions) {
       name.c_str(), static_cast<long long>(r.agents), static_cast<long long>(r.steps), r.seconds, static_cast<long long>(r.arrived),
       static_cast<long long>(r.active_end), r.start_distance, r.end_distance, r.progress, r.progress_seconds, r.advancing, r.moved,
       static_cast<double>(r.max_overlap_depth), static_cast<long long>(r.max_deep_pairs), static_cast<long long>(r.max_penetrations));
+  std::string stuck_where;
+  for (const StuckExample& x : r.stuck.examples)
+    stuck_where += fmt::format(" agent {} at {:.1f} s at ({:.2f}, {:.2f});", x.agent, x.time, x.position.x, x.position.y);
+  std::printf("  %s stuck agents: %lld (at most %lld at once, first at %.1f s)%s\n", name.c_str(), static_cast<long long>(r.stuck.agents),
+              static_cast<long long>(r.stuck.max_at_once), r.stuck.first_time, stuck_where.c_str());
   EXPECT_EQ(r.agents, std::min<std::int64_t>(n, io::load_builtin_scenario(name).spec.total_agents()));
   EXPECT_GT(r.steps, 0);
   EXPECT_EQ(r.non_finite, 0);
   EXPECT_EQ(r.max_penetrations, 0) << "in " << r.penetration_steps << " steps";
+  EXPECT_EQ(r.stuck.agents, 0) << stuck_where;
   EXPECT_LT(r.max_overlap_depth, kOverlapLimit);
   EXPECT_LE(static_cast<double>(r.max_deep_pairs), kDeepPairFraction * static_cast<double>(r.agents));
   EXPECT_GT(r.moved, 0.0);
