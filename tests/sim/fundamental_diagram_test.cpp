@@ -105,7 +105,9 @@ TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
   EXPECT_LE(rms, 0.15);
   for (std::size_t i = 1; i < points.size(); ++i) EXPECT_LT(points[i].speed, points[i - 1].speed) << "speed must fall with density";
   for (const Point& p : points) {
-    if (p.density < 4.5) EXPECT_GT(p.speed, 0.05) << "stopped at " << p.density << " /m2";
+    if (p.density < 4.5) {
+      EXPECT_GT(p.speed, 0.05) << "stopped at " << p.density << " /m2";
+    }
   }
   if (const char* path = std::getenv("THRONG_FD_CSV")) {
     std::ofstream out(path);
