@@ -1,0 +1,103 @@
+// Bottleneck flow under the collision-free speed model: a 10 m x 10 m room
+// holding 150 agents (r = 0.2 m) empties through a door of width 0.5 to
+// 2.4 m in a 0.4 m thick wall. Flow by the N-t curve of a line across the
+// door (method A of Liao et al. 2014). Every agent must leave, no two may
+// overlap by more than 5 cm at any step, and the flow must grow with the
+// width. Laboratory flows are higher (about 1.9 P/(m s), Seyfried et al.
+// 2009; docs/simulation.md): the bounds here guard the measured 1.05-1.2
+// P/(m s) of this model, fitted to Weidmann's curve, whose capacity is 1.22.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "sim/metrics.h"
+#include "sim/simulation.h"
+#include "tests/sim/test_scenarios.h"
+
+namespace throng::sim {
+namespace {
+
+struct DoorRun {
+  Index agents = 0, left = 0;
+  float deepest = 0.0f;
+  LineFlow flow;
+};
+
+DoorRun empty_room(float width, std::int64_t agents) {
+  const float lo = 5.0f - 0.5f * width, hi = 5.0f + 0.5f * width;
+  ScenarioSpec s;
+  s.name = "door";
+  s.model.kind = ModelKind::CollisionFreeSpeed;
+  s.planning = PlanningKind::None;
+  s.dt = 0.05f;
+  s.duration = 400.0f;
+  s.world.has_walkable = true;
+  s.world.walkable.outer = {{0, 0},      {10, 0},     {10, lo},  {10.4f, lo}, {10.4f, -10}, {30, -10},
+                            {30, 20},    {10.4f, 20}, {10.4f, hi}, {10, hi},  {10, 10},     {0, 10}};
+  GroupSpec g;
+  g.count = agents;
+  g.radius = 0.2f;
+  g.speed = {1.34f, 0.26f, 0.5f, 2.0f};
+  g.spawn.kind = Region::Kind::rect;
+  g.spawn.min = {0.3f, 0.3f};
+  g.spawn.max = {9.0f, 9.7f};
+  g.waypoints = {{GoalSpec::Kind::Point, {11.0f, 5.0f}, {}}};
+  g.goal.kind = GoalSpec::Kind::Random;
+  g.goal.region.kind = Region::Kind::rect;
+  g.goal.region.min = {25.0f, -8.0f};
+  g.goal.region.max = {29.0f, 18.0f};
+  g.arrival = ArrivalBehaviour::Despawn;
+  s.groups = {g};
+  Simulation sim(s);
+  DoorRun r;
+  r.agents = sim.agent_count();
+  const glm::vec2 a(10.2f, lo), b(10.2f, hi);
+  std::vector<double> times;
+  std::vector<glm::vec2> before = sim.positions();
+  std::vector<std::uint8_t> was = sim.flags();
+  while (!sim.all_arrived() && sim.time() < 400.0) {
+    const double t0 = sim.time();
+    sim.step();
+    const std::vector<glm::vec2> after = sim.positions();
+    const std::vector<std::uint8_t> is = sim.flags();
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      double f = 0;
+      if ((was[i] & kAgentActive) != 0 && (is[i] & kAgentActive) != 0 && step_crossing(before[i], after[i], a, b, &f) != 0)
+        times.push_back(t0 + f * s.dt);
+    }
+    before = after;
+    was = is;
+    const CrowdState& c = sim.crowd();
+    r.deepest = std::max(r.deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
+  }
+  std::sort(times.begin(), times.end());
+  r.left = sim.arrived_count();
+  r.flow = line_flow(times, width);
+  return r;
+}
+
+TEST(Bottleneck, CollisionFreeSpeedEmptiesARoomThroughDoorsOfEveryWidth) {
+  const std::vector<float> widths = test::sanitized() ? std::vector<float>{0.8f, 1.6f} : std::vector<float>{0.5f, 0.8f, 1.2f, 1.6f, 2.4f};
+  const std::int64_t agents = test::sanitized() ? 60 : 150;
+  double previous = 0;
+  for (float w : widths) {
+    SCOPED_TRACE(w);
+    const DoorRun r = empty_room(w, agents);
+    std::printf("  door %.1f m: %lld of %lld out, flow %.2f P/s (%.2f P/(m s)), deepest overlap %.3f m\n", w, static_cast<long long>(r.left),
+                static_cast<long long>(r.agents), r.flow.flow, r.flow.specific_flow, r.deepest);
+    EXPECT_EQ(r.left, r.agents);
+    EXPECT_EQ(r.flow.crossings, r.agents);  // each crosses the door line once
+    EXPECT_LE(r.deepest, 0.05f);
+    EXPECT_GT(r.flow.flow, previous) << "flow must grow with the door's width";
+    previous = r.flow.flow;
+    if (w >= 0.8f) {
+      EXPECT_GE(r.flow.specific_flow, 0.9);
+      EXPECT_LE(r.flow.specific_flow, 1.5);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace throng::sim
