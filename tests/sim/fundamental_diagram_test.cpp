@@ -87,9 +87,10 @@ Point measure(double rho) {
 }
 
 TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
-  // Under the sanitizers, three densities across the range (same checks).
+  // Under the sanitizers (several times slower), two densities (the same
+  // checks; 3 minutes with three).
   const std::vector<double> targets =
-      test::sanitized() ? std::vector<double>{1.0, 2.5, 4.0} : std::vector<double>{0.5, 1, 1.5, 2, 2.5, 3, 3.5, 4, 4.5, 5};
+      test::sanitized() ? std::vector<double>{1.0, 3.0} : std::vector<double>{0.5, 1, 1.5, 2, 2.5, 3, 3.5, 4, 4.5, 5};
   std::vector<Point> points;
   double squares = 0;
   for (double rho : targets) {
