@@ -144,10 +144,10 @@ double stage_ms(const nlohmann::json& stats, const char* stage) {
 void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nlohmann::json& stats, const std::string& written) {
   const auto& crowd = stats["crowd"];
   const double agent_steps = static_cast<double>(r.steps) * static_cast<double>(sim.agent_count());
-  std::printf("%s: %lld agents, %lld steps (%.1f s simulated) in %.2f s: %.3g agent-steps/s, %s, %s x%d%s\n", sim.spec().name.c_str(),
-              static_cast<long long>(sim.agent_count()), static_cast<long long>(r.steps), r.simulated_seconds, r.wall_seconds,
-              r.wall_seconds > 0 ? agent_steps / r.wall_seconds : 0.0, to_string(sim.scheduler()), to_string(current_backend()),
-              current_threads(), r.interrupted ? " (interrupted)" : "");
+  std::printf("%s: %lld agents, %lld steps (%.1f s simulated) in %.2f s: %.3g agent-steps/s, %s model, %s, %s x%d%s\n",
+              sim.spec().name.c_str(), static_cast<long long>(sim.agent_count()), static_cast<long long>(r.steps), r.simulated_seconds,
+              r.wall_seconds, r.wall_seconds > 0 ? agent_steps / r.wall_seconds : 0.0, to_string(sim.spec().model.kind),
+              to_string(sim.scheduler()), to_string(current_backend()), current_threads(), r.interrupted ? " (interrupted)" : "");
   const auto& at = crowd["arrival_time_s"];
   std::printf("  arrived %lld/%lld", crowd["arrived"].get<long long>(), static_cast<long long>(sim.agent_count()));
   if (crowd["arrived"].get<long long>() > 0) std::printf(" (mean %.1f s, last %.1f s)", at["mean"].get<double>(), at["max"].get<double>());
@@ -193,9 +193,10 @@ void run_scenario(const RunOptions& o) {
   if (o.seconds > 0) max_steps = static_cast<std::int64_t>(std::ceil(o.seconds / static_cast<double>(spec.dt) - 1e-9));
   if (max_steps > sim::ScenarioLimits{}.max_steps) throw Error("too many steps", at_field("--steps"));
 
-  std::fprintf(stderr, "throng run: %s (%s): %lld agents, up to %lld steps of %.3g s, %s, %s x%d\n", spec.name.c_str(),
+  std::fprintf(stderr, "throng run: %s (%s): %lld agents, up to %lld steps of %.3g s, %s model, %s, %s x%d\n", spec.name.c_str(),
                loaded.source.file.c_str(), static_cast<long long>(spec.total_agents()), static_cast<long long>(max_steps),
-               static_cast<double>(spec.dt), to_string(spec.scheduler), to_string(current_backend()), current_threads());
+               static_cast<double>(spec.dt), to_string(spec.model.kind), to_string(spec.scheduler), to_string(current_backend()),
+               current_threads());
   const auto setup_start = std::chrono::steady_clock::now();
   KernelTimings::global().reset();
   std::unique_ptr<sim::Simulation> sim = io::build_simulation(loaded);

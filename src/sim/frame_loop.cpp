@@ -61,6 +61,7 @@ void FrameLoop::finish(nlohmann::json& stats) {
                   {"simulated_seconds", result_.simulated_seconds},
                   {"wall_seconds", result_.wall_seconds},
                   {"seed", spec.seed},
+                  {"model", to_string(spec.model.kind)},
                   {"scheduler", to_string(sim_.scheduler())},
                   {"backend", to_string(current_backend())},
                   {"threads", current_threads()},

@@ -123,6 +123,7 @@ TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
   const Outcome o = run({"--threads", "2", "run", "circle", "--agents", "50", "--steps", "120", "--every", "10", "--out", dir_.string(), "--quiet"});
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_NE(o.out.find("circle: 50 agents, 120 steps"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("priority model, double_buffer"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("arrived"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("obstacle penetrations 0"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("stuck agents (at rest over 5 s with the way ahead free): 0"), std::string::npos) << o.out;
@@ -138,6 +139,7 @@ TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
   EXPECT_EQ(stats["run"]["steps"], 120);
   EXPECT_EQ(stats["run"]["agents"], 50);
   EXPECT_EQ(stats["run"]["threads"], 2);
+  EXPECT_EQ(stats["run"]["model"], "priority");  // the built-in circle keeps the default model
   EXPECT_FALSE(stats["run"]["interrupted"].get<bool>());
   EXPECT_EQ(stats["crowd"]["agents"], 50);
   EXPECT_EQ(stats["crowd"]["obstacle_penetrations"]["max"], 0);
