@@ -303,6 +303,40 @@ TEST(ScenarioYaml, MeasurementAreasAndLines) {
   EXPECT_FLOAT_EQ(lines_only.voronoi_cutoff, 2.0f);
 }
 
+TEST(ScenarioYaml, TtcModelKeys) {
+  const std::string text = std::string(kOneGroup) + R"(model:
+  type: ttc
+  ttc_strength: 2.0
+  ttc_time_horizon: 4
+  ttc_relaxation_time: 0.6
+  ttc_sensing_radius: 5
+  ttc_max_acceleration: 15
+  ttc_side_bias: 0.25
+)";
+  const sim::ModelParams m = parse_scenario(text, "ttc.yaml").spec.model;
+  EXPECT_EQ(m.kind, sim::ModelKind::Ttc);
+  EXPECT_FLOAT_EQ(m.ttc.strength, 2.0f);
+  EXPECT_FLOAT_EQ(m.ttc.time_horizon, 4.0f);
+  EXPECT_FLOAT_EQ(m.ttc.relaxation_time, 0.6f);
+  EXPECT_FLOAT_EQ(m.ttc.sensing_radius, 5.0f);
+  EXPECT_FLOAT_EQ(m.ttc.max_acceleration, 15.0f);
+  EXPECT_FLOAT_EQ(m.ttc.side_bias, 0.25f);
+  EXPECT_FLOAT_EQ(m.query_radius(), 5.0f);
+  // A parameter of another model names its owner, either way round.
+  try {
+    parse_scenario(std::string(kOneGroup) + "model: {type: ttc, time_gap: 1}\n", "a.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'time_gap' is a parameter of the collision_free_speed model"), std::string::npos) << e.what();
+  }
+  try {
+    parse_scenario(std::string(kOneGroup) + "model: {type: priority, ttc_strength: 1}\n", "b.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'ttc_strength' is a parameter of the ttc model"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ScenarioYaml, MeasurementListsAreBounded) {
   for (const char* list : {"areas", "lines"}) {
     std::string text = std::string(kOneGroup) + "measurement:\n  " + list + ":\n";
