@@ -48,12 +48,8 @@ void ModelParams::validate() const {
 }
 
 const char* to_string(ModelKind k) {
-  switch (k) {
-    case ModelKind::CollisionFreeSpeed: return "collision_free_speed";
-    case ModelKind::Priority: return "priority";
-    case ModelKind::Ttc: return "ttc";
-  }
-  return "?";
+  if (k == ModelKind::Priority) return "priority";
+  return k == ModelKind::Ttc ? "ttc" : "collision_free_speed";
 }
 
 ModelKind parse_model_kind(const std::string& text, const std::string& field) {

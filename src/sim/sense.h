@@ -90,6 +90,20 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec
   return best;
 }
 
+// Calls fn(q) with the nearest point q of each wall segment and circle of
+// the obstacle cell of p (everything within one cell side); a circle whose
+// centre is p has none.
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2 p, const Fn& fn) {
+  for_each_obstacle(
+      w, obstacle_cell(w, p), [&](const Segment& s) { fn(closest_point_on_segment(p, s.a, s.b)); },
+      [&](const Circle& k) {
+        const glm::vec2 d = p - k.center;
+        const float dist = length_of(d);
+        if (dist > 1e-6f) fn(k.center + d * (k.radius / dist));
+      });
+}
+
 // ---- collision-free speed -------------------------------------------------------
 
 // The new velocity of agent `self` under the collision-free speed model
@@ -117,13 +131,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     e0 = cfs_slide_along_wall(e0, d * (1.0f / sqrtf(d2)));
     walls += cfs_wall_push(me, q, c);
   };
-  for_each_obstacle(
-      w, obstacle_cell(w, me.p), [&](const Segment& s) { wall_point(closest_point_on_segment(me.p, s.a, s.b)); },
-      [&](const Circle& k) {
-        const glm::vec2 d = me.p - k.center;
-        const float dist = length_of(d);
-        if (dist > 1e-6f) wall_point(k.center + d * (k.radius / dist));
-      });
+  for_each_wall_point(w, me.p, wall_point);
   glm::vec2 sum = e0 + walls;
   for_each_candidate([&](Index j) {
     if (is_neighbour(j)) sum += cfs_neighbour_push(me, n.position[j], n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
@@ -170,13 +178,7 @@ THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, co
     const glm::vec2 x = me.p - q;
     if (length2(x) < sense2) f += ttc_avoidance(x, me.v, me.radius, t);
   };
-  for_each_obstacle(
-      w, obstacle_cell(w, me.p), [&](const Segment& s) { wall_point(closest_point_on_segment(me.p, s.a, s.b)); },
-      [&](const Circle& k) {
-        const glm::vec2 d = me.p - k.center;
-        const float dist = length_of(d);
-        if (dist > 1e-6f) wall_point(k.center + d * (k.radius / dist));
-      });
+  for_each_wall_point(w, me.p, wall_point);
   for_each_candidate([&](Index j) {
     if (j == self || (n.flags[j] & kAgentActive) == 0) return;
     const glm::vec2 x = me.p - n.position[j];

@@ -87,15 +87,15 @@ void expect_encounter_resolves(const std::string& what, const std::vector<Walker
 }
 
 TEST(CollisionFreeSpeed, HeadOnPairOnOneLinePassesWithoutDeadlock) {
-  expect_encounter_resolves("head-on", {{{0, 0}, {10, 0}, {}}, {{10, 0}, {0, 0}, {}}});
+  expect_encounter_resolves("head-on", encounters::head_on_pair());
 }
 
 TEST(CollisionFreeSpeed, NinetyDegreeCrossingResolves) {
-  expect_encounter_resolves("crossing", {{{-6, 0}, {6, 0}, {}}, {{0, -6}, {0, 6}, {}}});
+  expect_encounter_resolves("crossing", encounters::crossing_pair());
 }
 
 TEST(CollisionFreeSpeed, FourWaysMeetingInTheMiddleResolve) {
-  expect_encounter_resolves("four ways", {{{-6, 0}, {6, 0}, {}}, {{6, 0}, {-6, 0}, {}}, {{0, -6}, {0, 6}, {}}, {{0, 6}, {0, -6}, {}}});
+  expect_encounter_resolves("four ways", encounters::four_ways());
 }
 
 TEST(CollisionFreeSpeed, TwentyOnACircleReachTheirAntipodes) {

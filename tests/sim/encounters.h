@@ -76,6 +76,15 @@ inline void expect_encounter_resolves(ModelKind model, const std::string& what, 
   EXPECT_LE(deepest, 0.01f);
 }
 
+// Two walkers head-on on one line, 10 m apart.
+inline std::vector<Walker> head_on_pair() { return {{{0, 0}, {10, 0}, {}}, {{10, 0}, {0, 0}, {}}}; }
+// Two walkers crossing at 90 degrees, meeting in the middle.
+inline std::vector<Walker> crossing_pair() { return {{{-6, 0}, {6, 0}, {}}, {{0, -6}, {0, 6}, {}}}; }
+// Four walkers from the four sides, meeting in the middle.
+inline std::vector<Walker> four_ways() {
+  return {{{-6, 0}, {6, 0}, {}}, {{6, 0}, {-6, 0}, {}}, {{0, -6}, {0, 6}, {}}, {{0, 6}, {0, -6}, {}}};
+}
+
 // Twenty agents on a circle of radius 8 m, each walking to its antipode.
 inline std::vector<Walker> circle_of_twenty() {
   std::vector<Walker> w;

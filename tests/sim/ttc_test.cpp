@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <string>
 #include <vector>
 
 #include "encounters.h"
@@ -104,33 +103,27 @@ TEST(Ttc, OverlapPushesApartWhileApproachingAndForcesAreClamped) {
 
 // ---- encounters -------------------------------------------------------------------
 
-using encounters::Walker;
-void expect_encounter_resolves(const std::string& what, const std::vector<Walker>& walkers, const WorldSpec& world = {},
-                               double slowest = 1.5) {
-  encounters::expect_encounter_resolves(ModelKind::Ttc, what, walkers, world, slowest);
-}
-
-TEST(Ttc, HeadOnPairOnOneLinePasses) {
-  expect_encounter_resolves("head-on", {{{0, 0}, {10, 0}, {}}, {{10, 0}, {0, 0}, {}}});
-}
-
-TEST(Ttc, NinetyDegreeCrossingResolves) {
-  expect_encounter_resolves("crossing", {{{-6, 0}, {6, 0}, {}}, {{0, -6}, {0, 6}, {}}});
-}
-
-TEST(Ttc, FourWaysMeetingInTheMiddleResolve) {
-  expect_encounter_resolves("four ways", {{{-6, 0}, {6, 0}, {}}, {{6, 0}, {-6, 0}, {}}, {{0, -6}, {0, 6}, {}}, {{0, 6}, {0, -6}, {}}});
-}
-
-TEST(Ttc, TwentyOnACircleReachTheirAntipodes) {
-  // All twenty meet in the middle at once and swirl round it: 1.56x
-  // measured, just short of the 1.5x aim (collision-free speed 1.91x,
-  // priority 1.64x); the bound guards against regressions.
-  expect_encounter_resolves("circle of 20", encounters::circle_of_twenty(), {}, 1.65);
-}
-
-TEST(Ttc, BlindCornerPairPasses) {
-  expect_encounter_resolves("blind corner", encounters::blind_corner_pair(), encounters::l_corridor(), 1.5);
+// Each case: every agent arrives within `slowest` x its unhindered time, no
+// overlap deeper than 1 cm (encounters.h). Measured: head-on 1.10x,
+// crossing 1.14x, four ways 1.07x, blind corner 1.18x, circle of 20 1.56x.
+TEST(Ttc, EncountersResolve) {
+  struct Case {
+    const char* what;
+    std::vector<encounters::Walker> walkers;
+    WorldSpec world;
+    double slowest;
+  };
+  const std::vector<Case> cases = {
+      {"head-on", encounters::head_on_pair(), {}, 1.5},
+      {"crossing", encounters::crossing_pair(), {}, 1.5},
+      {"four ways", encounters::four_ways(), {}, 1.5},
+      {"blind corner", encounters::blind_corner_pair(), encounters::l_corridor(), 1.5},
+      // All twenty meet in the middle at once and swirl round it: 1.56x,
+      // just short of the 1.5x aim (collision-free speed 1.91x, priority
+      // 1.64x); the bound guards against regressions.
+      {"circle of 20", encounters::circle_of_twenty(), {}, 1.65},
+  };
+  for (const Case& c : cases) encounters::expect_encounter_resolves(ModelKind::Ttc, c.what, c.walkers, c.world, c.slowest);
 }
 
 }  // namespace
