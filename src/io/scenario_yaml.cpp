@@ -368,21 +368,29 @@ class Reader {
     static const std::vector<std::string_view> cfs = {"time_gap",       "neighbour_strength", "neighbour_range", "wall_strength",
                                                       "wall_range",     "avoid_strength",     "avoid_time",      "side_margin",
                                                       "turn_time",      "anticipation_time"};
+    static const std::vector<std::string_view> ttc = {"ttc_strength", "ttc_time_horizon", "ttc_relaxation_time", "ttc_sensing_radius",
+                                                      "ttc_max_acceleration", "ttc_side_bias"};
     visit(n, path);
     if (!n.IsMap()) fail(n, path, "expected a map (model.type and its parameters), got " + kind(n));
     sim::ModelParams m;
-    if (n["type"]) m.kind = sim::parse_model_kind(word(n["type"], child(path, "type"), {"collision_free_speed", "priority"}), child(path, "type"));
-    const std::vector<std::string_view>& own = m.kind == sim::ModelKind::Priority ? priority : cfs;
-    const std::vector<std::string_view>& other = m.kind == sim::ModelKind::Priority ? cfs : priority;
+    if (n["type"])
+      m.kind = sim::parse_model_kind(word(n["type"], child(path, "type"), {"collision_free_speed", "priority", "ttc"}), child(path, "type"));
+    auto keys_of_model = [&](sim::ModelKind k) -> const std::vector<std::string_view>& {
+      return k == sim::ModelKind::Priority ? priority : (k == sim::ModelKind::Ttc ? ttc : cfs);
+    };
+    const std::vector<std::string_view>& own = keys_of_model(m.kind);
     std::vector<std::string_view> allowed = shared;
     allowed.insert(allowed.end(), own.begin(), own.end());
     for (auto it = n.begin(); it != n.end(); ++it) {
       const YAML::Node key = it->first;
-      if (!key.IsScalar() || std::find(other.begin(), other.end(), key.Scalar()) == other.end()) continue;
-      const sim::ModelKind owner = m.kind == sim::ModelKind::Priority ? sim::ModelKind::CollisionFreeSpeed : sim::ModelKind::Priority;
-      fail_at(key.Mark(), child(path, key.Scalar()),
-              fmt::format("'{}' is a parameter of the {} model, and this scenario's model.type is {}", key.Scalar(), to_string(owner),
-                          to_string(m.kind)));
+      if (!key.IsScalar()) continue;
+      for (const sim::ModelKind owner : {sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Priority, sim::ModelKind::Ttc}) {
+        const std::vector<std::string_view>& keys = keys_of_model(owner);
+        if (owner == m.kind || std::find(keys.begin(), keys.end(), key.Scalar()) == keys.end()) continue;
+        fail_at(key.Mark(), child(path, key.Scalar()),
+                fmt::format("'{}' is a parameter of the {} model, and this scenario's model.type is {}", key.Scalar(), to_string(owner),
+                            to_string(m.kind)));
+      }
     }
     keys_of(n, path, allowed);
     auto opt = [&](const char* key, float& out) {
@@ -405,6 +413,12 @@ class Reader {
     opt("side_margin", m.cfs.side_margin);
     opt("turn_time", m.cfs.turn_time);
     opt("anticipation_time", m.cfs.anticipation_time);
+    opt("ttc_strength", m.ttc.strength);
+    opt("ttc_time_horizon", m.ttc.time_horizon);
+    opt("ttc_relaxation_time", m.ttc.relaxation_time);
+    opt("ttc_sensing_radius", m.ttc.sensing_radius);
+    opt("ttc_max_acceleration", m.ttc.max_acceleration);
+    opt("ttc_side_bias", m.ttc.side_bias);
     if (n["contact_iterations"]) m.contact_iterations = static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
     return m;
   }

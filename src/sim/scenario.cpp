@@ -39,14 +39,24 @@ void ModelParams::validate() const {
   check_range(cfs.side_margin, 0.0f, 10.0f, true, "model.side_margin", "anticipation side margin (m)");
   check_range(cfs.turn_time, 0.0f, 10.0f, true, "model.turn_time", "turn time (s)");
   check_range(cfs.anticipation_time, 0.0f, 10.0f, true, "model.anticipation_time", "anticipation time (s)");
+  check_range(ttc.strength, 0.0f, 100.0f, true, "model.ttc_strength", "interaction strength k (m^2)");
+  check_range(ttc.time_horizon, 0.1f, 100.0f, true, "model.ttc_time_horizon", "interaction time horizon tau0 (s)");
+  check_range(ttc.relaxation_time, 0.01f, 100.0f, true, "model.ttc_relaxation_time", "goal relaxation time (s)");
+  check_range(ttc.sensing_radius, 1.0f, 20.0f, true, "model.ttc_sensing_radius", "sensing radius (m)");
+  check_range(ttc.max_acceleration, 0.0f, 1000.0f, false, "model.ttc_max_acceleration", "largest acceleration (m/s^2)");
+  check_range(ttc.side_bias, 0.0f, 10.0f, true, "model.ttc_side_bias", "keep-right bias");
 }
 
-const char* to_string(ModelKind k) { return k == ModelKind::Priority ? "priority" : "collision_free_speed"; }
+const char* to_string(ModelKind k) {
+  if (k == ModelKind::Priority) return "priority";
+  return k == ModelKind::Ttc ? "ttc" : "collision_free_speed";
+}
 
 ModelKind parse_model_kind(const std::string& text, const std::string& field) {
   if (text == "collision_free_speed") return ModelKind::CollisionFreeSpeed;
   if (text == "priority") return ModelKind::Priority;
-  throw Error("unknown model type '" + text + "' (collision_free_speed or priority)", at_field(field));
+  if (text == "ttc") return ModelKind::Ttc;
+  throw Error("unknown model type '" + text + "' (collision_free_speed, priority or ttc)", at_field(field));
 }
 
 const char* to_string(ArrivalBehaviour a) {

@@ -7,6 +7,7 @@
 #include "sim/crowd.h"
 #include "sim/grid.h"
 #include "sim/steering.h"
+#include "sim/ttc.h"
 #include "sim/world.h"
 
 namespace throng::sim {
@@ -89,6 +90,20 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec
   return best;
 }
 
+// Calls fn(q) with the nearest point q of each wall segment and circle of
+// the obstacle cell of p (everything within one cell side); a circle whose
+// centre is p has none.
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2 p, const Fn& fn) {
+  for_each_obstacle(
+      w, obstacle_cell(w, p), [&](const Segment& s) { fn(closest_point_on_segment(p, s.a, s.b)); },
+      [&](const Circle& k) {
+        const glm::vec2 d = p - k.center;
+        const float dist = length_of(d);
+        if (dist > 1e-6f) fn(k.center + d * (k.radius / dist));
+      });
+}
+
 // ---- collision-free speed -------------------------------------------------------
 
 // The new velocity of agent `self` under the collision-free speed model
@@ -116,13 +131,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     e0 = cfs_slide_along_wall(e0, d * (1.0f / sqrtf(d2)));
     walls += cfs_wall_push(me, q, c);
   };
-  for_each_obstacle(
-      w, obstacle_cell(w, me.p), [&](const Segment& s) { wall_point(closest_point_on_segment(me.p, s.a, s.b)); },
-      [&](const Circle& k) {
-        const glm::vec2 d = me.p - k.center;
-        const float dist = length_of(d);
-        if (dist > 1e-6f) wall_point(k.center + d * (k.radius / dist));
-      });
+  for_each_wall_point(w, me.p, wall_point);
   glm::vec2 sum = e0 + walls;
   for_each_candidate([&](Index j) {
     if (is_neighbour(j)) sum += cfs_neighbour_push(me, n.position[j], n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
@@ -140,6 +149,43 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     gap_now = fminf(gap_now, cfs_gap_ahead(me.p, me.radius, e, q, n.radius[j]));
   });
   return e * fminf(cfs_speed(gap, v0, c.time_gap), fmaxf(gap_now, 0.0f) / dt);
+}
+
+// ---- time to collision -------------------------------------------------------
+
+// The agent being steered under the time-to-collision model.
+struct TtcAgent {
+  glm::vec2 p{0.0f};
+  glm::vec2 v{0.0f};
+  float radius = 0.2f;
+  glm::vec2 e0{1.0f, 0.0f};  // unit direction to the goal
+  float pref_speed = 1.3f;
+};
+
+// The total acceleration of agent `self` under the time-to-collision model
+// (ttc.h), clamped to max_acceleration: the goal term, then walls and
+// circles of the agent's obstacle cell (nearest points within the sensing
+// radius), then neighbours within the sensing radius in the order
+// `for_each_candidate` visits them (the 3x3 bins, or all agents for the
+// reference), so the sum is the same for any thread count.
+template <class ForEachCandidate>
+THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, const TtcAgent& me, const NeighbourArrays& n,
+                                              const ModelParams& m, const ForEachCandidate& for_each_candidate) {
+  const TtcParams& t = m.ttc;
+  const float sense2 = t.sensing_radius * t.sensing_radius;
+  glm::vec2 f = ttc_goal_force(me.v, me.pref_speed, me.e0, t);
+  auto wall_point = [&](glm::vec2 q) {
+    const glm::vec2 x = me.p - q;
+    if (length2(x) < sense2) f += ttc_avoidance(x, me.v, me.radius, t);
+  };
+  for_each_wall_point(w, me.p, wall_point);
+  for_each_candidate([&](Index j) {
+    if (j == self || (n.flags[j] & kAgentActive) == 0) return;
+    const glm::vec2 x = me.p - n.position[j];
+    if (length2(x) >= sense2) return;
+    f += ttc_avoidance(x, me.v - n.velocity[j], me.radius + n.radius[j], t);
+  });
+  return clamp_length(f, t.max_acceleration);
 }
 
 // Deterministic unit direction for two agents at exactly the same point.

@@ -5,9 +5,11 @@
 //            of its neighbours in the 3x3 bins and the walls nearby
 //            (sense.h). Priority: the higher-priority force, obstacle
 //            avoidance from the probe else agent avoidance. Collision-free
-//            speed: the new velocity (collision_free_speed.h).
+//            speed: the new velocity (collision_free_speed.h). Time to
+//            collision: the total acceleration (ttc.h).
 //   3 steer  priority: path following when nothing was sensed, then
-//            integration; collision-free speed: the sensed velocity
+//            integration; collision-free speed: the sensed velocity; time
+//            to collision: integration
 //   4 move   contact passes and wall projection, accept or reject the move,
 //            velocity, heading, arrivals and waypoints
 // under one of two schedulers:

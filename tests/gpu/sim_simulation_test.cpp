@@ -84,7 +84,9 @@ TEST(CudaSimulation, OneStepMatchesCpu) {
                         // differs by an ulp or two between the backends), the same bounds.
                         Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
                         Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
-                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs, ModelKind::CollisionFreeSpeed}})
+                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs, ModelKind::CollisionFreeSpeed},
+                        // The time-to-collision model: sums of exponentials and square roots, likewise.
+                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::Ttc}})
     expect_one_step_matches(c);
 }
 

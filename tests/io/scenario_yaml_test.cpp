@@ -303,6 +303,36 @@ TEST(ScenarioYaml, MeasurementAreasAndLines) {
   EXPECT_FLOAT_EQ(lines_only.voronoi_cutoff, 2.0f);
 }
 
+TEST(ScenarioYaml, TtcModelKeys) {
+  const std::string text = std::string(kOneGroup) + R"(model:
+  type: ttc
+  ttc_strength: 2.0
+  ttc_time_horizon: 4
+  ttc_relaxation_time: 0.6
+  ttc_sensing_radius: 5
+  ttc_max_acceleration: 15
+  ttc_side_bias: 0.25
+)";
+  const sim::ModelParams m = parse_scenario(text, "ttc.yaml").spec.model;
+  EXPECT_EQ(m.kind, sim::ModelKind::Ttc);
+  const std::vector<std::pair<float, float>> read = {{m.ttc.strength, 2.0f},         {m.ttc.time_horizon, 4.0f},
+                                                     {m.ttc.relaxation_time, 0.6f},  {m.ttc.sensing_radius, 5.0f},
+                                                     {m.ttc.max_acceleration, 15.0f}, {m.ttc.side_bias, 0.25f},
+                                                     {m.query_radius(), 5.0f}};
+  for (const auto& [got, want] : read) EXPECT_FLOAT_EQ(got, want);
+  // A parameter of another model names its owner, either way round.
+  for (const auto& [model, owner] : {std::pair{"{type: ttc, time_gap: 1}", "'time_gap' is a parameter of the collision_free_speed model"},
+                                     std::pair{"{type: priority, ttc_strength: 1}", "'ttc_strength' is a parameter of the ttc model"}}) {
+    std::string message = "no error";
+    try {
+      parse_scenario(std::string(kOneGroup) + "model: " + model + "\n", "a.yaml");
+    } catch (const Error& e) {
+      message = e.what();
+    }
+    EXPECT_NE(message.find(owner), std::string::npos) << message;
+  }
+}
+
 TEST(ScenarioYaml, MeasurementListsAreBounded) {
   for (const char* list : {"areas", "lines"}) {
     std::string text = std::string(kOneGroup) + "measurement:\n  " + list + ":\n";

@@ -200,7 +200,7 @@ void expect_identical(const Snapshot& a, const Snapshot& b, int threads) {
 // agents under the sanitizers.
 // Every model.
 TEST(Determinism, DoubleBufferIsBitwiseTheSameForOneTwoAndFourThreads) {
-  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed})
+  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc})
     for (const auto& [name, agents, steps] : {std::tuple{"bottleneck", 300, 400}, std::tuple{"crossing", 1200, 500}}) {
       SCOPED_TRACE(std::string(name) + ", " + to_string(model));
       ScenarioSpec spec = test::builtin(name, test::sanitized() ? agents / 3 : agents);
@@ -215,7 +215,7 @@ TEST(Determinism, DoubleBufferIsBitwiseTheSameForOneTwoAndFourThreads) {
 // The four-colour batches never let two cells of a batch touch the same
 // agents, so they too are independent of the thread count (every model).
 TEST(Determinism, FourColourIsBitwiseTheSameForOneTwoAndFourThreads) {
-  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed}) {
+  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc}) {
     SCOPED_TRACE(to_string(model));
     ScenarioSpec spec = test::builtin("bottleneck", 300);
     spec.model.kind = model;
@@ -241,44 +241,46 @@ TEST(Bins, SimulationWithBinsMatchesTheAllPairsReference) {
   }
 }
 
-// The collision-free speed model sums over its neighbours, so the bins'
-// visiting order changes the last bits and trajectories drift apart over
-// many steps; one step from the same state must agree to float rounding.
-TEST(Bins, CollisionFreeSpeedStepMatchesTheAllPairsReference) {
-  for (const auto& [name, agents] : {std::pair{"crossing", 800}, std::pair{"bottleneck", 300}}) {
-    SCOPED_TRACE(name);
-    ScenarioSpec spec = test::builtin(name, test::sanitized() ? agents / 3 : agents);
-    spec.model.kind = ModelKind::CollisionFreeSpeed;
-    SimulationOptions reference;
-    reference.neighbours = NeighbourSearch::AllPairs;
-    Simulation binned(spec), all_pairs(spec, reference);
-    binned.run(100);  // into the jam, then one step of each from the same state
-    CrowdState& to = all_pairs.crowd();
-    const CrowdState& from = binned.crowd();
-    auto copy = [](auto& dst, const auto& src) {
-      const auto host = src.to_vector();
-      dst.copy_from(host);
-    };
-    copy(to.position, from.position);
-    copy(to.velocity, from.velocity);
-    copy(to.heading, from.heading);
-    copy(to.flags, from.flags);
-    copy(to.goal, from.goal);
-    copy(to.path_start, from.path_start);
-    copy(to.waypoint_cursor, from.waypoint_cursor);
-    binned.step();
-    all_pairs.step();
-    const auto a = binned.velocities(), b = all_pairs.velocities();
-    ASSERT_EQ(a.size(), b.size());
-    float worst = 0.0f;
-    Index moving = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      worst = std::max(worst, std::max(std::fabs(a[i].x - b[i].x), std::fabs(a[i].y - b[i].y)));
-      moving += glm::length(a[i]) > 0.1f ? 1 : 0;
+// The collision-free speed and time-to-collision models sum over their
+// neighbours, so the bins' visiting order changes the last bits and
+// trajectories drift apart over many steps; one step from the same state
+// must agree to float rounding.
+TEST(Bins, SummingModelsStepMatchesTheAllPairsReference) {
+  for (const ModelKind model : {ModelKind::CollisionFreeSpeed, ModelKind::Ttc})
+    for (const auto& [name, agents] : {std::pair{"crossing", 800}, std::pair{"bottleneck", 300}}) {
+      SCOPED_TRACE(std::string(name) + ", " + to_string(model));
+      ScenarioSpec spec = test::builtin(name, test::sanitized() ? agents / 3 : agents);
+      spec.model.kind = model;
+      SimulationOptions reference;
+      reference.neighbours = NeighbourSearch::AllPairs;
+      Simulation binned(spec), all_pairs(spec, reference);
+      binned.run(100);  // into the jam, then one step of each from the same state
+      CrowdState& to = all_pairs.crowd();
+      const CrowdState& from = binned.crowd();
+      auto copy = [](auto& dst, const auto& src) {
+        const auto host = src.to_vector();
+        dst.copy_from(host);
+      };
+      copy(to.position, from.position);
+      copy(to.velocity, from.velocity);
+      copy(to.heading, from.heading);
+      copy(to.flags, from.flags);
+      copy(to.goal, from.goal);
+      copy(to.path_start, from.path_start);
+      copy(to.waypoint_cursor, from.waypoint_cursor);
+      binned.step();
+      all_pairs.step();
+      const auto a = binned.velocities(), b = all_pairs.velocities();
+      ASSERT_EQ(a.size(), b.size());
+      float worst = 0.0f;
+      Index moving = 0;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        worst = std::max(worst, std::max(std::fabs(a[i].x - b[i].x), std::fabs(a[i].y - b[i].y)));
+        moving += glm::length(a[i]) > 0.1f ? 1 : 0;
+      }
+      EXPECT_LT(worst, 1e-4f);
+      EXPECT_GT(moving, static_cast<Index>(a.size()) / 4);
     }
-    EXPECT_LT(worst, 1e-4f);
-    EXPECT_GT(moving, static_cast<Index>(a.size()) / 4);
-  }
 }
 
 TEST(Simulation, DifferentSeedsGiveDifferentCrowdsSameSeedTheSame) {
