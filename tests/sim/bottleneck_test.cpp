@@ -27,15 +27,9 @@ struct DoorRun {
 
 DoorRun empty_room(float width, std::int64_t agents) {
   const float lo = 5.0f - 0.5f * width, hi = 5.0f + 0.5f * width;
-  ScenarioSpec s;
-  s.name = "door";
-  s.model.kind = ModelKind::CollisionFreeSpeed;
-  s.planning = PlanningKind::None;
-  s.dt = 0.05f;
-  s.duration = 400.0f;
-  s.world.has_walkable = true;
-  s.world.walkable.outer = {{0, 0},      {10, 0},     {10, lo},  {10.4f, lo}, {10.4f, -10}, {30, -10},
-                            {30, 20},    {10.4f, 20}, {10.4f, hi}, {10, hi},  {10, 10},     {0, 10}};
+  ScenarioSpec s = test::collision_free_spec("door", 0.05f, 400.0f,
+                                             {{0, 0}, {10, 0}, {10, lo}, {10.4f, lo}, {10.4f, -10}, {30, -10},
+                                              {30, 20}, {10.4f, 20}, {10.4f, hi}, {10, hi}, {10, 10}, {0, 10}});
   GroupSpec g;
   g.count = agents;
   g.radius = 0.2f;

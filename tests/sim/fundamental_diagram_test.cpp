@@ -40,6 +40,33 @@ struct Point {
   double target = 0, density = 0, speed = 0;
 };
 
+// A corridor `width` wide, open far ahead of a crowd filling [0, length].
+ScenarioSpec corridor(const char* name, double length, float width) {
+  const float far = static_cast<float>(2.0 * length + 200.0);
+  return test::collision_free_spec(name, 0.05f, 70.0f, {{-1.0f, 0.0f}, {far, 0.0f}, {far, width}, {-1.0f, width}});
+}
+
+// Runs 70 s and averages, once a simulated second from 10 s on, the density
+// in `area` (per m^2, or per metre of its length when `per_metre`) and the
+// speed along the desired direction.
+Point sample_10_to_70_s(Simulation& sim, const Aabb& area, double target, bool per_metre) {
+  Point p{target, 0, 0};
+  int samples = 0;
+  const std::int64_t per_second = static_cast<std::int64_t>(std::lround(1.0 / sim.spec().dt));
+  for (std::int64_t k = 1; k <= 70 * per_second; ++k) {
+    sim.step();
+    if (k % per_second != 0 || k < 10 * per_second) continue;
+    const CrowdState& c = sim.crowd();
+    const AreaSample a = measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), area);
+    p.density += per_metre ? static_cast<double>(a.agents) / static_cast<double>(area.size().x) : a.density;
+    p.speed += a.mean_speed;
+    ++samples;
+  }
+  p.density /= samples;
+  p.speed /= samples;
+  return p;
+}
+
 // One density: the crowd fills [0, length] x [0, 10]; the area is centred
 // at x = X, X - 5 beyond where the tail walks by 70 s, and the fan from the
 // front needs longer than 70 s to come back to X + 5.
@@ -47,15 +74,7 @@ Point measure(double rho) {
   const double v = weidmann(rho), fan = v + rho * weidmann_slope(rho);
   const double X = v * 70.0 + 10.0;
   const double length = X + 5.0 + std::max(0.0, -fan * 70.0) + 10.0;
-  ScenarioSpec s;
-  s.name = "fundamental_diagram";
-  s.model.kind = ModelKind::CollisionFreeSpeed;
-  s.planning = PlanningKind::None;
-  s.dt = 0.05f;
-  s.duration = 70.0f;
-  s.world.has_walkable = true;
-  const float far = static_cast<float>(2.0 * length + 200.0);
-  s.world.walkable.outer = {{-1.0f, 0.0f}, {far, 0.0f}, {far, 10.0f}, {-1.0f, 10.0f}};
+  ScenarioSpec s = corridor("fundamental_diagram", length, 10.0f);
   GroupSpec g;
   g.count = static_cast<std::int64_t>(length * 10.0 * rho);
   g.radius = 0.2f;
@@ -68,22 +87,7 @@ Point measure(double rho) {
   g.arrival = ArrivalBehaviour::Stop;
   s.groups = {g};
   Simulation sim(s);
-  const Aabb area{{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 10.0f}};
-  Point p{rho, 0, 0};
-  int samples = 0;
-  const std::int64_t per_second = static_cast<std::int64_t>(std::lround(1.0 / s.dt));
-  for (std::int64_t k = 1; k <= 70 * per_second; ++k) {
-    sim.step();
-    if (k % per_second != 0 || k < 10 * per_second) continue;
-    const CrowdState& c = sim.crowd();
-    const AreaSample a = measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), area);
-    p.density += a.density;
-    p.speed += a.mean_speed;
-    ++samples;
-  }
-  p.density /= samples;
-  p.speed /= samples;
-  return p;
+  return sample_10_to_70_s(sim, {{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 10.0f}}, rho, false);
 }
 
 TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
@@ -129,15 +133,7 @@ Point measure_single_file(double rho) {
   // The tail may walk faster than the relation says: size for the free speed.
   const double d = 1.0 / rho;
   const double X = 1.34 * 70.0 + 10.0, length = X + 5.0 + 1.34 * 70.0 * 0.5 + 10.0;
-  ScenarioSpec s;
-  s.name = "single_file";
-  s.model.kind = ModelKind::CollisionFreeSpeed;
-  s.planning = PlanningKind::None;
-  s.dt = 0.05f;
-  s.duration = 70.0f;
-  s.world.has_walkable = true;
-  const float far = static_cast<float>(2.0 * length + 200.0);
-  s.world.walkable.outer = {{-1.0f, 0.0f}, {far, 0.0f}, {far, 0.5f}, {-1.0f, 0.5f}};
+  ScenarioSpec s = corridor("single_file", length, 0.5f);
   GroupSpec g;
   g.radius = 0.2f;
   g.speed = {1.34f, 0.0f, 1.34f, 1.34f};
@@ -148,21 +144,7 @@ Point measure_single_file(double rho) {
   g.goal.value = {static_cast<float>(length + 150.0), 0.0f};
   s.groups = {g};
   Simulation sim(s);
-  const Aabb area{{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 0.5f}};
-  Point p{rho, 0, 0};
-  int samples = 0;
-  for (std::int64_t k = 1; k <= 1400; ++k) {
-    sim.step();
-    if (k % 20 != 0 || k < 200) continue;
-    const CrowdState& c = sim.crowd();
-    const AreaSample a = measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), area);
-    p.density += static_cast<double>(a.agents) / 10.0;  // per metre of corridor
-    p.speed += a.mean_speed;
-    ++samples;
-  }
-  p.density /= samples;
-  p.speed /= samples;
-  return p;
+  return sample_10_to_70_s(sim, {{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 0.5f}}, rho, true);
 }
 
 TEST(FundamentalDiagram, CollisionFreeSpeedSingleFileFollowsSeyfried2005) {

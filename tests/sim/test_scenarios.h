@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string_view>
+#include <utility>
 
 #include "io/scenario_yaml.h"
 #include "sim/scenario.h"
@@ -29,6 +30,21 @@ inline ScenarioSpec open_field(std::int64_t count, glm::vec2 min, glm::vec2 max,
   g.goal.kind = GoalSpec::Kind::Offset;
   g.goal.value = offset;
   s.groups = {g};
+  return s;
+}
+
+// An empty scenario for the validation runs: the collision-free speed
+// model, no route planning (groups walk straight at their goals), and the
+// walkable region `outer`.
+inline ScenarioSpec collision_free_spec(const char* name, float dt, float duration, Ring outer) {
+  ScenarioSpec s;
+  s.name = name;
+  s.model.kind = ModelKind::CollisionFreeSpeed;
+  s.planning = PlanningKind::None;
+  s.dt = dt;
+  s.duration = duration;
+  s.world.has_walkable = true;
+  s.world.walkable.outer = std::move(outer);
   return s;
 }
 
