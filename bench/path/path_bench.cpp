@@ -175,6 +175,30 @@ void register_path(const Options& options) {
                 },
                 false, true});
 
+  // Set-up of a walkable square 2n m across holding one 1 x 10 m wall: the
+  // world index, the free space, its roadmap and routes round the wall for
+  // ten agents. The cost must follow what the world holds, not n.
+  add(options, {"path/huge_world_setup", {1000, 1000000},
+                [](benchmark::State& state, Index n) {
+                  const auto h = static_cast<float>(n);
+                  sim::WorldSpec spec;
+                  spec.has_walkable = true;
+                  spec.walkable.outer = sim::rect_ring({-h, -h}, {h, h});
+                  spec.polygons.push_back({sim::rect_ring({0, -5}, {1, 5}), {}});
+                  std::vector<glm::vec2> starts, goals;
+                  for (int k = 0; k < 10; ++k) {
+                    starts.emplace_back(-8.0f, -2.0f + 0.4f * static_cast<float>(k));
+                    goals.emplace_back(10.0f, -2.0f + 0.4f * static_cast<float>(k));
+                  }
+                  for (auto _ : state) {
+                    const sim::World world = sim::World::build(spec, 4.0f);
+                    const path::RoadmapRoutePlanner planner;
+                    benchmark::DoNotOptimize(planner.plan(world, starts, goals, 0.25f));
+                  }
+                  state.SetItemsProcessed(state.iterations());
+                },
+                false, true});
+
   // Routes for n agents (see RouteScene).
   add(options, {"path/route_plan/field", {1000, 10000}, route_plan("field")});
   add(options, {"path/route_plan/maze", {100}, route_plan("maze")});

@@ -19,6 +19,7 @@
 #include "app/commands.h"
 #include "app/sim_locomotion.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/exec.h"
 #include "core/timing.h"
 #include "io/run_outputs.h"
@@ -35,14 +36,14 @@ namespace throng::app {
 
 namespace {
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted.store(true); }
+extern "C" void on_interrupt(int) { interrupt_flag().store(true); }
 
-// SIGINT/SIGTERM end the run after the current frame; restored afterwards.
+// SIGINT/SIGTERM end set-up at its next check (core/interrupt.h) and the run
+// after the current frame; the previous handlers come back afterwards.
 class InterruptGuard {
  public:
   InterruptGuard() {
-    g_interrupted = false;
+    interrupt_flag() = false;
     struct sigaction sa {};
     sa.sa_handler = on_interrupt;
     sigemptyset(&sa.sa_mask);
@@ -182,7 +183,40 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
   if (!written.empty()) std::printf("  wrote %s\n", written.c_str());
 }
 
+// stats.json's "scenario": name, description, source and groups.
+nlohmann::json scenario_section(const io::LoadedScenario& loaded) {
+  const sim::ScenarioSpec& spec = loaded.spec;
+  nlohmann::json section = {{"name", spec.name}, {"description", spec.description}, {"source", loaded.source.file}, {"groups", nlohmann::json::array()}};
+  for (const sim::GroupSpec& g : spec.groups) section["groups"].push_back({{"name", g.name}, {"count", g.count}});
+  return section;
+}
+
+// stats.json of a run interrupted before its first step: what was asked for,
+// how far set-up came, and `interrupted: true` as after any Ctrl-C.
+nlohmann::json interrupted_setup_stats(const io::LoadedScenario& loaded, const Interrupted& e, double seconds) {
+  const sim::ScenarioSpec& spec = loaded.spec;
+  nlohmann::json stats;
+  stats["run"] = {{"scenario", spec.name},
+                  {"agents", spec.total_agents()},
+                  {"steps", 0},
+                  {"dt", spec.dt},
+                  {"simulated_seconds", 0.0},
+                  {"wall_seconds", seconds},
+                  {"seed", spec.seed},
+                  {"model", to_string(spec.model.kind)},
+                  {"scheduler", to_string(spec.scheduler)},
+                  {"backend", to_string(current_backend())},
+                  {"threads", current_threads()},
+                  {"interrupted", true},
+                  {"interrupted_during", e.during()},
+                  {"all_arrived", false}};
+  stats["scenario"] = scenario_section(loaded);
+  return stats;
+}
+
 void run_scenario(const RunOptions& o) {
+  // Ctrl-C from here on: set-up stops at its next check, the run after its frame.
+  const InterruptGuard guard;
   io::LoadedScenario loaded = io::load_scenario(o.scenario);
   sim::ScenarioSpec& spec = loaded.spec;
   if (o.agents > 0) sim::scale_agent_counts(spec, o.agents);
@@ -197,16 +231,25 @@ void run_scenario(const RunOptions& o) {
                loaded.source.file.c_str(), static_cast<long long>(spec.total_agents()), static_cast<long long>(max_steps),
                static_cast<double>(spec.dt), to_string(spec.model.kind), to_string(spec.scheduler), to_string(current_backend()),
                current_threads());
-  const auto setup_start = std::chrono::steady_clock::now();
-  KernelTimings::global().reset();
-  std::unique_ptr<sim::Simulation> sim = io::build_simulation(loaded);
-  std::fprintf(stderr, "throng run: world and crowd ready in %.2f s\n",
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count());
-
   const std::string dir = !o.out.empty() ? o.out : (!spec.outputs.dir.empty() ? spec.outputs.dir : "out/" + spec.name);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create the output folder: " + ec.message(), at_field("--out", dir));
+
+  const auto setup_start = std::chrono::steady_clock::now();
+  KernelTimings::global().reset();
+  std::unique_ptr<sim::Simulation> sim;
+  try {
+    sim = io::build_simulation(loaded);
+  } catch (const Interrupted& e) {
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
+    if (spec.outputs.stats) io::write_json_file(dir + "/stats.json", interrupted_setup_stats(loaded, e, seconds));
+    std::fprintf(stderr, "throng run: interrupted while %s, %.2f s into set-up; nothing was simulated%s\n", e.during().c_str(), seconds,
+                 spec.outputs.stats ? (" (wrote " + dir + "/stats.json)").c_str() : "");
+    std::exit(130);
+  }
+  std::fprintf(stderr, "throng run: world and crowd ready in %.2f s\n",
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count());
 
   sim::FrameLoop loop(*sim);
   sim::MetricsOptions metrics;
@@ -296,13 +339,9 @@ void run_scenario(const RunOptions& o) {
   sim::RunControl control;
   control.max_steps = max_steps;
   control.stop_when_arrived = spec.stop_when_arrived;
-  control.interrupt = &g_interrupted;
+  control.interrupt = &interrupt_flag();
   control.progress = [&](const sim::Simulation& s, const sim::FrameInfo& f) { progress.update(s, f); };
-  sim::RunResult result;
-  {
-    InterruptGuard guard;
-    result = loop.run(control);
-  }
+  const sim::RunResult result = loop.run(control);
 
   nlohmann::json stats;
   loop.finish(stats);
@@ -310,8 +349,7 @@ void run_scenario(const RunOptions& o) {
     const std::string rendered = finish_render();
     if (!rendered.empty()) written += (written.empty() ? "" : ", ") + rendered;
   }
-  stats["scenario"] = {{"name", spec.name}, {"description", spec.description}, {"source", loaded.source.file}, {"groups", nlohmann::json::array()}};
-  for (const sim::GroupSpec& g : spec.groups) stats["scenario"]["groups"].push_back({{"name", g.name}, {"count", g.count}});
+  stats["scenario"] = scenario_section(loaded);
   if (spec.outputs.stats) {
     io::write_json_file(dir + "/stats.json", stats);
     written += (written.empty() ? "" : ", ") + dir + "/stats.json";

@@ -213,6 +213,14 @@ bool FreeSpace::contains(glm::vec2 p) const {
   const std::int32_t cy = sim::cell_coord(p.y, cell_);
   const std::int32_t x_end = sim::cell_coord(bounds_.max.x, cell_);
   bool inside = false;
+  // A row longer than there are boundary edges (a huge, nearly empty world)
+  // is cheaper to answer from every edge: the cost stays bounded by what the
+  // world contains, not by its extent.
+  if (static_cast<double>(x_end) - sim::cell_coord(p.x, cell_) + 1 > static_cast<double>(boundary_.size())) {
+    for (const sim::Segment& e : boundary_)
+      if (sim::edge_crosses_ray(p, e.a, e.b)) inside = !inside;
+    return inside;
+  }
   // Each crossing is counted in the one cell of the row that holds it (an
   // edge is registered in every cell its pieces' boxes touch).
   for (std::int32_t x = sim::cell_coord(p.x, cell_); x <= x_end; ++x) {
@@ -268,6 +276,16 @@ void FreeSpace::for_cells_near_segment(glm::vec2 a, glm::vec2 b, float reach, Fn
   const std::int32_t x0 = sim::cell_coord(std::min(a.x, b.x) - grow, cell_), x1 = sim::cell_coord(std::max(a.x, b.x) + grow, cell_);
   const std::int32_t y0 = sim::cell_coord(std::min(a.y, b.y) - grow, cell_), y1 = sim::cell_coord(std::max(a.y, b.y) + grow, cell_);
   const float keep = reach + cell_ * 0.7072f;
+  // The band of cells along a segment far longer than the geometry is dense
+  // (kilometres of empty world) holds more cells than there are edges: then
+  // every edge is offered instead, so a query costs at most one pass over
+  // the boundary whatever the world's extent.
+  const double band_cells = (static_cast<double>(sim::length_of(b - a)) / cell_ + 2.0 * (grow / cell_ + 1.0)) * (2.0 * (grow / cell_ + 1.0));
+  if (band_cells > static_cast<double>(boundary_.size())) {
+    for (const sim::Segment& s : boundary_)
+      if (!fn(s)) return;
+    return;
+  }
   // Row by row, only the cells of the band around the part of [a, b] within
   // `grow` of the row (a long diagonal segment would otherwise visit its
   // whole bounding box).

@@ -49,8 +49,17 @@ Site site_of(const VoronoiDiagram::cell_type& cell, const std::vector<bp::segmen
   }
 }
 
+// An edge is cut into at most this many pieces per stretch: beyond
+// kMaxPieces * max_step (256 m at the defaults) the pieces grow, so a huge,
+// nearly empty world costs what it contains, not what it measures. Straight
+// edges lose nothing (their clearance is linear or has its minimum sampled);
+// an arc that long lies far from every site, where the tolerance matters
+// least.
+constexpr int kMaxPieces = 512;
+
 // Points of the edge from v0 to v1 (integer units), dense enough that the
-// polyline stays within `tol` of a parabolic arc and no piece exceeds `step`.
+// polyline stays within `tol` of a parabolic arc and no piece exceeds `step`
+// (up to kMaxPieces per stretch).
 std::vector<DVec> discretize(DVec v0, DVec v1, const Site& s0, const Site& s1, bool curved, double tol, double step) {
   std::vector<DVec> pts;
   if (!curved) {
@@ -67,7 +76,7 @@ std::vector<DVec> discretize(DVec v0, DVec v1, const Site& s0, const Site& s1, b
     std::sort(ts.begin(), ts.end());
     for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
       const double len = (ts[i + 1] - ts[i]) * std::sqrt(l2);
-      const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
+      const int n = std::clamp(static_cast<int>(std::ceil(len / step)), 1, kMaxPieces);
       for (int k = 0; k < n; ++k) pts.push_back(v0 + d * (ts[i] + (ts[i + 1] - ts[i]) * k / n));
     }
     pts.push_back(v1);
@@ -102,7 +111,7 @@ std::vector<DVec> discretize(DVec v0, DVec v1, const Site& s0, const Site& s1, b
     const double dx = xs[i + 1] - xs[i];
     const double slope = std::max(std::fabs(xs[i] - px), std::fabs(xs[i + 1] - px)) / py;
     const double len = std::fabs(dx) * std::sqrt(1 + slope * slope);
-    const int k = std::max(1, static_cast<int>(std::ceil(len / std::max(chord, 1e-9))));
+    const int k = static_cast<int>(std::clamp(std::ceil(len / std::max(chord, 1e-9)), 1.0, static_cast<double>(kMaxPieces)));
     for (int j = 0; j < k; ++j) pts.push_back(at(xs[i] + dx * j / k));
   }
   pts.front() = v0;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "path/host_parallel.h"
 
 namespace throng::path {
@@ -116,9 +117,11 @@ std::vector<std::vector<glm::vec2>> RoadmapRoutePlanner::plan(const sim::World& 
       "path.route_straight", n,
       [&](Index i) {
         const auto k = static_cast<std::size_t>(i);
+        if (interrupt_flag().load(std::memory_order_relaxed)) return;  // (checked after the loop)
         straight[k] = space.segment_clear(starts[k], goals[k], agent_radius) ? 1 : 0;
       },
       64);
+  check_interrupt("planning routes");
   std::int64_t straight_count = 0;
   for (std::uint8_t s : straight) straight_count += s;
   stats_.plan_seconds += seconds_since(t0);
@@ -131,12 +134,13 @@ std::vector<std::vector<glm::vec2>> RoadmapRoutePlanner::plan(const sim::World& 
         "path.route", n,
         [&](Index i) {
           const auto k = static_cast<std::size_t>(i);
-          if (straight[k] != 0) return;
+          if (straight[k] != 0 || interrupt_flag().load(std::memory_order_relaxed)) return;
           const PlannedPath p = planner.plan({starts[k], goals[k]});
           status[k] = p.status;
           if (p.found() && p.points.size() > 2) routes[k].assign(p.points.begin() + 1, p.points.end() - 1);
         },
         4);
+    check_interrupt("planning routes");
     for (std::size_t k = 0; k < starts.size(); ++k) {
       if (status[k] != PlanStatus::Found)
         ++fallback;

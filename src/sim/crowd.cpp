@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/random.h"
 
 namespace throng::sim {
@@ -257,6 +258,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
   out.position.reserve(n);
   Occupancy placed(std::max(2.0f * max_radius * 1.2f, 0.1f));
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
+    check_interrupt("placing agents");
     const GroupSpec& G = spec.groups[g];
     const std::string field = fmt::format("groups[{}]", g);
     const float r = G.radius;
@@ -339,7 +341,9 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
         // Against earlier groups with 0.99 * gap: a group of the same radius
         // on the same lattice has its sites exactly d from ours, which
         // rounding must not reject.
+        std::int64_t visited = 0;
         const std::int64_t sites = hex_sites(b, a, (a - d) * 0.5, rng, [&](glm::vec2 p) {
+          if ((++visited & 4095) == 0) check_interrupt("placing agents");
           if (region_contains(G.spawn, p) && world.disc_fits(p, wall_clearance) && !placed.overlaps(p, r, 0.99f * gap)) candidates.push_back(p);
         });
         if (static_cast<std::int64_t>(candidates.size()) >= G.count || a <= d) break;
@@ -385,6 +389,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     for (std::size_t k = 0; k < chosen.size(); ++k) {
       const glm::vec2 p = chosen[k];
       const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
+      if ((k & 4095) == 4095) check_interrupt("choosing goals");
       placed.add(p, r, agent);
       Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
       const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),

@@ -86,6 +86,21 @@ THRONG_HOST_DEVICE inline float distance_to_segment(glm::vec2 p, glm::vec2 a, gl
   return length_of(p - closest_point_on_segment(p, a, b));
 }
 
+// The segment [a, b] meets the box [lo, hi] (Liang-Barsky clipping; a
+// touch counts).
+THRONG_HOST_DEVICE inline bool segment_meets_box(glm::vec2 a, glm::vec2 b, glm::vec2 lo, glm::vec2 hi) {
+  float t0 = 0.0f, t1 = 1.0f;
+  const glm::vec2 d = b - a;
+  auto clip = [&](float p, float q) {  // the part with p t <= q
+    if (p == 0.0f) return q >= 0.0f;
+    const float t = q / p;
+    if (p < 0.0f) t0 = fmaxf(t0, t);
+    else t1 = fminf(t1, t);
+    return t0 <= t1;
+  };
+  return clip(-d.x, a.x - lo.x) && clip(d.x, hi.x - a.x) && clip(-d.y, a.y - lo.y) && clip(d.y, hi.y - a.y);
+}
+
 // Crossing-number step of the even-odd rule for edge (a, b) and a ray from p
 // towards +x: true when the edge toggles "inside".
 THRONG_HOST_DEVICE inline bool edge_crosses_ray(glm::vec2 p, glm::vec2 a, glm::vec2 b) {

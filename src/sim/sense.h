@@ -26,7 +26,7 @@ THRONG_HOST_DEVICE inline ObstacleSense sense_obstacles(const WorldView& w, cons
     best.hit = h;
     best.force = f;
   };
-  for_each_in_cell(w.segment_grid, pr.origin, [&](std::int32_t k) { consider(probe_segment(pr, w.segments[k].a, w.segments[k].b)); });
+  for_each_wall_near(w, pr.origin, [&](const Segment& s) { consider(probe_segment(pr, s.a, s.b)); });
   for_each_in_cell(w.circle_grid, pr.origin, [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
   return best;
 }

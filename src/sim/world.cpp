@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/random.h"
 
 namespace throng::sim {
@@ -199,6 +200,7 @@ World World::build(const WorldSpec& spec, float cell_size, const ScenarioLimits&
 }
 
 void World::index(const ScenarioLimits& limits, Memory memory) {
+  check_interrupt("indexing the world");
   const float cell = cell_size_;
   auto add_ring = [&](const Ring& r) {
     rings_.push_back({static_cast<std::int32_t>(vertices_.size()), static_cast<std::int32_t>(r.size())});
@@ -216,11 +218,28 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
     append_edges(p, segments_);
   }
 
+  // A wall crossing more than kLongWallCells cells (the sides of a walkable
+  // region kilometres across) stays out of the grid: the few longest are
+  // tested by every query instead (for_each_long_wall), so indexing costs
+  // what the world contains rather than what it measures.
+  constexpr double kLongWallCells = 1024;
+  constexpr std::size_t kMaxLongWalls = 64;
+  auto cells_crossed = [cell](const Segment& s) { return (std::fabs(s.b.x - s.a.x) + std::fabs(s.b.y - s.a.y)) / cell + 1.0; };
+  long_walls_.clear();
+  for (std::size_t k = 0; k < segments_.size(); ++k)
+    if (cells_crossed(segments_[k]) > kLongWallCells) long_walls_.push_back(static_cast<std::int32_t>(k));
+  std::stable_sort(long_walls_.begin(), long_walls_.end(),
+                   [&](std::int32_t a, std::int32_t b) { return cells_crossed(segments_[static_cast<std::size_t>(a)]) > cells_crossed(segments_[static_cast<std::size_t>(b)]); });
+  if (long_walls_.size() > kMaxLongWalls) long_walls_.resize(kMaxLongWalls);
+  std::sort(long_walls_.begin(), long_walls_.end());
+  std::vector<bool> in_grid(segments_.size(), true);
+  for (const std::int32_t k : long_walls_) in_grid[static_cast<std::size_t>(k)] = false;
+
   // Count registrations before allocating them.
   double total = 0;
   // (Halo registrations: 9 per cell before duplicates are merged.)
-  for (const Segment& s : segments_)
-    total += 9.0 * (2.0 * (std::fabs(s.b.x - s.a.x) + std::fabs(s.b.y - s.a.y)) / cell + 4.0);
+  for (std::size_t k = 0; k < segments_.size(); ++k)
+    if (in_grid[k]) total += 9.0 * (2.0 * cells_crossed(segments_[k]) + 2.0);
   for (const Circle& c : circles_) total += 9.0 * cells_in_box(sim::bounds(c), cell);
   for (const Polygon& p : polygons_) total += cells_in_box(sim::bounds(p), cell);
   if (total > static_cast<double>(limits.max_grid_items))
@@ -238,7 +257,8 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
         for (std::int32_t dx = -1; dx <= 1; ++dx) pairs.push_back({cell_key(x + dx, y + dy), k});
     };
   };
-  for (std::size_t k = 0; k < segments_.size(); ++k) cells_of_segment(segments_[k], cell, with_halo(static_cast<std::int32_t>(k)));
+  for (std::size_t k = 0; k < segments_.size(); ++k)
+    if (in_grid[k]) cells_of_segment(segments_[k], cell, with_halo(static_cast<std::int32_t>(k)));
   segment_grid_ = StaticGrid(cell, std::move(pairs), memory);
   pairs.clear();
   for (std::size_t k = 0; k < circles_.size(); ++k) cells_of_circle(circles_[k], cell, with_halo(static_cast<std::int32_t>(k)));
@@ -256,6 +276,7 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
   d_rings_ = Buffer<RingRef>(std::span<const RingRef>(rings_), memory);
   d_polygons_ = Buffer<PolygonRef>(std::span<const PolygonRef>(polygon_refs_), memory);
   d_segments_ = Buffer<Segment>(std::span<const Segment>(segments_), memory);
+  d_long_walls_ = Buffer<std::int32_t>(std::span<const std::int32_t>(long_walls_), memory);
   d_circles_ = Buffer<Circle>(std::span<const Circle>(circles_), memory);
 }
 
@@ -270,6 +291,7 @@ WorldView World::view() const {
   v.segments = d_segments_.span();
   v.circles = d_circles_.span();
   v.segment_grid = segment_grid_.view();
+  v.long_walls = d_long_walls_.span();
   v.circle_grid = circle_grid_.view();
   v.polygon_grid = polygon_grid_.view();
   return v;
@@ -286,6 +308,7 @@ WorldView World::host_view() const {
   v.segments = Span<const Segment>(segments_.data(), static_cast<Index>(segments_.size()));
   v.circles = Span<const Circle>(circles_.data(), static_cast<Index>(circles_.size()));
   v.segment_grid = segment_grid_.host_view();
+  v.long_walls = Span<const std::int32_t>(long_walls_.data(), static_cast<Index>(long_walls_.size()));
   v.circle_grid = circle_grid_.host_view();
   v.polygon_grid = polygon_grid_.host_view();
   return v;

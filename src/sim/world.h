@@ -44,6 +44,8 @@ struct WorldView {
   Span<const Segment> segments;
   Span<const Circle> circles;
   GridView segment_grid;
+  // Walls too long for the grid (World::index): every query tests them.
+  Span<const std::int32_t> long_walls;
   GridView circle_grid;
   GridView polygon_grid;
 };
@@ -86,20 +88,45 @@ THRONG_HOST_DEVICE inline bool in_free_space(const WorldView& w, glm::vec2 p) {
 // a cell side of it. The move stage keeps this per agent for a step (an
 // agent moves less than its radius in a step, far less than a cell side).
 struct ObstacleCell {
+  std::int32_t cx = 0, cy = 0;  // the wall grid's cell of the point
   std::int32_t wall_start = 0, wall_count = 0;
   std::int32_t circle_start = 0, circle_count = 0;
 };
 THRONG_HOST_DEVICE inline ObstacleCell obstacle_cell(const WorldView& w, glm::vec2 p) {
   ObstacleCell c;
-  const Index ws = w.segment_grid.find(cell_coord(p.x, w.segment_grid.cell_size), cell_coord(p.y, w.segment_grid.cell_size));
+  c.cx = cell_coord(p.x, w.segment_grid.cell_size);
+  c.cy = cell_coord(p.y, w.segment_grid.cell_size);
+  const Index ws = w.segment_grid.find(c.cx, c.cy);
   if (ws >= 0) c.wall_start = w.segment_grid.start[ws], c.wall_count = w.segment_grid.count[ws];
   const Index cs = w.circle_grid.find(cell_coord(p.x, w.circle_grid.cell_size), cell_coord(p.y, w.circle_grid.cell_size));
   if (cs >= 0) c.circle_start = w.circle_grid.start[cs], c.circle_count = w.circle_grid.count[cs];
   return c;
 }
+// The long walls that the grid would have listed in cell (cx, cy): those
+// meeting the cell and its ring of neighbours, in index order after the
+// cell's own.
+template <class WallFn>
+THRONG_HOST_DEVICE inline void for_each_long_wall(const WorldView& w, std::int32_t cx, std::int32_t cy, WallFn&& wall) {
+  const float side = w.segment_grid.cell_size, eps = side * 1e-4f;
+  const glm::vec2 lo(static_cast<float>(cx - 1) * side - eps, static_cast<float>(cy - 1) * side - eps);
+  const glm::vec2 hi(static_cast<float>(cx + 2) * side + eps, static_cast<float>(cy + 2) * side + eps);
+  for (Index m = 0; m < w.long_walls.size(); ++m) {
+    const Segment& s = w.segments[w.long_walls[m]];
+    if (segment_meets_box(s.a, s.b, lo, hi)) wall(s);
+  }
+}
+// Every wall within one cell side of p (and possibly some a little further).
+template <class WallFn>
+THRONG_HOST_DEVICE inline void for_each_wall_near(const WorldView& w, glm::vec2 p, WallFn&& wall) {
+  for_each_in_cell(w.segment_grid, p, [&](std::int32_t k) { wall(w.segments[k]); });
+  if (w.long_walls.size() > 0)
+    for_each_long_wall(w, cell_coord(p.x, w.segment_grid.cell_size), cell_coord(p.y, w.segment_grid.cell_size), wall);
+}
+
 template <class WallFn, class CircleFn>
 THRONG_HOST_DEVICE inline void for_each_obstacle(const WorldView& w, const ObstacleCell& c, WallFn&& wall, CircleFn&& circle) {
   for (std::int32_t m = 0; m < c.wall_count; ++m) wall(w.segments[w.segment_grid.items[c.wall_start + m]]);
+  if (w.long_walls.size() > 0) for_each_long_wall(w, c.cx, c.cy, wall);
   for (std::int32_t m = 0; m < c.circle_count; ++m) circle(w.circles[w.circle_grid.items[c.circle_start + m]]);
 }
 
@@ -175,6 +202,8 @@ class World {
   Buffer<RingRef> d_rings_;
   Buffer<PolygonRef> d_polygons_;
   Buffer<Segment> d_segments_;
+  std::vector<std::int32_t> long_walls_;
+  Buffer<std::int32_t> d_long_walls_;
   Buffer<Circle> d_circles_;
   StaticGrid segment_grid_, circle_grid_, polygon_grid_;
 };

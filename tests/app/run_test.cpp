@@ -378,4 +378,63 @@ TEST_F(RunCommand, CtrlCToTheProcessGroupDuringAVideoRunKeepsEveryFile) {
 #endif
 }
 
+// Ctrl-C to the process group while the world is built and the crowd placed
+// (half a million agents take seconds): set-up stops at its next check,
+// stats.json says the run was interrupted before its first step, exit 130.
+TEST_F(RunCommand, CtrlCDuringSetUpEndsItWithStatsAndStatus130) {
+  const fs::path log = dir_ / "log.txt";
+  const fs::path out = dir_ / "out";
+  const pid_t pid = start({"run", "plaza", "--agents", "500000", "--steps", "100000", "--no-animate", "--out", out.string(), "--quiet"}, log);
+  // The start line comes before set-up; signal as soon as it is there.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline && slurp(log).find("up to 100000 steps") == std::string::npos)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(kill(-pid, SIGINT), 0);
+  const Outcome o = finish(pid, log);
+  ASSERT_EQ(o.code, 130) << o.out;
+  EXPECT_NE(o.out.find("interrupted while"), std::string::npos) << o.out;
+  EXPECT_EQ(o.out.find("ready in"), std::string::npos) << "set-up finished before the signal:\n" << o.out;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out / "stats.json"));
+  EXPECT_TRUE(stats["run"]["interrupted"].get<bool>());
+  EXPECT_EQ(stats["run"]["steps"].get<long>(), 0);
+  EXPECT_FALSE(stats["run"]["interrupted_during"].get<std::string>().empty());
+  EXPECT_EQ(stats["scenario"]["name"], "plaza");
+  EXPECT_FALSE(fs::exists(out / "stats.json.tmp"));
+}
+
+// Set-up costs what the world holds, not how far it reaches: a walkable
+// square 2000 km across with one wall and ten agents routed round it (over
+// the roadmap: their goal is behind the wall). The
+// limit only catches a hang (it took 0.2 s on a 2-core machine; the
+// benchmark row path/huge_world_setup measures it).
+TEST_F(RunCommand, AHugeNearlyEmptyWorldSetsUpQuickly) {
+  const fs::path scene = dir_ / "huge.yaml";
+  std::ofstream(scene) << "name: huge\n"
+                          "world:\n"
+                          "  walkable: {rect: {min: [-1000000, -1000000], max: [1000000, 1000000]}}\n"
+                          "  obstacles:\n"
+                          "    - rect: {min: [0, -5], max: [1, 5]}\n"
+                          "groups:\n"
+                          "  - name: g\n"
+                          "    count: 10\n"
+                          "    radius: 0.25\n"
+                          "    spawn: {rect: {min: [-10, -2], max: [-5, 2]}}\n"
+                          "    goal: {point: [10, 0]}\n";
+  const fs::path log = dir_ / "log.txt";
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = start({"run", scene.string(), "--seconds", "30", "--no-animate", "--out", (dir_ / "out").string(), "--quiet"}, log);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(120))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (waitpid(pid, &status, WNOHANG) == 0) {
+    kill(-pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    FAIL() << "a 2000 km world with one wall did not finish in 120 s:\n" << slurp(log);
+  }
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << slurp(log);
+  const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "out" / "stats.json"));
+  EXPECT_EQ(stats["crowd"]["obstacle_penetrations"]["max"].get<long>(), 0);
+  EXPECT_EQ(stats["run"]["steps"].get<long>(), 300);
+}
+
 }  // namespace

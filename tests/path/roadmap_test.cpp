@@ -17,6 +17,38 @@ using testing::Shapes;
 
 FreeSpace space_of(const Shapes& s, FreeSpaceOptions o = {}) { return FreeSpace::build(&s.walkable, s.polygons, s.circles, o); }
 
+// A walkable region 2000 km across with one small obstacle: containment and
+// clear segments answer as brute force over the boundary does, and the
+// roadmap's polylines stay short (their pieces grow instead), so the cost
+// follows what the world contains rather than its extent.
+TEST(FreeSpace, AHugeNearlyEmptyWorldAnswersLikeBruteForce) {
+  Shapes s;
+  s.walkable.outer = sim::rect_ring({-1e6f, -1e6f}, {1e6f, 1e6f});
+  s.polygons.push_back({sim::rect_ring({0, -5}, {1, 5}), {}});
+  const FreeSpace fs = space_of(s);
+  auto brute_contains = [&](glm::vec2 p) {
+    bool inside = false;
+    for (const sim::Segment& e : fs.boundary())
+      if (sim::edge_crosses_ray(p, e.a, e.b)) inside = !inside;
+    return inside;
+  };
+  auto brute_clear = [&](glm::vec2 a, glm::vec2 b, float r) {
+    if (!brute_contains(a)) return false;
+    for (const sim::Segment& e : fs.boundary())
+      if (segment_segment_distance(a, b, e.a, e.b) < r) return false;
+    return true;
+  };
+  const glm::vec2 points[] = {{-10, 0}, {0.5f, 0}, {0.5f, 6}, {5e5f, -3e5f}, {1.5e6f, 0}, {-9.99e5f, 9.99e5f}, {2, 4.9f}};
+  for (const glm::vec2 p : points) EXPECT_EQ(fs.contains(p), brute_contains(p)) << p.x << ", " << p.y;
+  for (const glm::vec2 a : points)
+    for (const glm::vec2 b : points) EXPECT_EQ(fs.segment_clear(a, b, 0.3f), brute_clear(a, b, 0.3f)) << a.x << "," << a.y << " -> " << b.x << "," << b.y;
+  RoadmapOptions ro;
+  ro.radius = 0.25f;
+  const Roadmap map = build_roadmap(fs, ro);
+  EXPECT_GT(map.edges.size(), 0u);
+  EXPECT_LT(map.points.size(), 600u * map.edges.size());
+}
+
 TEST(CirclePolygon, ContainsTheCircleWithinTolerance) {
   for (float r : {0.05f, 0.5f, 3.0f, 40.0f}) {
     const sim::Circle c{{1.0f, -2.0f}, r};

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/ground.h"
@@ -80,6 +82,48 @@ TEST(WorldGeometry, FreeSpaceAndHoles) {
   EXPECT_TRUE(contains(w.what_blocks({15, 15}), "world.circles[0]"));
   EXPECT_TRUE(w.disc_fits({6, 6}, 0.25f));
   EXPECT_FALSE(w.disc_fits({4.1f, 3.0f}, 0.25f));  // too close to the obstacle's wall
+}
+
+// Walls crossing more than a thousand cells (the sides of a walkable region
+// kilometres across) are kept out of the grid and tested per query; a query
+// must still see every wall within one cell side, as the grid promises.
+TEST(WorldGeometry, LongWallsOutOfTheGridAreStillFoundNearby) {
+  WorldSpec spec;
+  spec.has_walkable = true;
+  constexpr float kHalf = 1e6f;
+  spec.walkable = {rect_ring({-kHalf, -kHalf}, {kHalf, kHalf}), {}};
+  spec.polygons.push_back({rect_ring({0, -5}, {1, 5}), {}});
+  // A diagonal wall 8 km long, inside the region.
+  spec.polygons.push_back({{{1000, 1000}, {6657, 6657}, {6657, 6658}, {1000, 1001}}, {}});
+  const float cell = 4.0f;
+  const World w = World::build(spec, cell);
+  const WorldView v = w.host_view();
+  EXPECT_GE(v.long_walls.size(), 5);  // the four sides and the diagonal
+  std::uint64_t state = 12345;
+  auto uniform = [&state](float lo, float hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * static_cast<float>(state >> 40) / static_cast<float>(1ull << 24);
+  };
+  std::vector<glm::vec2> probes;
+  for (int i = 0; i < 300; ++i) {
+    probes.push_back({uniform(-8, 8), uniform(-8, 8)});                     // the short obstacle
+    probes.push_back({kHalf - uniform(0, 6), uniform(-1e5f, 1e5f)});        // the east side
+    probes.push_back({uniform(-1e5f, 1e5f), -kHalf + uniform(0, 6)});       // the south side
+    const float t = uniform(1000, 6650);
+    probes.push_back({t + uniform(-5, 5), t + uniform(-5, 5)});             // along the diagonal
+  }
+  for (const glm::vec2 p : probes) {
+    std::vector<const Segment*> seen;
+    for_each_obstacle(v, obstacle_cell(v, p), [&](const Segment& s) { seen.push_back(&s); }, [](const Circle&) {});
+    std::vector<const Segment*> near;
+    for_each_wall_near(v, p, [&](const Segment& s) { near.push_back(&s); });
+    for (const Segment& s : w.segments()) {
+      if (distance_to_segment(p, s.a, s.b) > cell * 0.999f) continue;
+      EXPECT_NE(std::find(seen.begin(), seen.end(), &s), seen.end()) << "wall (" << s.a.x << ", " << s.a.y << ")-(" << s.b.x << ", " << s.b.y
+                                                                     << ") missed at " << p.x << ", " << p.y;
+      EXPECT_NE(std::find(near.begin(), near.end(), &s), near.end()) << "for_each_wall_near missed it at " << p.x << ", " << p.y;
+    }
+  }
 }
 
 TEST(Spawn, AgentsStartApartInFreeSpaceWithTheirGoals) {
