@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace throng::io {
 
@@ -162,11 +163,15 @@ std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& cli
 
 void write_bvh(const std::string& path, const motion::Skeleton& skeleton, const motion::Clip& clip, const BvhWriteOptions& options) {
   const std::string text = write_bvh_string(skeleton, clip, options);
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw Error("cannot open for writing", at_line(path, 0));
-  f.write(text.data(), static_cast<std::streamsize>(text.size()));
-  f.close();
-  if (!f) throw Error("write failed", at_line(path, 0));
+  OutputFile file(path);
+  {
+    std::ofstream f(file.writing_path(), std::ios::binary | std::ios::trunc);
+    if (!f) throw Error("cannot open for writing", at_line(path, 0));
+    f.write(text.data(), static_cast<std::streamsize>(text.size()));
+    f.close();
+    if (!f) throw Error("write failed", at_line(path, 0));
+  }
+  file.commit();
 }
 
 }  // namespace throng::io

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace throng::io {
 
@@ -57,17 +58,15 @@ void TrajectoryWriter::finish(const sim::Simulation&, nlohmann::json& stats) {
 }
 
 void write_json_file(const std::string& path, const nlohmann::json& j) {
-  const std::string tmp = path + ".tmp";
+  OutputFile file(path);
   {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error("cannot open for writing", Location{tmp, 0, 0, {}});
+    std::ofstream out(file.writing_path(), std::ios::binary | std::ios::trunc);
+    if (!out) throw Error("cannot open for writing", Location{path, 0, 0, {}});
     out << j.dump(2) << '\n';
     out.flush();
-    if (!out) throw Error("write failed", Location{tmp, 0, 0, {}});
+    if (!out) throw Error(std::string("write failed: ") + std::strerror(errno), Location{path, 0, 0, {}});
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw Error("cannot rename into place: " + ec.message(), Location{path, 0, 0, {}});
+  file.commit();
 }
 
 }  // namespace throng::io

@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace throng::render {
 
@@ -25,8 +26,10 @@ void write_png(const std::string& path, const Image& image) {
     data = rgb.data();
     channels = 3;
   }
-  if (stbi_write_png(path.c_str(), image.width, image.height, channels, data, image.width * channels) == 0)
-    throw Error("cannot write the PNG file (does its folder exist?)", at_field(path));
+  OutputFile file(path);
+  if (stbi_write_png(file.writing_path().c_str(), image.width, image.height, channels, data, image.width * channels) == 0)
+    throw Error("cannot write the PNG file (is its folder there, is the disk full?)", at_field(path));
+  file.commit();
 }
 
 Image read_png(const std::string& path) {

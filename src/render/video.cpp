@@ -124,7 +124,7 @@ bool ffmpeg_available(const std::string& executable) {
   return pid > 0 && wait_for(pid) == 0;
 }
 
-VideoWriter::VideoWriter(const VideoSpec& spec) : spec_(spec) {
+VideoWriter::VideoWriter(const VideoSpec& spec) : spec_(spec), file_(spec.path, OutputFile::OnFailure::KeepPartial) {
   spec.validate();
   if (!ffmpeg_available(spec.ffmpeg))
     throw Error(fmt::format("'{}' does not run: install ffmpeg (bash scripts/setup.sh --deps, or apt-get install ffmpeg)", spec.ffmpeg),
@@ -142,7 +142,7 @@ VideoWriter::VideoWriter(const VideoSpec& spec) : spec_(spec) {
                                          "-pixel_format", "rgba", "-video_size", fmt::format("{}x{}", spec.width, spec.height),
                                          "-framerate", fmt::format("{}", spec.fps), "-i", "pipe:0", "-an", "-c:v", "libx264",
                                          "-preset", "veryfast", "-crf", fmt::format("{}", spec.crf), "-pix_fmt", "yuv420p",
-                                         "-movflags", "+faststart", spec.path};
+                                         "-movflags", "+faststart", "-f", "mp4", file_.writing_path()};
   // "-nostdin" only stops ffmpeg reading keys; the frames come via pipe:0.
   pid_ = spawn(args, fds[0], log_fd, fds[1]);
   ::close(fds[0]);
@@ -155,15 +155,12 @@ VideoWriter::VideoWriter(const VideoSpec& spec) : spec_(spec) {
 }
 
 VideoWriter::~VideoWriter() {
-  try {
-    finish();
-  } catch (const Error& e) {
-    spdlog::error("video {}: {}", spec_.path, e.what());
-  }
+  if (const int code = close_stream(); code != 0) spdlog::error("video {}: ffmpeg failed (exit {}): {}", spec_.path, code, tail_of(log_path_));
   if (!log_path_.empty()) std::remove(log_path_.c_str());
 }
 
 void VideoWriter::fail(const std::string& what) {
+  failed_ = true;
   if (pipe_ >= 0) ::close(pipe_);
   pipe_ = -1;
   const int code = pid_ > 0 ? wait_for(pid_) : -1;
@@ -179,13 +176,21 @@ void VideoWriter::write(const Image& frame) {
   ++frames_;
 }
 
-void VideoWriter::finish() {
-  if (pid_ < 0) return;
+int VideoWriter::close_stream() {
+  if (pid_ < 0) return 0;
   ::close(pipe_);
   pipe_ = -1;
   const int code = wait_for(pid_);
   pid_ = -1;
-  if (code != 0) throw Error(fmt::format("ffmpeg failed (exit {}): {}", code, tail_of(log_path_)), at_field(spec_.path));
+  return code;
+}
+
+void VideoWriter::finish() {
+  if (file_.committed()) return;
+  if (failed_) throw Error(fmt::format("the video failed earlier; what was written is in {}", file_.writing_path()), at_field(spec_.path));
+  if (const int code = close_stream(); code != 0)
+    throw Error(fmt::format("ffmpeg failed (exit {}): {}", code, tail_of(log_path_)), at_field(spec_.path));
+  file_.commit();
 }
 
 }  // namespace throng::render

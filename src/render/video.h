@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/config.h"
+#include "core/output_file.h"
 #include "render/image.h"
 
 namespace throng::render {
@@ -26,9 +27,11 @@ bool ffmpeg_available(const std::string& executable = "ffmpeg");
 
 class VideoWriter {
  public:
-  // Starts ffmpeg writing spec.path. Throws Error when it cannot start.
+  // Starts ffmpeg writing spec.path + ".partial" (core/output_file.h).
+  // Throws Error when it cannot start.
   explicit VideoWriter(const VideoSpec& spec);
-  // Finishes quietly if finish() was not called (errors are only logged).
+  // Without finish() (an error elsewhere ended the run): lets ffmpeg close
+  // the file and keeps it as spec.path + ".partial", with a warning.
   ~VideoWriter();
   VideoWriter(const VideoWriter&) = delete;
   VideoWriter& operator=(const VideoWriter&) = delete;
@@ -36,19 +39,22 @@ class VideoWriter {
   // Appends one frame (spec.width x spec.height, top row first). Throws
   // Error when the size differs or ffmpeg has stopped (with its message).
   void write(const Image& frame);
-  // Closes the stream and waits for ffmpeg; throws Error with ffmpeg's
-  // message when it failed. Idempotent.
+  // Closes the stream, waits for ffmpeg and renames the video into place;
+  // throws Error with ffmpeg's message when it failed. Idempotent.
   void finish();
   Index frames_written() const { return frames_; }
   const VideoSpec& spec() const { return spec_; }
 
  private:
   [[noreturn]] void fail(const std::string& what);
+  int close_stream();  // closes the pipe, waits for ffmpeg: its exit status (0 when already closed)
   VideoSpec spec_;
+  OutputFile file_;
   int pid_ = -1;
   int pipe_ = -1;
   std::string log_path_;
   Index frames_ = 0;
+  bool failed_ = false;  // ffmpeg stopped early: the video stays partial
 };
 
 }  // namespace throng::render

@@ -338,7 +338,7 @@ TEST_F(RunCommand, InterruptLeavesCompleteFiles) {
   EXPECT_TRUE(stats["run"]["interrupted"].get<bool>());
   EXPECT_FALSE(stats["run"]["all_arrived"].get<bool>());
   EXPECT_EQ(stats["run"]["steps"].get<long>(), rows.rbegin()->first);
-  EXPECT_FALSE(fs::exists(out / "stats.json.tmp"));
+  EXPECT_FALSE(fs::exists(out / "stats.json.partial"));
 }
 
 // A terminal's Ctrl-C signals the whole foreground process group: throng
@@ -354,11 +354,12 @@ TEST_F(RunCommand, CtrlCToTheProcessGroupDuringAVideoRunKeepsEveryFile) {
   const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "200", "--render", "video", "--width", "160", "--height", "90",
                            "--out", out.string(), "--quiet"},
                           log);
-  // Wait until the encoder has written part of the file.
+  // Wait until the encoder has written part of the file (under its
+  // temporary name until the video is finished).
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (std::chrono::steady_clock::now() < deadline) {
     std::error_code ec;
-    if (fs::file_size(out / "crowd.mp4", ec) > 0 && !ec && fs::file_size(out / "trajectories.csv", ec) > 200 * 40 * 3 && !ec) break;
+    if (fs::file_size(out / "crowd.mp4.partial", ec) > 0 && !ec && fs::file_size(out / "trajectories.csv", ec) > 200 * 40 * 3 && !ec) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ASSERT_EQ(kill(-pid, SIGINT), 0);  // the group, as a terminal does
@@ -367,7 +368,8 @@ TEST_F(RunCommand, CtrlCToTheProcessGroupDuringAVideoRunKeepsEveryFile) {
   EXPECT_NE(o.out.find("(interrupted)"), std::string::npos) << o.out;
   const nlohmann::json stats = nlohmann::json::parse(slurp(out / "stats.json"));
   EXPECT_TRUE(stats["run"]["interrupted"].get<bool>());
-  EXPECT_FALSE(fs::exists(out / "stats.json.tmp"));
+  EXPECT_FALSE(fs::exists(out / "stats.json.partial"));
+  EXPECT_FALSE(fs::exists(out / "crowd.mp4.partial"));
   const std::map<long, int> rows = read_trajectories(out / "trajectories.csv", 200);
   ASSERT_GE(rows.size(), 2u);
   for (const auto& [frame, n] : rows) EXPECT_EQ(n, 200) << "frame " << frame;
@@ -399,7 +401,7 @@ TEST_F(RunCommand, CtrlCDuringSetUpEndsItWithStatsAndStatus130) {
   EXPECT_EQ(stats["run"]["steps"].get<long>(), 0);
   EXPECT_FALSE(stats["run"]["interrupted_during"].get<std::string>().empty());
   EXPECT_EQ(stats["scenario"]["name"], "plaza");
-  EXPECT_FALSE(fs::exists(out / "stats.json.tmp"));
+  EXPECT_FALSE(fs::exists(out / "stats.json.partial"));
 }
 
 // Set-up costs what the world holds, not how far it reaches: a walkable

@@ -70,6 +70,25 @@ TEST_F(VideoTest, WritesAPlayableMp4) {
   EXPECT_NEAR(p.duration, 2.0, 0.05) << p;
 }
 
+// Destroyed without finish() (an error elsewhere ended the run), the writer
+// lets ffmpeg close the file and keeps it under a name that says it is
+// incomplete; the final name never holds a partial video.
+TEST_F(VideoTest, AnUnfinishedVideoStaysPartial) {
+  const std::string dir = temp_dir("partial");
+  VideoSpec spec;
+  spec.path = dir + "/clip.mp4";
+  spec.width = 64;
+  spec.height = 48;
+  {
+    VideoWriter w(spec);
+    for (int f = 0; f < 10; ++f) w.write(solid(64, 48, static_cast<std::uint8_t>(f * 20)));
+  }
+  EXPECT_FALSE(std::filesystem::exists(spec.path));
+  const VideoProbe p = probe_video(spec.path + ".partial");
+  EXPECT_EQ(p.codec, "h264") << p;
+  EXPECT_EQ(p.frames, 10) << p;
+}
+
 TEST_F(VideoTest, BadSpecsAndFramesAreErrors) {
   VideoSpec spec;
   spec.path = temp_dir("bad") + "/x.mp4";
