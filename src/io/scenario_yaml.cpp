@@ -137,7 +137,8 @@ class Reader {
     double v = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return "expected a number, got " + shown(n.Scalar());
-    if (!std::isfinite(v) || std::fabs(v) > 3.0e38) return "the number must be finite, got " + shown(n.Scalar());
+    if (!std::isfinite(v) || std::fabs(v) > 3.0e38)
+      return "the number " + shown(n.Scalar()) + " is too large: values are single precision (up to 3.4e38), and positions must lie within the extent limit";
     *out = v;
     return {};
   }
@@ -753,6 +754,8 @@ LoadedScenario load_scenario(const std::string& name_or_path, const ScenarioRead
   if (builtin_scenario_text(name_or_path)) return load_builtin_scenario(name_or_path, limits);
   std::error_code ec;
   if (std::filesystem::is_regular_file(name_or_path, ec)) return read_scenario_file(name_or_path, limits);
+  if (std::filesystem::is_directory(name_or_path, ec))
+    throw Error("is a folder, not a scenario file (give the .yaml file inside it)", Location{name_or_path, 0, 0, {}});
   const bool looks_like_path = name_or_path.find('/') != std::string::npos || name_or_path.find('.') != std::string::npos;
   if (looks_like_path) throw Error("no such scenario file", Location{name_or_path, 0, 0, {}});
   return load_builtin_scenario(name_or_path, limits);  // throws, listing the built-ins

@@ -295,6 +295,9 @@ TEST_F(RunCommand, UnknownNamesAndBadOptionsAreErrors) {
   Outcome o = run({"run", "circel"});
   EXPECT_EQ(o.code, 1);
   EXPECT_NE(o.out.find("no built-in scenario 'circel' (built-ins: bottleneck, circle, corridor, crossing, maze, plaza)"), std::string::npos) << o.out;
+  o = run({"run", dir_.string()});  // a folder is not a scenario
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find(dir_.string() + ": is a folder, not a scenario file"), std::string::npos) << o.out;
   // Command lines CLI11 rejects exit with 2 (src/app/main.cpp), naming the option.
   o = run({"run", "circle", "--steps", "5", "--seconds", "3"});
   EXPECT_NE(o.code, 0);
