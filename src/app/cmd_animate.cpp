@@ -22,8 +22,10 @@
 #include "app/locomotion_stats.h"
 #include "core/camera.h"
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "core/timing.h"
 #include "io/animate_yaml.h"
+#include "io/run_outputs.h"
 #include "motion/locomotion.h"
 
 namespace throng::app {
@@ -45,6 +47,8 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
   if (duration_override > 0.0f) spec.duration_s = duration_override;
   if (characters_override > 0) spec.characters = characters_override;
   const std::string out_dir = out_override.empty() ? spec.output : out_override;
+  check_memory_budget(static_cast<double>(spec.characters) * kLocomotionBytesPerAgent, fmt::format("{} characters", spec.characters),
+                      characters_override > 0 ? "--characters" : "characters");
 
   FormationCrowd formation_crowd(spec, folder);  // blend space, formation, speeds drawn from the seed
   const motion::BlendSpace1D& space = formation_crowd.space();
@@ -130,10 +134,7 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
   fs::create_directories(out_dir, ec);
   if (ec || !fs::is_directory(out_dir)) throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(out_dir, 0));
   const fs::path json_path = fs::path(out_dir) / "stats.json";
-  std::ofstream out(json_path, std::ios::binary);
-  out << stats.dump(2) << "\n";
-  out.close();
-  if (!out) throw Error("cannot write stats.json", at_line(json_path.string(), 0));
+  io::write_json_file(json_path.string(), stats);
 
   std::printf("%s: %lld characters, %d joints, %lld frames at %g fps (%s mode, %s, %d threads)\n", spec.name.c_str(),
               static_cast<long long>(n), space.joint_count(), static_cast<long long>(frames), static_cast<double>(spec.fps),

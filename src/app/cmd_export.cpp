@@ -16,6 +16,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "io/bvh_writer.h"
+#include "io/run_outputs.h"
 #include "motion/cycle.h"
 #include "motion/default_set.h"
 #include "motion/foot_skating.h"
@@ -104,10 +105,7 @@ void add_export_command(CLI::App& app, const GlobalOptions& g) {
       spdlog::info("{}: {}", file, m.description);
     }
     const fs::path json_path = fs::path(dir) / "motions.json";
-    std::ofstream out(json_path, std::ios::binary);
-    out << summary.dump(2) << "\n";
-    out.close();
-    if (!out) throw Error("cannot write motions.json", at_line(json_path.string(), 0));
+    io::write_json_file(json_path.string(), summary);
     spdlog::info("wrote {} clips and motions.json to {}", motions.size(), dir);
   });
 }

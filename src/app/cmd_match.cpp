@@ -17,13 +17,14 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "core/exec.h"
+#include "core/random.h"
 #include "io/bvh_writer.h"
 #include "io/paths_yaml.h"
+#include "io/run_outputs.h"
 #include "io/state_machine_yaml.h"
 #include "motion/default_set.h"
 #include "path/pipeline.h"
 #include "path/planner.h"
-#include "core/random.h"
 
 namespace throng::app {
 
@@ -198,10 +199,7 @@ void run_match(const MatchArgs& a) {
   fs::create_directories(a.out, ec);
   if (ec || !fs::is_directory(a.out)) throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(a.out, 0));
   const fs::path json_path = fs::path(a.out) / "match.json";
-  std::ofstream out(json_path, std::ios::binary);
-  out << report.dump(2) << "\n";
-  out.close();
-  if (!out) throw Error("cannot write match.json", at_line(json_path.string(), 0));
+  io::write_json_file(json_path.string(), report);
   for (std::size_t i = 0; i < run.clips.size(); ++i) {
     if (run.clips[i].frame_count == 0) continue;
     io::BvhWriteOptions w;

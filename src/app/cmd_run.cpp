@@ -20,6 +20,7 @@
 #include "app/sim_locomotion.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/memory_budget.h"
 #include "core/exec.h"
 #include "core/timing.h"
 #include "io/run_outputs.h"
@@ -235,6 +236,11 @@ void run_scenario(const RunOptions& o) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create the output folder: " + ec.message(), at_field("--out", dir));
+
+  const std::int64_t total = spec.total_agents();
+  const bool animate_planned = !o.no_animate && (o.animate || !o.render.empty() || total <= kAnimateUpTo);
+  check_memory_budget(static_cast<double>(total) * (kSimBytesPerAgent + (animate_planned ? kLocomotionBytesPerAgent : 0.0)),
+                      fmt::format("{} agents{}", total, animate_planned ? ", animated" : ""), o.agents > 0 ? "--agents" : "groups");
 
   const auto setup_start = std::chrono::steady_clock::now();
   KernelTimings::global().reset();

@@ -12,15 +12,24 @@ struct GlobalOptions {
   std::string backend = "auto";  // auto | cpu | cuda
   int threads = 0;               // 0 = all cores
   std::string log_level = "info";
+  std::string max_memory;        // "" = 80 % of physical memory (core/memory_budget.h)
 };
 
-// Applies --backend/--threads/--log-level; throws Error on bad values.
+// Applies --backend/--threads/--log-level/--max-memory; throws Error on bad values.
 void apply_global_options(const GlobalOptions& g);
 
 // Adds --backend/--threads/--log-level to `app`, bound to `g`. main() adds
 // them to the top level and to every subcommand, so they may be given
 // before or after the subcommand's name.
 void add_global_options(CLI::App& app, GlobalOptions& g);
+
+// Memory per agent for the budget check before set-up (core/memory_budget.h):
+// growth of the resident set per agent measured with the built-in plaza
+// between 10^4 and 10^5 agents (simulation 0.58 KB; locomotion with the
+// 22-joint default character 0.68 KB, also per character of `throng
+// animate`), rounded up.
+constexpr double kSimBytesPerAgent = 640;
+constexpr double kLocomotionBytesPerAgent = 768;
 
 // Range checks whose errors read "--agents: must be at least 1, got 0"
 // (CLI11's own print the bounds of the type, a 309-digit number for double).

@@ -14,6 +14,7 @@
 #include "app/version.h"
 #include "core/error.h"
 #include "core/exec.h"
+#include "core/memory_budget.h"
 #include "core/spelling.h"
 
 namespace throng::app {
@@ -25,6 +26,7 @@ void apply_global_options(const GlobalOptions& g) {
   spdlog::set_level(level);
   if (g.threads < 0) throw Error("thread count must be >= 0 (0 = all cores)", at_field("--threads"));
   configure_execution(resolve_backend(parse_backend_choice(g.backend)), g.threads);
+  set_memory_budget(g.max_memory.empty() ? 0 : parse_memory_size(g.max_memory, "--max-memory"));
 }
 
 void add_global_options(CLI::App& app, GlobalOptions& g) {
@@ -32,6 +34,7 @@ void add_global_options(CLI::App& app, GlobalOptions& g) {
   app.add_option("--backend", g.backend, "Where kernels run: auto, cpu or cuda")->check(CLI::IsMember({"auto", "cpu", "cuda"}))->group(group);
   app.add_option("--threads", g.threads, "CPU threads (0 = all cores)")->check(at_least(0))->group(group);
   app.add_option("--log-level", g.log_level, "trace, debug, info, warn, error or off")->group(group);
+  app.add_option("--max-memory", g.max_memory, "Memory a command may plan to use, e.g. 8G (default: 80 % of physical memory)")->group(group);
 }
 
 }  // namespace throng::app

@@ -442,4 +442,22 @@ TEST_F(RunCommand, AHugeNearlyEmptyWorldSetsUpQuickly) {
   EXPECT_EQ(stats["run"]["steps"].get<long>(), 300);
 }
 
+// A request beyond the memory budget is refused before any work starts, with
+// the figures; --max-memory is a global option (before or after the command).
+TEST_F(RunCommand, RequestsBeyondTheMemoryBudgetAreRefusedUpFront) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Outcome o = run({"--max-memory", "1G", "animate", "--characters", "10000000", "--out", dir_.string()});
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("--characters: about 7.15 GiB for 10000000 characters exceeds the memory budget of 1 GiB (--max-memory)"),
+            std::string::npos)
+      << o.out;
+  o = run({"run", "plaza", "--agents", "2000000", "--max-memory", "500M", "--out", dir_.string()});
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("--agents: about 1.19 GiB for 2000000 agents exceeds the memory budget of 500 MiB"), std::string::npos) << o.out;
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(60)) << "the refusal came after the work";
+  o = run({"run", "circle", "--max-memory", "lots"});
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("--max-memory: expected a size such as 512M, 8G or 1.5GiB, got 'lots'"), std::string::npos) << o.out;
+}
+
 }  // namespace
