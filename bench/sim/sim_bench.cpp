@@ -50,7 +50,8 @@ Body step(sim::ModelKind model, Variant variant) {
 
 void register_sim(const Options& options) {
   const std::vector<Index> sizes = {1000, 10000, 100000, 1000000};
-  for (const sim::ModelKind model : {sim::ModelKind::Priority, sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Ttc}) {
+  for (const sim::ModelKind model : {sim::ModelKind::Priority, sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Ttc,
+                                    sim::ModelKind::SocialForce}) {
     const std::string prefix = std::string("sim/plaza_step/") + sim::to_string(model);
     add(options, {prefix + "/double_buffer", sizes, step(model, Variant::DoubleBuffer), true});
     add(options, {prefix + "/four_colour", sizes, step(model, Variant::FourColour), true});

@@ -371,12 +371,17 @@ class Reader {
                                                       "turn_time",      "anticipation_time"};
     static const std::vector<std::string_view> ttc = {"ttc_strength", "ttc_time_horizon", "ttc_relaxation_time", "ttc_sensing_radius",
                                                       "ttc_max_acceleration", "ttc_side_bias"};
+    static const std::vector<std::string_view> sf = {"sf_mass",       "sf_relaxation_time", "sf_strength",       "sf_range",
+                                                     "sf_body_stiffness", "sf_friction",    "sf_anisotropy",     "sf_sensing_radius",
+                                                     "sf_max_substep", "sf_side_bias"};
     visit(n, path);
     if (!n.IsMap()) fail(n, path, "expected a map (model.type and its parameters), got " + kind(n));
     sim::ModelParams m;
     if (n["type"])
-      m.kind = sim::parse_model_kind(word(n["type"], child(path, "type"), {"collision_free_speed", "priority", "ttc"}), child(path, "type"));
+      m.kind = sim::parse_model_kind(word(n["type"], child(path, "type"), {"collision_free_speed", "priority", "ttc", "social_force"}),
+                                    child(path, "type"));
     auto keys_of_model = [&](sim::ModelKind k) -> const std::vector<std::string_view>& {
+      if (k == sim::ModelKind::SocialForce) return sf;
       return k == sim::ModelKind::Priority ? priority : (k == sim::ModelKind::Ttc ? ttc : cfs);
     };
     const std::vector<std::string_view>& own = keys_of_model(m.kind);
@@ -385,7 +390,8 @@ class Reader {
     for (auto it = n.begin(); it != n.end(); ++it) {
       const YAML::Node key = it->first;
       if (!key.IsScalar()) continue;
-      for (const sim::ModelKind owner : {sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Priority, sim::ModelKind::Ttc}) {
+      for (const sim::ModelKind owner : {sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Priority, sim::ModelKind::Ttc,
+                                      sim::ModelKind::SocialForce}) {
         const std::vector<std::string_view>& keys = keys_of_model(owner);
         if (owner == m.kind || std::find(keys.begin(), keys.end(), key.Scalar()) == keys.end()) continue;
         fail_at(key.Mark(), child(path, key.Scalar()),
@@ -420,6 +426,16 @@ class Reader {
     opt("ttc_sensing_radius", m.ttc.sensing_radius);
     opt("ttc_max_acceleration", m.ttc.max_acceleration);
     opt("ttc_side_bias", m.ttc.side_bias);
+    opt("sf_mass", m.sf.mass);
+    opt("sf_relaxation_time", m.sf.relaxation_time);
+    opt("sf_strength", m.sf.strength);
+    opt("sf_range", m.sf.range);
+    opt("sf_body_stiffness", m.sf.body_stiffness);
+    opt("sf_friction", m.sf.friction);
+    opt("sf_anisotropy", m.sf.anisotropy);
+    opt("sf_sensing_radius", m.sf.sensing_radius);
+    opt("sf_max_substep", m.sf.max_substep);
+    opt("sf_side_bias", m.sf.side_bias);
     if (n["contact_iterations"]) m.contact_iterations = static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
     return m;
   }

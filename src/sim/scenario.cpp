@@ -45,10 +45,21 @@ void ModelParams::validate() const {
   check_range(ttc.sensing_radius, 1.0f, 20.0f, true, "model.ttc_sensing_radius", "sensing radius (m)");
   check_range(ttc.max_acceleration, 0.0f, 1000.0f, false, "model.ttc_max_acceleration", "largest acceleration (m/s^2)");
   check_range(ttc.side_bias, 0.0f, 10.0f, true, "model.ttc_side_bias", "keep-right bias");
+  check_range(sf.mass, 1.0f, 1000.0f, true, "model.sf_mass", "mass (kg)");
+  check_range(sf.relaxation_time, 0.01f, 100.0f, true, "model.sf_relaxation_time", "goal relaxation time (s)");
+  check_range(sf.strength, 0.0f, 1.0e5f, true, "model.sf_strength", "social repulsion strength A (N)");
+  check_range(sf.range, 0.01f, 10.0f, true, "model.sf_range", "social repulsion range B (m)");
+  check_range(sf.body_stiffness, 0.0f, 1.0e7f, true, "model.sf_body_stiffness", "body stiffness k (kg/s^2)");
+  check_range(sf.friction, 0.0f, 1.0e7f, true, "model.sf_friction", "sliding friction kappa (kg/(m s))");
+  check_range(sf.anisotropy, 0.0f, 1.0f, true, "model.sf_anisotropy", "anisotropy lambda");
+  check_range(sf.sensing_radius, 1.0f, 20.0f, true, "model.sf_sensing_radius", "sensing radius (m)");
+  check_range(sf.max_substep, 0.0005f, 0.05f, true, "model.sf_max_substep", "largest substep (s)");
+  check_range(sf.side_bias, 0.0f, 10.0f, true, "model.sf_side_bias", "keep-right bias");
 }
 
 const char* to_string(ModelKind k) {
   if (k == ModelKind::Priority) return "priority";
+  if (k == ModelKind::SocialForce) return "social_force";
   return k == ModelKind::Ttc ? "ttc" : "collision_free_speed";
 }
 
@@ -56,7 +67,8 @@ ModelKind parse_model_kind(const std::string& text, const std::string& field) {
   if (text == "collision_free_speed") return ModelKind::CollisionFreeSpeed;
   if (text == "priority") return ModelKind::Priority;
   if (text == "ttc") return ModelKind::Ttc;
-  throw Error("unknown model type '" + text + "' (collision_free_speed, priority or ttc)", at_field(field));
+  if (text == "social_force") return ModelKind::SocialForce;
+  throw Error("unknown model type '" + text + "' (collision_free_speed, priority, ttc or social_force)", at_field(field));
 }
 
 const char* to_string(ArrivalBehaviour a) {

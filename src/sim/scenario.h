@@ -23,9 +23,10 @@ enum class ModelKind : std::uint8_t {
   CollisionFreeSpeed,  // Tordeux, Chraibi, Seyfried 2016, with anticipation (collision_free_speed.h)
   Priority,            // the paper's three forces by priority (steering.h)
   Ttc,                 // Karamouzas, Skinner, Guy 2014: the time-to-collision power law (ttc.h)
+  SocialForce,         // Helbing, Farkas, Vicsek 2000: the social force with body contact and friction (social_force.h)
 };
 const char* to_string(ModelKind k);
-// "collision_free_speed" | "priority" | "ttc"; throws Error naming `field` otherwise.
+// "collision_free_speed" | "priority" | "ttc" | "social_force"; throws Error naming `field` otherwise.
 ModelKind parse_model_kind(const std::string& text, const std::string& field);
 
 // Parameters of the collision-free speed model (collision_free_speed.h).
@@ -60,11 +61,32 @@ struct TtcParams {
   float side_bias = 0.5f;         // keep right: share of |F_ij| also pushed right of the relative velocity (0 = the paper's)
 };
 
+// Parameters of the social force model (social_force.h). Defaults: m, tau,
+// A, B, k and kappa as Helbing, Farkas, Vicsek 2000 ("Simulating dynamical
+// features of escape panic", Nature 407, 487-490: 80 kg, 0.5 s, 2000 N,
+// 0.08 m, 1.2e5 kg/s^2, 2.4e5 kg/(m s)), isotropic as that paper (lambda =
+// 1; Helbing, Johansson 2009 use about 0.3 for walkers, which jams this
+// engine's four-way and circle encounters, docs/simulation.md); the sensing
+// radius, the substep and the keep-right bias are this engine's.
+struct SocialForceParams {
+  float mass = 80.0f;               // kg: m
+  float relaxation_time = 0.5f;     // s: tau, the driving term m (v0 e0 - v) / tau
+  float strength = 2000.0f;         // N: A, the social repulsion at contact
+  float range = 0.08f;              // m: B, its decay length
+  float body_stiffness = 1.2e5f;    // kg/s^2: k, the body force k g(r_ij - d_ij)
+  float friction = 2.4e5f;          // kg/(m s): kappa, the sliding friction kappa g(r_ij - d_ij) dv^t
+  float anisotropy = 1.0f;          // lambda: weight of the social repulsion from behind (1 = isotropic, the 2000 paper's)
+  float sensing_radius = 2.0f;      // m: neighbours whose centre lies within this are felt
+  float max_substep = 0.01f;        // s: the step is integrated in substeps of at most this (the body force's stiffness)
+  float side_bias = 2.5f;           // keep right: share of the social repulsion also pushed right of the relative velocity (0 = the paper's)
+};
+
 // The steering model and its parameters, and those of the move stage.
 struct ModelParams {
   ModelKind kind = ModelKind::Priority;
   CollisionFreeSpeedParams cfs;
   TtcParams ttc;
+  SocialForceParams sf;
   // The priority model (the paper's):
   float pred_time = 1.0f;          // s: prediction horizon (predTime)
   float max_force = 4.0f;          // m/s^2: largest steering acceleration
@@ -79,15 +101,16 @@ struct ModelParams {
   // within it. Priority: 2 * pred_time * max_speed (the paper's). Collision-
   // free speed: the gap that allows max_speed (T * max_speed) plus two of
   // the largest radius (kCfsMaxRadius), at least the anticipation reach.
-  // Time to collision: its sensing radius.
+  // Time to collision and social force: their sensing radius.
   THRONG_HOST_DEVICE float query_radius() const {
     if (kind == ModelKind::Priority) return 2.0f * pred_time * max_speed;
     if (kind == ModelKind::Ttc) return ttc.sensing_radius;
+    if (kind == ModelKind::SocialForce) return sf.sensing_radius;
     const float gap = cfs.time_gap * max_speed, anticipate = 0.5f * cfs.avoid_time * max_speed;
     return 2.0f * kCfsMaxRadius + (gap > anticipate ? gap : anticipate);
   }
-  // The largest agent radius the bins allow (time to collision: as the
-  // collision-free speed model).
+  // The largest agent radius the bins allow (time to collision and social
+  // force: as the collision-free speed model).
   THRONG_HOST_DEVICE float max_radius() const { return kind == ModelKind::Priority ? pred_time * max_speed : kCfsMaxRadius; }
   static constexpr float kCfsMaxRadius = 0.5f;  // m
   // Throws Error naming the field ("model.pred_time") for NaN, negative or

@@ -6,6 +6,7 @@
 #include "sim/collision_free_speed.h"
 #include "sim/crowd.h"
 #include "sim/grid.h"
+#include "sim/social_force.h"
 #include "sim/steering.h"
 #include "sim/ttc.h"
 #include "sim/world.h"
@@ -186,6 +187,60 @@ THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, co
     f += ttc_avoidance(x, me.v - n.velocity[j], me.radius + n.radius[j], t);
   });
   return clamp_length(f, t.max_acceleration);
+}
+
+// ---- social force -----------------------------------------------------------------
+
+// The agent being steered under the social force model.
+struct SfAgent {
+  glm::vec2 p{0.0f};
+  glm::vec2 v{0.0f};
+  float radius = 0.2f;
+  glm::vec2 e0{1.0f, 0.0f};  // unit direction to the goal
+  float pref_speed = 1.3f;
+};
+
+// The total force (N) on `me` at time t into the step: the driving term,
+// then walls and circles of its obstacle cell (nearest points within the
+// sensing radius), then neighbours within the sensing radius, each where it
+// was sensed at the start of the step moved on t at its velocity, in the
+// order `for_each_candidate` visits them (the sum is the same for any
+// thread count); h: the substep (sf_contact_force).
+template <class ForEachCandidate>
+THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index self, const SfAgent& me, float t, float h,
+                                                   const NeighbourArrays& n, const SocialForceParams& s,
+                                                   const ForEachCandidate& for_each_candidate) {
+  const float sense2 = s.sensing_radius * s.sensing_radius;
+  glm::vec2 f = sf_driving_force(me.v, me.pref_speed, me.e0, s);
+  for_each_wall_point(w, me.p, [&](glm::vec2 q) {
+    if (length2(me.p - q) < sense2) f += sf_wall_force(me.p, me.v, me.radius, q, s, h);
+  });
+  const glm::vec2 heading = normalize_or(me.v, me.e0);
+  for_each_candidate([&](Index j) {
+    if (j == self || (n.flags[j] & kAgentActive) == 0) return;
+    const glm::vec2 x = me.p - (n.position[j] + n.velocity[j] * t);
+    if (length2(x) < sense2) f += sf_neighbour_force(x, me.v, n.velocity[j], me.radius + n.radius[j], heading, s, h);
+  });
+  return f;
+}
+
+// The step of `me` under the social force model (social_force.h): dt
+// integrated in sf_substeps substeps, symplectic Euler (v first, at most
+// max_speed, then p), against neighbours moving on at constant velocity.
+// Returns the step's mean velocity, the displacement / dt.
+template <class ForEachCandidate>
+THRONG_HOST_DEVICE inline glm::vec2 social_force_velocity(const WorldView& w, Index self, SfAgent me, float dt, const NeighbourArrays& n,
+                                                          const ModelParams& m, const ForEachCandidate& for_each_candidate) {
+  const SocialForceParams& s = m.sf;
+  const int substeps = sf_substeps(dt, s);
+  const float h = dt / static_cast<float>(substeps);
+  const glm::vec2 start = me.p;
+  for (int k = 0; k < substeps; ++k) {
+    const glm::vec2 f = sf_total_force(w, self, me, static_cast<float>(k) * h, h, n, s, for_each_candidate);
+    me.v = clamp_length(me.v + f * (h / s.mass), m.max_speed);
+    me.p += me.v * h;
+  }
+  return (me.p - start) * (1.0f / dt);
 }
 
 // Deterministic unit direction for two agents at exactly the same point.

@@ -6,10 +6,11 @@
 //            (sense.h). Priority: the higher-priority force, obstacle
 //            avoidance from the probe else agent avoidance. Collision-free
 //            speed: the new velocity (collision_free_speed.h). Time to
-//            collision: the total acceleration (ttc.h).
+//            collision: the total acceleration (ttc.h). Social force: the
+//            step's mean velocity, integrated in substeps (social_force.h).
 //   3 steer  priority: path following when nothing was sensed, then
 //            integration; collision-free speed: the sensed velocity; time
-//            to collision: integration
+//            to collision: integration; social force: the sensed velocity
 //   4 move   contact passes and wall projection, accept or reject the move,
 //            velocity, heading, arrivals and waypoints
 // under one of two schedulers:

@@ -79,17 +79,37 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const Agen
   return ttc_force(ctx.world, i, me, n, ctx.model, for_each_candidate);
 }
 
+// Sense under the social force model: the step's mean velocity.
+template <class ForEachCandidate>
+THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a, Index i,
+                                                       const ForEachCandidate& for_each_candidate) {
+  const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+  const glm::vec2 p = a.position[i];
+  const SfAgent me{p, a.velocity[i], a.radius[i], normalize_or(a.goal[i] - p, glm::vec2(0.0f)), a.pref_speed[i]};
+  return social_force_velocity(ctx.world, i, me, ctx.dt, n, ctx.model, for_each_candidate);
+}
+
+// The sense of the models that sum over every candidate neighbour
+// (collision-free speed, time to collision, social force).
+template <class ForEachCandidate>
+THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, const AgentArrays& a, Index i,
+                                                     const ForEachCandidate& for_each_candidate) {
+  if (ctx.model.kind == ModelKind::Ttc) return sense_ttc(ctx, a, i, for_each_candidate);
+  if (ctx.model.kind == ModelKind::SocialForce) return sense_social_force(ctx, a, i, for_each_candidate);
+  return sense_collision_free(ctx, a, i, for_each_candidate);
+}
+
 // Sense: what the model makes of the agent's surroundings, zero for agents
 // that do not steer. Priority: the avoidance force (zero when nothing is
 // sensed); collision-free speed: the new velocity; time to collision: the
-// total acceleration. Neighbours come from the 3x3 bins around (cx, cy), the
+// total acceleration; social force: the step's mean velocity. Neighbours come from the 3x3 bins around (cx, cy), the
 // agent's cell.
 THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy) {
   if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
     auto candidates = [&](const auto& fn) { for_each_in_cells(ctx.bins, cells, fn); };
-    return ctx.model.kind == ModelKind::Ttc ? sense_ttc(ctx, a, i, candidates) : sense_collision_free(ctx, a, i, candidates);
+    return sense_candidates(ctx, a, i, candidates);
   }
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
   return sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
@@ -100,7 +120,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
 // Steer: integrates what was sensed. Priority: path following when the
 // sensed force is zero, else that force; collision-free speed: the sensed
 // velocity as it is (a first-order model); time to collision: the sensed
-// acceleration, up to max_speed.
+// acceleration, up to max_speed; social force: the sensed mean velocity
+// (the model integrated its substeps in the sense stage).
 THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentArrays& a, Index i, glm::vec2 sensed, glm::vec2& out_p,
                                            glm::vec2& out_v) {
   const glm::vec2 p = a.position[i], v = a.velocity[i];
@@ -110,7 +131,7 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
     return;
   }
   const ModelParams& m = ctx.model;
-  if (m.kind == ModelKind::CollisionFreeSpeed) {
+  if (m.kind == ModelKind::CollisionFreeSpeed || m.kind == ModelKind::SocialForce) {
     out_v = sensed;
   } else if (m.kind == ModelKind::Ttc) {
     out_v = clamp_length(v + sensed * ctx.dt, m.max_speed);
@@ -166,7 +187,7 @@ struct SenseAllPairs {
       auto candidates = [&](const auto& fn) {
         for (Index j = 0; j < count; ++j) fn(j);
       };
-      sensed[i] = ctx.model.kind == ModelKind::Ttc ? sense_ttc(ctx, a, i, candidates) : sense_collision_free(ctx, a, i, candidates);
+      sensed[i] = sense_candidates(ctx, a, i, candidates);
       return;
     }
     const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};

@@ -86,7 +86,10 @@ TEST(CudaSimulation, OneStepMatchesCpu) {
                         Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
                         Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs, ModelKind::CollisionFreeSpeed},
                         // The time-to-collision model: sums of exponentials and square roots, likewise.
-                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::Ttc}})
+                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::Ttc},
+                        // The social force model: the same sums, over ten substeps.
+                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::SocialForce},
+                        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::SocialForce}})
     expect_one_step_matches(c);
 }
 

@@ -333,6 +333,40 @@ TEST(ScenarioYaml, TtcModelKeys) {
   }
 }
 
+TEST(ScenarioYaml, SocialForceModelKeys) {
+  const std::string text = std::string(kOneGroup) + R"(model:
+  type: social_force
+  sf_mass: 70
+  sf_relaxation_time: 0.4
+  sf_strength: 1500
+  sf_range: 0.1
+  sf_body_stiffness: 1.0e5
+  sf_friction: 2.0e5
+  sf_anisotropy: 0.3
+  sf_sensing_radius: 3
+  sf_max_substep: 0.02
+  sf_side_bias: 1
+)";
+  const sim::ModelParams m = parse_scenario(text, "sf.yaml").spec.model;
+  EXPECT_EQ(m.kind, sim::ModelKind::SocialForce);
+  const std::vector<std::pair<float, float>> read = {
+      {m.sf.mass, 70.0f},          {m.sf.relaxation_time, 0.4f}, {m.sf.strength, 1500.0f},    {m.sf.range, 0.1f},
+      {m.sf.body_stiffness, 1e5f}, {m.sf.friction, 2e5f},        {m.sf.anisotropy, 0.3f},     {m.sf.sensing_radius, 3.0f},
+      {m.sf.max_substep, 0.02f},   {m.sf.side_bias, 1.0f},       {m.query_radius(), 3.0f}};
+  for (const auto& [got, want] : read) EXPECT_FLOAT_EQ(got, want);
+  // A parameter of another model names its owner, either way round.
+  for (const auto& [model, owner] : {std::pair{"{type: social_force, ttc_strength: 1}", "'ttc_strength' is a parameter of the ttc model"},
+                                     std::pair{"{type: ttc, sf_mass: 80}", "'sf_mass' is a parameter of the social_force model"}}) {
+    std::string message = "no error";
+    try {
+      parse_scenario(std::string(kOneGroup) + "model: " + model + "\n", "a.yaml");
+    } catch (const Error& e) {
+      message = e.what();
+    }
+    EXPECT_NE(message.find(owner), std::string::npos) << message;
+  }
+}
+
 TEST(ScenarioYaml, MeasurementListsAreBounded) {
   for (const char* list : {"areas", "lines"}) {
     std::string text = std::string(kOneGroup) + "measurement:\n  " + list + ":\n";

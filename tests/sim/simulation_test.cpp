@@ -200,7 +200,7 @@ void expect_identical(const Snapshot& a, const Snapshot& b, int threads) {
 // agents under the sanitizers.
 // Every model.
 TEST(Determinism, DoubleBufferIsBitwiseTheSameForOneTwoAndFourThreads) {
-  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc})
+  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce})
     for (const auto& [name, agents, steps] : {std::tuple{"bottleneck", 300, 400}, std::tuple{"crossing", 1200, 500}}) {
       SCOPED_TRACE(std::string(name) + ", " + to_string(model));
       ScenarioSpec spec = test::builtin(name, test::sanitized() ? agents / 3 : agents);
@@ -215,7 +215,7 @@ TEST(Determinism, DoubleBufferIsBitwiseTheSameForOneTwoAndFourThreads) {
 // The four-colour batches never let two cells of a batch touch the same
 // agents, so they too are independent of the thread count (every model).
 TEST(Determinism, FourColourIsBitwiseTheSameForOneTwoAndFourThreads) {
-  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc}) {
+  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce}) {
     SCOPED_TRACE(to_string(model));
     ScenarioSpec spec = test::builtin("bottleneck", 300);
     spec.model.kind = model;
@@ -241,12 +241,12 @@ TEST(Bins, SimulationWithBinsMatchesTheAllPairsReference) {
   }
 }
 
-// The collision-free speed and time-to-collision models sum over their
+// The collision-free speed, time-to-collision and social force models sum over their
 // neighbours, so the bins' visiting order changes the last bits and
 // trajectories drift apart over many steps; one step from the same state
 // must agree to float rounding.
 TEST(Bins, SummingModelsStepMatchesTheAllPairsReference) {
-  for (const ModelKind model : {ModelKind::CollisionFreeSpeed, ModelKind::Ttc})
+  for (const ModelKind model : {ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce})
     for (const auto& [name, agents] : {std::pair{"crossing", 800}, std::pair{"bottleneck", 300}}) {
       SCOPED_TRACE(std::string(name) + ", " + to_string(model));
       ScenarioSpec spec = test::builtin(name, test::sanitized() ? agents / 3 : agents);
