@@ -1,6 +1,7 @@
 // throng run [SCENARIO|NAME]: runs a scenario file or a built-in scenario,
 // animates every agent with the locomotion stage (app/sim_locomotion.h),
-// writes DIR/trajectories.csv and DIR/stats.json, with --render a video or
+// writes DIR/trajectories.{csv,txt,sqlite} (--trajectory-format), the walkable
+// area (DIR/geometry.wkt, .geojson) and DIR/stats.json, with --render a video or
 // PNG frames under the scenario's camera, and prints a summary.
 #include <fmt/format.h>
 #include <unistd.h>
@@ -222,7 +223,7 @@ void run_scenario(const RunOptions& o) {
   std::optional<io::GeometryFiles> geometry_files;
   if (spec.outputs.trajectories && !o.no_trajectories) {
     io::TrajectoryOutput t;
-    t.format = format_flag.value_or(io::TrajectoryFormat::Csv);
+    t.format = format_flag.value_or(loaded.trajectory_format);
     t.path = dir + "/" + io::trajectory_file_name(t.format);
     t.every = o.every > 0 ? o.every : (spec.outputs.every > 0 ? spec.outputs.every : metrics.sample_every);
     t.dt = static_cast<double>(spec.dt);
