@@ -70,6 +70,7 @@ struct RunOptions {
   std::string out;
   std::int64_t every = 0;
   std::string trajectory_format;  // empty = the scenario's, else csv
+  std::optional<io::TrajectoryFormat> format;  // trajectory_format, checked
   bool no_trajectories = false;
   bool quiet = false;
   // Locomotion: on by default up to kAnimateUpTo agents.
@@ -186,9 +187,6 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
 }
 
 void run_scenario(const RunOptions& o) {
-  // A misspelt format fails before the (possibly long) set-up.
-  std::optional<io::TrajectoryFormat> format_flag;
-  if (!o.trajectory_format.empty()) format_flag = io::parse_trajectory_format(o.trajectory_format, "--trajectory-format");
   io::LoadedScenario loaded = io::load_scenario(o.scenario);
   sim::ScenarioSpec& spec = loaded.spec;
   if (o.agents > 0) sim::scale_agent_counts(spec, o.agents);
@@ -223,7 +221,7 @@ void run_scenario(const RunOptions& o) {
   std::optional<io::GeometryFiles> geometry_files;
   if (spec.outputs.trajectories && !o.no_trajectories) {
     io::TrajectoryOutput t;
-    t.format = format_flag.value_or(loaded.trajectory_format);
+    t.format = o.format.value_or(loaded.trajectory_format);
     t.path = dir + "/" + io::trajectory_file_name(t.format);
     t.every = o.every > 0 ? o.every : (spec.outputs.every > 0 ? spec.outputs.every : metrics.sample_every);
     t.dt = static_cast<double>(spec.dt);
@@ -404,6 +402,8 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
                   {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera", "--camera-period"},
                   "--render video|frames");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");
+    // Checked here, like the other flags, before the (possibly long) set-up.
+    if (!o.trajectory_format.empty()) o.format = io::parse_trajectory_format(o.trajectory_format, "--trajectory-format");
     apply_global_options(g);
     run_scenario(o);
   });
