@@ -1,6 +1,7 @@
 // throng run [SCENARIO|NAME]: runs a scenario file or a built-in scenario,
 // animates every agent with the locomotion stage (app/sim_locomotion.h),
-// writes DIR/trajectories.csv and DIR/stats.json, with --render a video or
+// writes DIR/trajectories.{csv,txt,sqlite} (--trajectory-format), the walkable
+// area (DIR/geometry.wkt, .geojson) and DIR/stats.json, with --render a video or
 // PNG frames under the scenario's camera, and prints a summary.
 #include <fmt/format.h>
 #include <unistd.h>
@@ -25,6 +26,7 @@
 #include "core/timing.h"
 #include "io/run_outputs.h"
 #include "io/scenario_yaml.h"
+#include "io/walkable_area.h"
 #include "sim/frame_loop.h"
 #include "sim/metrics_stage.h"
 
@@ -69,6 +71,8 @@ struct RunOptions {
   std::string scheduler;
   std::string out;
   std::int64_t every = 0;
+  std::string trajectory_format;  // empty = the scenario's, else csv
+  std::optional<io::TrajectoryFormat> format;  // trajectory_format, checked
   bool no_trajectories = false;
   bool quiet = false;
   // Locomotion: on by default up to kAnimateUpTo agents.
@@ -263,10 +267,20 @@ void run_scenario(const RunOptions& o) {
   metrics.measurement = spec.measurement;
   loop.emplace<sim::CrowdMetricsStage>(*sim, metrics);
   std::string written;
+  std::optional<io::GeometryFiles> geometry_files;
   if (spec.outputs.trajectories && !o.no_trajectories) {
-    const std::int64_t every = o.every > 0 ? o.every : (spec.outputs.every > 0 ? spec.outputs.every : metrics.sample_every);
-    loop.emplace<io::TrajectoryWriter>(dir + "/trajectories.csv", every);
-    written = dir + "/trajectories.csv";
+    io::TrajectoryOutput t;
+    t.format = o.format.value_or(loaded.trajectory_format);
+    t.path = dir + "/" + io::trajectory_file_name(t.format);
+    t.every = o.every > 0 ? o.every : (spec.outputs.every > 0 ? spec.outputs.every : metrics.sample_every);
+    t.dt = static_cast<double>(spec.dt);
+    // The walkable area goes beside the trajectories (and into the SQLite
+    // file): analysis tools need both.
+    const std::vector<sim::Polygon> area = io::walkable_area(*sim);
+    t.geometry_wkt = io::to_wkt(area);
+    geometry_files = io::write_geometry_files(dir, area);
+    written = t.path + ", " + geometry_files->wkt + ", " + geometry_files->geojson;
+    loop.emplace<io::TrajectoryWriter>(std::move(t));
   }
 
   const Index n = sim->agent_count();
@@ -351,6 +365,7 @@ void run_scenario(const RunOptions& o) {
 
   nlohmann::json stats;
   loop.finish(stats);
+  if (geometry_files) stats["trajectories"]["geometry"] = {{"wkt", geometry_files->wkt}, {"geojson", geometry_files->geojson}};
   if (finish_render) {
     const std::string rendered = finish_render();
     if (!rendered.empty()) written += (written.empty() ? "" : ", ") + rendered;
@@ -386,7 +401,10 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--out", o.out, "Output folder (default: the scenario's, else out/<name>)");
   cmd->add_option("--every", o.every, "Write trajectories every K-th frame (default: the scenario's, else once a simulated second)")
       ->check(at_least(1));
-  cmd->add_flag("--no-trajectories", o.no_trajectories, "Do not write trajectories.csv");
+  cmd->add_option("--trajectory-format", o.trajectory_format,
+                  "Trajectory file format: csv (trajectories.csv), pedpy (trajectories.txt) or sqlite (trajectories.sqlite, JuPedSim's "
+                  "schema); default: the scenario's outputs.trajectories.format, else csv");
+  cmd->add_flag("--no-trajectories", o.no_trajectories, "Write no trajectories (nor geometry.wkt and geometry.geojson)");
   cmd->add_flag("--quiet", o.quiet, "No progress display");
   auto* no_animate = cmd->add_flag("--no-animate", o.no_animate, "Skip the locomotion stage (agents are not animated)");
   cmd->add_flag("--animate", o.animate, fmt::format("Animate even above {} agents", kAnimateUpTo))->excludes(no_animate);
@@ -428,6 +446,8 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
                   {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera", "--camera-period"},
                   "--render video|frames");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");
+    // Checked here, like the other flags, before the (possibly long) set-up.
+    if (!o.trajectory_format.empty()) o.format = io::parse_trajectory_format(o.trajectory_format, "--trajectory-format");
     apply_global_options(g);
     run_scenario(o);
   });

@@ -623,17 +623,30 @@ class Reader {
     return m;
   }
 
-  sim::OutputSpec outputs(const YAML::Node& n, const std::string& path) {
+  // `trajectories` is true/false (the short form), or a map with `format`
+  // and `every`; `outputs.every` (the older place for the stride) stays
+  // accepted, but not together with `trajectories.every`.
+  sim::OutputSpec outputs(const YAML::Node& n, const std::string& path, TrajectoryFormat& format) {
     expect_map(n, path, {"dir", "every", "trajectories", "stats"});
     sim::OutputSpec o;
     if (n["dir"]) o.dir = text(n["dir"], child(path, "dir"));
     if (n["every"]) o.every = integer(n["every"], child(path, "every"), 0, limits_.scenario.max_steps);
-    if (n["trajectories"]) o.trajectories = boolean(n["trajectories"], child(path, "trajectories"));
+    if (const YAML::Node t = n["trajectories"]; t && t.IsMap()) {
+      const std::string tp = child(path, "trajectories");
+      expect_map(t, tp, {"format", "every"});
+      if (t["format"]) format = parse_trajectory_format(text(t["format"], child(tp, "format")), child(tp, "format"));
+      if (t["every"]) {
+        if (n["every"]) fail(t["every"], child(tp, "every"), fmt::format("give the stride once: {} or {}", child(path, "every"), child(tp, "every")));
+        o.every = integer(t["every"], child(tp, "every"), 1, limits_.scenario.max_steps);
+      }
+    } else if (t) {
+      o.trajectories = boolean(t, child(path, "trajectories"));
+    }
     if (n["stats"]) o.stats = boolean(n["stats"], child(path, "stats"));
     return o;
   }
 
-  sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name) {
+  sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name, TrajectoryFormat& format) {
     expect_map(root, "",
                {"name", "description", "seed", "scheduler", "planning", "dt", "duration", "steps", "stop_when_arrived", "model", "world", "groups",
                 "camera", "measurement", "outputs"});
@@ -668,7 +681,7 @@ class Reader {
       if (c["period"]) s.camera_period_s = real_in(c["period"], "camera.period", 0.1, 1e6);
     }
     if (const YAML::Node m = root["measurement"]) s.measurement = measurement(m, "measurement");
-    if (root["outputs"]) s.outputs = outputs(root["outputs"], "outputs");
+    if (root["outputs"]) s.outputs = outputs(root["outputs"], "outputs", format);
     return s;
   }
 
@@ -731,7 +744,7 @@ LoadedScenario parse_scenario(std::string_view text, const std::string& name, co
   if (!root || root.IsNull()) throw Error("the file is empty; a scenario needs at least 'groups'", Location{name, 1, 1, {}});
   try {
     Reader reader(name, limits, out.source);
-    out.spec = reader.scenario(root, stem_of(name));
+    out.spec = reader.scenario(root, stem_of(name), out.trajectory_format);
   } catch (const YAML::Exception& e) {
     // yaml-cpp's own checks (e.g. a bad conversion) still get a position.
     throw Error("YAML: " + e.msg, Location{name, e.mark.is_null() ? 1 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1, {}});

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/trajectory_format.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
 
@@ -53,6 +54,9 @@ struct ScenarioSource {
 struct LoadedScenario {
   sim::ScenarioSpec spec;
   ScenarioSource source;
+  // outputs.trajectories.format: kept here, beside the simulation's spec,
+  // because only `throng run` reads it.
+  TrajectoryFormat trajectory_format = TrajectoryFormat::Csv;
 };
 
 // Parses YAML text; `name` is the file name used in errors.

@@ -7,7 +7,7 @@
 //
 //   FrameLoop loop(sim);
 //   loop.emplace<CrowdMetricsStage>(sim, 10);        // sim/metrics_stage.h
-//   loop.emplace<io::TrajectoryWriter>(path, 5);      // io/trajectory_csv.h
+//   loop.emplace<io::TrajectoryWriter>(output);       // io/run_outputs.h
 //   const RunResult r = loop.run(control);
 //   nlohmann::json stats;  loop.finish(stats);
 #pragma once

@@ -342,6 +342,24 @@ TEST(Cli, LodThresholdErrorsNameTheFlag) {
   }
 }
 
+TEST(Cli, TrajectoryFormatErrorsNameTheFlagOrTheKey) {
+  Streams r = run_split("run circle --agents 5 --steps 1 --quiet --trajectory-format parquet");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err, "throng: error: --trajectory-format: unknown trajectory format 'parquet': expected csv, pedpy or sqlite\n");
+  r = run_split("run circle --agents 5 --steps 1 --quiet --trajectory-format PedPy");
+  EXPECT_EQ(r.err, "throng: error: --trajectory-format: unknown trajectory format 'PedPy': expected csv, pedpy or sqlite (did you mean 'pedpy'?)\n");
+  const std::filesystem::path yaml = std::filesystem::temp_directory_path() / "throng_cli_bad_format.yaml";
+  std::ofstream(yaml) << "groups:\n  - count: 2\n    spawn: {rect: {min: [0, 0], max: [2, 2]}}\n    goal: {point: [5, 1]}\n"
+                         "outputs:\n  trajectories: {format: hdf5}\n";
+  r = run_split("run " + yaml.string() + " --quiet");
+  EXPECT_EQ(r.code, 1);
+  // The last line (the backend's note comes first: the scenario is read after it).
+  EXPECT_TRUE(r.err.ends_with("\nthrong: error: " + yaml.string() +
+                              ":6:26: outputs.trajectories.format: unknown trajectory format 'hdf5': expected csv, pedpy or sqlite\n"))
+      << r.err;
+  std::filesystem::remove(yaml);
+}
+
 TEST(Cli, ConvertChoosesTheWriterByExtension) {
   const auto dir = fresh_dir("throng_cli_convert_ext");
   ASSERT_EQ(run_split("--log-level warn export-default " + dir.string()).code, 0);

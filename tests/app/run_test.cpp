@@ -3,6 +3,7 @@
 // leaves complete files when interrupted with Ctrl-C (SIGINT).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -342,6 +343,52 @@ TEST_F(RunCommand, InterruptLeavesCompleteFiles) {
   EXPECT_FALSE(stats["run"]["all_arrived"].get<bool>());
   EXPECT_EQ(stats["run"]["steps"].get<long>(), rows.rbegin()->first);
   EXPECT_FALSE(fs::exists(out / "stats.json.partial"));
+}
+
+// The same with the SQLite format: every frame is a transaction, so the
+// database holds whole frames only, each listed in frame_data, and no
+// journal is left behind.
+TEST_F(RunCommand, InterruptLeavesAReadableSqliteDatabaseOfCompleteFrames) {
+  const fs::path log = dir_ / "log.txt";
+  const fs::path out = dir_ / "out";
+  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--trajectory-format", "sqlite", "--no-animate",
+                           "--out", out.string(), "--quiet"},
+                          log);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::error_code ec;
+    if (fs::file_size(out / "trajectories.sqlite", ec) > 400 * 40 * 20 && !ec) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  const Outcome o = finish(pid, log);
+  ASSERT_EQ(o.code, 130) << o.out;
+  EXPECT_FALSE(fs::exists(out / "trajectories.sqlite-journal"));
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2((out / "trajectories.sqlite").c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  auto one = [db](const char* sql) {
+    sqlite3_stmt* s = nullptr;
+    EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &s, nullptr), SQLITE_OK) << sql;
+    const long v = sqlite3_step(s) == SQLITE_ROW ? static_cast<long>(sqlite3_column_int64(s, 0)) : -1;
+    sqlite3_finalize(s);
+    return v;
+  };
+  const long frames = one("SELECT count(*) FROM frame_data");
+  EXPECT_GE(frames, 3);
+  EXPECT_EQ(one("SELECT count(DISTINCT frame) FROM trajectory_data"), frames);
+  EXPECT_EQ(one("SELECT count(*) FROM trajectory_data"), 400 * frames);
+  EXPECT_EQ(one("SELECT max(frame) FROM frame_data"), frames - 1);
+  EXPECT_EQ(one("SELECT value FROM metadata WHERE key = 'version'"), 2);
+  EXPECT_EQ(one("SELECT count(*) FROM geometry"), 1);
+  sqlite3_close(db);
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out / "stats.json"));
+  EXPECT_TRUE(stats["run"]["interrupted"].get<bool>());
+  EXPECT_EQ(stats["trajectories"]["format"], "sqlite");
+  EXPECT_EQ(stats["trajectories"]["path"], (out / "trajectories.sqlite").string());
+  EXPECT_EQ(stats["trajectories"]["frames"].get<long>(), frames);
+  EXPECT_EQ(stats["trajectories"]["geometry"]["wkt"], (out / "geometry.wkt").string());
+  EXPECT_EQ(slurp(out / "geometry.wkt").rfind("POLYGON ((", 0), 0u);
+  EXPECT_TRUE(nlohmann::json::parse(slurp(out / "geometry.geojson")).contains("features"));
 }
 
 // A terminal's Ctrl-C signals the whole foreground process group: throng

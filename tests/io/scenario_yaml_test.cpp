@@ -272,6 +272,38 @@ groups:
     goal: {point: [20, 2]}
 )";
 
+TEST(ScenarioYaml, TrajectoryOutputsLongAndShortForms) {
+  const std::string head = "groups:\n  - count: 1\n    spawn: {points: [[0, 0]]}\n    goal: {point: [5, 0]}\n";
+  const LoadedScenario map_form = parse_scenario(head + "outputs:\n  trajectories: {format: sqlite, every: 7}\n", "t.yaml");
+  EXPECT_EQ(map_form.trajectory_format, TrajectoryFormat::Sqlite);
+  EXPECT_EQ(map_form.spec.outputs.every, 7);
+  EXPECT_TRUE(map_form.spec.outputs.trajectories);
+  const LoadedScenario format_only = parse_scenario(head + "outputs:\n  every: 3\n  trajectories:\n    format: pedpy\n", "t.yaml");
+  EXPECT_EQ(format_only.trajectory_format, TrajectoryFormat::Pedpy);
+  EXPECT_EQ(format_only.spec.outputs.every, 3);  // the stride where it always was
+  const LoadedScenario short_form = parse_scenario(head + "outputs: {every: 3, trajectories: true}\n", "t.yaml");
+  EXPECT_EQ(short_form.trajectory_format, TrajectoryFormat::Csv);
+  EXPECT_EQ(short_form.spec.outputs.every, 3);
+  EXPECT_TRUE(short_form.spec.outputs.trajectories);
+  EXPECT_FALSE(parse_scenario(head + "outputs: {trajectories: false}\n", "t.yaml").spec.outputs.trajectories);
+  EXPECT_EQ(parse_scenario(head, "t.yaml").trajectory_format, TrajectoryFormat::Csv);
+  try {
+    parse_scenario(head + "outputs:\n  trajectories: {format: hdf5}\n", "t.yaml");
+    FAIL() << "accepted hdf5";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.location().field, "outputs.trajectories.format");
+    EXPECT_EQ(e.location().line, 6);
+    EXPECT_NE(e.message().find("unknown trajectory format 'hdf5': expected csv, pedpy or sqlite"), std::string::npos) << e.message();
+  }
+  try {
+    parse_scenario(head + "outputs:\n  trajectories: {fromat: csv}\n", "t.yaml");
+    FAIL() << "accepted fromat";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.location().field, "outputs.trajectories.fromat");
+    EXPECT_NE(e.message().find("did you mean 'format'"), std::string::npos) << e.message();
+  }
+}
+
 TEST(ScenarioYaml, MeasurementAreasAndLines) {
   const std::string text = std::string(kOneGroup) + R"(measurement:
   voronoi_cutoff: 1.5
