@@ -145,11 +145,14 @@ std::unique_ptr<TrajectorySink> make_sink(const TrajectoryOutput& o) {
 
 }  // namespace
 
-TrajectoryWriter::TrajectoryWriter(TrajectoryOutput output) : output_(std::move(output)) {
+TrajectoryWriter::TrajectoryWriter(TrajectoryOutput output)
+    : output_(std::move(output)), file_(output_.path, OutputFile::OnFailure::KeepPartial) {
   if (output_.every < 1)
     throw Error(fmt::format("the trajectory stride must be >= 1 frame (got {})", output_.every), at_field("--every"));
   if (!(output_.dt > 0)) throw Error(fmt::format("the time step must be > 0 s (got {})", output_.dt), at_field("dt"));
-  sink_ = make_sink(output_);
+  TrajectoryOutput writing = output_;
+  writing.path = file_.writing_path();
+  sink_ = make_sink(writing);
 }
 
 TrajectoryWriter::~TrajectoryWriter() = default;
@@ -179,6 +182,7 @@ void TrajectoryWriter::after_step(const sim::Simulation& sim, const sim::FrameIn
 void TrajectoryWriter::finish(const sim::Simulation&, nlohmann::json& stats) {
   if (sink_ == nullptr) return;
   sink_->close();
+  file_.commit();
   nlohmann::json section = {{"format", to_string(output_.format)}, {"path", output_.path}, {"every_frames", output_.every},
                             {"frames", frames_}, {"rows", rows_}, {"columns", sink_->columns()}};
   sink_->describe(section);

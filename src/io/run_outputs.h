@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/output_file.h"
 #include "io/trajectory_format.h"
 #include "sim/frame_loop.h"
 
@@ -59,7 +60,9 @@ struct TrajectoryOutput {
 double trajectory_frame_rate(double dt, std::int64_t every);
 
 // The frame stage `emit.trajectories`. Frame 0 is the initial state; every
-// `every`-th step is written, and with CSV also the last one.
+// `every`-th step is written, and with CSV also the last one. The file is
+// written as PATH.partial and renamed to PATH by finish() (core/output_file.h);
+// a run that ends in an error keeps PATH.partial, with a warning.
 //
 // csv: DIR/trajectories.csv, one row per active agent per written frame,
 //   frame,time,agent,x,y,heading,speed
@@ -87,6 +90,7 @@ class TrajectoryWriter : public sim::FrameStage {
  private:
   bool due(const sim::FrameInfo& frame) const;
   TrajectoryOutput output_;
+  OutputFile file_;  // declared before sink_: the sink closes the file before an abandoned one is kept
   std::unique_ptr<TrajectorySink> sink_;
   std::int64_t rows_ = 0, frames_ = 0, last_written_ = -1;
   std::vector<TrajectoryRow> buffer_;

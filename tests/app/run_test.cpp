@@ -3,6 +3,7 @@
 // leaves complete files when interrupted with Ctrl-C (SIGINT).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -33,12 +34,19 @@ struct Outcome {
 
 // Starts `throng args...` with stdout and stderr into `log`, leading a new
 // process group (pgid = pid); returns the pid.
-pid_t start(const std::vector<std::string>& args, const fs::path& log) {
+// file_size_limit > 0: no file of the run may grow past it (RLIMIT_FSIZE,
+// inherited by the encoder), a full disk as far as the writers can tell.
+pid_t start(const std::vector<std::string>& args, const fs::path& log, rlim_t file_size_limit = 0) {
   const pid_t pid = fork();
   if (pid == 0) {
     // A process group of its own, as a shell gives a foreground job: a
     // test can signal the whole group the way a terminal's Ctrl-C does.
     setpgid(0, 0);
+    if (file_size_limit > 0) {
+      signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails with EFBIG instead of killing
+      const rlimit limit{file_size_limit, file_size_limit};
+      setrlimit(RLIMIT_FSIZE, &limit);
+    }
     std::FILE* f = std::fopen(log.c_str(), "w");
     if (f != nullptr) {
       dup2(fileno(f), STDOUT_FILENO);
@@ -325,7 +333,7 @@ TEST_F(RunCommand, InterruptLeavesCompleteFiles) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline) {
     std::error_code ec;
-    if (fs::file_size(out / "trajectories.csv", ec) > 3 * 400 * 30 && !ec) break;
+    if (fs::file_size(out / "trajectories.csv.partial", ec) > 3 * 400 * 30 && !ec) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ASSERT_EQ(kill(pid, SIGINT), 0);
@@ -357,7 +365,7 @@ TEST_F(RunCommand, InterruptLeavesAReadableSqliteDatabaseOfCompleteFrames) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline) {
     std::error_code ec;
-    if (fs::file_size(out / "trajectories.sqlite", ec) > 400 * 40 * 20 && !ec) break;
+    if (fs::file_size(out / "trajectories.sqlite.partial", ec) > 400 * 40 * 20 && !ec) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ASSERT_EQ(kill(pid, SIGINT), 0);
@@ -409,7 +417,7 @@ TEST_F(RunCommand, CtrlCToTheProcessGroupDuringAVideoRunKeepsEveryFile) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (std::chrono::steady_clock::now() < deadline) {
     std::error_code ec;
-    if (fs::file_size(out / "crowd.mp4.partial", ec) > 0 && !ec && fs::file_size(out / "trajectories.csv", ec) > 200 * 40 * 3 && !ec) break;
+    if (fs::file_size(out / "crowd.mp4.partial", ec) > 0 && !ec && fs::file_size(out / "trajectories.csv.partial", ec) > 200 * 40 * 3 && !ec) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ASSERT_EQ(kill(-pid, SIGINT), 0);  // the group, as a terminal does
@@ -505,6 +513,32 @@ TEST_F(RunCommand, RequestsBeyondTheMemoryBudgetAreRefusedUpFront) {
   o = run({"run", "circle", "--max-memory", "lots"});
   EXPECT_EQ(o.code, 1) << o.out;
   EXPECT_NE(o.out.find("--max-memory: expected a size such as 512M, 8G or 1.5GiB, got 'lots'"), std::string::npos) << o.out;
+}
+
+// A disk that fills up mid-run (every file capped at 300 KB): the run fails
+// with a message, and every file it leaves is either whole or named
+// `.partial`: no truncated trajectories.csv or crowd.mp4 under its final name.
+TEST_F(RunCommand, AFullDiskLeavesNoUnmarkedPartialFile) {
+#if !defined(THRONG_HAVE_RENDER)
+  const std::vector<std::string> render;
+#else
+  const std::vector<std::string> render = {"--render", "video", "--width", "160", "--height", "90"};
+#endif
+  const fs::path log = dir_ / "log.txt";
+  const fs::path out = dir_ / "out";
+  std::vector<std::string> args = {"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--out", out.string(), "--quiet"};
+  args.insert(args.end(), render.begin(), render.end());
+  const Outcome o = finish(start(args, log, 300 * 1024), log);
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("File too large"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("trajectories.csv is incomplete: kept as " + (out / "trajectories.csv.partial").string()), std::string::npos) << o.out;
+  EXPECT_TRUE(fs::exists(out / "trajectories.csv.partial"));
+  for (const char* whole : {"trajectories.csv", "crowd.mp4", "stats.json"}) EXPECT_FALSE(fs::exists(out / whole)) << whole;
+  for (const fs::directory_entry& e : fs::directory_iterator(out)) {
+    const std::string name = e.path().filename().string();
+    const bool marked = name.size() > 8 && name.substr(name.size() - 8) == ".partial";
+    EXPECT_TRUE(marked || name == "geometry.wkt" || name == "geometry.geojson") << "unexpected file " << name;
+  }
 }
 
 }  // namespace
