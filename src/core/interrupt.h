@@ -30,4 +30,9 @@ inline void check_interrupt(const char* during) {
   if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted(during);
 }
 
+// check_interrupt, and on long set-up a sign of life: at most every 2 s an
+// info line on stderr, "set-up: placing agents (40 %)" (fraction in [0, 1],
+// or negative when unknown). Call it from the thread that runs set-up.
+void setup_checkpoint(const char* during, double fraction = -1.0);
+
 }  // namespace throng

@@ -630,7 +630,7 @@ class Reader {
     expect_map(n, path, {"dir", "every", "trajectories", "stats"});
     sim::OutputSpec o;
     if (n["dir"]) o.dir = text(n["dir"], child(path, "dir"));
-    if (n["every"]) o.every = integer(n["every"], child(path, "every"), 0, limits_.scenario.max_steps);
+    if (n["every"]) o.every = integer(n["every"], child(path, "every"), 1, limits_.scenario.max_steps);
     if (const YAML::Node t = n["trajectories"]; t && t.IsMap()) {
       const std::string tp = child(path, "trajectories");
       expect_map(t, tp, {"format", "every"});

@@ -343,7 +343,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
         // rounding must not reject.
         std::int64_t visited = 0;
         const std::int64_t sites = hex_sites(b, a, (a - d) * 0.5, rng, [&](glm::vec2 p) {
-          if ((++visited & 4095) == 0) check_interrupt("placing agents");
+          if ((++visited & 4095) == 0) setup_checkpoint("placing agents");
           if (region_contains(G.spawn, p) && world.disc_fits(p, wall_clearance) && !placed.overlaps(p, r, 0.99f * gap)) candidates.push_back(p);
         });
         if (static_cast<std::int64_t>(candidates.size()) >= G.count || a <= d) break;
@@ -389,7 +389,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     for (std::size_t k = 0; k < chosen.size(); ++k) {
       const glm::vec2 p = chosen[k];
       const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
-      if ((k & 4095) == 4095) check_interrupt("choosing goals");
+      if ((k & 4095) == 4095) setup_checkpoint("choosing goals", static_cast<double>(k) / static_cast<double>(chosen.size()));
       placed.add(p, r, agent);
       Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
       const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
