@@ -154,8 +154,9 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
 
 // ---- time to collision -------------------------------------------------------
 
-// The agent being steered under the time-to-collision model.
-struct TtcAgent {
+// The agent being steered under a force model (time to collision, social
+// force): its state, where it heads and how fast it would like to walk.
+struct ForceAgent {
   glm::vec2 p{0.0f};
   glm::vec2 v{0.0f};
   float radius = 0.2f;
@@ -170,7 +171,7 @@ struct TtcAgent {
 // `for_each_candidate` visits them (the 3x3 bins, or all agents for the
 // reference), so the sum is the same for any thread count.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, const TtcAgent& me, const NeighbourArrays& n,
+THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, const ForceAgent& me, const NeighbourArrays& n,
                                               const ModelParams& m, const ForEachCandidate& for_each_candidate) {
   const TtcParams& t = m.ttc;
   const float sense2 = t.sensing_radius * t.sensing_radius;
@@ -191,15 +192,6 @@ THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, co
 
 // ---- social force -----------------------------------------------------------------
 
-// The agent being steered under the social force model.
-struct SfAgent {
-  glm::vec2 p{0.0f};
-  glm::vec2 v{0.0f};
-  float radius = 0.2f;
-  glm::vec2 e0{1.0f, 0.0f};  // unit direction to the goal
-  float pref_speed = 1.3f;
-};
-
 // The total force (N) on `me` at time t into the step: the driving term,
 // then walls and circles of its obstacle cell (nearest points within the
 // sensing radius), then neighbours within the sensing radius, each where it
@@ -207,7 +199,7 @@ struct SfAgent {
 // order `for_each_candidate` visits them (the sum is the same for any
 // thread count); h: the substep (sf_contact_force).
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index self, const SfAgent& me, float t, float h,
+THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index self, const ForceAgent& me, float t, float h,
                                                    const NeighbourArrays& n, const SocialForceParams& s,
                                                    const ForEachCandidate& for_each_candidate) {
   const float sense2 = s.sensing_radius * s.sensing_radius;
@@ -229,7 +221,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index sel
 // max_speed, then p), against neighbours moving on at constant velocity.
 // Returns the step's mean velocity, the displacement / dt.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 social_force_velocity(const WorldView& w, Index self, SfAgent me, float dt, const NeighbourArrays& n,
+THRONG_HOST_DEVICE inline glm::vec2 social_force_velocity(const WorldView& w, Index self, ForceAgent me, float dt, const NeighbourArrays& n,
                                                           const ModelParams& m, const ForEachCandidate& for_each_candidate) {
   const SocialForceParams& s = m.sf;
   const int substeps = sf_substeps(dt, s);

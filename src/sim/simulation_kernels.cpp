@@ -70,13 +70,17 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx,
   return collision_free_velocity(ctx.world, i, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
 }
 
+// Agent i as the force models see it: heading straight for its goal.
+THRONG_HOST_DEVICE inline ForceAgent force_agent(const AgentArrays& a, Index i) {
+  const glm::vec2 p = a.position[i];
+  return {p, a.velocity[i], a.radius[i], normalize_or(a.goal[i] - p, glm::vec2(0.0f)), a.pref_speed[i]};
+}
+
 // Sense under the time-to-collision model: the agent's total acceleration.
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i, const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-  const glm::vec2 p = a.position[i];
-  const TtcAgent me{p, a.velocity[i], a.radius[i], normalize_or(a.goal[i] - p, glm::vec2(0.0f)), a.pref_speed[i]};
-  return ttc_force(ctx.world, i, me, n, ctx.model, for_each_candidate);
+  return ttc_force(ctx.world, i, force_agent(a, i), n, ctx.model, for_each_candidate);
 }
 
 // Sense under the social force model: the step's mean velocity.
@@ -84,9 +88,7 @@ template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a, Index i,
                                                        const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-  const glm::vec2 p = a.position[i];
-  const SfAgent me{p, a.velocity[i], a.radius[i], normalize_or(a.goal[i] - p, glm::vec2(0.0f)), a.pref_speed[i]};
-  return social_force_velocity(ctx.world, i, me, ctx.dt, n, ctx.model, for_each_candidate);
+  return social_force_velocity(ctx.world, i, force_agent(a, i), ctx.dt, n, ctx.model, for_each_candidate);
 }
 
 // The sense of the models that sum over every candidate neighbour

@@ -335,6 +335,18 @@ TEST(ScenarioYaml, MeasurementAreasAndLines) {
   EXPECT_FLOAT_EQ(lines_only.voronoi_cutoff, 2.0f);
 }
 
+
+// Parsing the one-group scenario with `model` fails with a message naming
+// the model that owns the misplaced parameter.
+void expect_owner_named(const std::string& model, const std::string& owner) {
+  std::string message = "no error";
+  try {
+    parse_scenario(std::string(kOneGroup) + "model: " + model + "\n", "a.yaml");
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find(owner), std::string::npos) << message;
+}
 TEST(ScenarioYaml, TtcModelKeys) {
   const std::string text = std::string(kOneGroup) + R"(model:
   type: ttc
@@ -353,16 +365,8 @@ TEST(ScenarioYaml, TtcModelKeys) {
                                                      {m.query_radius(), 5.0f}};
   for (const auto& [got, want] : read) EXPECT_FLOAT_EQ(got, want);
   // A parameter of another model names its owner, either way round.
-  for (const auto& [model, owner] : {std::pair{"{type: ttc, time_gap: 1}", "'time_gap' is a parameter of the collision_free_speed model"},
-                                     std::pair{"{type: priority, ttc_strength: 1}", "'ttc_strength' is a parameter of the ttc model"}}) {
-    std::string message = "no error";
-    try {
-      parse_scenario(std::string(kOneGroup) + "model: " + model + "\n", "a.yaml");
-    } catch (const Error& e) {
-      message = e.what();
-    }
-    EXPECT_NE(message.find(owner), std::string::npos) << message;
-  }
+  expect_owner_named("{type: ttc, time_gap: 1}", "'time_gap' is a parameter of the collision_free_speed model");
+  expect_owner_named("{type: priority, ttc_strength: 1}", "'ttc_strength' is a parameter of the ttc model");
 }
 
 TEST(ScenarioYaml, SocialForceModelKeys) {
@@ -387,16 +391,8 @@ TEST(ScenarioYaml, SocialForceModelKeys) {
       {m.sf.max_substep, 0.02f},   {m.sf.side_bias, 1.0f},       {m.query_radius(), 3.0f}};
   for (const auto& [got, want] : read) EXPECT_FLOAT_EQ(got, want);
   // A parameter of another model names its owner, either way round.
-  for (const auto& [model, owner] : {std::pair{"{type: social_force, ttc_strength: 1}", "'ttc_strength' is a parameter of the ttc model"},
-                                     std::pair{"{type: ttc, sf_mass: 80}", "'sf_mass' is a parameter of the social_force model"}}) {
-    std::string message = "no error";
-    try {
-      parse_scenario(std::string(kOneGroup) + "model: " + model + "\n", "a.yaml");
-    } catch (const Error& e) {
-      message = e.what();
-    }
-    EXPECT_NE(message.find(owner), std::string::npos) << message;
-  }
+  expect_owner_named("{type: social_force, ttc_strength: 1}", "'ttc_strength' is a parameter of the ttc model");
+  expect_owner_named("{type: ttc, sf_mass: 80}", "'sf_mass' is a parameter of the social_force model");
 }
 
 TEST(ScenarioYaml, MeasurementListsAreBounded) {
