@@ -445,6 +445,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
     refuse_unless(*cmd, !o.render.empty(),
                   {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera", "--camera-period"},
                   "--render video|frames");
+    refuse_unless(*cmd, !o.no_lod, {"--lod-thresholds"}, "joint LOD (it has no effect with --no-lod)");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");
     // Checked here, like the other flags, before the (possibly long) set-up.
     if (!o.trajectory_format.empty()) o.format = io::parse_trajectory_format(o.trajectory_format, "--trajectory-format");

@@ -292,7 +292,14 @@ TEST(Cli, RangeErrorsNameTheFlagInPlainNumbers) {
     const Streams r = run_split("view --agents 0");
     EXPECT_EQ(r.code, 2);
     EXPECT_EQ(r.err, "throng: error: --agents: must be between 1 and 16777216, got 0 (see --help)\n");
+    const Streams w = run_split("view --width 100000");
+    EXPECT_EQ(w.code, 2);
+    EXPECT_EQ(w.err, "throng: error: --width: must be between 16 and 7680, got 100000 (see --help)\n");
   }
+  // Joint-LOD thresholds mean nothing without joint LOD: refused, not ignored.
+  const Streams l = run_split("run circle --no-lod --lod-thresholds 900,20");
+  EXPECT_NE(l.code, 0);
+  EXPECT_EQ(l.err, "throng: error: --lod-thresholds: needs joint LOD (it has no effect with --no-lod)\n");
 }
 
 TEST(Cli, RenderOptionsNeedRender) {
