@@ -79,6 +79,7 @@ struct RunOptions {
   bool animate = false;
   bool no_animate = false;
   bool no_lod = false;
+  bool lod_colours = false;  // render: colour characters by joint-LOD level (a debug view)
   std::vector<float> lod_thresholds;
   // Rendering (video or frames) under the scenario's camera.
   std::string render;
@@ -290,6 +291,7 @@ void run_scenario(const RunOptions& o) {
     std::fprintf(stderr, "throng run: %lld agents: locomotion off above %lld agents (--animate turns it on; see docs/render.md for its cost)\n",
                  static_cast<long long>(n), static_cast<long long>(kAnimateUpTo));
   std::function<std::string()> finish_render;  // ends the video; returns what it wrote
+  const auto character_px = std::make_shared<std::vector<float>>();  // per rendered frame (median_character_px)
   if (animate) {
     LocomotionStageOptions lo;
     lo.locomotion.lod_thresholds = o.lod_thresholds;
@@ -305,13 +307,13 @@ void run_scenario(const RunOptions& o) {
       record.height = o.height;
       record.fps = o.fps;
       record.options.mode = render::parse_render_mode(o.render_mode, "--render-mode");
+      record.options.lod_colours = o.lod_colours;
       record.validate();
       Camera start = lod_camera;
       start.width = o.width;
       start.height = o.height;
-      // --camera, else the scenario's camera.motion, else an orbit (the demo follows the crowd).
-      const std::string motion =
-          !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : (o.demo ? "follow" : "orbit"));
+      // --camera, else the scenario's camera.motion, else one that follows the crowd.
+      const std::string motion = !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : "follow");
       const double speed = o.render_speed;
       const sim::Simulation* simulation = sim.get();
       if (motion == "follow") {
@@ -331,9 +333,11 @@ void run_scenario(const RunOptions& o) {
       lo.fps = static_cast<double>(per_video) / frame_time;
       const double until = o.render_seconds > 0.0 ? o.render_seconds : std::numeric_limits<double>::infinity();
       auto recorder = std::make_shared<std::unique_ptr<render::Recorder>>();
-      lo.on_frame = [recorder, record, per_video, until, simulation, anim_fps = lo.fps](double t, const Camera* camera, SimulationLocomotion& moved) {
+      lo.on_frame = [recorder, record, per_video, until, simulation, character_px, anim_fps = lo.fps](double t, const Camera* camera,
+                                                                                                    SimulationLocomotion& moved) {
         if (std::llround(t * anim_fps) % per_video != 0 || t > until + 1e-9) return;
         ScopedTimer timer("render.frame");
+        character_px->push_back(median_character_px(*camera, *simulation));
         if (!*recorder) {
           *recorder = std::make_unique<render::Recorder>(record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
           (*recorder)->set_world(simulation->world());
@@ -369,6 +373,14 @@ void run_scenario(const RunOptions& o) {
   if (finish_render) {
     const std::string rendered = finish_render();
     if (!rendered.empty()) written += (written.empty() ? "" : ", ") + rendered;
+  }
+  if (!character_px->empty()) {
+    // How large the characters came out: the median over rendered frames of
+    // each frame's median (a 1.75 m character standing at each agent).
+    std::vector<float> px = *character_px;
+    std::nth_element(px.begin(), px.begin() + static_cast<std::ptrdiff_t>(px.size() / 2), px.end());
+    stats["render"] = {{"frames", character_px->size()}, {"median_character_px", px[px.size() / 2]}};
+    std::fprintf(stderr, "throng run: characters in the picture: a median %.0f px tall\n", static_cast<double>(px[px.size() / 2]));
   }
   stats["scenario"] = scenario_section(loaded);
   if (spec.outputs.stats) {
@@ -411,6 +423,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--render", o.render, "Write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames) under the scenario's camera")
       ->check(CLI::IsMember({"video", "frames"}));
   cmd->add_flag("--no-lod", o.no_lod, "Synthesise every joint of every agent (no joint LOD)");
+  cmd->add_flag("--lod-colours", o.lod_colours, "Render characters in joint-LOD level colours instead of their clothes (a debug view)");
   cmd->add_option("--lod-thresholds", o.lod_thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
   cmd->add_flag("--no-render", o.no_render, "The demo: do not write its video");
   cmd->add_option("--render-mode", o.render_mode, "skinned (the mannequin) or joints (a sphere per bone)")
@@ -443,7 +456,8 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
     // Options that only shape the video or frames are refused without them
     // rather than ignored (the demo renders unless --no-render).
     refuse_unless(*cmd, !o.render.empty(),
-                  {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera", "--camera-period"},
+                  {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera", "--camera-period",
+                   "--lod-colours"},
                   "--render video|frames");
     refuse_unless(*cmd, !o.no_lod, {"--lod-thresholds"}, "joint LOD (it has no effect with --no-lod)");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");

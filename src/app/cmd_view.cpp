@@ -167,7 +167,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--layout", layout, "For formation: ring (walking round rings) or grid")
       ->check(CLI::IsMember({"ring", "grid"}));
   cmd->add_option("--mode", mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")->check(CLI::IsMember({"skinned", "joints"}));
-  cmd->add_flag("!--no-lod-colours", o.lod_colours, "Clothing colours instead of joint-LOD levels (L toggles)");
+  cmd->add_flag("--lod-colours", o.lod_colours, "Joint-LOD level colours instead of clothes, a debug view (L toggles)");
   cmd->add_option("--width", o.width, "Window width, pixels")->check(between(16, 7680));
   cmd->add_option("--height", o.height, "Window height, pixels")->check(between(16, 4320));
   cmd->add_option("--frames", o.frames, "Quit after this many frames, at 1/30 s each (0 = when closed)");

@@ -30,7 +30,7 @@ namespace throng::render {
 
 struct RenderOptions {
   RenderMode mode = RenderMode::Joints;
-  bool lod_colours = true;  // colour by joint-LOD level (paper Fig. 8); else by character
+  bool lod_colours = false;  // colour by joint-LOD level (paper Fig. 8, a debug view); else by character
   bool ground = true;
   bool grid = true;
   bool obstacles = true;

@@ -68,7 +68,7 @@ struct InputState {
   bool paused = false;
   bool step = false;
   double speed = 1.0;
-  bool lod_colours = true;
+  bool lod_colours = false;
   RenderMode mode = RenderMode::Skinned;
   double last_x = 0.0, last_y = 0.0;
   bool dragging_orbit = false, dragging_pan = false;

@@ -68,7 +68,7 @@ struct ViewerOptions {
   bool panel = true;
   bool bins = false;  // start with the agents-per-cell overlay on
   RenderMode mode = RenderMode::Skinned;
-  bool lod_colours = true;
+  bool lod_colours = false;  // joint-LOD level colours instead of clothes (a debug view)
   void validate() const;  // Error naming the option ("--width")
 };
 

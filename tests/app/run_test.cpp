@@ -541,4 +541,23 @@ TEST_F(RunCommand, AFullDiskLeavesNoUnmarkedPartialFile) {
   }
 }
 
+// The first picture a newcomer makes: 300 agents on the circle, rendered
+// with the defaults. The camera follows the crowd without letting the
+// characters shrink to dots: stats.json's median character height in the
+// frames (a 1.75 m person at each agent in the picture) is at least 30 px.
+TEST_F(RunCommand, RenderedCharactersAreLargeEnoughToSee) {
+#if !defined(THRONG_HAVE_RENDER)
+  GTEST_SKIP() << "this build has no renderer";
+#else
+  const fs::path out = dir_ / "out";
+  const Outcome o = run({"--threads", "2", "run", "circle", "--agents", "300", "--seconds", "3", "--render", "frames", "--width", "320",
+                         "--height", "180", "--no-trajectories", "--out", out.string()});
+  ASSERT_EQ(o.code, 0) << o.out;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out / "stats.json"));
+  EXPECT_GT(stats["render"]["frames"].get<long>(), 10);
+  EXPECT_GE(stats["render"]["median_character_px"].get<double>(), 30.0) << stats["render"];
+  EXPECT_NE(o.out.find("characters in the picture: a median"), std::string::npos) << o.out;
+#endif
+}
+
 }  // namespace

@@ -77,9 +77,11 @@ TEST_F(RendererTest, AgentsShowWhereTheyStandAndNowhereElse) {
   Renderer r(make_joint_rig(c.skeleton));
   const Camera cam = camera();
   RenderStats stats;
-  const Image with = draw(r, cam, c.poses(), {}, &stats);
+  RenderOptions by_level;
+  by_level.lod_colours = true;
+  const Image with = draw(r, cam, c.poses(), by_level, &stats);
   TPoseCrowd none;
-  const Image without = draw(r, cam, none.poses());
+  const Image without = draw(r, cam, none.poses(), by_level);
   EXPECT_EQ(stats.characters, 4);
   EXPECT_EQ(stats.visible, 3);  // the one behind the camera is culled
   EXPECT_EQ(stats.instances, 3 * r.rig().bone_count());
@@ -254,6 +256,7 @@ TEST_F(RendererTest, SkinnedAgentsShowWhereTheyStandAndNowhereElse) {
   Renderer r(make_crowd_rigs(c.skeleton));
   RenderOptions skinned;
   skinned.mode = RenderMode::Skinned;
+  skinned.lod_colours = true;
   skinned.fine_min_pixels = 0.0f;  // the rig's own mesh for all, as the CPU reference skins it
   const Camera cam = camera();
   RenderStats stats;
@@ -321,6 +324,7 @@ TEST_F(RendererTest, SkinnedPartsTakeTheirOwnLevelsAndClothesOtherwise) {
   Renderer r(make_crowd_rigs(c.skeleton));
   RenderOptions skinned;
   skinned.mode = RenderMode::Skinned;
+  skinned.lod_colours = true;
   Camera cam = camera();
   cam.position = {0.0f, 1.3f, 4.0f};
   cam.target = {0.0f, 1.0f, 0.0f};
@@ -485,6 +489,7 @@ Image golden_scene(RenderMode mode) {
   cam.target = {0.0f, 1.0f, 0.0f};
   RenderOptions o;
   o.mode = mode;
+  o.lod_colours = true;  // the committed pictures show the joint-LOD colours
   OffscreenTarget target(cam.width, cam.height, 4);
   target.bind();
   r.render(cam, c.poses(), o);

@@ -281,7 +281,7 @@ TEST(ThrongRunCamera, FollowKeepsTheCrowdInTheMiddleOfTheFrame) {
     const std::string out_dir = dir + "/" + camera + "_" + lod;
     std::string out;
     const int code = run_throng("--backend cpu --threads 2 run '" + scenario + "' --seconds 2 --render frames --width 160 --height 90 --fps 2 "
-                                "--no-trajectories --quiet --camera " + camera + " --lod-thresholds " +
+                                "--no-trajectories --quiet --lod-colours --camera " + camera + " --lod-thresholds " +
                                     (lod == "fine" ? "0.002,0.001" : "100000000,10000000") + " --out '" + out_dir + "'",
                                 out);
     EXPECT_EQ(code, 0) << out;

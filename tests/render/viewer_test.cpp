@@ -82,8 +82,8 @@ std::size_t distinct_colours(const Image& im) {
   return colours.size();
 }
 
-// Pixels that differ between a picture with joint-LOD colours and the same
-// with clothing colours (--no-lod-colours): those of characters, as
+// Pixels that differ between a picture with joint-LOD colours (--lod-colours)
+// and the same with clothing colours (the default): those of characters, as
 // everything else (sky, ground, obstacles) is drawn the same in both.
 std::int64_t character_pixels(const Image& lod, const Image& clothes) {
   const ImageDifference d = compare_images(lod, clothes);
@@ -114,7 +114,7 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
   const Image im = read_png(shot);
   EXPECT_EQ(im.width, 480);
   EXPECT_EQ(im.height, 270);
-  // A real picture: the panel, the ground, characters in LOD colours.
+  // A real picture: the panel, the ground, characters in their clothes.
   EXPECT_GT(distinct_colours(im), 200u);
 }
 
@@ -129,10 +129,10 @@ TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   std::string out;
   const std::string frames = std::string(THRONG_EXE) + " --threads 2 view corridor --agents 120 --headless --render frames --frames 3 --width 160 --height 90 "
                              "--camera flyover --out ";
-  ASSERT_EQ(run(frames + dir.string(), out), 0) << out;
+  ASSERT_EQ(run(frames + dir.string() + " --lod-colours", out), 0) << out;
   EXPECT_NE(out.find("3 frames"), std::string::npos) << out;
   out.clear();
-  ASSERT_EQ(run(frames + (dir / "clothes").string() + " --no-lod-colours", out), 0) << out;
+  ASSERT_EQ(run(frames + (dir / "clothes").string(), out), 0) << out;
   for (int f = 0; f < 3; ++f) {
     const std::string name = "frame_0000" + std::to_string(f) + ".png";
     const Image im = read_png((dir / name).string());
@@ -150,9 +150,9 @@ TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   const std::string clothes_shot = (dir / "formation_clothes.png").string();
   const std::string formation = std::string(THRONG_EXE) + " view formation --layout grid --agents 50 --headless --frames 2 --width 160 --height 90 ";
   out.clear();
-  ASSERT_EQ(run(formation + "--screenshot " + shot, out), 0) << out;
+  ASSERT_EQ(run(formation + "--lod-colours --screenshot " + shot, out), 0) << out;
   out.clear();
-  ASSERT_EQ(run(formation + "--no-lod-colours --screenshot " + clothes_shot, out), 0) << out;
+  ASSERT_EQ(run(formation + "--screenshot " + clothes_shot, out), 0) << out;
   const Image im = read_png(shot);
   EXPECT_EQ(im.width, 160);
   EXPECT_EQ(im.height, 90);
