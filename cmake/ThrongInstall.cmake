@@ -11,6 +11,8 @@
 #                                 throng::sim, throng::anim, throng::path,
 #                                 throng::io (and throng::render when built)
 #   lib/pkgconfig/throng.pc       the same for pkg-config
+#   lib/python3.X/dist-packages/  the Python module, when built
+#                                 (src/python/CMakeLists.txt)
 # Tests, benches and fuzz targets are not installed; the built-in scenarios
 # are compiled into throng_io.
 include(GNUInstallDirs)

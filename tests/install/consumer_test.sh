@@ -2,6 +2,9 @@
 # Install.ConsumerBuildsAgainstThePackage: installs this build into a
 # temporary prefix, builds tests/install/consumer against it with
 # find_package(throng), runs it, and checks throng.pc with pkg-config.
+# When the Python module was built (THRONG_PYTHON, the interpreter, and
+# THRONG_PYTHON_INSTALL_DIR set by CTest), it imports the installed module and
+# steps a simulation.
 # Any failure fails the test; nothing is skipped.
 # Usage: consumer_test.sh BUILD_DIR SOURCE_DIR CMAKE CXX_COMPILER GENERATOR [LAUNCHER]
 set -euo pipefail
@@ -61,4 +64,19 @@ libs=$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --libs throng)
 "$cxx" "$obj" -o "$work/consumer_pc" $libs || fail "link with pkg-config --libs throng"
 out_pc=$("$work/consumer_pc") || fail "pkg-config-linked consumer exited $?"
 [ "$out_pc" = "$out" ] || fail "pkg-config-linked consumer printed: $out_pc"
+if [ -n "${THRONG_PYTHON:-}" ]; then
+  echo "== import the installed Python module"
+  pydir=$prefix/${THRONG_PYTHON_INSTALL_DIR:?THRONG_PYTHON_INSTALL_DIR unset}
+  ls "$pydir"/throng*.so > /dev/null 2>&1 || fail "Python module not installed in $pydir"
+  # From an empty folder: nothing of the build tree or source tree on the path.
+  py_out=$(cd "$work" && PYTHONPATH="$pydir" "$THRONG_PYTHON" -c '
+import throng
+assert throng.__file__.startswith("'"$pydir"'"), throng.__file__
+sim = throng.Simulation("circle", agents=20)
+sim.step(10)
+print(f"python: {throng.__name__} steps={sim.steps} agents={sim.agent_count} shape={sim.positions.shape}")
+') || fail "import throng from $pydir"
+  echo "$py_out"
+  [ "$py_out" = "python: throng steps=10 agents=20 shape=(20, 2)" ] || fail "unexpected output: $py_out"
+fi
 echo "PASS"
