@@ -63,7 +63,7 @@ try:
     rss = soak["rss_mib"]
     print(f'{run["agents"]} | {run["steps"]} | {run["wall_seconds"]:.0f} | {100 * soak["max_overlap_m"]:.2f} | '
           f'{100 * crowd["overlaps"]["max_depth_m"]:.2f} | {rss["first"]:.1f} | {rss["after_warmup"] or 0:.1f} | {rss["end"]:.1f} | '
-          f'{100 * rss["growth"]:+.1f}% | {"pass" if soak["passed"] and status == "0" else "FAIL"}')
+          f'{100 * rss["growth"]:+.1f}% | {"pass" if soak["passed"] and status == "0" else "interrupted" if soak["passed"] and status == "130" else "FAIL"}')
 except (OSError, KeyError):
     last = checks[-1] if checks else {}
     print(f'? | {last.get("step", 0)} | {last.get("wall_s", 0):.0f} | {100 * last.get("max_overlap_m", 0):.2f} | - | '

@@ -33,8 +33,8 @@ OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float>
                               float reach);
 
 // The deepest pair overlap the steering models keep to, m: a third of the
-// 0.25 m radius (docs/simulation.md, "Acceptance"). The soak checks and the
-// acceptance tests hold every step of a run to it.
+// 0.25 m radius (docs/simulation.md, "Acceptance", where the acceptance
+// tests hold every step to the same 8 cm). The soak checks hold a long run to it.
 inline constexpr float kOverlapBound = 0.08f;
 
 // Agents (active or not) whose position or velocity is NaN or infinite.
