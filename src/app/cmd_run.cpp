@@ -29,6 +29,7 @@
 #include "io/walkable_area.h"
 #include "sim/frame_loop.h"
 #include "sim/metrics_stage.h"
+#include "sim/soak_stage.h"
 
 #if defined(THRONG_HAVE_RENDER)
 #include "render/camera_path.h"
@@ -74,6 +75,7 @@ struct RunOptions {
   std::string trajectory_format;  // empty = the scenario's, else csv
   std::optional<io::TrajectoryFormat> format;  // trajectory_format, checked
   bool no_trajectories = false;
+  std::int64_t check_every = 0;  // soak checks every K steps; 0 = none
   bool quiet = false;
   // Locomotion: on by default up to kAnimateUpTo agents.
   bool animate = false;
@@ -186,6 +188,16 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
     else
       std::printf("\n  foot skating: no contacts measured\n");
   }
+  if (stats.contains("soak")) {
+    const auto& s = stats["soak"];
+    const auto& rss = s["rss_mib"];
+    std::printf("  soak checks: %lld, every %lld steps; deepest overlap %.1f cm (bound %.0f cm); resident memory %.1f -> %.1f MiB",
+                s["checks"].get<long long>(), s["check_every_steps"].get<long long>(), 100.0 * s["max_overlap_m"].get<double>(),
+                100.0 * s["overlap_bound_m"].get<double>(), rss["first"].get<double>(), rss["end"].get<double>());
+    if (!rss["after_warmup"].is_null())
+      std::printf(" (%+.1f%% after step %lld)", 100.0 * rss["growth"].get<double>(), rss["warmup_step"].get<long long>());
+    std::printf("\n");
+  }
   if (!written.empty()) std::printf("  wrote %s\n", written.c_str());
 }
 
@@ -267,6 +279,14 @@ void run_scenario(const RunOptions& o) {
   metrics.sample_every = std::max<std::int64_t>(1, std::llround(1.0 / static_cast<double>(spec.dt)));
   metrics.measurement = spec.measurement;
   loop.emplace<sim::CrowdMetricsStage>(*sim, metrics);
+  const sim::SoakCheckStage* soak = nullptr;
+  if (o.check_every > 0) {
+    sim::SoakOptions checks;
+    checks.every = o.check_every;
+    checks.max_steps = max_steps;
+    checks.report = dir + "/soak.jsonl";
+    soak = &loop.emplace<sim::SoakCheckStage>(checks);
+  }
   std::string written;
   std::optional<io::GeometryFiles> geometry_files;
   if (spec.outputs.trajectories && !o.no_trajectories) {
@@ -387,8 +407,13 @@ void run_scenario(const RunOptions& o) {
     io::write_json_file(dir + "/stats.json", stats);
     written += (written.empty() ? "" : ", ") + dir + "/stats.json";
   }
+  if (soak != nullptr) written += (written.empty() ? "" : ", ") + dir + "/soak.jsonl";
   print_summary(*sim, result, stats, written);
   std::fflush(stdout);
+  if (soak != nullptr && !soak->failure().empty()) {
+    std::fprintf(stderr, "throng: error: soak check: %s\n", soak->failure().c_str());
+    std::exit(1);
+  }
   if (result.interrupted) {
     std::fprintf(stderr, "throng run: interrupted after %lld steps; the files above are complete up to that step\n",
                  static_cast<long long>(result.steps));
@@ -418,6 +443,10 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
                   "schema); default: the scenario's outputs.trajectories.format, else csv");
   cmd->add_flag("--no-trajectories", o.no_trajectories, "Write no trajectories (nor geometry.wkt and geometry.geojson)");
   cmd->add_flag("--quiet", o.quiet, "No progress display");
+  cmd->add_option("--check-every", o.check_every,
+                  "Soak checks every K steps: fail on a non-finite agent, one outside free space, an overlap beyond 8 cm, or resident "
+                  "memory growing over 5% after the first tenth of the run; DIR/soak.jsonl and stats.json's soak section")
+      ->check(at_least(1));
   auto* no_animate = cmd->add_flag("--no-animate", o.no_animate, "Skip the locomotion stage (agents are not animated)");
   cmd->add_flag("--animate", o.animate, fmt::format("Animate even above {} agents", kAnimateUpTo))->excludes(no_animate);
   cmd->add_option("--render", o.render, "Write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames) under the scenario's camera")

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <fstream>
 
 #include "core/error.h"
 
@@ -20,6 +21,16 @@ constexpr double kDefaultFraction = 0.8;
 std::uint64_t physical_memory_bytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
   return pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) : 0;
+}
+
+std::uint64_t resident_memory_bytes() {
+  // statm: total and resident sizes in pages. Read fresh each time (not
+  // getrusage's peak), so that memory given back shows as well.
+  std::ifstream statm("/proc/self/statm");
+  std::uint64_t total = 0, resident = 0;
+  const long page = sysconf(_SC_PAGE_SIZE);
+  if (!(statm >> total >> resident) || page <= 0) return 0;
+  return resident * static_cast<std::uint64_t>(page);
 }
 
 std::uint64_t memory_budget() {

@@ -12,6 +12,9 @@ namespace throng {
 
 // Physical memory of this machine in bytes (0 when unknown).
 std::uint64_t physical_memory_bytes();
+// This process's resident set size in bytes, now (from /proc/self/statm; 0
+// when unknown). What a long run watches for memory growth.
+std::uint64_t resident_memory_bytes();
 // The budget in bytes: the one set, else 80 % of physical memory (no limit
 // when that is unknown).
 std::uint64_t memory_budget();

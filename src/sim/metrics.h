@@ -32,6 +32,14 @@ struct OverlapStats {
 OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags, float tolerance,
                               float reach);
 
+// The deepest pair overlap the steering models keep to, m: a third of the
+// 0.25 m radius (docs/simulation.md, "Acceptance", where the acceptance
+// tests hold every step to the same 8 cm). The soak checks hold a long run to it.
+inline constexpr float kOverlapBound = 0.08f;
+
+// Agents (active or not) whose position or velocity is NaN or infinite.
+Index count_non_finite(Span<const glm::vec2> positions, Span<const glm::vec2> velocities);
+
 // Active agents whose disc enters an obstacle by more than `tolerance` (or
 // whose centre is outside free space).
 Index count_obstacle_penetrations(const World& world, Span<const glm::vec2> positions, Span<const float> radii,

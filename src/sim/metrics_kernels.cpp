@@ -1,5 +1,7 @@
 // Metrics over the crowd: deterministic parallel reductions.
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 
 #include "core/reduce.h"
 #include "sim/crowd.h"
@@ -40,6 +42,10 @@ struct OverlapOf {
     return acc;
   }
 };
+
+// NaN fails every comparison and infinity exceeds FLT_MAX: one test for
+// both that compiles the same for the host and CUDA.
+THRONG_HOST_DEVICE inline bool is_finite(glm::vec2 v) { return fabsf(v.x) <= FLT_MAX && fabsf(v.y) <= FLT_MAX; }
 
 struct CountPair {
   Index count;
@@ -89,6 +95,13 @@ Index count_obstacle_penetrations(const World& world, Span<const glm::vec2> posi
         if ((flags[i] & kAgentActive) == 0) return 0;
         return disc_is_clear(w, positions[i], radii[i], tolerance) ? 0 : 1;
       },
+      THRONG_LAMBDA(Index a, Index b)->Index { return a + b; });
+}
+
+Index count_non_finite(Span<const glm::vec2> positions, Span<const glm::vec2> velocities) {
+  return parallel_reduce(
+      "sim.metrics.non_finite", positions.size(), Index{0},
+      THRONG_LAMBDA(Index i)->Index { return is_finite(positions[i]) && is_finite(velocities[i]) ? 0 : 1; },
       THRONG_LAMBDA(Index a, Index b)->Index { return a + b; });
 }
 

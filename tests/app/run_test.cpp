@@ -283,6 +283,21 @@ TEST_F(RunCommand, NoAnimateSkipsTheLocomotionStage) {
   EXPECT_NE(both.out.find("--no-animate"), std::string::npos) << both.out;
 }
 
+TEST_F(RunCommand, CheckEveryWritesASoakReportAndSection) {
+  const Outcome o = run({"run", "corridor", "--agents", "50", "--steps", "30", "--check-every", "10", "--no-animate", "--no-trajectories",
+                         "--quiet", "--out", dir_.string()});
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("soak checks: 4, every 10 steps"), std::string::npos) << o.out;
+  std::ifstream report(dir_ / "soak.jsonl");
+  int lines = 0;
+  for (std::string line; std::getline(report, line); ++lines) EXPECT_EQ(nlohmann::json::parse(line)["step"], 10 * lines);
+  EXPECT_EQ(lines, 4);  // steps 0, 10, 20, 30
+  const nlohmann::json soak = nlohmann::json::parse(slurp(dir_ / "stats.json"))["soak"];
+  EXPECT_TRUE(soak["passed"]) << soak.dump();
+  EXPECT_EQ(soak["steps"], 30);
+  EXPECT_GT(soak["rss_mib"]["end"].get<double>(), 0.0);
+}
+
 TEST_F(RunCommand, ABadScenarioFileIsOneLineWithItsPosition) {
   const fs::path bad = dir_ / "bad.yaml";
   std::ofstream(bad) << "name: bad\ngroups:\n  - count: ten\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: [9, 9]\n";
