@@ -100,38 +100,57 @@ void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame
   density_.cell = h.cell;
   density_.bin_width = h.bin_width;
   for (int b = 0; b < kDensityBins; ++b) density_.agents[static_cast<std::size_t>(b)] += h.agents[static_cast<std::size_t>(b)];
-  samples_.push_back(s);
+  accumulate(s);
+  samples_.push(std::move(s));
+}
+
+void CrowdMetricsStage::accumulate(const Sample& s) {
+  Totals& t = totals_;
+  t.max_pairs = std::max(t.max_pairs, s.overlaps.pairs);
+  t.max_penetrations = std::max(t.max_penetrations, s.penetrations);
+  t.max_depth = std::max(t.max_depth, s.overlaps.max_depth);
+  t.min_separation = std::min(t.min_separation, s.overlaps.min_separation);
+  t.speed_sum += s.mean_speed;
+  t.area_sums.resize(s.areas.size());
+  for (std::size_t k = 0; k < s.areas.size(); ++k) {
+    const nlohmann::json values = area_sample_json(s.time, s.areas[k]);
+    for (const auto& [key, value] : values.items())
+      if (key != "time") t.area_sums[k][key] += value.get<double>();
+  }
+  const AreaSample& a = s.areas.front().classic;
+  if (a.agents == 0) return;
+  const VoronoiSample& v = s.areas.front().voronoi;
+  DensityBin& b = fd_bins_[static_cast<std::int64_t>(std::floor(a.density / options_.density_bin_width))];
+  ++b.samples;
+  b.speed += a.mean_speed;
+  b.speed_magnitude += a.mean_speed_magnitude;
+  b.flow += a.flow;
+  b.voronoi_density += v.density;
+  b.voronoi_speed += v.speed;
 }
 
 void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
   const ArrivalStats arrivals = arrival_stats(sim.arrival_times());
-  Index max_pairs = 0, max_penetrations = 0;
-  float max_depth = 0.0f, min_separation = INFINITY;
-  double speed_sum = 0;
-  for (const Sample& s : samples_) {
-    max_pairs = std::max(max_pairs, s.overlaps.pairs);
-    max_penetrations = std::max(max_penetrations, s.penetrations);
-    max_depth = std::max(max_depth, s.overlaps.max_depth);
-    min_separation = std::min(min_separation, s.overlaps.min_separation);
-    speed_sum += s.mean_speed;
-  }
-  const Sample last = samples_.empty() ? Sample{} : samples_.back();
+  const Totals& t = totals_;
+  const double taken = static_cast<double>(samples_.seen());
+  const Sample last = samples_.empty() ? Sample{} : samples_.newest();
   auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   stats["crowd"] = {
       {"agents", sim.agent_count()},
       {"active_at_end", sim.active_count()},
       {"arrived", arrivals.arrived},
       {"arrival_time_s", {{"mean", arrivals.mean_time}, {"min", arrivals.min_time}, {"max", arrivals.max_time}}},
-      {"samples", samples_.size()},
+      {"samples", samples_.seen()},
       {"sample_every_frames", options_.sample_every},
+      {"series_stride", samples_.stride()},
       {"overlaps",
        {{"tolerance_m", options_.overlap_tolerance},
         {"pairs_at_end", last.overlaps.pairs},
-        {"max_pairs", max_pairs},
-        {"max_depth_m", max_depth}}},
-      {"min_separation_m", finite_or_null(min_separation)},
-      {"obstacle_penetrations", {{"tolerance_m", options_.penetration_tolerance}, {"at_end", last.penetrations}, {"max", max_penetrations}}},
-      {"mean_speed_mps", {{"at_end", last.mean_speed}, {"over_samples", samples_.empty() ? 0.0 : speed_sum / static_cast<double>(samples_.size())}}},
+        {"max_pairs", t.max_pairs},
+        {"max_depth_m", t.max_depth}}},
+      {"min_separation_m", finite_or_null(t.min_separation)},
+      {"obstacle_penetrations", {{"tolerance_m", options_.penetration_tolerance}, {"at_end", last.penetrations}, {"max", t.max_penetrations}}},
+      {"mean_speed_mps", {{"at_end", last.mean_speed}, {"over_samples", taken > 0 ? t.speed_sum / taken : 0.0}}},
   };
   nlohmann::json bins = nlohmann::json::array();
   for (int b = 0; b < kDensityBins; ++b)
@@ -141,27 +160,10 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
   stats["density_histogram"] = {{"cell_m", density_.cell}, {"bin_width_per_m2", density_.bin_width}, {"bins", bins}};
 
   // Fundamental diagram: samples of the first measurement area grouped by density.
-  struct Bin {
-    Index samples = 0;
-    double speed = 0, speed_magnitude = 0, flow = 0, voronoi_density = 0, voronoi_speed = 0;
-  };
-  std::map<std::int64_t, Bin> by_density;
   nlohmann::json series = nlohmann::json::array();
-  for (const Sample& s : samples_) {
-    const AreaSample& a = s.areas.front().classic;
-    const VoronoiSample& v = s.areas.front().voronoi;
-    series.push_back(area_sample_json(s.time, s.areas.front()));
-    if (a.agents == 0) continue;
-    Bin& b = by_density[static_cast<std::int64_t>(std::floor(a.density / options_.density_bin_width))];
-    ++b.samples;
-    b.speed += a.mean_speed;
-    b.speed_magnitude += a.mean_speed_magnitude;
-    b.flow += a.flow;
-    b.voronoi_density += v.density;
-    b.voronoi_speed += v.speed;
-  }
+  for (const Sample& s : samples_.values()) series.push_back(area_sample_json(s.time, s.areas.front()));
   nlohmann::json diagram = nlohmann::json::array();
-  for (const auto& [k, b] : by_density) {
+  for (const auto& [k, b] : fd_bins_) {
     const double n = static_cast<double>(b.samples);
     diagram.push_back({{"min_density", static_cast<double>(k) * options_.density_bin_width},
                        {"max_density", static_cast<double>(k + 1) * options_.density_bin_width},
@@ -213,18 +215,16 @@ nlohmann::json CrowdMetricsStage::area_sample_json(double time, const AreaMeasur
 
 nlohmann::json CrowdMetricsStage::measurement_section() const {
   const MeasurementSpec& spec = options_.measurement;
+  const std::vector<Sample> kept = samples_.values();
   nlohmann::json areas = nlohmann::json::array();
   for (std::size_t k = 0; k < spec.areas.size(); ++k) {
     nlohmann::json series = nlohmann::json::array();
-    for (const Sample& s : samples_) series.push_back(area_sample_json(s.time, s.areas[k]));
-    // Means of every value but the time over every sample, empty ones
-    // included, as the series shows them.
-    std::map<std::string, double> sums;
-    for (const nlohmann::json& s : series)
-      for (const auto& [key, value] : s.items())
-        if (key != "time") sums[key] += value.get<double>();
+    for (const Sample& s : kept) series.push_back(area_sample_json(s.time, s.areas[k]));
+    // Means of every value but the time over every sample taken (kept in
+    // the series or not), empty ones included.
     nlohmann::json mean = nlohmann::json::object();
-    for (const auto& [key, sum] : sums) mean[key] = sum / static_cast<double>(series.size());
+    if (k < totals_.area_sums.size())
+      for (const auto& [key, sum] : totals_.area_sums[k]) mean[key] = sum / static_cast<double>(samples_.seen());
     const Aabb& r = spec.areas[k].rect;
     areas.push_back({{"name", spec.areas[k].name}, {"min", {r.min.x, r.min.y}}, {"max", {r.max.x, r.max.y}},
                      {"area_m2", static_cast<double>(r.size().x) * r.size().y}, {"mean", mean}, {"samples", series}});

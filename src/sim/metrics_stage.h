@@ -5,9 +5,13 @@
 // "fundamental_diagram" and "measurement" sections of stats.json.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
+#include "core/thinned_series.h"
 #include "sim/frame_loop.h"
 #include "sim/metrics.h"
 
@@ -21,6 +25,12 @@ struct MetricsOptions {
   StuckOptions stuck;                   // what counts as a stuck agent
   float density_bin_width = 0.25f;      // agents/m^2 per fundamental-diagram bin
 };
+
+// Samples kept for stats.json's series (ThinnedSeries: evenly spread over
+// the run, the last always among them); the means, maxima and the
+// fundamental diagram's bins are summed over every sample as it comes, so
+// a run of any length keeps bounded memory.
+inline constexpr std::size_t kMaxSeriesSamples = 4000;
 
 // N-t points written per line and direction: every crossing up to this
 // many, then every k-th (and the last) so that stats.json stays small.
@@ -52,7 +62,9 @@ class CrowdMetricsStage : public FrameStage {
   struct LineTimes {
     std::vector<double> positive, negative;
   };
-  const std::vector<Sample>& samples() const { return samples_; }
+  // The samples kept for the series (all of them up to kMaxSeriesSamples).
+  std::vector<Sample> samples() const { return samples_.values(); }
+  std::uint64_t samples_taken() const { return samples_.seen(); }
   const std::vector<MeasurementArea>& areas() const { return options_.measurement.areas; }
   const std::vector<LineTimes>& line_times() const { return line_times_; }
   const StuckStats& stuck() const { return stuck_.stats(); }
@@ -63,9 +75,26 @@ class CrowdMetricsStage : public FrameStage {
   nlohmann::json stuck_section() const;
   // One sample of an area: classic and Voronoi values side by side.
   static nlohmann::json area_sample_json(double time, const AreaMeasure& m);
+  // Adds a sample to the running totals below.
+  void accumulate(const Sample& s);
+
+  // Sums over every sample taken, kept or not.
+  struct Totals {
+    Index max_pairs = 0, max_penetrations = 0;
+    float max_depth = 0.0f, min_separation = INFINITY;
+    double speed_sum = 0;
+    std::vector<std::map<std::string, double>> area_sums;  // per area, per key of area_sample_json
+  };
+  // Fundamental-diagram sums of the first area's samples in one density bin.
+  struct DensityBin {
+    Index samples = 0;
+    double speed = 0, speed_magnitude = 0, flow = 0, voronoi_density = 0, voronoi_speed = 0;
+  };
 
   MetricsOptions options_;
-  std::vector<Sample> samples_;
+  ThinnedSeries<Sample> samples_{kMaxSeriesSamples};
+  Totals totals_;
+  std::map<std::int64_t, DensityBin> fd_bins_;  // by floor(density / bin width)
   DensityHistogram density_;  // summed over samples (agent-samples per bin)
   // Lines: crossings are seen between consecutive frames, so the stage keeps
   // the positions and flags of the frame before.

@@ -33,6 +33,55 @@ class RecordingStage : public FrameStage {
   std::vector<std::string>& log_;
 };
 
+// The mean speed of the crowd at every frame, by the metric function: the
+// reference for the metrics stage's running means.
+class MeanSpeedStage : public FrameStage {
+ public:
+  std::string name() const override { return "test.mean_speed"; }
+  void after_step(const Simulation& sim, const FrameInfo&) override {
+    speeds.push_back(mean_speed(sim.crowd().velocity.span(), sim.crowd().flags.span()));
+  }
+  std::vector<double> speeds;
+};
+
+// A run with more samples than the series keeps: the series is thinned
+// (bounded, evenly spread, the last frame last) while the counts, means and
+// maxima still cover every sample taken.
+TEST(FrameLoop, MetricsOfALongRunKeepBoundedSeriesAndExactMeans) {
+  const ScenarioSpec spec = test::builtin("circle", 12);
+  Simulation sim(spec);
+  FrameLoop loop(sim);
+  MetricsOptions options;
+  options.sample_every = 1;
+  const auto& metrics = loop.emplace<CrowdMetricsStage>(sim, options);
+  const auto& reference = loop.emplace<MeanSpeedStage>();
+  RunControl control;
+  const std::int64_t steps = static_cast<std::int64_t>(2 * kMaxSeriesSamples + 123);
+  control.max_steps = steps;
+  control.stop_when_arrived = false;
+  loop.run(control);
+  nlohmann::json stats;
+  loop.finish(stats);
+  ASSERT_EQ(reference.speeds.size(), static_cast<std::size_t>(steps + 1));
+  EXPECT_EQ(metrics.samples_taken(), static_cast<std::uint64_t>(steps + 1));
+  EXPECT_EQ(stats["crowd"]["samples"].get<std::int64_t>(), steps + 1);
+  EXPECT_EQ(stats["crowd"]["series_stride"].get<std::int64_t>(), 4);
+  double sum = 0;
+  for (const double v : reference.speeds) sum += v;
+  EXPECT_NEAR(stats["crowd"]["mean_speed_mps"]["over_samples"].get<double>(), sum / static_cast<double>(reference.speeds.size()), 1e-9);
+  const nlohmann::json& series = stats["measurement"]["areas"][0]["samples"];
+  EXPECT_LE(series.size(), kMaxSeriesSamples + 1);
+  EXPECT_GE(series.size(), kMaxSeriesSamples / 2);
+  EXPECT_EQ(series.size(), stats["fundamental_diagram"]["samples"].size());
+  EXPECT_DOUBLE_EQ(series.back()["time"].get<double>(), static_cast<double>(steps) * spec.dt);
+  for (std::size_t i = 1; i + 1 < series.size(); ++i)
+    EXPECT_NEAR(series[i]["time"].get<double>() - series[i - 1]["time"].get<double>(), 4 * spec.dt, 1e-6) << i;
+  // The fundamental diagram's bins count every sample with agents in the area.
+  std::int64_t binned = 0;
+  for (const auto& b : stats["fundamental_diagram"]["bins"]) binned += b["samples"].get<std::int64_t>();
+  EXPECT_GT(binned, static_cast<std::int64_t>(series.size()));
+}
+
 TEST(FrameLoop, StagesRunAfterEachStepInOrder) {
   Simulation sim(test::builtin("circle", 20));
   FrameLoop loop(sim);
