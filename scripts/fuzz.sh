@@ -6,6 +6,10 @@
 # failing target prints its whole log and the inputs kept. Every target
 # runs; the script fails if any found something.
 #   FUZZ_SECONDS=60 bash scripts/fuzz.sh
+# Long offline runs: FUZZ_TARGETS="fuzz_bvh fuzz_scenario" picks targets,
+# FUZZ_CORPUS_DIR=DIR keeps each target's grown corpus in DIR/<target>
+# (seeded from fuzz/ on the first run, reused after) instead of a
+# temporary copy, FUZZ_NICE=19 runs the targets at that niceness.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -19,6 +23,13 @@ fi
 cmake --build "$build_dir" -j "${JOBS:-$(nproc)}" -- --quiet
 shopt -s nullglob
 targets=("$build_dir"/fuzz/fuzz_*)
+if [ -n "${FUZZ_TARGETS:-}" ]; then
+  targets=()
+  for name in $FUZZ_TARGETS; do
+    [ -x "$build_dir/fuzz/$name" ] || { echo "fuzz: no target $name in $build_dir/fuzz" >&2; exit 1; }
+    targets+=("$build_dir/fuzz/$name")
+  done
+fi
 if ((${#targets[@]} == 0)); then
   echo "fuzz: no fuzz targets were built" >&2
   exit 1
@@ -30,11 +41,19 @@ failed=()
 for t in "${targets[@]}"; do
   name=$(basename "$t")
   seeds=$(find fuzz -type d -name "corpus_${name#fuzz_}" | head -n 1)
-  work=$(mktemp -d)
-  [ -n "$seeds" ] && cp -r "$seeds"/. "$work"/
+  if [ -n "${FUZZ_CORPUS_DIR:-}" ]; then
+    work="$(realpath -m "$FUZZ_CORPUS_DIR")/$name"
+    if [ ! -d "$work" ]; then
+      mkdir -p "$work"
+      if [ -n "$seeds" ]; then cp -r "$seeds"/. "$work"/; fi
+    fi
+  else
+    work=$(mktemp -d)
+    [ -n "$seeds" ] && cp -r "$seeds"/. "$work"/
+  fi
   mkdir -p "$crashes/$name"
   echo "fuzz: $name for ${seconds}s (seeds: ${seeds:-none})"
-  if (cd "$work" && "$root/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+  if (cd "$work" && nice -n "${FUZZ_NICE:-0}" "$root/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
         -artifact_prefix="$crashes/$name/" -print_final_stats=1 "$work" >"$logs/$name.log" 2>&1); then
     grep -E '^(#[0-9]+.*DONE|stat::number_of_executed_units|stat::peak_rss_mb|Done [0-9]+ runs)' "$logs/$name.log" | sed 's/^/  /' || true
   else
@@ -44,7 +63,7 @@ for t in "${targets[@]}"; do
     ls -l "$crashes/$name" >&2
     failed+=("$name")
   fi
-  rm -rf "$work"
+  [ -n "${FUZZ_CORPUS_DIR:-}" ] || rm -rf "$work"
   rmdir "$crashes/$name" 2>/dev/null || true  # empty: nothing found
 done
 if ((${#failed[@]})); then

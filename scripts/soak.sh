@@ -5,7 +5,7 @@
 # that finds a non-finite agent, an agent outside free space or an overlap
 # beyond the model's 8 cm bound, and at the end when resident memory grew
 # more than 5% after the first tenth of the run. Prints a table of the
-# figures (docs/soak.md); each run's soak.jsonl, stats.json and log are in
+# figures (docs/simulation.md, "Soak test"); each run's soak.jsonl, stats.json and log are in
 # $SOAK_DIR/<config>/.
 #   bash scripts/soak.sh [small|large|all]        (default all)
 #   SOAK_SMALL_STEPS=100000 SOAK_LARGE_STEPS=2000 bash scripts/soak.sh
