@@ -36,7 +36,9 @@ TEST(ThinnedSeries, EvenlySpreadBoundedAndNewestLastForAnyLength) {
       ASSERT_EQ(s.newest(), n - 1);
       ASSERT_EQ(s.seen(), n);
       // The stride doubles only when needed: half of it would overflow.
-      if (s.stride() > 1) ASSERT_GT((n - 1) / (s.stride() / 2) + 1, capacity) << "capacity " << capacity << ", n " << n;
+      if (s.stride() > 1) {
+        ASSERT_GT((n - 1) / (s.stride() / 2) + 1, capacity) << "capacity " << capacity << ", n " << n;
+      }
     }
   }
 }

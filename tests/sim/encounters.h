@@ -99,6 +99,20 @@ inline std::vector<Walker> circle_of_twenty() {
 
 // An L-shaped corridor 2 m wide: one walker comes from the west arm, one
 // from the north arm; they meet at the corner without seeing each other.
+inline WorldSpec l_corridor();
+inline std::vector<Walker> blind_corner_pair();
+
+// The five standard encounters under `model`: head-on, crossing, four ways
+// and the blind corner held to 1.5x (the aim), the circle of twenty to its
+// own bounds (all meet at once: the hardest of them).
+inline void expect_standard_encounters_resolve(ModelKind model, double circle_slowest, float circle_deepest = 0.01f) {
+  expect_encounter_resolves(model, "head-on", head_on_pair());
+  expect_encounter_resolves(model, "crossing", crossing_pair());
+  expect_encounter_resolves(model, "four ways", four_ways());
+  expect_encounter_resolves(model, "blind corner", blind_corner_pair(), l_corridor());
+  expect_encounter_resolves(model, "circle of 20", circle_of_twenty(), {}, circle_slowest, circle_deepest);
+}
+
 inline WorldSpec l_corridor() {
   WorldSpec world;
   world.has_walkable = true;
