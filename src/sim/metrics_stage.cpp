@@ -160,8 +160,9 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
   stats["density_histogram"] = {{"cell_m", density_.cell}, {"bin_width_per_m2", density_.bin_width}, {"bins", bins}};
 
   // Fundamental diagram: samples of the first measurement area grouped by density.
+  const std::vector<Sample> kept = samples_.values();
   nlohmann::json series = nlohmann::json::array();
-  for (const Sample& s : samples_.values()) series.push_back(area_sample_json(s.time, s.areas.front()));
+  for (const Sample& s : kept) series.push_back(area_sample_json(s.time, s.areas.front()));
   nlohmann::json diagram = nlohmann::json::array();
   for (const auto& [k, b] : fd_bins_) {
     const double n = static_cast<double>(b.samples);
@@ -183,7 +184,7 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
                                   {"density_bin_width_per_m2", options_.density_bin_width},
                                   {"bins", diagram},
                                   {"samples", series}};
-  stats["measurement"] = measurement_section();
+  stats["measurement"] = measurement_section(kept);
   stats["stuck_agents"] = stuck_section();
 }
 
@@ -213,9 +214,8 @@ nlohmann::json CrowdMetricsStage::area_sample_json(double time, const AreaMeasur
           {"flow", a.flow}, {"voronoi_flow", v.density * v.speed}};
 }
 
-nlohmann::json CrowdMetricsStage::measurement_section() const {
+nlohmann::json CrowdMetricsStage::measurement_section(const std::vector<Sample>& kept) const {
   const MeasurementSpec& spec = options_.measurement;
-  const std::vector<Sample> kept = samples_.values();
   nlohmann::json areas = nlohmann::json::array();
   for (std::size_t k = 0; k < spec.areas.size(); ++k) {
     nlohmann::json series = nlohmann::json::array();

@@ -71,7 +71,8 @@ class CrowdMetricsStage : public FrameStage {
 
  private:
   void record_crossings(const Simulation& sim, const FrameInfo& frame);
-  nlohmann::json measurement_section() const;
+  // `kept`: the samples kept for the series (samples_.values()).
+  nlohmann::json measurement_section(const std::vector<Sample>& kept) const;
   nlohmann::json stuck_section() const;
   // One sample of an area: classic and Voronoi values side by side.
   static nlohmann::json area_sample_json(double time, const AreaMeasure& m);
