@@ -8,8 +8,17 @@
 #include <cstdlib>
 #include <string_view>
 
+#include <spdlog/spdlog.h>
+
 #include "core/error.h"
 #include "io/scenario_yaml.h"
+
+// The simulation logs its set-up (routes planned, agents without one) at
+// info and warn; per input that would bury libFuzzer's own lines.
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  spdlog::set_level(spdlog::level::err);
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace throng;

@@ -363,7 +363,8 @@ class Reader {
   // those every model shares. A parameter of another model is an error that
   // says which type it belongs to.
   sim::ModelParams model(const YAML::Node& n, const std::string& path) {
-    static const std::vector<std::string_view> shared = {"type", "max_speed", "contact_iterations"};
+    static const std::vector<std::string_view> shared = {"type", "max_speed", "contact_iterations", "contact_extra_iterations",
+                                                         "contact_tolerance"};
     static const std::vector<std::string_view> priority = {"pred_time", "max_force", "personal_space", "lane_half_width", "relaxation_time",
                                                            "probe_margin"};
     static const std::vector<std::string_view> cfs = {"time_gap",       "neighbour_strength", "neighbour_range", "wall_strength",
@@ -437,6 +438,10 @@ class Reader {
     opt("sf_max_substep", m.sf.max_substep);
     opt("sf_side_bias", m.sf.side_bias);
     if (n["contact_iterations"]) m.contact_iterations = static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
+    if (n["contact_extra_iterations"])
+      m.contact_extra_iterations =
+          static_cast<std::int32_t>(integer(n["contact_extra_iterations"], child(path, "contact_extra_iterations"), 0, 64));
+    opt("contact_tolerance", m.contact_tolerance);
     return m;
   }
 

@@ -97,6 +97,10 @@ struct ModelParams {
   // Every model:
   float max_speed = 2.0f;          // m/s: no agent is faster (maxVelocity)
   std::int32_t contact_iterations = 4;  // contact/obstacle projection passes per step (the added constraint)
+  // More passes, at most this many, while the last found a pair overlapping
+  // by more than contact_tolerance (a jam; see sim/simulation.h).
+  std::int32_t contact_extra_iterations = 8;
+  float contact_tolerance = 0.03f;  // m
   // Side of the steering bins: every neighbour the model looks at lies
   // within it. Priority: 2 * pred_time * max_speed (the paper's). Collision-
   // free speed: the gap that allows max_speed (T * max_speed) plus two of

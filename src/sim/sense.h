@@ -245,11 +245,14 @@ THRONG_HOST_DEVICE inline glm::vec2 tie_direction(Index i, Index j) {
 }
 
 // Contact constraint (the addition to the paper's model): each overlapping
-// pair is pushed apart, this agent taking half of the overlap.
+// pair is pushed apart, this agent taking half of the overlap. `deepest`
+// becomes the deepest of those overlaps (m; 0 when none).
 // Candidates: the contact bins' cells `cells` (the 3x3 around the agent's).
 THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cells3x3& cells, Index self, glm::vec2 p, float radius,
-                                                 Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags) {
+                                                 Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags,
+                                                 float& deepest) {
   glm::vec2 push(0.0f);
+  deepest = 0.0f;
   for_each_in_cells(bins, cells, [&](std::int32_t j) {
     if (j == self || (flags[j] & kAgentActive) == 0) return;
     const glm::vec2 d = p - positions[j];
@@ -259,6 +262,7 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cel
     const float dist = sqrtf(d2);
     const glm::vec2 dir = dist > 1e-6f ? d * (1.0f / dist) : tie_direction(self, j);
     push += dir * (0.5f * (reach - dist));
+    deepest = fmaxf(deepest, reach - dist);
   });
   return push;
 }

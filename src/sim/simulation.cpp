@@ -29,6 +29,7 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   scratch_ = Buffer<glm::vec2>(crowd_.count, m);
   sensed_ = Buffer<glm::vec2>::zeros(crowd_.count, m);      // inactive agents are never sensed
   move_cells_ = Buffer<MoveCells>::zeros(crowd_.count, m);  // nor given move cells
+  contact_depth_ = Buffer<float>::zeros(crowd_.count, m);
 }
 
 StepContext Simulation::context() const {
@@ -78,15 +79,23 @@ void Simulation::move(const StepContext& ctx) {
   const Span<const glm::vec2> anchor = anchor_.span();
   const Span<const MoveCells> cells = move_cells_.span();
   move_cells(ctx, anchor, move_cells_.span());
+  const Span<float> depth = contact_depth_.span();
+  const ModelParams& m = spec_.model;
+  // The fixed passes, then the extra ones while the last pass found a
+  // pair deeper than the tolerance (the depth it saw before pushing).
+  auto settled = [&](std::int32_t passes) {
+    return passes >= m.contact_iterations &&
+           (passes == 0 || passes >= m.contact_iterations + m.contact_extra_iterations || deepest_contact(depth) <= m.contact_tolerance);
+  };
   if (scheduler_ == SchedulerKind::DoubleBuffer) {  // (the all-pairs reference included)
     Span<glm::vec2> in = candidate_.span(), out = scratch_.span();
-    for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) {
-      contacts_double_buffer(ctx, a, anchor, cells, in, out);
+    for (contact_passes_ = 0; !settled(contact_passes_); ++contact_passes_) {
+      contacts_double_buffer(ctx, a, anchor, cells, in, out, depth);
       std::swap(in, out);
     }
     finalize_step(ctx, a, anchor, cells, in);
   } else {
-    for (std::int32_t k = 0; k < spec_.model.contact_iterations; ++k) contacts_four_colour(ctx, a, anchor, cells);
+    for (contact_passes_ = 0; !settled(contact_passes_); ++contact_passes_) contacts_four_colour(ctx, a, anchor, cells, depth);
     finalize_step(ctx, a, anchor, cells, a.position);
   }
 }

@@ -23,7 +23,11 @@
 //
 // The move stage adds to the paper's forces a contact constraint: after
 // integration, `model.contact_iterations` passes push overlapping pairs
-// apart (each takes half the overlap) and project agents out of walls; a
+// apart (each takes half the overlap) and project agents out of walls;
+// while the last pass still found an overlap deeper than
+// `model.contact_tolerance` (a jam pressing many agents together), up to
+// `model.contact_extra_iterations` more passes run, so crowds pushed into
+// a corner keep within the overlap bound and light crowds pay nothing; a
 // position still closer than its radius to a wall is rejected (the agent
 // stays put), so agents never penetrate obstacles. Velocity is the actual
 // displacement / dt, so blocked agents slow down.
@@ -95,13 +99,18 @@ void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<cons
 // Both: the move cells around each binned agent's anchor (its position at
 // the start of the step).
 void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells);
+// Contact passes write, per agent, the deepest overlap the pass found
+// before pushing (`depth`, m; 0 for inactive agents).
 // Double buffer: one contact pass from `in` to `out`.
 void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                            Span<const glm::vec2> in, Span<glm::vec2> out);
+                            Span<const glm::vec2> in, Span<glm::vec2> out, Span<float> depth);
 // Four colour: sense + steer, then each contact pass, in place on a.position
 // and a.velocity, colour by colour.
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a);
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells);
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                          Span<float> depth);
+// The deepest of the per-agent overlaps a contact pass wrote.
+float deepest_contact(Span<const float> depth);
 // Both: accepts or rejects each moved position, sets velocity, heading,
 // arrivals and waypoints. `moved` may alias a.position.
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
@@ -141,6 +150,9 @@ class Simulation {
   SchedulerKind scheduler() const { return scheduler_; }
   void set_scheduler(SchedulerKind s) { scheduler_ = s; }
   std::int64_t steps_done() const { return steps_done_; }
+  // Contact passes the last step ran: contact_iterations, plus the extra
+  // passes a jam needed.
+  std::int32_t last_contact_passes() const { return contact_passes_; }
   double time() const { return static_cast<double>(steps_done_) * spec_.dt; }
   Index agent_count() const { return crowd_.count; }
 
@@ -169,7 +181,9 @@ class Simulation {
   NeighbourSearch neighbours_ = NeighbourSearch::Bins;
   float max_radius_ = 0.0f;
   std::int64_t steps_done_ = 0;
+  std::int32_t contact_passes_ = 0;
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
+  Buffer<float> contact_depth_;  // per agent: the deepest overlap the last contact pass found
   Buffer<MoveCells> move_cells_;
 };
 

@@ -147,15 +147,29 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
   out_p = p + out_v * ctx.dt;
 }
 
-// One contact pass for one agent reading positions P.
+// The move stage accepts a position only if it keeps the disc off every
+// wall and is short enough that it cannot have crossed one (see the header).
+THRONG_HOST_DEVICE inline bool acceptable_move(const StepContext& ctx, const MoveCells& cells, glm::vec2 from, glm::vec2 p, float r) {
+  const bool short_enough = length2(p - from) <= (kAcceptFraction * r) * (kAcceptFraction * r);
+  return short_enough && wall_clearance(ctx.world, cells.obstacles, p, r) >= r - kWallTolerance;
+}
+
+// One contact pass for one agent reading positions P; `deepest` becomes the
+// deepest overlap of the agent the pass found (before its push).
 THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i, const MoveCells& cells,
-                                                  glm::vec2 anchor, Span<const glm::vec2> P) {
+                                                  glm::vec2 anchor, Span<const glm::vec2> P, float& deepest) {
   glm::vec2 p = P[i];
+  deepest = 0.0f;
   if ((a.flags[i] & kAgentActive) == 0) return p;
   const float r = a.radius[i];
-  p += clamp_length(contact_push(ctx.contact_bins, cells.agents, i, p, r, P, a.radius, a.flags), 0.5f * r);
+  p += clamp_length(contact_push(ctx.contact_bins, cells.agents, i, p, r, P, a.radius, a.flags, deepest), 0.5f * r);
   p = anchor + clamp_length(p - anchor, kMaxStepFraction * r);
-  return project_out_of_obstacles(ctx.world, cells.obstacles, p, r, anchor);
+  p = project_out_of_obstacles(ctx.world, cells.obstacles, p, r, anchor);
+  // Where the move stage would reject the position (pressed into a sharp
+  // corner), the agent stays at its anchor already now: later passes then
+  // push its neighbours away from where it will be, not from where it
+  // will not.
+  return acceptable_move(ctx, cells, anchor, p, r) ? p : anchor;
 }
 
 // Agents are visited in bin order (k -> items[k]): neighbours in space are
@@ -232,7 +246,8 @@ struct ContactsDoubleBuffer {
   Span<const glm::vec2> anchor, in;
   Span<const MoveCells> cells;
   Span<glm::vec2> out;
-  THRONG_HOST_DEVICE void operator()(Index i) const { out[i] = contact_agent(ctx, a, i, cells[i], anchor[i], in); }
+  Span<float> depth;
+  THRONG_HOST_DEVICE void operator()(Index i) const { out[i] = contact_agent(ctx, a, i, cells[i], anchor[i], in, depth[i]); }
 };
 
 // Four colour: one launch per colour over the table slots; a slot of that
@@ -262,6 +277,7 @@ struct ContactsColour {
   AgentArrays a;
   Span<const glm::vec2> anchor;
   Span<const MoveCells> cells;
+  Span<float> depth;
   int colour;
   THRONG_HOST_DEVICE void operator()(Index s) const {
     const std::uint64_t key = ctx.contact_bins.keys[s];
@@ -269,7 +285,7 @@ struct ContactsColour {
     const std::int32_t b = ctx.contact_bins.start[s], n = ctx.contact_bins.count[s];
     for (std::int32_t k = 0; k < n; ++k) {
       const Index i = ctx.contact_bins.items[b + k];
-      a.position[i] = contact_agent(ctx, a, i, cells[i], anchor[i], a.position);
+      a.position[i] = contact_agent(ctx, a, i, cells[i], anchor[i], a.position, depth[i]);
     }
   }
 };
@@ -286,10 +302,7 @@ struct Finalize {
     const glm::vec2 from = anchor[i];
     glm::vec2 p = moved[i];
     const float r = a.radius[i];
-    // Accept the move only if it keeps the disc off every wall and is short
-    // enough that it cannot have crossed one (see the header).
-    const bool short_enough = length2(p - from) <= (kAcceptFraction * r) * (kAcceptFraction * r);
-    if (!(short_enough && wall_clearance(ctx.world, cells[i].obstacles, p, r) >= r - kWallTolerance)) p = from;
+    if (!acceptable_move(ctx, cells[i], from, p, r)) p = from;
     glm::vec2 v = clamp_length((p - from) * (1.0f / ctx.dt), ctx.model.max_speed);
     if ((flags & kAgentStopped) != 0) v = glm::vec2(0.0f);
     a.position[i] = p;
@@ -351,17 +364,24 @@ void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveC
 }
 
 void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                            Span<const glm::vec2> in, Span<glm::vec2> out) {
-  parallel_for("sim.move.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, cells, out}, kAgentGrain);
+                            Span<const glm::vec2> in, Span<glm::vec2> out, Span<float> depth) {
+  parallel_for("sim.move.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, cells, out, depth}, kAgentGrain);
 }
 
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
   for (int c = 0; c < 4; ++c) parallel_for("sim.sense_steer.colour", ctx.bins.capacity(), SenseSteerColour{ctx, a, c}, kSlotGrain);
 }
 
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells) {
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
+                          Span<float> depth) {
   for (int c = 0; c < 4; ++c)
-    parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, cells, c}, kSlotGrain);
+    parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, cells, depth, c}, kSlotGrain);
+}
+
+float deepest_contact(Span<const float> depth) {
+  return parallel_reduce(
+      "sim.move.contacts.deepest", depth.size(), 0.0f, THRONG_LAMBDA(Index i)->float { return depth[i]; },
+      THRONG_LAMBDA(float x, float y)->float { return x > y ? x : y; });
 }
 
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,

@@ -127,6 +127,8 @@ model:
   relaxation_time: 0.4
   probe_margin: 0.15
   contact_iterations: 3
+  contact_extra_iterations: 5
+  contact_tolerance: 0.02
 world:
   walkable:
     polygon: [[-50, -50], [50, -50], [50, 50], [-50, 50]]
@@ -200,6 +202,8 @@ outputs:
   EXPECT_FLOAT_EQ(s.model.relaxation_time, 0.4f);
   EXPECT_FLOAT_EQ(s.model.probe_margin, 0.15f);
   EXPECT_EQ(s.model.contact_iterations, 3);
+  EXPECT_EQ(s.model.contact_extra_iterations, 5);
+  EXPECT_FLOAT_EQ(s.model.contact_tolerance, 0.02f);
   ASSERT_TRUE(s.world.has_walkable);
   EXPECT_EQ(s.world.walkable.outer.size(), 4u);
   EXPECT_EQ(s.world.walkable.holes.size(), 1u);
@@ -252,11 +256,11 @@ outputs:
   EXPECT_EQ(s.outputs.every, 4);
   EXPECT_FALSE(s.outputs.trajectories);
   // Every key's position is known.
-  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 41);
-  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 50);
-  EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").line, 56);  // each point, though not recorded as a key
+  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 43);
+  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 52);
+  EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").line, 58);  // each point, though not recorded as a key
   EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").column, 11);
-  EXPECT_EQ(l.source.locate("groups[3].spawn.points[7]").line, 55);  // beyond the list: where the list starts
+  EXPECT_EQ(l.source.locate("groups[3].spawn.points[7]").line, 57);  // beyond the list: where the list starts
   // And it all builds and runs.
   const auto sim = build_simulation(l);
   EXPECT_EQ(sim->agent_count(), 26);

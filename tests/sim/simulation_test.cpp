@@ -139,6 +139,91 @@ TEST(Acceptance, CircleThousandAgentsFourColour) { acceptance("circle", 1000, 30
 TEST(Acceptance, CrossingTwoThousandAgentsDoubleBuffer) { acceptance("crossing", 2000, 600, SchedulerKind::DoubleBuffer); }
 TEST(Acceptance, CrossingTwoThousandAgentsFourColour) { acceptance("crossing", 2000, 600, SchedulerKind::FourColour); }
 
+// A crowd pressed into a corner it cannot reach, found by the structure-
+// aware scenario fuzzer: 37 agents walk straight at (0, 0), behind a thin
+// wedge in the corner of a small room. Agents the crowd squeezed into the
+// wedge's sharp angle used to be sent back to where they stood after the
+// contact passes (a position too close to a wall is rejected), onto the
+// neighbours that had made room: 8.3 cm overlaps at step 41. The passes
+// now reject such a position themselves, so neighbours are pushed from
+// where the agent stays. Every step, both schedulers: within the bound.
+constexpr const char* kCornerJam = R"(
+seed: 446
+dt: 0.1
+planning: none
+model: {type: priority, max_speed: 1.25, personal_space: 0.3, probe_margin: 0}
+world:
+  walkable: {rect: {min: [0, 0], max: [4.35, 8.45]}}
+  obstacles:
+    - {polygon: [[2.35, 5.43], [0.65, 5.80], [1.68, 4.40]]}
+    - {rect: {min: [4.15, 5.8], max: [4.35, 8.45]}}
+    - {polygon: [[0.71, 0.77], [0.06, 0.22], [-0.42, -1.83]]}
+    - {polygon: [[5.51, 4.17], [3.67, 3.32], [2.62, 2.60], [2.26, 1.11], [3.41, 0.85], [4.87, 0.26]]}
+    - {rect: {min: [3.8, 5.15], max: [4.1, 8.45]}}
+    - {circle: {center: [3.8, 2.25], radius: 1.95}}
+groups:
+  - {count: 37, radius: 0.25, spawn: {rect: {min: [0.8, 0.85], max: [4.35, 6.95]}}, goal: {point: [0, 0]}}
+)";
+
+TEST(Contacts, ACrowdPressedIntoASharpCornerKeepsTheOverlapBound) {
+  const ScenarioSpec spec = io::parse_scenario(kCornerJam, "corner_jam").spec;
+  for (const SchedulerKind scheduler : {SchedulerKind::DoubleBuffer, SchedulerKind::FourColour}) {
+    const RunRecord r = run_to_arrival(spec, scheduler, 600);
+    std::printf("  corner jam, %s: %lld steps, deepest overlap %.3f m\n", to_string(scheduler), static_cast<long long>(r.steps),
+                r.max_overlap_depth);
+    EXPECT_FALSE(r.all_arrived) << to_string(scheduler);  // the goal lies inside the wedge: the crowd stays pressed
+    EXPECT_EQ(r.max_penetrations, 0) << to_string(scheduler);
+    EXPECT_LT(r.max_overlap_depth, kOverlapLimit) << to_string(scheduler);
+  }
+}
+
+// The extra contact passes, counted: agents apart take the fixed passes
+// only; a crowd squeezed into an n x n lattice closer than the discs' 0.5 m
+// takes more. A 5 x 5 squeeze at 0.42 m (8 cm overlaps) settles below the
+// tolerance before the cap; an 8 x 8 one at 0.44 m is still deeper at the
+// cap (each agent moves at most 0.9 radius a step, and the Jacobi passes
+// converge slowly over many rows) but shallower than after the fixed passes.
+struct SqueezeResult {
+  std::int32_t passes = 0;
+  float deepest = 0.0f;  // m, after the step
+};
+SqueezeResult squeeze_one_step(SchedulerKind scheduler, int side, float spacing, std::int32_t extra) {
+  const Index n = side * side;
+  ScenarioSpec spec = test::open_field(n, glm::vec2(0.0f), glm::vec2(8.0f), glm::vec2(50.0f, 0.0f));
+  spec.scheduler = scheduler;
+  spec.model.contact_extra_iterations = extra;
+  Simulation sim(spec);
+  Span<glm::vec2> p = sim.crowd().position.span();
+  for (Index i = 0; i < n; ++i) p[i] = glm::vec2(spacing * static_cast<float>(i % side), spacing * static_cast<float>(i / side));
+  sim.step();
+  const CrowdState& c = sim.crowd();
+  return {sim.last_contact_passes(), measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, sim.contact_cell()).max_depth};
+}
+
+TEST(Contacts, ExtraPassesRunWhileAPairIsDeeperThanTheTolerance) {
+  const ModelParams d;
+  for (const SchedulerKind scheduler : {SchedulerKind::DoubleBuffer, SchedulerKind::FourColour}) {
+    SCOPED_TRACE(to_string(scheduler));
+    const SqueezeResult apart = squeeze_one_step(scheduler, 8, 0.6f, d.contact_extra_iterations);
+    EXPECT_EQ(apart.passes, d.contact_iterations);
+    EXPECT_EQ(apart.deepest, 0.0f);
+
+    const SqueezeResult small = squeeze_one_step(scheduler, 5, 0.42f, d.contact_extra_iterations);
+    EXPECT_GT(small.passes, d.contact_iterations);
+    EXPECT_LT(small.passes, d.contact_iterations + d.contact_extra_iterations);
+    EXPECT_LE(small.deepest, d.contact_tolerance);
+
+    const SqueezeResult fixed = squeeze_one_step(scheduler, 8, 0.44f, 0);
+    const SqueezeResult extra = squeeze_one_step(scheduler, 8, 0.44f, d.contact_extra_iterations);
+    std::printf("  %s: 5 x 5 squeeze %d passes, %.4f m; 8 x 8: %d passes, %.4f m, with the extra passes %d, %.4f m\n", to_string(scheduler),
+                small.passes, small.deepest, fixed.passes, fixed.deepest, extra.passes, extra.deepest);
+    EXPECT_EQ(fixed.passes, d.contact_iterations);
+    EXPECT_EQ(extra.passes, d.contact_iterations + d.contact_extra_iterations);
+    EXPECT_GT(fixed.deepest, d.contact_tolerance);
+    EXPECT_LT(extra.deepest, 0.8f * fixed.deepest);
+  }
+}
+
 // Both schedulers on the same scenario (the circle with 400 agents, 200
 // under the sanitizers: a dense jam in a few hundred steps; three seeds,
 // arrival times pooled): the statistics agree.
