@@ -17,7 +17,7 @@ void LocomotionTally::add(const anim::FrameStats& frame, double ms) {
   characters = frame.characters;
   joints_synthesised += frame.joints_synthesised;
   from_cache += frame.from_cache;
-  frame_ms.push_back(ms);
+  frame_ms.push(ms);
   if (frame.lod) {
     level_counts.resize(frame.lod->level_counts.size(), 0);
     joints_histogram.resize(frame.lod->joints_synthesised.size(), 0);
@@ -27,10 +27,8 @@ void LocomotionTally::add(const anim::FrameStats& frame, double ms) {
 }
 
 nlohmann::json LocomotionTally::frame_ms_json() const {
-  double mean = 0.0;
-  for (double m : frame_ms) mean += m / static_cast<double>(frame_ms.size());
-  const double max = frame_ms.empty() ? 0.0 : *std::max_element(frame_ms.begin(), frame_ms.end());
-  return {{"median", percentile(frame_ms, 0.5)}, {"mean", mean}, {"p95", percentile(frame_ms, 0.95)}, {"max", max}};
+  const std::vector<double> kept = frame_ms.values();
+  return {{"median", percentile(kept, 0.5)}, {"mean", frame_ms.mean()}, {"p95", percentile(kept, 0.95)}, {"max", frame_ms.max()}};
 }
 
 nlohmann::json LocomotionTally::lod_json(const anim::CrowdAnimator& crowd, const std::vector<float>& thresholds) const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "anim/between_steps.h"
@@ -210,7 +211,7 @@ const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim
   if (dt > 0.0f && tracked_ > 0 && (skating_frames_ == 0 || skating_frames_ >= kSkatingWindow)) {
     if (skating_frames_ > 0) {
       const motion::FootSkatingReport r = crowd_->foot_skating();
-      slides_cm_.insert(slides_cm_.end(), r.slides_cm.begin(), r.slides_cm.end());
+      for (const double slide : r.slides_cm) slides_cm_.push(slide);
     }
     crowd_->track(tracked_agents(crowd_->count(), tracked_));
     skating_frames_ = 0;
@@ -238,16 +239,17 @@ nlohmann::json SimulationLocomotion::stats() const {
       tally_.character_frames() > 0.0 ? static_cast<double>(tally_.joints_synthesised) / tally_.character_frames() : 0.0;
   if (nlohmann::json lod = tally_.lod_json(crowd, thresholds_); !lod.is_null()) out["lod"] = lod;
   if (nlohmann::json cache = tally_.cache_json(crowd); !cache.is_null()) out["cache"] = cache;
-  std::vector<double> slides = slides_cm_;
-  if (skating_frames_ > 0) {
-    const motion::FootSkatingReport r = crowd.foot_skating();
-    slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
-  }
-  const motion::FootSkatingReport skate = motion::summarise_foot_skating(std::move(slides));
-  out["foot_skating_cm"] = {{"mean", skate.mean_cm},
-                            {"p95", skate.p95_cm},
-                            {"max", skate.max_cm},
-                            {"contacts", skate.contacts},
+  ThinnedSample slides = slides_cm_;
+  if (skating_frames_ > 0)
+    for (const double slide : crowd.foot_skating().slides_cm) slides.push(slide);
+  // The p95 of the kept slides; mean, max and count over every contact.
+  const motion::FootSkatingReport kept = motion::summarise_foot_skating(slides.values());
+  const bool any = slides.count() > 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out["foot_skating_cm"] = {{"mean", any ? slides.mean() : nan},
+                            {"p95", kept.p95_cm},
+                            {"max", any ? slides.max() : nan},
+                            {"contacts", slides.count()},
                             {"agents", std::min(crowd.count(), tracked_)}};
   return out;
 }

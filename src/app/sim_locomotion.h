@@ -74,6 +74,9 @@ class FollowCamera {
   float distance_ = 10.0f;
 };
 
+// Foot slides kept for the p95 of a long run (mean and max are exact).
+inline constexpr std::size_t kMaxSkatingSlides = 65536;
+
 class SimulationLocomotion {
  public:
   SimulationLocomotion(const sim::Simulation& sim, const LocomotionOptions& options = {});
@@ -107,7 +110,7 @@ class SimulationLocomotion {
   Buffer<float> previous_headings_, shown_headings_;
   LocomotionTally tally_;  // over the frames
   std::int32_t skating_frames_ = 0;  // frames in the current foot-tracking window
-  std::vector<double> slides_cm_;    // contacts of the windows closed so far
+  ThinnedSample slides_cm_{kMaxSkatingSlides};  // contacts of the windows closed so far
 };
 
 // `throng run`'s locomotion stage ("anim.locomotion"). Frames: one per

@@ -6,9 +6,9 @@
 // Memory is at most capacity + 1 values, whatever the run's length.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <utility>
 #include <vector>
 
@@ -22,15 +22,15 @@ class ThinnedSeries {
   void push(T value) {
     const std::uint64_t index = seen_++;
     if (index % stride_ != 0) {
-      newest_ = std::move(value);
+      newest_.assign(1, std::move(value));
       return;
     }
-    newest_.reset();
+    newest_.clear();
     kept_.push_back(std::move(value));
     if (kept_.size() <= capacity_) return;
     // Kept values are those at multiples of the stride; keep the even ones.
     const bool newest_dropped = (kept_.size() - 1) % 2 == 1;
-    if (newest_dropped) newest_ = std::move(kept_.back());
+    if (newest_dropped) newest_.assign(1, std::move(kept_.back()));
     std::size_t out = 1;  // the first stays where it is (no self-move)
     for (std::size_t i = 2; i < kept_.size(); i += 2) kept_[out++] = std::move(kept_[i]);
     kept_.resize(out);
@@ -40,21 +40,49 @@ class ThinnedSeries {
   // The kept values in order, the newest last.
   std::vector<T> values() const {
     std::vector<T> v = kept_;
-    if (newest_) v.push_back(*newest_);
+    v.insert(v.end(), newest_.begin(), newest_.end());
     return v;
   }
   std::uint64_t seen() const { return seen_; }      // values pushed
   std::uint64_t stride() const { return stride_; }  // 1 while nothing was dropped
   bool empty() const { return seen_ == 0; }
   // The newest value; call only when !empty().
-  const T& newest() const { return newest_ ? *newest_ : kept_.back(); }
+  const T& newest() const { return newest_.empty() ? kept_.back() : newest_.front(); }
 
  private:
   std::size_t capacity_;
   std::uint64_t seen_ = 0;
   std::uint64_t stride_ = 1;
   std::vector<T> kept_;
-  std::optional<T> newest_;
+  // The newest value when it is not kept: none or one (a vector, not an
+  // optional: GCC 12 warns of a maybe-uninitialized optional<double> copy).
+  std::vector<T> newest_;
+};
+
+// Numbers of an unbounded sequence (frame times, foot slides of a long
+// run): count, mean and maximum exact, and a ThinnedSeries of the values
+// for percentiles (exact while nothing was dropped, then over the evenly
+// spread values kept).
+class ThinnedSample {
+ public:
+  explicit ThinnedSample(std::size_t capacity) : kept_(capacity) {}
+
+  void push(double v) {
+    max_ = count_ == 0 ? v : std::max(max_, v);
+    ++count_;
+    sum_ += v;
+    kept_.push(v);
+  }
+  std::uint64_t count() const { return count_; }
+  double mean() const { return count_ > 0 ? sum_ / static_cast<double>(count_) : 0.0; }
+  double max() const { return max_; }  // 0 for no values
+  std::vector<double> values() const { return kept_.values(); }
+  std::uint64_t stride() const { return kept_.stride(); }
+
+ private:
+  ThinnedSeries<double> kept_;
+  std::uint64_t count_ = 0;
+  double sum_ = 0.0, max_ = 0.0;
 };
 
 }  // namespace throng

@@ -89,8 +89,12 @@ void FootSkatingRecorder::track(std::vector<Index> characters, Index character_c
   tracked_ = std::move(characters);
   joints_ = joint_count;
   frames_ = 0;
-  positions_.assign(tracked_.size(), {});
-  rotations_.assign(tracked_.size(), {});
+  // Cleared, not freed: the next window fills the same storage, so a long
+  // run recording window after window allocates only for the first.
+  positions_.resize(tracked_.size());
+  rotations_.resize(tracked_.size());
+  for (auto& p : positions_) p.clear();
+  for (auto& r : rotations_) r.clear();
 }
 
 FootSkatingRecorder::Frame FootSkatingRecorder::append(std::size_t t) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -52,6 +54,34 @@ TEST(ThinnedSeries, ValuesOwningMemorySurviveThinning) {
   for (const std::vector<int>& v : got) EXPECT_EQ(v.size(), 3u);
   EXPECT_EQ(got.front(), std::vector<int>(3, 0));
   EXPECT_EQ(got.back(), std::vector<int>(3, 99));
+}
+
+// ThinnedSample: count, mean and maximum against sums over every value,
+// the kept values those of a ThinnedSeries fed the same, and a copy that
+// goes on independently.
+TEST(ThinnedSample, ExactCountMeanAndMaxWithBoundedValues) {
+  ThinnedSample s(64);
+  ThinnedSeries<double> reference(64);
+  EXPECT_EQ(s.count(), 0u);
+  EXPECT_EQ(s.mean(), 0.0);
+  double sum = 0.0, max = -1e300;
+  for (int i = 0; i < 10000; ++i) {
+    const double v = std::sin(0.37 * i) * 10.0 + (i == 7777 ? 50.0 : 0.0);
+    s.push(v);
+    reference.push(v);
+    sum += v;
+    max = std::max(max, v);
+  }
+  EXPECT_EQ(s.count(), 10000u);
+  EXPECT_NEAR(s.mean(), sum / 10000.0, 1e-12);
+  EXPECT_EQ(s.max(), max);
+  EXPECT_EQ(s.values(), reference.values());
+  EXPECT_LE(s.values().size(), 65u);
+  ThinnedSample copy = s;
+  copy.push(1000.0);
+  EXPECT_EQ(copy.max(), 1000.0);
+  EXPECT_EQ(s.max(), max);
+  EXPECT_EQ(copy.count(), 10001u);
 }
 
 }  // namespace
