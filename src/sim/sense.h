@@ -269,16 +269,21 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cel
 
 // Moves a disc out of every wall and circle of `cell` it overlaps (two
 // passes for corners). `anchor` (the last valid position) breaks ties when
-// the centre lies on a wall.
+// the centre lies on a wall. `clear` becomes true when a pass found nothing
+// to move: the disc then keeps its radius from every wall and circle of
+// the cell (what the move stage's acceptance asks), with no need to measure.
 THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w, const ObstacleCell& cell, glm::vec2 p, float r,
-                                                             glm::vec2 anchor) {
-  for (int pass = 0; pass < 2; ++pass)
+                                                             glm::vec2 anchor, bool& clear) {
+  clear = false;
+  for (int pass = 0; pass < 2 && !clear; ++pass) {
+    bool touched = false;
     for_each_obstacle(
         w, cell,
         [&](const Segment& s) {
           const glm::vec2 q = closest_point_on_segment(p, s.a, s.b);
           const float d = length_of(p - q);
           if (d >= r) return;
+          touched = true;
           glm::vec2 n = normalize_or(perp_left(s.b - s.a), glm::vec2(1.0f, 0.0f));
           if (dot2(n, anchor - s.a) < 0.0f) n = -n;
           const glm::vec2 dir = d > 1e-6f ? (p - q) * (1.0f / d) : n;
@@ -287,8 +292,11 @@ THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w,
         [&](const Circle& c) {
           const glm::vec2 d = p - c.center;
           if (length2(d) >= (c.radius + r) * (c.radius + r)) return;
+          touched = true;
           p = c.center + normalize_or(d, normalize_or(anchor - c.center, glm::vec2(1.0f, 0.0f))) * (c.radius + r);
         });
+    clear = !touched;
+  }
   return p;
 }
 

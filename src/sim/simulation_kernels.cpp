@@ -164,11 +164,14 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const 
   const float r = a.radius[i];
   p += clamp_length(contact_push(ctx.contact_bins, cells.agents, i, p, r, P, a.radius, a.flags, deepest), 0.5f * r);
   p = anchor + clamp_length(p - anchor, kMaxStepFraction * r);
-  p = project_out_of_obstacles(ctx.world, cells.obstacles, p, r, anchor);
+  bool clear = false;
+  p = project_out_of_obstacles(ctx.world, cells.obstacles, p, r, anchor, clear);
   // Where the move stage would reject the position (pressed into a sharp
   // corner), the agent stays at its anchor already now: later passes then
   // push its neighbours away from where it will be, not from where it
-  // will not.
+  // will not. (A position clear of every wall needs only the length test.)
+  const bool short_enough = length2(p - anchor) <= (kAcceptFraction * r) * (kAcceptFraction * r);
+  if (clear && short_enough) return p;
   return acceptable_move(ctx, cells, anchor, p, r) ? p : anchor;
 }
 
