@@ -52,7 +52,7 @@ install(FILES ${PROJECT_BINARY_DIR}/package/throngConfig.cmake
 
 # pkg-config: the libraries in link order (a family before what it uses).
 set(pc_libs "")
-set(pc_requires "tbb fmt spdlog yaml-cpp glm nlohmann_json sqlite3")
+set(pc_requires "tbb fmt spdlog yaml-cpp glm nlohmann_json sqlite3 tinygltf")
 foreach(family render io path anim sim motion core)
   if(TARGET throng_${family})
     string(APPEND pc_libs " -lthrong_${family}")

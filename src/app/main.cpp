@@ -98,6 +98,7 @@ int main(int argc, char** argv) {
   add_info_command(app, g);
   add_convert_command(app, g);
   add_export_command(app, g);
+  add_export_crowd_command(app, g);
   add_match_command(app, g);
   add_view_command(app, g);
   add_version_command(app);

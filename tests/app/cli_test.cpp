@@ -12,6 +12,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "io/crowd_gltf.h"
+
 namespace {
 
 struct Result {
@@ -386,5 +388,35 @@ TEST(Cli, ConvertChoosesTheWriterByExtension) {
   std::string first;
   std::getline(written, first);
   EXPECT_EQ(first, "HIERARCHY");
+  std::filesystem::remove_all(dir);
+}
+
+// The acceptance size: 200 agents of the circle for 20 s at 24 fps is one
+// .glb under 50 MB that parses back with every agent and frame; bad
+// requests are refused before any work, naming the flag.
+TEST(Cli, ExportCrowdWritesABoundedGlbThatParsesBack) {
+  const auto dir = fresh_dir("throng_cli_export_crowd");
+  const std::string glb = (dir / "crowd.glb").string();
+  const Streams r = run_split("--log-level warn export-crowd circle --agents 200 --seconds 20 --out " + glb);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote " + glb + ": 200 agents x 22 joints, 481 frames at 24 fps"), std::string::npos) << r.out;
+  const auto bytes = std::filesystem::file_size(glb);
+  std::printf("  %s: %.1f MB\n", glb.c_str(), static_cast<double>(bytes) / 1e6);
+  EXPECT_LT(bytes, 50u * 1000u * 1000u);
+  const throng::io::CrowdGlb back(glb);
+  EXPECT_EQ(back.agents(), 200);
+  EXPECT_EQ(back.frames(), 481);
+  EXPECT_DOUBLE_EQ(back.fps(), 24.0);
+
+  Streams bad = run_split("export-crowd circle --agents 200 --seconds 20 --max-size 1 --out " + glb + ".x.glb");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("--max-size"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(glb + ".x.glb"));
+  bad = run_split("export-crowd circle --out " + (dir / "crowd.gltf").string());
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("--out"), std::string::npos) << bad.err;
+  bad = run_split("export-crowd " + dir.string());
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("is a folder"), std::string::npos) << bad.err;
   std::filesystem::remove_all(dir);
 }

@@ -16,6 +16,7 @@
 #include "core/buffer.h"
 #include "core/camera.h"
 #include "core/error.h"
+#include "io/crowd_gltf.h"
 #include "motion/default_set.h"
 #include "motion/locomotion.h"
 #include "render/framebuffer.h"
@@ -450,6 +451,77 @@ TEST_F(RendererTest, GpuSkinningMatchesTheCpuReference) {
   const std::vector<float> agent_yaws(yaws.begin(), yaws.begin() + agents);
   streams.resolve(positions, agent_yaws, resolved.span());
   compare(r.capture_skinned(poses_of(streams, resolved.span()), DrawTier::Fine), resolved.to_vector(), rig.mesh, agents);
+}
+
+// A crowd exported to glTF and read back (io/crowd_gltf.h) draws like the
+// crowd itself: palettes from the file's nodes (forward kinematics of its
+// keys) and its inverse bind matrices against throng's own pose of the same
+// frame (world joint frames). Silhouettes (pixels differing from the empty
+// scene) overlap by at least 97%.
+TEST_F(RendererTest, ACrowdReadBackFromItsGltfDrawsLikeThrongsOwn) {
+  const motion::BlendSpace1D space = motion::make_default_blend_space();
+  const Index n = 8;
+  anim::CrowdAnimatorConfig config;
+  config.lod = false;
+  anim::CrowdAnimator crowd(space, n, config);
+  std::vector<glm::vec3> at;
+  std::vector<float> yaws, scales, speeds;
+  for (Index i = 0; i < n; ++i) {
+    at.emplace_back(-5.0f + 1.4f * static_cast<float>(i), 0.0f, -1.0f * static_cast<float>(i % 3));
+    yaws.push_back(0.8f * static_cast<float>(i));
+    scales.push_back(0.9f + 0.03f * static_cast<float>(i));
+    speeds.push_back(0.3f + 0.2f * static_cast<float>(i));
+  }
+  crowd.place(at, yaws, scales);
+  crowd.set_speeds(speeds);
+  io::CrowdTake take(anim::make_rig("mannequin", space.skeleton()), scales, 30.0);
+  for (int f = 0; f < 15; ++f) {
+    crowd.animate({1.0f / 30.0f, nullptr, true});
+    take.add_frame(crowd.joint_positions(), crowd.joint_rotations());
+  }
+  const std::string path = (std::filesystem::temp_directory_path() / "throng_renderer_crowd.glb").string();
+  io::write_crowd_glb(path, take);
+  const io::CrowdGlb glb(path);
+  std::filesystem::remove(path);
+  const std::int32_t J = glb.joints();
+  std::vector<anim::Mat3x4> palettes;
+  std::vector<Index> offsets;
+  std::vector<glm::vec3> p;
+  std::vector<glm::quat> q;
+  std::vector<float> s;
+  for (Index c = 0; c < n; ++c) {
+    offsets.push_back(c * J);
+    glb.joint_frames(c, glb.frames() - 1, p, q, s);
+    for (std::int32_t j = 0; j < J; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      anim::Mat3x4 world = anim::mat3x4_from(q[k], p[k]);
+      for (glm::vec4* row : {&world.r0, &world.r1, &world.r2}) *row = glm::vec4(glm::vec3(*row) * s[k], row->w);
+      palettes.push_back(world * glb.inverse_bind()[k]);
+    }
+  }
+  CharacterPoses from_file;
+  from_file.palettes = palettes;
+  from_file.palette_offsets = offsets;
+
+  Renderer r(make_crowd_rigs(space.skeleton()));
+  const Camera cam = camera(480, 270);
+  RenderOptions skinned;
+  skinned.mode = RenderMode::Skinned;
+  const Image own = draw(r, cam, poses_of(crowd), skinned);
+  const Image exported = draw(r, cam, from_file, skinned);
+  const Image empty = draw(r, cam, TPoseCrowd().poses(), skinned);
+  std::int64_t both = 0, either = 0;
+  for (std::int32_t y = 0; y < cam.height; ++y)
+    for (std::int32_t x = 0; x < cam.width; ++x) {
+      const bool a = colour_distance(own, x, y, empty.pixel(x, y)) > 24, b = colour_distance(exported, x, y, empty.pixel(x, y)) > 24;
+      both += a && b;
+      either += a || b;
+    }
+  const double overlap = either > 0 ? static_cast<double>(both) / static_cast<double>(either) : 0.0;
+  std::printf("  silhouettes: %lld pixels in both, %lld in either: overlap %.4f\n", static_cast<long long>(both), static_cast<long long>(either),
+              overlap);
+  EXPECT_GT(either, 1000);  // eight characters, 12 to 16 m away
+  EXPECT_GT(overlap, 0.97);
 }
 
 // A fixed scene against a committed picture, in both modes. Regenerate
