@@ -282,7 +282,8 @@ std::vector<T> read_plain(const tinygltf::Model& m, int index, int component, in
     throw Error(what + ": unexpected component type", in_file(path, what));
   const tinygltf::BufferView& v = m.bufferViews[static_cast<std::size_t>(a.bufferView)];
   const std::size_t stride = v.byteStride != 0 ? v.byteStride : sizeof(T);
-  const std::vector<unsigned char>& data = m.buffers.at(static_cast<std::size_t>(v.buffer)).data;
+  if (v.buffer < 0 || v.buffer >= static_cast<int>(m.buffers.size())) throw Error(what + ": no such buffer", in_file(path, what));
+  const std::vector<unsigned char>& data = m.buffers[static_cast<std::size_t>(v.buffer)].data;
   const std::size_t start = v.byteOffset + a.byteOffset;
   if (a.count > 0 && (start + (a.count - 1) * stride + sizeof(T) > v.byteOffset + v.byteLength || v.byteOffset + v.byteLength > data.size()))
     throw Error(what + ": data beyond its buffer", in_file(path, what));
@@ -295,15 +296,36 @@ glm::vec3 vec3_of(const std::vector<double>& v, glm::vec3 otherwise) {
   return v.size() == 3 ? glm::vec3(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])) : otherwise;
 }
 
+// Images are not part of a crowd: skip them rather than decode them.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) { return true; }
+
 }  // namespace
 
 CrowdGlb::CrowdGlb(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw Error("no such .glb file", in_file(path));
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size >= (std::uintmax_t{1} << 32)) throw Error("unreadable, or 4 GiB or larger", in_file(path));
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()))) throw Error("cannot read", in_file(path));
+  load(bytes, path);
+}
+
+CrowdGlb CrowdGlb::parse(std::span<const unsigned char> bytes, const std::string& name) {
+  CrowdGlb glb;
+  glb.load(bytes, name);
+  return glb;
+}
+
+void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& path) {
+  if (bytes.size() >= (std::size_t{1} << 32)) throw Error("4 GiB or larger", in_file(path));
   tinygltf::Model m;
   tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skip_image, nullptr);
   std::string err, warn;
-  if (!loader.LoadBinaryFromFile(&m, &err, &warn, path)) throw Error("not a glTF binary: " + err, in_file(path));
+  if (!loader.LoadBinaryFromMemory(&m, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size())))
+    throw Error("not a glTF binary: " + err, in_file(path));
   if (m.skins.empty() || m.meshes.size() != 1) throw Error("expected one mesh and a skin per agent (throng export-crowd's layout)", in_file(path));
   agents_ = static_cast<Index>(m.skins.size());
   joints_ = static_cast<std::int32_t>(m.skins[0].joints.size());
@@ -345,7 +367,9 @@ CrowdGlb::CrowdGlb(const std::string& path) {
     x.r2 = glm::vec4(c[2], c[6], c[10], c[14]);
     inverse_bind_.push_back(x);
   }
-  const tinygltf::Primitive& prim = m.meshes[0].primitives.at(0);
+  if (static_cast<std::int32_t>(inverse_bind_.size()) != joints_) throw Error("one inverse bind matrix per joint expected", in_file(path, "skins[0]"));
+  if (m.meshes[0].primitives.empty()) throw Error("the mesh has no primitive", in_file(path, "meshes[0]"));
+  const tinygltf::Primitive& prim = m.meshes[0].primitives[0];
   auto attribute = [&](const char* name) {
     const auto it = prim.attributes.find(name);
     if (it == prim.attributes.end()) throw Error(std::string("mesh has no ") + name, in_file(path, "meshes[0]"));
@@ -360,7 +384,11 @@ CrowdGlb::CrowdGlb(const std::string& path) {
   for (std::size_t i = 0; i + 4 <= wts.size(); i += 4) mesh_.weights.emplace_back(wts[i], wts[i + 1], wts[i + 2], wts[i + 3]);
   mesh_.joints = read_plain<glm::u16vec4>(m, attribute("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, path, "JOINTS_0");
   mesh_.indices = read_plain<std::uint32_t>(m, prim.indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, path, "indices");
-  mesh_.validate();
+  try {
+    mesh_.validate();
+  } catch (const Error& e) {
+    throw Error(std::string("mesh: ") + e.what(), in_file(path, "meshes[0]"));
+  }
 
   if (m.animations.empty()) return;
   const tinygltf::Animation& anim = m.animations[0];

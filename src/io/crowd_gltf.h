@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -72,8 +73,10 @@ void write_crowd_glb(const std::string& path, const CrowdTake& take);
 class CrowdGlb {
  public:
   // Throws Error naming the file when it does not parse as glTF or is not
-  // laid out as write_crowd_glb lays it out.
+  // laid out as write_crowd_glb lays it out. Embedded images are skipped.
   explicit CrowdGlb(const std::string& path);
+  // The same from bytes in memory; `name` names them in errors.
+  static CrowdGlb parse(std::span<const unsigned char> bytes, const std::string& name);
 
   Index agents() const { return agents_; }
   std::int32_t joints() const { return joints_; }
@@ -86,6 +89,8 @@ class CrowdGlb {
   const anim::SkinnedMesh& mesh() const { return mesh_; }
 
  private:
+  CrowdGlb() = default;
+  void load(std::span<const unsigned char> bytes, const std::string& path);
   struct Node {
     std::int32_t parent = -1;  // within the agent's joints
     glm::vec3 translation{0.0f};
