@@ -2,6 +2,8 @@
 
 #include <tiny_gltf.h>
 
+#include <glm/mat4x4.hpp>
+
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -253,37 +255,18 @@ void write_crowd_glb(const std::string& path, const CrowdTake& take) {
 
 namespace {
 
-// Accessor `index` of `m` as floats (`width` per element), checked against
-// the type and its buffer.
-std::vector<float> read_floats(const tinygltf::Model& m, int index, int type, int width, const std::string& path, const std::string& what) {
-  if (index < 0 || index >= static_cast<int>(m.accessors.size())) throw Error(what + ": no such accessor", in_file(path, what));
-  const tinygltf::Accessor& a = m.accessors[static_cast<std::size_t>(index)];
-  if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != type || a.bufferView < 0 ||
-      a.bufferView >= static_cast<int>(m.bufferViews.size()))
-    throw Error(what + ": expected float data of " + std::to_string(width) + " components", in_file(path, what));
-  const tinygltf::BufferView& v = m.bufferViews[static_cast<std::size_t>(a.bufferView)];
-  const std::size_t element = static_cast<std::size_t>(width) * sizeof(float);
-  const std::size_t stride = v.byteStride != 0 ? v.byteStride : element;
-  if (v.buffer < 0 || v.buffer >= static_cast<int>(m.buffers.size())) throw Error(what + ": no such buffer", in_file(path, what));
-  const std::vector<unsigned char>& data = m.buffers[static_cast<std::size_t>(v.buffer)].data;
-  const std::size_t start = v.byteOffset + a.byteOffset;
-  if (a.count > 0 && (start + (a.count - 1) * stride + element > v.byteOffset + v.byteLength || v.byteOffset + v.byteLength > data.size()))
-    throw Error(what + ": data beyond its buffer", in_file(path, what));
-  std::vector<float> out(a.count * static_cast<std::size_t>(width));
-  for (std::size_t i = 0; i < a.count; ++i) std::memcpy(&out[i * static_cast<std::size_t>(width)], &data[start + i * stride], element);
-  return out;
-}
-
+// Accessor `index` of `m` as `T` per element (its component type and type
+// checked, every element inside its buffer view and buffer), tightly packed.
 template <class T>
-std::vector<T> read_plain(const tinygltf::Model& m, int index, int component, int type, const std::string& path, const std::string& what) {
+std::vector<T> read_accessor(const tinygltf::Model& m, int index, int component, int type, const std::string& path, const std::string& what) {
   if (index < 0 || index >= static_cast<int>(m.accessors.size())) throw Error(what + ": no such accessor", in_file(path, what));
   const tinygltf::Accessor& a = m.accessors[static_cast<std::size_t>(index)];
   if (a.componentType != component || a.type != type || a.bufferView < 0 || a.bufferView >= static_cast<int>(m.bufferViews.size()))
-    throw Error(what + ": unexpected component type", in_file(path, what));
+    throw Error(what + ": unexpected component type or type", in_file(path, what));
   const tinygltf::BufferView& v = m.bufferViews[static_cast<std::size_t>(a.bufferView)];
-  const std::size_t stride = v.byteStride != 0 ? v.byteStride : sizeof(T);
   if (v.buffer < 0 || v.buffer >= static_cast<int>(m.buffers.size())) throw Error(what + ": no such buffer", in_file(path, what));
   const std::vector<unsigned char>& data = m.buffers[static_cast<std::size_t>(v.buffer)].data;
+  const std::size_t stride = v.byteStride != 0 ? v.byteStride : sizeof(T);
   const std::size_t start = v.byteOffset + a.byteOffset;
   if (a.count > 0 && (start + (a.count - 1) * stride + sizeof(T) > v.byteOffset + v.byteLength || v.byteOffset + v.byteLength > data.size()))
     throw Error(what + ": data beyond its buffer", in_file(path, what));
@@ -358,9 +341,9 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
       n.scale = gn.scale.size() == 3 ? static_cast<float>(gn.scale[0]) : 1.0f;
     }
   }
-  const std::vector<float> ibm = read_floats(m, m.skins[0].inverseBindMatrices, TINYGLTF_TYPE_MAT4, 16, path, "inverseBindMatrices");
-  for (std::size_t j = 0; j + 16 <= ibm.size(); j += 16) {
-    const float* c = &ibm[j];  // column-major
+  for (const glm::mat4& ibm : read_accessor<glm::mat4>(m, m.skins[0].inverseBindMatrices, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4,
+                                                        path, "inverseBindMatrices")) {
+    const float* c = &ibm[0][0];  // column-major
     anim::Mat3x4 x;
     x.r0 = glm::vec4(c[0], c[4], c[8], c[12]);
     x.r1 = glm::vec4(c[1], c[5], c[9], c[13]);
@@ -375,15 +358,13 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
     if (it == prim.attributes.end()) throw Error(std::string("mesh has no ") + name, in_file(path, "meshes[0]"));
     return it->second;
   };
-  const std::vector<float> pos = read_floats(m, attribute("POSITION"), TINYGLTF_TYPE_VEC3, 3, path, "POSITION");
-  const std::vector<float> nrm = read_floats(m, attribute("NORMAL"), TINYGLTF_TYPE_VEC3, 3, path, "NORMAL");
-  const std::vector<float> wts = read_floats(m, attribute("WEIGHTS_0"), TINYGLTF_TYPE_VEC4, 4, path, "WEIGHTS_0");
+  constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
   mesh_.joint_count = joints_;
-  for (std::size_t i = 0; i + 3 <= pos.size(); i += 3) mesh_.positions.emplace_back(pos[i], pos[i + 1], pos[i + 2]);
-  for (std::size_t i = 0; i + 3 <= nrm.size(); i += 3) mesh_.normals.emplace_back(nrm[i], nrm[i + 1], nrm[i + 2]);
-  for (std::size_t i = 0; i + 4 <= wts.size(); i += 4) mesh_.weights.emplace_back(wts[i], wts[i + 1], wts[i + 2], wts[i + 3]);
-  mesh_.joints = read_plain<glm::u16vec4>(m, attribute("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, path, "JOINTS_0");
-  mesh_.indices = read_plain<std::uint32_t>(m, prim.indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, path, "indices");
+  mesh_.positions = read_accessor<glm::vec3>(m, attribute("POSITION"), kFloat, TINYGLTF_TYPE_VEC3, path, "POSITION");
+  mesh_.normals = read_accessor<glm::vec3>(m, attribute("NORMAL"), kFloat, TINYGLTF_TYPE_VEC3, path, "NORMAL");
+  mesh_.weights = read_accessor<glm::vec4>(m, attribute("WEIGHTS_0"), kFloat, TINYGLTF_TYPE_VEC4, path, "WEIGHTS_0");
+  mesh_.joints = read_accessor<glm::u16vec4>(m, attribute("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, path, "JOINTS_0");
+  mesh_.indices = read_accessor<std::uint32_t>(m, prim.indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, path, "indices");
   try {
     mesh_.validate();
   } catch (const Error& e) {
@@ -402,11 +383,18 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
     const tinygltf::AnimationSampler& s = anim.samplers[static_cast<std::size_t>(c.sampler)];
     const bool rotation = c.target_path == "rotation";
     if (!rotation && c.target_path != "translation") throw Error("only translation and rotation are keyed", in_file(path, c.target_path));
-    keys_.push_back(read_floats(m, s.output, rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, rotation ? 4 : 3, path, "sampler output"));
-    const auto frames = static_cast<std::int32_t>(keys_.back().size() / (rotation ? 4 : 3));
-    if (frames_ != 0 && frames != frames_) throw Error("channels differ in key count", in_file(path, "animations[0]"));
-    frames_ = frames;
-    (rotation ? n.rotation_keys : n.translation_keys) = static_cast<std::int32_t>(keys_.size()) - 1;
+    std::size_t frames = 0;
+    if (rotation) {
+      rotation_keys_.push_back(read_accessor<glm::vec4>(m, s.output, kFloat, TINYGLTF_TYPE_VEC4, path, "sampler output"));
+      frames = rotation_keys_.back().size();
+      n.rotation_keys = static_cast<std::int32_t>(rotation_keys_.size()) - 1;
+    } else {
+      translation_keys_.push_back(read_accessor<glm::vec3>(m, s.output, kFloat, TINYGLTF_TYPE_VEC3, path, "sampler output"));
+      frames = translation_keys_.back().size();
+      n.translation_keys = static_cast<std::int32_t>(translation_keys_.size()) - 1;
+    }
+    if (frames_ != 0 && static_cast<std::int32_t>(frames) != frames_) throw Error("channels differ in key count", in_file(path, "animations[0]"));
+    frames_ = static_cast<std::int32_t>(frames);
   }
 }
 
@@ -421,13 +409,10 @@ void CrowdGlb::joint_frames(Index a, std::int32_t frame, std::vector<glm::vec3>&
     const Node& n = nodes_[static_cast<std::size_t>(a * joints_ + j)];
     glm::vec3 t = n.translation;
     glm::quat r = n.rotation;
-    if (n.translation_keys >= 0) {
-      const float* v = &keys_[static_cast<std::size_t>(n.translation_keys)][k * 3];
-      t = glm::vec3(v[0], v[1], v[2]);
-    }
+    if (n.translation_keys >= 0) t = translation_keys_[static_cast<std::size_t>(n.translation_keys)][k];
     if (n.rotation_keys >= 0) {
-      const float* v = &keys_[static_cast<std::size_t>(n.rotation_keys)][k * 4];
-      r = glm::quat(v[3], v[0], v[1], v[2]);
+      const glm::vec4& v = rotation_keys_[static_cast<std::size_t>(n.rotation_keys)][k];  // x, y, z, w
+      r = glm::quat(v.w, v.x, v.y, v.z);
     }
     const auto J = static_cast<std::size_t>(j);
     if (n.parent < 0) {

@@ -25,6 +25,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "anim/rig.h"
 #include "core/span.h"
@@ -96,13 +97,14 @@ class CrowdGlb {
     glm::vec3 translation{0.0f};
     glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
     float scale = 1.0f;
-    std::int32_t translation_keys = -1, rotation_keys = -1;  // into keys_: keyed values, or -1
+    std::int32_t translation_keys = -1, rotation_keys = -1;  // into translation_keys_, rotation_keys_; -1: not keyed
   };
   Index agents_ = 0;
   std::int32_t joints_ = 0, frames_ = 0;
   double fps_ = 0.0;
   std::vector<Node> nodes_;  // [a * J + j]
-  std::vector<std::vector<float>> keys_;  // per keyed channel: frames * 3 or 4 floats
+  std::vector<std::vector<glm::vec3>> translation_keys_;  // per keyed channel, per frame
+  std::vector<std::vector<glm::vec4>> rotation_keys_;     // per keyed channel, per frame: x, y, z, w
   std::vector<anim::Mat3x4> inverse_bind_;
   anim::SkinnedMesh mesh_;
 };

@@ -81,21 +81,25 @@ void Simulation::move(const StepContext& ctx) {
   move_cells(ctx, anchor, move_cells_.span());
   const Span<float> depth = contact_depth_.span();
   const ModelParams& m = spec_.model;
-  // The fixed passes, then the extra ones while the last pass found a
-  // pair deeper than the tolerance (the depth it saw before pushing).
-  auto settled = [&](std::int32_t passes) {
-    return passes >= m.contact_iterations &&
-           (passes == 0 || passes >= m.contact_iterations + m.contact_extra_iterations || deepest_contact(depth) <= m.contact_tolerance);
+  // The fixed passes, then extra ones while the last pass found a pair
+  // deeper than the tolerance (the depth it saw before pushing).
+  auto run_passes = [&](auto&& pass) {
+    for (contact_passes_ = 0; contact_passes_ < m.contact_iterations; ++contact_passes_) pass();
+    while (m.contact_iterations > 0 && contact_passes_ < m.contact_iterations + m.contact_extra_iterations &&
+           deepest_contact(depth) > m.contact_tolerance) {
+      pass();
+      ++contact_passes_;
+    }
   };
   if (scheduler_ == SchedulerKind::DoubleBuffer) {  // (the all-pairs reference included)
     Span<glm::vec2> in = candidate_.span(), out = scratch_.span();
-    for (contact_passes_ = 0; !settled(contact_passes_); ++contact_passes_) {
+    run_passes([&] {
       contacts_double_buffer(ctx, a, anchor, cells, in, out, depth);
       std::swap(in, out);
-    }
+    });
     finalize_step(ctx, a, anchor, cells, in);
   } else {
-    for (contact_passes_ = 0; !settled(contact_passes_); ++contact_passes_) contacts_four_colour(ctx, a, anchor, cells, depth);
+    run_passes([&] { contacts_four_colour(ctx, a, anchor, cells, depth); });
     finalize_step(ctx, a, anchor, cells, a.position);
   }
 }

@@ -149,9 +149,11 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
 
 // The move stage accepts a position only if it keeps the disc off every
 // wall and is short enough that it cannot have crossed one (see the header).
-THRONG_HOST_DEVICE inline bool acceptable_move(const StepContext& ctx, const MoveCells& cells, glm::vec2 from, glm::vec2 p, float r) {
+// `known_clear`: the caller already knows the disc is off every wall.
+THRONG_HOST_DEVICE inline bool acceptable_move(const StepContext& ctx, const MoveCells& cells, glm::vec2 from, glm::vec2 p, float r,
+                                               bool known_clear = false) {
   const bool short_enough = length2(p - from) <= (kAcceptFraction * r) * (kAcceptFraction * r);
-  return short_enough && wall_clearance(ctx.world, cells.obstacles, p, r) >= r - kWallTolerance;
+  return short_enough && (known_clear || wall_clearance(ctx.world, cells.obstacles, p, r) >= r - kWallTolerance);
 }
 
 // One contact pass for one agent reading positions P; `deepest` becomes the
@@ -169,10 +171,8 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const 
   // Where the move stage would reject the position (pressed into a sharp
   // corner), the agent stays at its anchor already now: later passes then
   // push its neighbours away from where it will be, not from where it
-  // will not. (A position clear of every wall needs only the length test.)
-  const bool short_enough = length2(p - anchor) <= (kAcceptFraction * r) * (kAcceptFraction * r);
-  if (clear && short_enough) return p;
-  return acceptable_move(ctx, cells, anchor, p, r) ? p : anchor;
+  // will not. (A position the projection left clear needs only the length test.)
+  return acceptable_move(ctx, cells, anchor, p, r, clear) ? p : anchor;
 }
 
 // Agents are visited in bin order (k -> items[k]): neighbours in space are
