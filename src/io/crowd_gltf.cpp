@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <utility>
@@ -307,8 +308,13 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skip_image, nullptr);
   std::string err, warn;
-  if (!loader.LoadBinaryFromMemory(&m, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size())))
-    throw Error("not a glTF binary: " + err, in_file(path));
+  bool loaded = false;
+  try {  // tinygltf 2.7 throws std::out_of_range on some malformed JSON chunks
+    loaded = loader.LoadBinaryFromMemory(&m, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()));
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
+  if (!loaded) throw Error("not a glTF binary: " + err, in_file(path));
   if (m.skins.empty() || m.meshes.size() != 1) throw Error("expected one mesh and a skin per agent (throng export-crowd's layout)", in_file(path));
   agents_ = static_cast<Index>(m.skins.size());
   joints_ = static_cast<std::int32_t>(m.skins[0].joints.size());
@@ -393,6 +399,7 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
       frames = translation_keys_.back().size();
       n.translation_keys = static_cast<std::int32_t>(translation_keys_.size()) - 1;
     }
+    if (frames == 0) throw Error("a channel without keys", in_file(path, "animations[0]"));
     if (frames_ != 0 && static_cast<std::int32_t>(frames) != frames_) throw Error("channels differ in key count", in_file(path, "animations[0]"));
     frames_ = static_cast<std::int32_t>(frames);
   }
