@@ -100,8 +100,147 @@ void append_partial(const Roadmap& m, const EdgePoint& at, bool to_b, std::vecto
     for (std::int32_t i = at.piece; i >= 0; --i) push_point(out, m.edge_point(at.edge, i));
 }
 
+// Where a query's start and goal join the roadmap, with the costs the search
+// needs: along the attach edges from their node a and in all (cost units),
+// and the straight attach lengths (m).
+struct Attachment {
+  EdgePoint s, g;
+  RoadmapEdge se, ge;  // the edges s and g lie on
+  float s_from_a = 0, g_from_a = 0, s_total = 0, g_total = 0, s_attach = 0, g_attach = 0;
+};
+
+// Cost of a whole roadmap edge (cumulative cost at its last point).
+float edge_total(std::span<const float> cumulative_cost, const RoadmapEdge& edge) {
+  return cumulative_cost[static_cast<std::size_t>(edge.point_begin + edge.point_count - 1)];
+}
+
+// The attachment of start s and goal g (both on an edge); s_from_a and
+// g_from_a are their costs from their edges' node a.
+Attachment attachment(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const EdgePoint& s, const EdgePoint& g,
+                      float s_from_a, float g_from_a) {
+  Attachment at;
+  at.s = s;
+  at.g = g;
+  at.se = m.edges[static_cast<std::size_t>(s.edge)];
+  at.ge = m.edges[static_cast<std::size_t>(g.edge)];
+  at.s_from_a = s_from_a;
+  at.g_from_a = g_from_a;
+  at.s_total = edge_total(cumulative_cost, at.se);
+  at.g_total = edge_total(cumulative_cost, at.ge);
+  at.s_attach = sim::length_of(s.point - q.start);
+  at.g_attach = sim::length_of(g.point - q.goal);
+  return at;
+}
+
+// A* from S (node n, the start) to G (node n + 1, the goal) over the roadmap
+// nodes. Returns the chain of nodes S..G, empty when G is not reached (or
+// start and goal lie in different components).
+std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const Attachment& at) {
+  const std::int32_t n = m.node_count();
+  const std::int32_t S = n, G = n + 1;
+  const RoadmapEdge& se = at.se;
+  const RoadmapEdge& ge = at.ge;
+  if (m.node_component[static_cast<std::size_t>(se.a)] != m.node_component[static_cast<std::size_t>(ge.a)]) return {};
+  std::vector<float> cost(static_cast<std::size_t>(n + 2), INFINITY);
+  std::vector<std::int32_t> parent(static_cast<std::size_t>(n + 2), -1);
+  auto h = [&](std::int32_t v) { return v == G ? 0.0f : sim::length_of((v == S ? q.start : m.nodes[static_cast<std::size_t>(v)]) - q.goal); };
+  using Entry = std::pair<float, std::int32_t>;  // (f, node): ties broken by node index
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  auto relax = [&](std::int32_t from, std::int32_t to, float c) {
+    const float g2 = cost[static_cast<std::size_t>(from)] + c;
+    if (g2 < cost[static_cast<std::size_t>(to)]) {
+      cost[static_cast<std::size_t>(to)] = g2;
+      parent[static_cast<std::size_t>(to)] = from;
+      open.push({g2 + h(to), to});
+    }
+  };
+  cost[static_cast<std::size_t>(S)] = 0;
+  open.push({h(S), S});
+  while (!open.empty()) {
+    const auto [f, v] = open.top();
+    open.pop();
+    if (f > cost[static_cast<std::size_t>(v)] + h(v) + 1e-6f * std::max(1.0f, f)) continue;  // stale
+    if (v == G) break;
+    if (v == S) {
+      relax(S, se.a, at.s_attach + at.s_from_a);
+      relax(S, se.b, at.s_attach + at.s_total - at.s_from_a);
+      if (at.s.edge == at.g.edge) relax(S, G, at.s_attach + std::fabs(at.g_from_a - at.s_from_a) + at.g_attach);
+      continue;
+    }
+    if (v == ge.a) relax(v, G, at.g_from_a + at.g_attach);
+    if (v == ge.b) relax(v, G, at.g_total - at.g_from_a + at.g_attach);
+    for (std::int32_t k = m.adjacency_begin[static_cast<std::size_t>(v)]; k < m.adjacency_begin[static_cast<std::size_t>(v) + 1]; ++k) {
+      const std::int32_t e = m.adjacency[static_cast<std::size_t>(k)];
+      const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
+      relax(v, edge.a == v ? edge.b : edge.a, edge_total(cumulative_cost, edge));
+    }
+  }
+  std::vector<std::int32_t> chain;
+  if (!(cost[static_cast<std::size_t>(G)] < INFINITY)) return chain;
+  for (std::int32_t v = G; v >= 0; v = parent[static_cast<std::size_t>(v)]) chain.push_back(v);
+  std::reverse(chain.begin(), chain.end());
+  return chain;
+}
+
+// Appends the polyline of the cheapest edge joining nodes u and v, from u
+// to v (what the search relaxed between them).
+void append_cheapest_edge(const Roadmap& m, std::span<const float> cumulative_cost, std::int32_t u, std::int32_t v, std::vector<glm::vec2>& raw) {
+  std::int32_t best = -1;
+  float best_cost = INFINITY;
+  for (std::int32_t a = m.adjacency_begin[static_cast<std::size_t>(u)]; a < m.adjacency_begin[static_cast<std::size_t>(u) + 1]; ++a) {
+    const std::int32_t e = m.adjacency[static_cast<std::size_t>(a)];
+    const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
+    if (!((edge.a == u && edge.b == v) || (edge.a == v && edge.b == u))) continue;
+    const float c = edge_total(cumulative_cost, edge);
+    if (c < best_cost) {
+      best_cost = c;
+      best = e;
+    }
+  }
+  const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(best)];
+  if (edge.a == u)
+    for (std::int32_t i = 0; i < edge.point_count; ++i) push_point(raw, m.edge_point(best, i));
+  else
+    for (std::int32_t i = edge.point_count - 1; i >= 0; --i) push_point(raw, m.edge_point(best, i));
+}
+
+// The roadmap polyline (m) of a found chain S..G: start, its attach point,
+// the edges between the chain's nodes, the goal's attach point, goal.
+std::vector<glm::vec2> chain_polyline(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const Attachment& at,
+                                      const std::vector<std::int32_t>& chain) {
+  const EdgePoint& s = at.s;
+  const EdgePoint& g = at.g;
+  const RoadmapEdge& se = at.se;
+  const RoadmapEdge& ge = at.ge;
+  std::vector<glm::vec2> raw;
+  push_point(raw, q.start);
+  push_point(raw, s.point);
+  if (chain.size() == 2) {  // S -> G along the shared edge
+    const bool forward = s.piece < g.piece || (s.piece == g.piece && s.t <= g.t);
+    if (forward)
+      for (std::int32_t i = s.piece + 1; i <= g.piece; ++i) push_point(raw, m.edge_point(s.edge, i));
+    else
+      for (std::int32_t i = s.piece; i > g.piece; --i) push_point(raw, m.edge_point(s.edge, i));
+  } else {
+    append_partial(m, s, chain[1] == se.b && !(chain[1] == se.a && at.s_from_a <= at.s_total - at.s_from_a), raw);
+    for (std::size_t k = 1; k + 2 < chain.size(); ++k) append_cheapest_edge(m, cumulative_cost, chain[k], chain[k + 1], raw);
+    // From the last node along the goal's edge to its attach point.
+    const std::int32_t last = chain[chain.size() - 2];
+    const bool from_a = last == ge.a && !(last == ge.b && at.g_total - at.g_from_a < at.g_from_a);
+    if (from_a)
+      for (std::int32_t i = 0; i <= g.piece; ++i) push_point(raw, m.edge_point(g.edge, i));
+    else
+      for (std::int32_t i = ge.point_count - 1; i > g.piece; --i) push_point(raw, m.edge_point(g.edge, i));
+  }
+  push_point(raw, g.point);
+  push_point(raw, q.goal);
+  return raw;
+}
+
 }  // namespace
 
+// Stages: start and goal checks; the straight line, or attachment, search
+// and chain polyline; then smoothing and the path's length and clearance.
 PlannedPath Planner::plan(const PathQuery& q) const {
   PlannedPath out;
   const float r = options_.radius;
@@ -122,105 +261,13 @@ PlannedPath Planner::plan(const PathQuery& q) const {
       out.status = PlanStatus::Unreachable;
       return out;
     }
-    const Roadmap& m = roadmap_;
-    const std::int32_t n = m.node_count();
-    const std::int32_t S = n, G = n + 1;
-    const RoadmapEdge& se = m.edges[static_cast<std::size_t>(s.edge)];
-    const RoadmapEdge& ge = m.edges[static_cast<std::size_t>(g.edge)];
-    if (m.node_component[static_cast<std::size_t>(se.a)] != m.node_component[static_cast<std::size_t>(ge.a)]) {
+    const Attachment at = attachment(roadmap_, cumulative_cost_, q, s, g, cost_to_edge_start(s), cost_to_edge_start(g));
+    const std::vector<std::int32_t> chain = search(roadmap_, cumulative_cost_, q, at);
+    if (chain.empty()) {
       out.status = PlanStatus::Unreachable;
       return out;
     }
-    const float s_from_a = cost_to_edge_start(s), g_from_a = cost_to_edge_start(g);
-    const float s_total = cumulative_cost_[static_cast<std::size_t>(se.point_begin + se.point_count - 1)];
-    const float g_total = cumulative_cost_[static_cast<std::size_t>(ge.point_begin + ge.point_count - 1)];
-    const float s_attach = sim::length_of(s.point - q.start), g_attach = sim::length_of(g.point - q.goal);
-
-    std::vector<float> cost(static_cast<std::size_t>(n + 2), INFINITY);
-    std::vector<std::int32_t> parent(static_cast<std::size_t>(n + 2), -1);
-    auto h = [&](std::int32_t v) { return v == G ? 0.0f : sim::length_of((v == S ? q.start : m.nodes[static_cast<std::size_t>(v)]) - q.goal); };
-    using Entry = std::pair<float, std::int32_t>;  // (f, node): ties broken by node index
-    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
-    auto relax = [&](std::int32_t from, std::int32_t to, float c) {
-      const float g2 = cost[static_cast<std::size_t>(from)] + c;
-      if (g2 < cost[static_cast<std::size_t>(to)]) {
-        cost[static_cast<std::size_t>(to)] = g2;
-        parent[static_cast<std::size_t>(to)] = from;
-        open.push({g2 + h(to), to});
-      }
-    };
-    cost[static_cast<std::size_t>(S)] = 0;
-    open.push({h(S), S});
-    while (!open.empty()) {
-      const auto [f, v] = open.top();
-      open.pop();
-      if (f > cost[static_cast<std::size_t>(v)] + h(v) + 1e-6f * std::max(1.0f, f)) continue;  // stale
-      if (v == G) break;
-      if (v == S) {
-        relax(S, se.a, s_attach + s_from_a);
-        relax(S, se.b, s_attach + s_total - s_from_a);
-        if (s.edge == g.edge) relax(S, G, s_attach + std::fabs(g_from_a - s_from_a) + g_attach);
-        continue;
-      }
-      if (v == ge.a) relax(v, G, g_from_a + g_attach);
-      if (v == ge.b) relax(v, G, g_total - g_from_a + g_attach);
-      for (std::int32_t k = m.adjacency_begin[static_cast<std::size_t>(v)]; k < m.adjacency_begin[static_cast<std::size_t>(v) + 1]; ++k) {
-        const std::int32_t e = m.adjacency[static_cast<std::size_t>(k)];
-        const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
-        const float c = cumulative_cost_[static_cast<std::size_t>(edge.point_begin + edge.point_count - 1)];
-        relax(v, edge.a == v ? edge.b : edge.a, c);
-      }
-    }
-    if (!(cost[static_cast<std::size_t>(G)] < INFINITY)) {
-      out.status = PlanStatus::Unreachable;
-      return out;
-    }
-    // Nodes from S to G; the edge between two consecutive nodes is the
-    // cheapest one joining them (what the search relaxed).
-    std::vector<std::int32_t> chain;
-    for (std::int32_t v = G; v >= 0; v = parent[static_cast<std::size_t>(v)]) chain.push_back(v);
-    std::reverse(chain.begin(), chain.end());
-    push_point(raw, q.start);
-    push_point(raw, s.point);
-    if (chain.size() == 2) {  // S -> G along the shared edge
-      const bool forward = s.piece < g.piece || (s.piece == g.piece && s.t <= g.t);
-      if (forward)
-        for (std::int32_t i = s.piece + 1; i <= g.piece; ++i) push_point(raw, m.edge_point(s.edge, i));
-      else
-        for (std::int32_t i = s.piece; i > g.piece; --i) push_point(raw, m.edge_point(s.edge, i));
-    } else {
-      append_partial(m, s, chain[1] == se.b && !(chain[1] == se.a && s_from_a <= s_total - s_from_a), raw);
-      for (std::size_t k = 1; k + 2 < chain.size(); ++k) {
-        const std::int32_t u = chain[k], v = chain[k + 1];
-        // The cheapest edge u-v.
-        std::int32_t best = -1;
-        float best_cost = INFINITY;
-        for (std::int32_t a = m.adjacency_begin[static_cast<std::size_t>(u)]; a < m.adjacency_begin[static_cast<std::size_t>(u) + 1]; ++a) {
-          const std::int32_t e = m.adjacency[static_cast<std::size_t>(a)];
-          const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
-          if (!((edge.a == u && edge.b == v) || (edge.a == v && edge.b == u))) continue;
-          const float c = cumulative_cost_[static_cast<std::size_t>(edge.point_begin + edge.point_count - 1)];
-          if (c < best_cost) {
-            best_cost = c;
-            best = e;
-          }
-        }
-        const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(best)];
-        if (edge.a == u)
-          for (std::int32_t i = 0; i < edge.point_count; ++i) push_point(raw, m.edge_point(best, i));
-        else
-          for (std::int32_t i = edge.point_count - 1; i >= 0; --i) push_point(raw, m.edge_point(best, i));
-      }
-      // From the last node along the goal's edge to its attach point.
-      const std::int32_t last = chain[chain.size() - 2];
-      const bool from_a = last == ge.a && !(last == ge.b && g_total - g_from_a < g_from_a);
-      if (from_a)
-        for (std::int32_t i = 0; i <= g.piece; ++i) push_point(raw, m.edge_point(g.edge, i));
-      else
-        for (std::int32_t i = ge.point_count - 1; i > g.piece; --i) push_point(raw, m.edge_point(g.edge, i));
-    }
-    push_point(raw, g.point);
-    push_point(raw, q.goal);
+    raw = chain_polyline(roadmap_, cumulative_cost_, q, at, chain);
   }
   out.status = PlanStatus::Found;
   out.roadmap_points = raw;

@@ -133,122 +133,142 @@ struct UnionFind {
   }
 };
 
-}  // namespace
+// Map point (m) of a point in integer units of resolution `res` (m).
+glm::vec2 to_map(DVec p, double res) { return glm::vec2(static_cast<float>(p.x * res), static_cast<float>(p.y * res)); }
 
-void RoadmapOptions::validate() const {
-  if (!(std::isfinite(radius) && radius >= 0)) throw Error("radius must be >= 0", at_field("roadmap.radius"));
-  if (!(std::isfinite(arc_tolerance) && arc_tolerance > 0 && arc_tolerance <= 1))
-    throw Error("arc tolerance must be in (0, 1] m", at_field("roadmap.arc_tolerance"));
-  if (!(std::isfinite(max_step) && max_step > 0)) throw Error("max step must be > 0", at_field("roadmap.max_step"));
+// Clearance (units) at p of an edge between sites s0 and s1.
+double clearance_at(const Site& s0, const Site& s1, DVec p) { return std::min(s0.distance(p), s1.distance(p)); }
+
+// Where the clearance rises through `keep` between `bad` (below) and `good`
+// (at or above): bisection, the good side kept (units).
+DVec crossing(const Site& s0, const Site& s1, double keep, DVec bad, DVec good) {
+  for (int it = 0; it < 40; ++it) {
+    const DVec m = (bad + good) * 0.5;
+    (clearance_at(s0, s1, m) >= keep ? good : bad) = m;
+  }
+  return good;
 }
 
-Roadmap build_roadmap(const FreeSpace& space, const RoadmapOptions& options) {
-  options.validate();
-  Roadmap map;
-  map.options = options;
-  const double res = space.resolution();
-  const double keep = options.kept_clearance(space.resolution()) / res;  // in units
-  const double tol = options.arc_tolerance / res, step = options.max_step / res;
+// A stretch of an edge's polyline with its clearances (units).
+struct Run {
+  std::vector<DVec> pts;
+  std::vector<double> c;
+};
 
-  std::vector<bp::segment_data<int>> segments;
-  segments.reserve(space.boundary_units().size());
-  for (const auto& s : space.boundary_units())
-    segments.emplace_back(bp::point_data<int>(s.x0, s.y0), bp::point_data<int>(s.x1, s.y1));
-  VoronoiDiagram vd;
-  bp::construct_voronoi(segments.begin(), segments.end(), &vd);
-
-  std::unordered_map<const VoronoiDiagram::vertex_type*, std::int32_t> vertex_node;
-  auto to_map = [res](DVec p) { return glm::vec2(static_cast<float>(p.x * res), static_cast<float>(p.y * res)); };
-  auto add_node = [&](DVec p, double clearance) {
-    map.nodes.push_back(to_map(p));
-    map.node_clearance.push_back(static_cast<float>(clearance * res));
-    return static_cast<std::int32_t>(map.nodes.size() - 1);
-  };
-  auto node_of_vertex = [&](const VoronoiDiagram::vertex_type* v, double clearance) {
-    auto it = vertex_node.find(v);
-    if (it != vertex_node.end()) return it->second;
-    const std::int32_t id = add_node({v->x(), v->y()}, clearance);
-    vertex_node.emplace(v, id);
-    return id;
-  };
-
-  for (const auto& edge : vd.edges()) {
-    if (!edge.is_primary() || edge.is_infinite() || edge.twin() < &edge) continue;
-    ++map.voronoi_edges;
-    const Site s0 = site_of(*edge.cell(), segments), s1 = site_of(*edge.twin()->cell(), segments);
-    const DVec v0{edge.vertex0()->x(), edge.vertex0()->y()}, v1{edge.vertex1()->x(), edge.vertex1()->y()};
-    const std::vector<DVec> pts = discretize(v0, v1, s0, s1, edge.is_curved(), tol, step);
-    // Wholly inside or outside free space (an edge never crosses a site):
-    // test a point away from the ends.
-    const DVec mid = pts.size() > 2 ? pts[pts.size() / 2] : (pts.front() + pts.back()) * 0.5;
-    if (!space.contains(to_map(mid))) continue;
-    ++map.inside_edges;
-    auto clearance = [&](DVec p) { return std::min(s0.distance(p), s1.distance(p)); };
-    std::vector<double> c(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) c[i] = clearance(pts[i]);
-
-    // Cut the polyline where the clearance crosses `keep`; keep the runs above.
-    std::size_t i = 0;
-    while (i < pts.size()) {
-      if (c[i] < keep) {
-        ++i;
-        continue;
-      }
-      std::size_t j = i;
-      while (j + 1 < pts.size() && c[j + 1] >= keep) ++j;
-      std::vector<DVec> run;
-      std::vector<double> run_c;
-      // Where the clearance rises through `keep` on the piece before i (bisection, good side kept).
-      auto crossing = [&](DVec bad, DVec good) {
-        for (int it = 0; it < 40; ++it) {
-          const DVec m = (bad + good) * 0.5;
-          (clearance(m) >= keep ? good : bad) = m;
-        }
-        return good;
-      };
-      if (i > 0) {
-        const DVec p = crossing(pts[i - 1], pts[i]);
-        run.push_back(p);
-        run_c.push_back(clearance(p));
-      }
-      for (std::size_t k = i; k <= j; ++k) {
-        run.push_back(pts[k]);
-        run_c.push_back(c[k]);
-      }
-      if (j + 1 < pts.size()) {
-        const DVec p = crossing(pts[j + 1], pts[j]);
-        run.push_back(p);
-        run_c.push_back(clearance(p));
-      }
-      i = j + 1;
-      // Drop repeated points (a cut at a sample point).
-      std::vector<DVec> poly;
-      std::vector<double> poly_c;
-      for (std::size_t k = 0; k < run.size(); ++k)
-        if (poly.empty() || norm(run[k] - poly.back()) > 1e-9) {
-          poly.push_back(run[k]);
-          poly_c.push_back(run_c[k]);
-        }
-      if (poly.size() < 2) continue;
-      const bool starts_at_vertex = norm(poly.front() - v0) <= 1e-9, ends_at_vertex = norm(poly.back() - v1) <= 1e-9;
-      RoadmapEdge e;
-      e.a = starts_at_vertex ? node_of_vertex(edge.vertex0(), poly_c.front()) : add_node(poly.front(), poly_c.front());
-      e.b = ends_at_vertex ? node_of_vertex(edge.vertex1(), poly_c.back()) : add_node(poly.back(), poly_c.back());
-      e.point_begin = static_cast<std::int32_t>(map.points.size());
-      e.point_count = static_cast<std::int32_t>(poly.size());
-      e.min_clearance = INFINITY;
-      for (std::size_t k = 0; k < poly.size(); ++k) {
-        map.points.push_back(to_map(poly[k]));
-        map.point_clearance.push_back(static_cast<float>(poly_c[k] * res));
-        e.min_clearance = std::min(e.min_clearance, static_cast<float>(poly_c[k] * res));
-        if (k > 0) e.length += static_cast<float>(norm(poly[k] - poly[k - 1]) * res);
-      }
-      if (e.a == e.b && e.length <= 0) continue;
-      map.edges.push_back(e);
+// Points i..j of `pts` (clearances c, all >= keep), extended to where the
+// clearance crosses `keep` on the pieces before and after, repeated points
+// dropped (a cut at a sample point). Units.
+Run kept_run(const std::vector<DVec>& pts, const std::vector<double>& c, std::size_t i, std::size_t j, const Site& s0, const Site& s1,
+             double keep) {
+  std::vector<DVec> run;
+  std::vector<double> run_c;
+  if (i > 0) {
+    const DVec p = crossing(s0, s1, keep, pts[i - 1], pts[i]);
+    run.push_back(p);
+    run_c.push_back(clearance_at(s0, s1, p));
+  }
+  for (std::size_t k = i; k <= j; ++k) {
+    run.push_back(pts[k]);
+    run_c.push_back(c[k]);
+  }
+  if (j + 1 < pts.size()) {
+    const DVec p = crossing(s0, s1, keep, pts[j + 1], pts[j]);
+    run.push_back(p);
+    run_c.push_back(clearance_at(s0, s1, p));
+  }
+  Run poly;
+  for (std::size_t k = 0; k < run.size(); ++k)
+    if (poly.pts.empty() || norm(run[k] - poly.pts.back()) > 1e-9) {
+      poly.pts.push_back(run[k]);
+      poly.c.push_back(run_c[k]);
     }
+  return poly;
+}
+
+// Adds nodes and edges to a roadmap under construction; a Voronoi vertex
+// becomes one node however many edges reach it.
+class RoadmapBuilder {
+ public:
+  RoadmapBuilder(Roadmap& map, double res) : map_(map), res_(res) {}
+
+  // A node at p (units) with its clearance (units); returns its index.
+  std::int32_t add_node(DVec p, double clearance) {
+    map_.nodes.push_back(to_map(p, res_));
+    map_.node_clearance.push_back(static_cast<float>(clearance * res_));
+    return static_cast<std::int32_t>(map_.nodes.size() - 1);
   }
 
-  // Adjacency and components.
+  std::int32_t node_of_vertex(const VoronoiDiagram::vertex_type* v, double clearance) {
+    auto it = vertex_node_.find(v);
+    if (it != vertex_node_.end()) return it->second;
+    const std::int32_t id = add_node({v->x(), v->y()}, clearance);
+    vertex_node_.emplace(v, id);
+    return id;
+  }
+
+  // The run `poly` of Voronoi edge `edge` (from v0 to v1, units) as a
+  // roadmap edge; its ends are the edge's vertices where they coincide,
+  // else new nodes. Skipped when it is a loop of zero length.
+  void add_edge(const VoronoiDiagram::edge_type& edge, DVec v0, DVec v1, const Run& poly) {
+    const bool starts_at_vertex = norm(poly.pts.front() - v0) <= 1e-9, ends_at_vertex = norm(poly.pts.back() - v1) <= 1e-9;
+    RoadmapEdge e;
+    e.a = starts_at_vertex ? node_of_vertex(edge.vertex0(), poly.c.front()) : add_node(poly.pts.front(), poly.c.front());
+    e.b = ends_at_vertex ? node_of_vertex(edge.vertex1(), poly.c.back()) : add_node(poly.pts.back(), poly.c.back());
+    e.point_begin = static_cast<std::int32_t>(map_.points.size());
+    e.point_count = static_cast<std::int32_t>(poly.pts.size());
+    e.min_clearance = INFINITY;
+    for (std::size_t k = 0; k < poly.pts.size(); ++k) {
+      map_.points.push_back(to_map(poly.pts[k], res_));
+      map_.point_clearance.push_back(static_cast<float>(poly.c[k] * res_));
+      e.min_clearance = std::min(e.min_clearance, static_cast<float>(poly.c[k] * res_));
+      if (k > 0) e.length += static_cast<float>(norm(poly.pts[k] - poly.pts[k - 1]) * res_);
+    }
+    if (e.a == e.b && e.length <= 0) return;
+    map_.edges.push_back(e);
+  }
+
+ private:
+  Roadmap& map_;
+  double res_;
+  std::unordered_map<const VoronoiDiagram::vertex_type*, std::int32_t> vertex_node_;
+};
+
+// One finite primary Voronoi edge: discretized (tol, step in units), kept
+// only inside free space, and cut into runs of clearance >= keep (units),
+// each added as a roadmap edge. Counts map.inside_edges.
+void add_voronoi_edge(const FreeSpace& space, const VoronoiDiagram::edge_type& edge, const std::vector<bp::segment_data<int>>& segments, double tol,
+                      double step, double keep, Roadmap& map, RoadmapBuilder& builder) {
+  const double res = space.resolution();
+  const Site s0 = site_of(*edge.cell(), segments), s1 = site_of(*edge.twin()->cell(), segments);
+  const DVec v0{edge.vertex0()->x(), edge.vertex0()->y()}, v1{edge.vertex1()->x(), edge.vertex1()->y()};
+  const std::vector<DVec> pts = discretize(v0, v1, s0, s1, edge.is_curved(), tol, step);
+  // Wholly inside or outside free space (an edge never crosses a site):
+  // test a point away from the ends.
+  const DVec mid = pts.size() > 2 ? pts[pts.size() / 2] : (pts.front() + pts.back()) * 0.5;
+  if (!space.contains(to_map(mid, res))) return;
+  ++map.inside_edges;
+  std::vector<double> c(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) c[i] = clearance_at(s0, s1, pts[i]);
+
+  // Cut the polyline where the clearance crosses `keep`; keep the runs above.
+  std::size_t i = 0;
+  while (i < pts.size()) {
+    if (c[i] < keep) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j + 1 < pts.size() && c[j + 1] >= keep) ++j;
+    const Run poly = kept_run(pts, c, i, j, s0, s1, keep);
+    i = j + 1;
+    if (poly.pts.size() < 2) continue;
+    builder.add_edge(edge, v0, v1, poly);
+  }
+}
+
+// The map's adjacency (CSR, edges in index order at each node) and each
+// node's connected component (its smallest node index).
+void link_nodes(Roadmap& map) {
   const std::size_t n = map.nodes.size();
   map.adjacency_begin.assign(n + 1, 0);
   for (const RoadmapEdge& e : map.edges) {
@@ -267,6 +287,41 @@ Roadmap build_roadmap(const FreeSpace& space, const RoadmapOptions& options) {
   }
   map.node_component.resize(n);
   for (std::size_t k = 0; k < n; ++k) map.node_component[k] = uf.find(static_cast<std::int32_t>(k));
+}
+
+}  // namespace
+
+void RoadmapOptions::validate() const {
+  if (!(std::isfinite(radius) && radius >= 0)) throw Error("radius must be >= 0", at_field("roadmap.radius"));
+  if (!(std::isfinite(arc_tolerance) && arc_tolerance > 0 && arc_tolerance <= 1))
+    throw Error("arc tolerance must be in (0, 1] m", at_field("roadmap.arc_tolerance"));
+  if (!(std::isfinite(max_step) && max_step > 0)) throw Error("max step must be > 0", at_field("roadmap.max_step"));
+}
+
+// Stages: the Voronoi diagram of the boundary segments (integer units), its
+// edges inside free space cut to the kept clearance, then adjacency.
+Roadmap build_roadmap(const FreeSpace& space, const RoadmapOptions& options) {
+  options.validate();
+  Roadmap map;
+  map.options = options;
+  const double res = space.resolution();
+  const double keep = options.kept_clearance(space.resolution()) / res;  // in units
+  const double tol = options.arc_tolerance / res, step = options.max_step / res;
+
+  std::vector<bp::segment_data<int>> segments;
+  segments.reserve(space.boundary_units().size());
+  for (const auto& s : space.boundary_units())
+    segments.emplace_back(bp::point_data<int>(s.x0, s.y0), bp::point_data<int>(s.x1, s.y1));
+  VoronoiDiagram vd;
+  bp::construct_voronoi(segments.begin(), segments.end(), &vd);
+
+  RoadmapBuilder builder(map, res);
+  for (const auto& edge : vd.edges()) {
+    if (!edge.is_primary() || edge.is_infinite() || edge.twin() < &edge) continue;
+    ++map.voronoi_edges;
+    add_voronoi_edge(space, edge, segments, tol, step, keep, map, builder);
+  }
+  link_nodes(map);
   return map;
 }
 

@@ -62,8 +62,18 @@ void StateMachine::pose(std::int32_t seg, double t, std::vector<glm::quat>& rota
   root = glm::mix(c.clip.root_positions[static_cast<std::size_t>(p.f0)], c.clip.root_positions[static_cast<std::size_t>(p.f1)], p.w);
 }
 
-StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
-  auto fail = [](const std::string& what, const Location& where) { throw Error(what, where); };
+namespace {
+
+[[noreturn]] void fail(const std::string& what, const Location& where) { throw Error(what, where); }
+
+// Name -> index of the spec's groups, states and clips.
+struct Names {
+  std::map<std::string, std::int32_t> group_of, state_of, clip_of;
+};
+
+// Checks the spec's scalar fields and its sizes (segment and clip counts);
+// throws Error naming the field.
+void check_limits(const StateMachineSpec& spec) {
   if (!(spec.fps >= 1 && spec.fps <= 1000)) fail("fps must be in [1, 1000]", at_field("fps"));
   if (!(spec.spacing >= 1e-3f && spec.spacing <= 1.0f)) fail("spacing must be in [0.001, 1] m", at_field("spacing"));
   if (spec.points_per_segment < 2 || spec.points_per_segment > 4096) fail("points_per_segment must be in [2, 4096]", at_field("points_per_segment"));
@@ -75,57 +85,64 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
   // The transition table has segments^2 entries.
   if (segment_total > 4096) fail("a machine may have at most 4096 segments", at_field("states"));
   if (spec.clips.size() > 1024) fail("a machine may have at most 1024 clips", at_field("clips"));
+}
 
-  StateMachine m;
-  m.spec_ = spec;
-  m.skeleton_ = skeleton;
-  const double fps = spec.fps;
-  const double d = static_cast<double>(spec.spacing) * spec.points_per_segment;
-
-  // Groups and states by name.
-  std::map<std::string, std::int32_t> group_of, state_of, clip_of;
+// Groups in spec order with their parents resolved (acyclic); fills
+// names.group_of.
+std::vector<MachineGroup> name_groups(const StateMachineSpec& spec, Names& names) {
+  std::vector<MachineGroup> groups;
   for (const GroupSpec& g : spec.groups) {
     if (g.name.empty()) fail("a group needs a name", g.where);
-    if (group_of.count(g.name)) fail("group '" + g.name + "' is defined twice", g.where);
-    group_of[g.name] = static_cast<std::int32_t>(m.groups_.size());
-    m.groups_.push_back({g.name, -1});
+    if (names.group_of.count(g.name)) fail("group '" + g.name + "' is defined twice", g.where);
+    names.group_of[g.name] = static_cast<std::int32_t>(groups.size());
+    groups.push_back({g.name, -1});
   }
   for (std::size_t i = 0; i < spec.groups.size(); ++i) {
     const GroupSpec& g = spec.groups[i];
     if (g.parent.empty()) continue;
-    auto it = group_of.find(g.parent);
-    if (it == group_of.end()) fail("unknown parent group '" + g.parent + "'", g.where);
-    m.groups_[i].parent = it->second;
+    auto it = names.group_of.find(g.parent);
+    if (it == names.group_of.end()) fail("unknown parent group '" + g.parent + "'", g.where);
+    groups[i].parent = it->second;
     // No cycles: walk up at most group-count steps.
     std::int32_t up = it->second;
-    for (std::size_t steps = 0; up >= 0; ++steps, up = m.groups_[static_cast<std::size_t>(up)].parent)
+    for (std::size_t steps = 0; up >= 0; ++steps, up = groups[static_cast<std::size_t>(up)].parent)
       if (steps > spec.groups.size() || up == static_cast<std::int32_t>(i)) fail("group '" + g.name + "' is its own ancestor", g.where);
   }
+  return groups;
+}
+
+// Fills names.clip_of: each clip's index in spec.clips.
+void name_clips(const StateMachineSpec& spec, Names& names) {
   for (std::size_t i = 0; i < spec.clips.size(); ++i) {
     const ClipSpec& c = spec.clips[i];
     if (c.name.empty()) fail("a clip needs a name", c.where);
-    if (clip_of.count(c.name)) fail("clip '" + c.name + "' is defined twice", c.where);
-    clip_of[c.name] = static_cast<std::int32_t>(i);
+    if (names.clip_of.count(c.name)) fail("clip '" + c.name + "' is defined twice", c.where);
+    names.clip_of[c.name] = static_cast<std::int32_t>(i);
   }
+}
 
-  // How far into each clip the segments reach (seconds), to size its samples.
+// States in spec order (no segments yet), checking their segments; fills
+// names.state_of. Returns how far into each clip the segments reach
+// (seconds; d = segment arc length, m), to size the clip's samples.
+std::vector<double> name_states(const StateMachineSpec& spec, double d, Names& names, std::vector<MachineState>& states) {
+  const double fps = spec.fps;
   std::vector<double> clip_end(spec.clips.size(), 0.0);
   for (const StateSpec& s : spec.states) {
     if (s.name.empty()) fail("a state needs a name", s.where);
-    if (state_of.count(s.name) || group_of.count(s.name)) fail("state '" + s.name + "' is defined twice (or is also a group)", s.where);
-    state_of[s.name] = static_cast<std::int32_t>(m.states_.size());
+    if (names.state_of.count(s.name) || names.group_of.count(s.name)) fail("state '" + s.name + "' is defined twice (or is also a group)", s.where);
+    names.state_of[s.name] = static_cast<std::int32_t>(states.size());
     MachineState st;
     st.name = s.name;
     st.locomotion = s.locomotion;
     if (!s.group.empty()) {
-      auto it = group_of.find(s.group);
-      if (it == group_of.end()) fail("unknown group '" + s.group + "'", s.where);
+      auto it = names.group_of.find(s.group);
+      if (it == names.group_of.end()) fail("unknown group '" + s.group + "'", s.where);
       st.group = it->second;
     }
     if (s.segments.empty()) fail("state '" + s.name + "' has no segments", s.where);
     for (const SegmentSpec& seg : s.segments) {
-      auto it = clip_of.find(seg.clip);
-      if (it == clip_of.end()) fail("unknown clip '" + seg.clip + "'", seg.where);
+      auto it = names.clip_of.find(seg.clip);
+      if (it == names.clip_of.end()) fail("unknown clip '" + seg.clip + "'", seg.where);
       if (!(seg.start_frame >= 0 && seg.start_frame <= 36000)) fail("start frame must be in [0, 36000]", seg.where);
       if (!(seg.frames >= 0 && seg.frames <= 36000)) fail("frames must be in [0, 36000]", seg.where);
       const motion::LocomotionSpec& ls = spec.clips[static_cast<std::size_t>(it->second)].spec;
@@ -135,41 +152,198 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
       auto& end = clip_end[static_cast<std::size_t>(it->second)];
       end = std::max(end, need);
     }
-    m.states_.push_back(st);
+    states.push_back(st);
   }
+  return clip_end;
+}
 
-  // Clips: sampled from before 0 (transitions, smoothing) to past the segments' ends.
-  for (std::size_t i = 0; i < spec.clips.size(); ++i) {
-    const ClipSpec& c = spec.clips[i];
-    motion::LocomotionSpec ls = c.spec;
-    ls.fps = fps;
-    try {
-      ls.validate();
-    } catch (const Error& e) {
-      fail(e.message(), c.where);
-    }
-    MachineClip mc;
-    mc.name = c.name;
-    mc.fps = fps;
-    mc.generator = std::make_shared<motion::LocomotionGenerator>(skeleton, ls);
-    mc.period_frames = mc.generator->targets().period_frames;
-    const double pad = (mc.period_frames + 2.0 * spec.transition_frames + 4.0) / fps;
-    mc.time_of_first_frame = -pad;
-    const auto frames = static_cast<std::int32_t>(std::ceil((clip_end[i] + 2.0 * pad) * fps)) + 1;
-    if (frames > 100'000) fail("clip would need more than 100,000 frames (lower the start frames or raise the speed)", c.where);
-    mc.clip.resize(frames, skeleton.joint_count());
-    mc.clip.frame_time = static_cast<float>(1.0 / fps);
-    std::vector<glm::quat> rot(static_cast<std::size_t>(skeleton.joint_count()));
-    for (std::int32_t f = 0; f < frames; ++f) {
-      glm::vec3 root;
-      mc.generator->pose_at(mc.time_of_first_frame + f / fps, rot, root);
-      for (std::int32_t j = 0; j < skeleton.joint_count(); ++j) mc.clip.rotation(f, j) = rot[static_cast<std::size_t>(j)];
-      mc.clip.root_positions[static_cast<std::size_t>(f)] = root;
-    }
-    m.clips_.push_back(std::move(mc));
+// Clip `c` generated at the spec's fps and sampled from before 0
+// (transitions, smoothing) to past `clip_end` (s), the segments' reach.
+MachineClip sample_clip(const ClipSpec& c, const StateMachineSpec& spec, const motion::Skeleton& skeleton, double clip_end) {
+  const double fps = spec.fps;
+  motion::LocomotionSpec ls = c.spec;
+  ls.fps = fps;
+  try {
+    ls.validate();
+  } catch (const Error& e) {
+    fail(e.message(), c.where);
   }
+  MachineClip mc;
+  mc.name = c.name;
+  mc.fps = fps;
+  mc.generator = std::make_shared<motion::LocomotionGenerator>(skeleton, ls);
+  mc.period_frames = mc.generator->targets().period_frames;
+  const double pad = (mc.period_frames + 2.0 * spec.transition_frames + 4.0) / fps;
+  mc.time_of_first_frame = -pad;
+  const auto frames = static_cast<std::int32_t>(std::ceil((clip_end + 2.0 * pad) * fps)) + 1;
+  if (frames > 100'000) fail("clip would need more than 100,000 frames (lower the start frames or raise the speed)", c.where);
+  mc.clip.resize(frames, skeleton.joint_count());
+  mc.clip.frame_time = static_cast<float>(1.0 / fps);
+  std::vector<glm::quat> rot(static_cast<std::size_t>(skeleton.joint_count()));
+  for (std::int32_t f = 0; f < frames; ++f) {
+    glm::vec3 root;
+    mc.generator->pose_at(mc.time_of_first_frame + f / fps, rot, root);
+    for (std::int32_t j = 0; j < skeleton.joint_count(); ++j) mc.clip.rotation(f, j) = rot[static_cast<std::size_t>(j)];
+    mc.clip.root_positions[static_cast<std::size_t>(f)] = root;
+  }
+  return mc;
+}
 
-  // Segments.
+// A standing segment (ms.start_time set, s): its duration (s) from `frames`
+// or the clip's period, and its frame where the root stands, facing its way.
+void stand(MotionSegment& ms, const MachineClip& mc, const SegmentSpec& seg, double fps) {
+  ms.duration = (seg.frames > 0 ? seg.frames : static_cast<double>(mc.period_frames)) / fps;
+  const FramePos fp = frame_pos(mc.clip, mc.time_of_first_frame, fps, ms.start_time);
+  ms.origin = mc.raw_root(ms.start_time);
+  ms.heading = static_cast<float>(heading_from_yaw(static_cast<float>(motion::heading_of(mc.clip.rotation(fp.f0, 0)))));
+  ms.end_point = rotate_ccw(mc.raw_root(ms.start_time + ms.duration) - ms.origin, -ms.heading);
+}
+
+// Clip times (s) at smoothed-root arc lengths j * spacing, j = 0..k, from
+// `start` on: a march in quarter frames, linear inside a step. Fails past
+// `limit` + 1 s (the clip's end); d = k * spacing, m, for the message.
+std::vector<double> arc_times(const MachineClip& mc, const SegmentSpec& seg, const StateMachineSpec& spec, double start, double limit, double d) {
+  const double fps = spec.fps;
+  const double dt = 0.25 / fps;
+  double t = start, arc = 0;
+  glm::vec2 prev = mc.smoothed_root(t);
+  std::vector<double> times = {t};
+  std::int32_t next = 1;
+  while (next <= spec.points_per_segment) {
+    const glm::vec2 p = mc.smoothed_root(t + dt);
+    const double step = sim::length_of(p - prev);
+    while (next <= spec.points_per_segment && arc + step >= next * static_cast<double>(spec.spacing)) {
+      const double f = step > 0 ? (next * static_cast<double>(spec.spacing) - arc) / step : 0.0;
+      times.push_back(t + f * dt);
+      ++next;
+    }
+    arc += step;
+    prev = p;
+    t += dt;
+    if (t > limit + 1.0) fail(fmt::format("segment of clip '{}' does not cover {:.3f} m", seg.clip, d), seg.where);
+  }
+  return times;
+}
+
+// Map heading (rad) of the smoothed root at clip time t (s): its motion over
+// one frame centred on t.
+float smoothed_heading(const MachineClip& mc, double fps, double t) {
+  const glm::vec2 v = mc.smoothed_root(t + 0.5 / fps) - mc.smoothed_root(t - 0.5 / fps);
+  return std::atan2(v.y, v.x);
+}
+
+// A locomotion segment (ms.start_time set, s) covering d metres of smoothed
+// root: its k point times and trajectory in its own frame, duration (s),
+// speed (m/s), end point and end heading (rad).
+void walk(MotionSegment& ms, const MachineClip& mc, const SegmentSpec& seg, const StateMachineSpec& spec, double limit, double d) {
+  const double fps = spec.fps;
+  std::vector<double> times = arc_times(mc, seg, spec, ms.start_time, limit, d);
+  const double t_end = times.back();
+  times.pop_back();
+  ms.times = times;
+  ms.duration = t_end - ms.start_time;
+  ms.speed = static_cast<float>(d / ms.duration);
+  ms.origin = mc.smoothed_root(ms.start_time);
+  ms.heading = static_cast<float>(smoothed_heading(mc, fps, ms.start_time));
+  for (double tt : ms.times) ms.trajectory.push_back(rotate_ccw(mc.smoothed_root(tt) - ms.origin, -ms.heading));
+  ms.end_point = rotate_ccw(mc.smoothed_root(t_end) - ms.origin, -ms.heading);
+  ms.end_heading = static_cast<float>(std::remainder(smoothed_heading(mc, fps, t_end) - ms.heading, 2.0 * std::numbers::pi));
+}
+
+// Indices of the states `name` stands for: the state itself, or every state
+// with the group among its ancestors (in state order).
+std::vector<std::int32_t> states_under(const std::string& name, const Location& where, const Names& names, const std::vector<MachineState>& states,
+                                       const std::vector<MachineGroup>& groups) {
+  std::vector<std::int32_t> out;
+  if (auto it = names.state_of.find(name); it != names.state_of.end()) return std::vector<std::int32_t>{it->second};
+  auto it = names.group_of.find(name);
+  if (it == names.group_of.end()) fail("unknown state or group '" + name + "'", where);
+  for (std::size_t s = 0; s < states.size(); ++s)
+    for (std::int32_t g = states[s].group; g >= 0; g = groups[static_cast<std::size_t>(g)].parent)
+      if (g == it->second) {
+        out.push_back(static_cast<std::int32_t>(s));
+        break;
+      }
+  return out;
+}
+
+// Edges expanded to states (every state under `from` to every state under
+// `to`): allowed and edge_cost, S x S row-major, cost the cheapest edge's.
+void expand_edges(const StateMachineSpec& spec, const Names& names, const std::vector<MachineState>& states, const std::vector<MachineGroup>& groups,
+                  std::vector<std::uint8_t>& allowed, std::vector<float>& edge_cost) {
+  const std::size_t S = states.size();
+  allowed.assign(S * S, 0);
+  edge_cost.assign(S * S, INFINITY);
+  for (const EdgeSpec& e : spec.edges) {
+    if (!(e.cost >= 0 && std::isfinite(e.cost))) fail("edge cost must be >= 0", e.where);
+    for (std::int32_t a : states_under(e.from, e.where, names, states, groups))
+      for (std::int32_t b : states_under(e.to, e.where, names, states, groups)) {
+        const std::size_t i = static_cast<std::size_t>(a) * S + static_cast<std::size_t>(b);
+        allowed[i] = 1;
+        edge_cost[i] = std::min(edge_cost[i], e.cost);
+      }
+  }
+}
+
+// Joint positions (m) of segment `seg` at t seconds after its start,
+// relative to the root and turned into its heading frame (heading = twist
+// of the root rotation about +Y).
+std::vector<glm::vec3> heading_frame_pose(const StateMachine& m, const motion::Skeleton& skeleton, std::int32_t seg, double t) {
+  const std::int32_t J = skeleton.joint_count();
+  std::vector<glm::quat> rot;
+  glm::vec3 root;
+  m.pose(seg, t, rot, root);
+  std::vector<glm::vec3> pos(static_cast<std::size_t>(J));
+  std::vector<glm::quat> wrot(static_cast<std::size_t>(J));
+  motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), rot.data(), nullptr, root, pos.data(), wrot.data());
+  const glm::quat unyaw = glm::angleAxis(static_cast<float>(-motion::heading_of(rot[0])), glm::vec3(0, 1, 0));
+  for (glm::vec3& p : pos) p = unyaw * (p - root);
+  return pos;
+}
+
+// Transition costs, M x M row-major over m's segments: INFINITY where the
+// states may not follow, else edge cost + pose_weight * k * mean joint
+// mismatch (m) between a's last pose and b's first.
+std::vector<float> transition_costs(const StateMachine& m, const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
+  const std::int32_t J = skeleton.joint_count();
+  const std::vector<MotionSegment>& segments = m.segments();
+  const std::size_t M = segments.size();
+  std::vector<std::vector<glm::vec3>> first(M), last(M);
+  for (std::size_t i = 0; i < M; ++i) {
+    first[i] = heading_frame_pose(m, skeleton, static_cast<std::int32_t>(i), 0.0);
+    last[i] = heading_frame_pose(m, skeleton, static_cast<std::int32_t>(i), segments[i].duration);
+  }
+  std::vector<float> transition(M * M, INFINITY);
+  for (std::size_t a = 0; a < M; ++a)
+    for (std::size_t b = 0; b < M; ++b) {
+      const std::int32_t sa = segments[a].state, sb = segments[b].state;
+      if (!m.allowed(sa, sb)) continue;
+      double mismatch = 0;
+      for (std::int32_t j = 0; j < J; ++j) mismatch += glm::length(last[a][static_cast<std::size_t>(j)] - first[b][static_cast<std::size_t>(j)]);
+      mismatch /= std::max(1, J);
+      transition[a * M + b] = m.edge_cost(sa, sb) + static_cast<float>(spec.pose_weight * spec.points_per_segment * mismatch);
+    }
+  return transition;
+}
+
+}  // namespace
+
+// Stages: limits, names (groups, clips, states), clips sampled, segments
+// (standing or locomotion), edges, start and end states, transition costs.
+StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
+  check_limits(spec);
+  StateMachine m;
+  m.spec_ = spec;
+  m.skeleton_ = skeleton;
+  const double fps = spec.fps;
+  const double d = static_cast<double>(spec.spacing) * spec.points_per_segment;
+
+  Names names;
+  m.groups_ = name_groups(spec, names);
+  name_clips(spec, names);
+  const std::vector<double> clip_end = name_states(spec, d, names, m.states_);
+  for (std::size_t i = 0; i < spec.clips.size(); ++i) m.clips_.push_back(sample_clip(spec.clips[i], spec, skeleton, clip_end[i]));
+
   for (std::size_t si = 0; si < spec.states.size(); ++si) {
     const StateSpec& s = spec.states[si];
     for (std::size_t k = 0; k < s.segments.size(); ++k) {
@@ -177,52 +351,13 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
       MotionSegment ms;
       ms.name = fmt::format("{}/{}", s.name, k);
       ms.state = static_cast<std::int32_t>(si);
-      ms.clip = clip_of[seg.clip];
+      ms.clip = names.clip_of.at(seg.clip);
       const MachineClip& mc = m.clips_[static_cast<std::size_t>(ms.clip)];
       ms.start_time = seg.start_frame / fps;
       if (!s.locomotion) {
-        ms.duration = (seg.frames > 0 ? seg.frames : static_cast<double>(mc.period_frames)) / fps;
-        // Standing: the frame is where the root stands and the way it faces.
-        const FramePos fp = frame_pos(mc.clip, mc.time_of_first_frame, fps, ms.start_time);
-        ms.origin = mc.raw_root(ms.start_time);
-        ms.heading = static_cast<float>(heading_from_yaw(static_cast<float>(motion::heading_of(mc.clip.rotation(fp.f0, 0)))));
-        ms.end_point = rotate_ccw(mc.raw_root(ms.start_time + ms.duration) - ms.origin, -ms.heading);
+        stand(ms, mc, seg, fps);
       } else {
-        // March along the smoothed root in quarter frames, recording the
-        // times at arc length j * s (j = 0..k); linear inside a step.
-        const double dt = 0.25 / fps;
-        const double limit = clip_end[static_cast<std::size_t>(ms.clip)];
-        double t = ms.start_time, arc = 0;
-        glm::vec2 prev = mc.smoothed_root(t);
-        std::vector<double> times = {t};
-        std::int32_t next = 1;
-        while (next <= spec.points_per_segment) {
-          const glm::vec2 p = mc.smoothed_root(t + dt);
-          const double step = sim::length_of(p - prev);
-          while (next <= spec.points_per_segment && arc + step >= next * static_cast<double>(spec.spacing)) {
-            const double f = step > 0 ? (next * static_cast<double>(spec.spacing) - arc) / step : 0.0;
-            times.push_back(t + f * dt);
-            ++next;
-          }
-          arc += step;
-          prev = p;
-          t += dt;
-          if (t > limit + 1.0) fail(fmt::format("segment of clip '{}' does not cover {:.3f} m", seg.clip, d), seg.where);
-        }
-        const double t_end = times.back();
-        times.pop_back();
-        ms.times = times;
-        ms.duration = t_end - ms.start_time;
-        ms.speed = static_cast<float>(d / ms.duration);
-        auto heading_at = [&](double tt) {
-          const glm::vec2 v = mc.smoothed_root(tt + 0.5 / fps) - mc.smoothed_root(tt - 0.5 / fps);
-          return std::atan2(v.y, v.x);
-        };
-        ms.origin = mc.smoothed_root(ms.start_time);
-        ms.heading = static_cast<float>(heading_at(ms.start_time));
-        for (double tt : ms.times) ms.trajectory.push_back(rotate_ccw(mc.smoothed_root(tt) - ms.origin, -ms.heading));
-        ms.end_point = rotate_ccw(mc.smoothed_root(t_end) - ms.origin, -ms.heading);
-        ms.end_heading = static_cast<float>(std::remainder(heading_at(t_end) - ms.heading, 2.0 * std::numbers::pi));
+        walk(ms, mc, seg, spec, clip_end[static_cast<std::size_t>(ms.clip)], d);
         m.locomotion_.push_back(static_cast<std::int32_t>(m.segments_.size()));
       }
       m.states_[si].segments.push_back(static_cast<std::int32_t>(m.segments_.size()));
@@ -230,68 +365,13 @@ StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Ske
     }
   }
 
-  // Edges, expanded to states: every state under `from` to every state under `to`.
-  const std::size_t S = m.states_.size();
-  m.allowed_.assign(S * S, 0);
-  m.edge_cost_.assign(S * S, INFINITY);
-  auto under = [&](const std::string& name, const Location& where) {
-    std::vector<std::int32_t> out;
-    if (auto it = state_of.find(name); it != state_of.end()) return std::vector<std::int32_t>{it->second};
-    auto it = group_of.find(name);
-    if (it == group_of.end()) fail("unknown state or group '" + name + "'", where);
-    for (std::size_t s = 0; s < S; ++s)
-      for (std::int32_t g = m.states_[s].group; g >= 0; g = m.groups_[static_cast<std::size_t>(g)].parent)
-        if (g == it->second) {
-          out.push_back(static_cast<std::int32_t>(s));
-          break;
-        }
-    return out;
-  };
-  for (const EdgeSpec& e : spec.edges) {
-    if (!(e.cost >= 0 && std::isfinite(e.cost))) fail("edge cost must be >= 0", e.where);
-    for (std::int32_t a : under(e.from, e.where))
-      for (std::int32_t b : under(e.to, e.where)) {
-        const std::size_t i = static_cast<std::size_t>(a) * S + static_cast<std::size_t>(b);
-        m.allowed_[i] = 1;
-        m.edge_cost_[i] = std::min(m.edge_cost_[i], e.cost);
-      }
-  }
+  expand_edges(spec, names, m.states_, m.groups_, m.allowed_, m.edge_cost_);
   if (!spec.start_state.empty() && (m.start_state_ = m.state_index(spec.start_state)) < 0)
     fail("unknown start state '" + spec.start_state + "'", at_field("start_state"));
   if (!spec.end_state.empty() && (m.end_state_ = m.state_index(spec.end_state)) < 0)
     fail("unknown end state '" + spec.end_state + "'", at_field("end_state"));
   if (m.locomotion_.empty()) fail("a machine needs at least one locomotion state", at_field("states"));
-
-  // Pose mismatch between every segment's last and first poses, each in its
-  // root's heading frame (heading = twist of the root rotation about +Y).
-  const std::int32_t J = skeleton.joint_count();
-  auto local_pose = [&](std::int32_t seg, double t) {
-    std::vector<glm::quat> rot;
-    glm::vec3 root;
-    m.pose(seg, t, rot, root);
-    std::vector<glm::vec3> pos(static_cast<std::size_t>(J));
-    std::vector<glm::quat> wrot(static_cast<std::size_t>(J));
-    motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), rot.data(), nullptr, root, pos.data(), wrot.data());
-    const glm::quat unyaw = glm::angleAxis(static_cast<float>(-motion::heading_of(rot[0])), glm::vec3(0, 1, 0));
-    for (glm::vec3& p : pos) p = unyaw * (p - root);
-    return pos;
-  };
-  const std::size_t M = m.segments_.size();
-  std::vector<std::vector<glm::vec3>> first(M), last(M);
-  for (std::size_t i = 0; i < M; ++i) {
-    first[i] = local_pose(static_cast<std::int32_t>(i), 0.0);
-    last[i] = local_pose(static_cast<std::int32_t>(i), m.segments_[i].duration);
-  }
-  m.transition_.assign(M * M, INFINITY);
-  for (std::size_t a = 0; a < M; ++a)
-    for (std::size_t b = 0; b < M; ++b) {
-      const std::int32_t sa = m.segments_[a].state, sb = m.segments_[b].state;
-      if (!m.allowed(sa, sb)) continue;
-      double mismatch = 0;
-      for (std::int32_t j = 0; j < J; ++j) mismatch += glm::length(last[a][static_cast<std::size_t>(j)] - first[b][static_cast<std::size_t>(j)]);
-      mismatch /= std::max(1, J);
-      m.transition_[a * M + b] = m.edge_cost(sa, sb) + static_cast<float>(spec.pose_weight * spec.points_per_segment * mismatch);
-    }
+  m.transition_ = transition_costs(m, spec, skeleton);
   return m;
 }
 
