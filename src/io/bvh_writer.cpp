@@ -1,5 +1,6 @@
 #include "io/bvh_writer.h"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -43,9 +44,10 @@ void check_finite(double v, const char* what, std::int32_t frame, const std::str
     throw Error(std::string("non-finite ") + what + " in frame " + std::to_string(frame) + ", joint '" + joint + "'", at_field("clip"));
 }
 
-}  // namespace
-
-std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& clip, const BvhWriteOptions& options) {
+// Frame time written (s): options.frame_time when > 0, else the clip's.
+// Throws Error when the skeleton is invalid, the clip does not match it or
+// its own arrays, or the frame time is not positive and finite.
+double check_clip(const motion::Skeleton& sk, const motion::Clip& clip, const BvhWriteOptions& options) {
   sk.validate();
   const std::size_t J = static_cast<std::size_t>(sk.joint_count());
   const auto frames = static_cast<std::size_t>(std::max(clip.frame_count, 0));
@@ -56,51 +58,73 @@ std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& cli
                 at_field("clip"));
   const double frame_time = options.frame_time > 0.0 ? options.frame_time : static_cast<double>(clip.frame_time);
   if (!std::isfinite(frame_time) || !(frame_time > 0.0)) throw Error("must be positive and finite", at_field("clip.frame_time"));
-  const double per_metre = 1.0 / motion::metres_per_unit(options.unit);
+  return frame_time;
+}
 
-  std::vector<std::vector<std::int32_t>> children(J);
-  for (std::size_t j = 1; j < J; ++j) children[static_cast<std::size_t>(sk.parents[j])].push_back(static_cast<std::int32_t>(j));
-  std::vector<std::uint8_t> animated(J, 0);
+// What the hierarchy and the motion both need, per joint: children (index
+// order), whether the clip animates its translation, its written name.
+struct JointLayout {
+  std::vector<std::vector<std::int32_t>> children;
+  std::vector<std::uint8_t> animated;
+  std::vector<std::string> names;
+  std::vector<std::int32_t> order;  // depth first, as written
+};
+
+JointLayout joint_layout(const motion::Skeleton& sk, const motion::Clip& clip, std::size_t frames) {
+  const std::size_t J = static_cast<std::size_t>(sk.joint_count());
+  JointLayout l;
+  l.children.resize(J);
+  for (std::size_t j = 1; j < J; ++j) l.children[static_cast<std::size_t>(sk.parents[j])].push_back(static_cast<std::int32_t>(j));
+  l.animated.assign(J, 0);
   if (!clip.translations.empty())
     for (std::size_t f = 0; f < frames; ++f)
       for (std::size_t j = 1; j < J; ++j)
-        if (clip.translations[f * J + j] != sk.offsets[j]) animated[j] = 1;
-  std::vector<std::string> names(J);
-  for (std::size_t j = 0; j < J; ++j) names[j] = clean_name(sk.names[j], j);
+        if (clip.translations[f * J + j] != sk.offsets[j]) l.animated[j] = 1;
+  l.names.resize(J);
+  for (std::size_t j = 0; j < J; ++j) l.names[j] = clean_name(sk.names[j], j);
+  return l;
+}
 
-  const auto axes = motion::euler_axes(options.order);
-  std::string rotation_channels;
-  for (int a : axes) rotation_channels.append(" ").append(1, static_cast<char>('X' + a)).append("rotation");
+// An "OFFSET x y z" line at `depth` tabs: v (m) times per_metre, as floats.
+void append_offset(std::string& out, std::size_t depth, const glm::vec3& v, double per_metre) {
+  indent(out, depth);
+  out.append("OFFSET");
+  for (int i = 0; i < 3; ++i) {
+    out.push_back(' ');
+    append_number(out, static_cast<float>(v[i] * per_metre));
+  }
+  out.append("\n");
+}
 
-  std::string out = "HIERARCHY\n";
-  std::vector<std::int32_t> order;  // depth first, as written
-  order.reserve(J);
-  auto open = [&](std::int32_t j, std::size_t depth) {
-    const auto u = static_cast<std::size_t>(j);
-    order.push_back(j);
-    indent(out, depth);
-    out.append(j == 0 ? "ROOT " : "JOINT ").append(names[u]).append("\n");
-    indent(out, depth);
-    out.append("{\n");
-    indent(out, depth + 1);
-    out.append("OFFSET");
-    for (int i = 0; i < 3; ++i) {
-      out.push_back(' ');
-      append_number(out, static_cast<float>(sk.offsets[u][i] * per_metre));
-    }
-    out.append("\n");
-    indent(out, depth + 1);
-    const bool positions = j == 0 || animated[u];
-    out.append("CHANNELS ").append(positions ? "6 Xposition Yposition Zposition" : "3").append(rotation_channels).append("\n");
-  };
+// The opening of joint j's block at `depth`: name, offset, channels; j
+// joins l.order.
+void open_joint(std::string& out, const motion::Skeleton& sk, JointLayout& l, std::int32_t j, std::size_t depth, const std::string& rotation_channels,
+                double per_metre) {
+  const auto u = static_cast<std::size_t>(j);
+  l.order.push_back(j);
+  indent(out, depth);
+  out.append(j == 0 ? "ROOT " : "JOINT ").append(l.names[u]).append("\n");
+  indent(out, depth);
+  out.append("{\n");
+  append_offset(out, depth + 1, sk.offsets[u], per_metre);
+  indent(out, depth + 1);
+  const bool positions = j == 0 || l.animated[u];
+  out.append("CHANNELS ").append(positions ? "6 Xposition Yposition Zposition" : "3").append(rotation_channels).append("\n");
+}
+
+// The HIERARCHY section: joints depth first from the root, children in
+// index order, end sites where the skeleton has them; fills l.order.
+void write_hierarchy(std::string& out, const motion::Skeleton& sk, JointLayout& l, const std::string& rotation_channels, double per_metre) {
+  out.append("HIERARCHY\n");
+  l.order.reserve(l.names.size());
   std::vector<std::pair<std::int32_t, std::size_t>> stack = {{0, 0}};
-  open(0, 0);
+  open_joint(out, sk, l, 0, 0, rotation_channels, per_metre);
   while (!stack.empty()) {
     auto& [j, next_child] = stack.back();
     const auto u = static_cast<std::size_t>(j);
-    if (next_child < children[u].size()) {
-      const std::int32_t c = children[u][next_child++];
-      open(c, stack.size());
+    if (next_child < l.children[u].size()) {
+      const std::int32_t c = l.children[u][next_child++];
+      open_joint(out, sk, l, c, stack.size(), rotation_channels, per_metre);
       stack.emplace_back(c, 0);
       continue;
     }
@@ -110,13 +134,7 @@ std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& cli
       out.append("End Site\n");
       indent(out, depth + 1);
       out.append("{\n");
-      indent(out, depth + 2);
-      out.append("OFFSET");
-      for (int i = 0; i < 3; ++i) {
-        out.push_back(' ');
-        append_number(out, static_cast<float>(sk.end_sites[u][i] * per_metre));
-      }
-      out.append("\n");
+      append_offset(out, depth + 2, sk.end_sites[u], per_metre);
       indent(out, depth + 1);
       out.append("}\n");
     }
@@ -124,6 +142,55 @@ std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& cli
     out.append("}\n");
     stack.pop_back();
   }
+}
+
+// One MOTION line: frame f's channels for the joints in l.order, positions
+// (m times per_metre) then rotations (degrees, Euler angles in options.order
+// written in the order of `axes`).
+void write_frame(std::string& out, const motion::Clip& clip, const JointLayout& l, std::size_t f, const BvhWriteOptions& options,
+                 const std::array<int, 3>& axes, double per_metre) {
+  const std::size_t J = l.names.size();
+  bool first = true;
+  auto value = [&](float v) {
+    if (!first) out.push_back(' ');
+    first = false;
+    append_number(out, v);
+  };
+  for (std::int32_t j : l.order) {
+    const auto u = static_cast<std::size_t>(j);
+    const std::size_t k = f * J + u;
+    if (j == 0 || l.animated[u]) {
+      const glm::vec3 p = j == 0 ? clip.root_positions[f] : clip.translations[k];
+      for (int i = 0; i < 3; ++i) {
+        check_finite(p[i], "position", static_cast<std::int32_t>(f), l.names[u]);
+        value(static_cast<float>(p[i] * per_metre));
+      }
+    }
+    const glm::quat& q = clip.rotations[k];
+    check_finite(static_cast<double>(glm::dot(q, q)), "rotation", static_cast<std::int32_t>(f), l.names[u]);
+    if (!(glm::dot(q, q) > 0.0f)) check_finite(NAN, "rotation (zero quaternion)", static_cast<std::int32_t>(f), l.names[u]);
+    const glm::dvec3 e = motion::quat_to_euler(options.order, glm::dquat(q));
+    for (int a : axes) value(static_cast<float>(e[a] * kDegreesPerRadian));
+  }
+  out.append("\n");
+}
+
+}  // namespace
+
+// Stages: checks, joint layout, HIERARCHY, then MOTION (frame count, frame
+// time, one line per frame).
+std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& clip, const BvhWriteOptions& options) {
+  const double frame_time = check_clip(sk, clip, options);
+  const std::size_t J = static_cast<std::size_t>(sk.joint_count());
+  const auto frames = static_cast<std::size_t>(std::max(clip.frame_count, 0));
+  const double per_metre = 1.0 / motion::metres_per_unit(options.unit);
+  JointLayout l = joint_layout(sk, clip, frames);
+
+  const auto axes = motion::euler_axes(options.order);
+  std::string rotation_channels;
+  for (int a : axes) rotation_channels.append(" ").append(1, static_cast<char>('X' + a)).append("rotation");
+  std::string out;
+  write_hierarchy(out, sk, l, rotation_channels, per_metre);
 
   out.append("MOTION\nFrames: ").append(std::to_string(frames)).append("\nFrame Time: ");
   if (options.frame_time > 0.0) {
@@ -133,31 +200,7 @@ std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& cli
   }
   out.append("\n");
   out.reserve(out.size() + frames * J * 40);
-  for (std::size_t f = 0; f < frames; ++f) {
-    bool first = true;
-    auto value = [&](float v) {
-      if (!first) out.push_back(' ');
-      first = false;
-      append_number(out, v);
-    };
-    for (std::int32_t j : order) {
-      const auto u = static_cast<std::size_t>(j);
-      const std::size_t k = f * J + u;
-      if (j == 0 || animated[u]) {
-        const glm::vec3 p = j == 0 ? clip.root_positions[f] : clip.translations[k];
-        for (int i = 0; i < 3; ++i) {
-          check_finite(p[i], "position", static_cast<std::int32_t>(f), names[u]);
-          value(static_cast<float>(p[i] * per_metre));
-        }
-      }
-      const glm::quat& q = clip.rotations[k];
-      check_finite(static_cast<double>(glm::dot(q, q)), "rotation", static_cast<std::int32_t>(f), names[u]);
-      if (!(glm::dot(q, q) > 0.0f)) check_finite(NAN, "rotation (zero quaternion)", static_cast<std::int32_t>(f), names[u]);
-      const glm::dvec3 e = motion::quat_to_euler(options.order, glm::dquat(q));
-      for (int a : axes) value(static_cast<float>(e[a] * kDegreesPerRadian));
-    }
-    out.append("\n");
-  }
+  for (std::size_t f = 0; f < frames; ++f) write_frame(out, clip, l, f, options, axes, per_metre);
   return out;
 }
 

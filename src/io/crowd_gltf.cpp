@@ -283,6 +283,90 @@ glm::vec3 vec3_of(const std::vector<double>& v, glm::vec3 otherwise) {
 // Images are not part of a crowd: skip them rather than decode them.
 bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) { return true; }
 
+// The glTF model in `bytes` (a .glb under 4 GiB), images skipped; throws
+// Error naming `path` when it does not parse.
+tinygltf::Model parse_glb(std::span<const unsigned char> bytes, const std::string& path) {
+  if (bytes.size() >= (std::size_t{1} << 32)) throw Error("4 GiB or larger", in_file(path));
+  tinygltf::Model m;
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skip_image, nullptr);
+  std::string err, warn;
+  bool loaded = false;
+  try {  // tinygltf 2.7 throws std::out_of_range on some malformed JSON chunks
+    loaded = loader.LoadBinaryFromMemory(&m, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()));
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
+  if (!loaded) throw Error("not a glTF binary: " + err, in_file(path));
+  return m;
+}
+
+// Parent node index of every node (-1: none), from the nodes' children.
+std::vector<int> parent_nodes(const tinygltf::Model& m, const std::string& path) {
+  std::vector<int> parent_node(m.nodes.size(), -1);
+  for (std::size_t i = 0; i < m.nodes.size(); ++i)
+    for (const int c : m.nodes[i].children) {
+      if (c < 0 || c >= static_cast<int>(m.nodes.size())) throw Error("child out of range", in_file(path, "nodes"));
+      parent_node[static_cast<std::size_t>(c)] = static_cast<int>(i);
+    }
+  return parent_node;
+}
+
+// Skin 0's inverse bind matrices as rows (glTF stores them column-major),
+// one per joint.
+std::vector<anim::Mat3x4> read_inverse_bind(const tinygltf::Model& m, std::int32_t joints, const std::string& path) {
+  std::vector<anim::Mat3x4> inverse_bind;
+  for (const glm::mat4& ibm : read_accessor<glm::mat4>(m, m.skins[0].inverseBindMatrices, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4,
+                                                        path, "inverseBindMatrices")) {
+    const float* c = &ibm[0][0];  // column-major
+    anim::Mat3x4 x;
+    x.r0 = glm::vec4(c[0], c[4], c[8], c[12]);
+    x.r1 = glm::vec4(c[1], c[5], c[9], c[13]);
+    x.r2 = glm::vec4(c[2], c[6], c[10], c[14]);
+    inverse_bind.push_back(x);
+  }
+  if (static_cast<std::int32_t>(inverse_bind.size()) != joints) throw Error("one inverse bind matrix per joint expected", in_file(path, "skins[0]"));
+  return inverse_bind;
+}
+
+// Mesh 0's first primitive as a skinned mesh of `joints` joints, validated.
+anim::SkinnedMesh read_mesh(const tinygltf::Model& m, std::int32_t joints, const std::string& path) {
+  if (m.meshes[0].primitives.empty()) throw Error("the mesh has no primitive", in_file(path, "meshes[0]"));
+  const tinygltf::Primitive& prim = m.meshes[0].primitives[0];
+  auto attribute = [&](const char* name) {
+    const auto it = prim.attributes.find(name);
+    if (it == prim.attributes.end()) throw Error(std::string("mesh has no ") + name, in_file(path, "meshes[0]"));
+    return it->second;
+  };
+  constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  anim::SkinnedMesh mesh;
+  mesh.joint_count = joints;
+  mesh.positions = read_accessor<glm::vec3>(m, attribute("POSITION"), kFloat, TINYGLTF_TYPE_VEC3, path, "POSITION");
+  mesh.normals = read_accessor<glm::vec3>(m, attribute("NORMAL"), kFloat, TINYGLTF_TYPE_VEC3, path, "NORMAL");
+  mesh.weights = read_accessor<glm::vec4>(m, attribute("WEIGHTS_0"), kFloat, TINYGLTF_TYPE_VEC4, path, "WEIGHTS_0");
+  mesh.joints = read_accessor<glm::u16vec4>(m, attribute("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, path, "JOINTS_0");
+  mesh.indices = read_accessor<std::uint32_t>(m, prim.indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, path, "indices");
+  try {
+    mesh.validate();
+  } catch (const Error& e) {
+    throw Error(std::string("mesh: ") + e.what(), in_file(path, "meshes[0]"));
+  }
+  return mesh;
+}
+
+// The joint a channel of animation `anim` keys, as its index a * joints + j,
+// after checking the channel's sampler, target node (not a mesh node) and
+// path (translation or rotation).
+std::size_t keyed_joint(const tinygltf::Model& m, const tinygltf::Animation& anim, const tinygltf::AnimationChannel& c, std::int32_t joints,
+                        const std::string& path) {
+  if (c.sampler < 0 || c.sampler >= static_cast<int>(anim.samplers.size()) || c.target_node < 0 ||
+      c.target_node >= static_cast<int>(m.nodes.size()))
+    throw Error("channel out of range", in_file(path, "animations[0].channels"));
+  const int node = c.target_node;
+  if (node % (joints + 1) == joints) throw Error("a mesh node is animated", in_file(path, "animations[0].channels"));
+  if (c.target_path != "rotation" && c.target_path != "translation") throw Error("only translation and rotation are keyed", in_file(path, c.target_path));
+  return static_cast<std::size_t>((node / (joints + 1)) * joints + node % (joints + 1));
+}
 }  // namespace
 
 CrowdGlb::CrowdGlb(const std::string& path) {
@@ -302,19 +386,10 @@ CrowdGlb CrowdGlb::parse(std::span<const unsigned char> bytes, const std::string
   return glb;
 }
 
+// Stages: parse, layout checks, joint nodes (parents, rest pose), inverse
+// bind matrices, mesh, then the keyed channels of animation 0.
 void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& path) {
-  if (bytes.size() >= (std::size_t{1} << 32)) throw Error("4 GiB or larger", in_file(path));
-  tinygltf::Model m;
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skip_image, nullptr);
-  std::string err, warn;
-  bool loaded = false;
-  try {  // tinygltf 2.7 throws std::out_of_range on some malformed JSON chunks
-    loaded = loader.LoadBinaryFromMemory(&m, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()));
-  } catch (const std::exception& e) {
-    err = e.what();
-  }
-  if (!loaded) throw Error("not a glTF binary: " + err, in_file(path));
+  const tinygltf::Model m = parse_glb(bytes, path);
   if (m.skins.empty() || m.meshes.size() != 1) throw Error("expected one mesh and a skin per agent (throng export-crowd's layout)", in_file(path));
   agents_ = static_cast<Index>(m.skins.size());
   joints_ = static_cast<std::int32_t>(m.skins[0].joints.size());
@@ -322,12 +397,7 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
     throw Error("node count is not agents x (joints + 1)", in_file(path, "nodes"));
   if (m.asset.extras.Has("fps")) fps_ = m.asset.extras.Get("fps").GetNumberAsDouble();
 
-  std::vector<int> parent_node(m.nodes.size(), -1);
-  for (std::size_t i = 0; i < m.nodes.size(); ++i)
-    for (const int c : m.nodes[i].children) {
-      if (c < 0 || c >= static_cast<int>(m.nodes.size())) throw Error("child out of range", in_file(path, "nodes"));
-      parent_node[static_cast<std::size_t>(c)] = static_cast<int>(i);
-    }
+  const std::vector<int> parent_node = parent_nodes(m, path);
   nodes_.resize(static_cast<std::size_t>(agents_) * static_cast<std::size_t>(joints_));
   for (Index a = 0; a < agents_; ++a) {
     const tinygltf::Skin& skin = m.skins[static_cast<std::size_t>(a)];
@@ -347,50 +417,17 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
       n.scale = gn.scale.size() == 3 ? static_cast<float>(gn.scale[0]) : 1.0f;
     }
   }
-  for (const glm::mat4& ibm : read_accessor<glm::mat4>(m, m.skins[0].inverseBindMatrices, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4,
-                                                        path, "inverseBindMatrices")) {
-    const float* c = &ibm[0][0];  // column-major
-    anim::Mat3x4 x;
-    x.r0 = glm::vec4(c[0], c[4], c[8], c[12]);
-    x.r1 = glm::vec4(c[1], c[5], c[9], c[13]);
-    x.r2 = glm::vec4(c[2], c[6], c[10], c[14]);
-    inverse_bind_.push_back(x);
-  }
-  if (static_cast<std::int32_t>(inverse_bind_.size()) != joints_) throw Error("one inverse bind matrix per joint expected", in_file(path, "skins[0]"));
-  if (m.meshes[0].primitives.empty()) throw Error("the mesh has no primitive", in_file(path, "meshes[0]"));
-  const tinygltf::Primitive& prim = m.meshes[0].primitives[0];
-  auto attribute = [&](const char* name) {
-    const auto it = prim.attributes.find(name);
-    if (it == prim.attributes.end()) throw Error(std::string("mesh has no ") + name, in_file(path, "meshes[0]"));
-    return it->second;
-  };
-  constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
-  mesh_.joint_count = joints_;
-  mesh_.positions = read_accessor<glm::vec3>(m, attribute("POSITION"), kFloat, TINYGLTF_TYPE_VEC3, path, "POSITION");
-  mesh_.normals = read_accessor<glm::vec3>(m, attribute("NORMAL"), kFloat, TINYGLTF_TYPE_VEC3, path, "NORMAL");
-  mesh_.weights = read_accessor<glm::vec4>(m, attribute("WEIGHTS_0"), kFloat, TINYGLTF_TYPE_VEC4, path, "WEIGHTS_0");
-  mesh_.joints = read_accessor<glm::u16vec4>(m, attribute("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, path, "JOINTS_0");
-  mesh_.indices = read_accessor<std::uint32_t>(m, prim.indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, path, "indices");
-  try {
-    mesh_.validate();
-  } catch (const Error& e) {
-    throw Error(std::string("mesh: ") + e.what(), in_file(path, "meshes[0]"));
-  }
+  inverse_bind_ = read_inverse_bind(m, joints_, path);
+  mesh_ = read_mesh(m, joints_, path);
 
   if (m.animations.empty()) return;
   const tinygltf::Animation& anim = m.animations[0];
+  constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
   for (const tinygltf::AnimationChannel& c : anim.channels) {
-    if (c.sampler < 0 || c.sampler >= static_cast<int>(anim.samplers.size()) || c.target_node < 0 ||
-        c.target_node >= static_cast<int>(m.nodes.size()))
-      throw Error("channel out of range", in_file(path, "animations[0].channels"));
-    const int node = c.target_node;
-    if (node % (joints_ + 1) == joints_) throw Error("a mesh node is animated", in_file(path, "animations[0].channels"));
-    Node& n = nodes_[static_cast<std::size_t>((node / (joints_ + 1)) * joints_ + node % (joints_ + 1))];
+    Node& n = nodes_[keyed_joint(m, anim, c, joints_, path)];
     const tinygltf::AnimationSampler& s = anim.samplers[static_cast<std::size_t>(c.sampler)];
-    const bool rotation = c.target_path == "rotation";
-    if (!rotation && c.target_path != "translation") throw Error("only translation and rotation are keyed", in_file(path, c.target_path));
     std::size_t frames = 0;
-    if (rotation) {
+    if (c.target_path == "rotation") {
       rotation_keys_.push_back(read_accessor<glm::vec4>(m, s.output, kFloat, TINYGLTF_TYPE_VEC4, path, "sampler output"));
       frames = rotation_keys_.back().size();
       n.rotation_keys = static_cast<std::int32_t>(rotation_keys_.size()) - 1;
