@@ -119,6 +119,67 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// What the programs of one frame share: the camera's view-projection, the
+// background, the eye (world, m), the fog distance (m) and the ground square
+// under the eye (centre, half size in m) that the ground and the bins cover.
+struct FrameView {
+  glm::mat4 view_projection;
+  glm::vec3 background;
+  glm::vec3 eye;
+  float fog;
+  glm::vec3 ground_centre;
+  float ground_half;
+};
+
+FrameView frame_view(const Camera& camera, const RenderOptions& options) {
+  FrameView v;
+  v.view_projection = projection_matrix(camera) * view_matrix(camera);
+  v.background = options.background;
+  v.eye = camera.position;
+  v.fog = options.fog_distance > 0.0f ? options.fog_distance : camera.far_plane;
+  // The ground: a square under the camera reaching the far plane.
+  v.ground_centre = glm::vec3(camera.position.x, 0.0f, camera.position.z);
+  v.ground_half = std::min(camera.far_plane, 5000.0f);
+  return v;
+}
+
+// Clears the bound framebuffer (colour to options.background, depth, stencil)
+// over camera.width x camera.height pixels and sets the opaque pass's state.
+void clear_frame(const Camera& camera, const RenderOptions& options) {
+  glViewport(0, 0, camera.width, camera.height);
+  glClearColor(options.background.r, options.background.g, options.background.b, 1.0f);
+  glClearDepth(1.0);
+  glClearStencil(0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
+  glDisable(GL_STENCIL_TEST);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_MULTISAMPLE);
+}
+
+// Uses program p with the frame's view-projection, background, eye and fog.
+void set_lighting(const GlProgram& p, const FrameView& view) {
+  glUseProgram(p.get());
+  glUniformMatrix4fv(uniform(p, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view.view_projection));
+  glUniform3fv(uniform(p, "u_background"), 1, glm::value_ptr(view.background));
+  glUniform3fv(uniform(p, "u_camera"), 1, glm::value_ptr(view.eye));
+  glUniform1f(uniform(p, "u_fog_distance"), view.fog);
+}
+
+// Uses joint program p (ellipsoids or lines): lighting, the rig's bone and
+// point counts, and the colours (by joint-LOD level when lod_colours).
+void use_joint_program(const GlProgram& p, const FrameView& view, const JointRig& rig, bool lod_colours) {
+  set_lighting(p, view);
+  glUniform1i(uniform(p, "u_bone_count"), rig.bone_count());
+  glUniform1i(uniform(p, "u_point_count"), static_cast<GLint>(rig.point_count()));
+  glUniform1i(uniform(p, "u_colour_by_lod"), lod_colours ? 1 : 0);
+  glUniform3fv(uniform(p, "u_lod_palette"), 16, &kLodPalette[0][0]);
+  glUniform3fv(uniform(p, "u_clothes"), 8, &kClothes[0][0]);
+}
+
 }  // namespace
 
 glm::vec3 lod_level_colour(std::int32_t level) {
@@ -179,6 +240,19 @@ struct Renderer::State {
   // group and sets the program's bases; the rest of the group goes in later calls.
   void bind_slot_range(const GlProgram& program, const DrawGroups& groups, std::int32_t group, Index first, Index count);
   Index slots_per_draw(std::int32_t joints) const;
+
+  // Stages of Renderer::render. prepare: cull, slots, packing; the visible,
+  // fine, lines and instance counts into stats; returns the frame's draw groups.
+  DrawGroups prepare(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options, RenderStats& stats);
+  // The ground square (a metre grid when grid), the bins heat map, the paths.
+  void draw_ground(const FrameView& view, bool grid);
+  void draw_bins(const FrameView& view);
+  void draw_paths(const FrameView& view);
+  // Characters of the visible groups; triangles submitted added to stats.
+  void draw_joint_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours, RenderStats& stats);
+  void draw_skinned_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours, RenderStats& stats);
+  // Obstacle walls, then their tops filled even-odd through the stencil.
+  void draw_obstacles(const FrameView& view);
 };
 
 Renderer::Renderer(const JointRig& rig) : Renderer(CrowdRigs{rig, {}}) {}
@@ -466,186 +540,167 @@ void Renderer::set_bins(const BinsOverlay& bins) {
   check_gl("render.bins");
 }
 
-RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options) {
-  camera.validate();
-  options.validate();
-  poses.validate(s_->rigs, options.mode);
-  State& s = *s_;
-  const JointRig& rig = s.rigs.joints;
-  const bool skinned = options.mode == RenderMode::Skinned;
-  RenderStats stats;
-  stats.characters = poses.character_count();
-  const auto t0 = std::chrono::steady_clock::now();
-
+DrawGroups Renderer::State::prepare(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options, RenderStats& stats) {
+  const bool skinned_mode = options.mode == RenderMode::Skinned;
   // Cull, give every visible character a slot, pack its points or palette.
-  const DrawGroups groups = s.cull(&camera, poses, options, options.mode, -1);
-  if (skinned) s.pack_palettes(poses, groups);
-  else s.pack_points(poses, groups);
-  const Index P = rig.point_count();
+  const DrawGroups groups = cull(&camera, poses, options, options.mode, -1);
+  if (skinned_mode) pack_palettes(poses, groups);
+  else pack_points(poses, groups);
   for (std::int32_t g = 0; g < groups.count; ++g) {
     if (g % kDrawTiers == static_cast<int>(DrawTier::Fine)) stats.fine += groups.slots[g];
     if (g % kDrawTiers == static_cast<int>(DrawTier::Lines)) stats.lines += groups.slots[g];
   }
   stats.visible = groups.visible();
-  stats.instances = skinned ? stats.visible : stats.visible * rig.bone_count();
-  stats.prepare_ms = ms_since(t0);
+  stats.instances = skinned_mode ? stats.visible : stats.visible * rigs.joints.bone_count();
+  return groups;
+}
 
-  // Draw.
-  const auto t1 = std::chrono::steady_clock::now();
-  ScopedTimer draw_timer("render.draw");
-  const glm::mat4 view_projection = projection_matrix(camera) * view_matrix(camera);
-  const float fog = options.fog_distance > 0.0f ? options.fog_distance : camera.far_plane;
-  glViewport(0, 0, camera.width, camera.height);
-  glClearColor(options.background.r, options.background.g, options.background.b, 1.0f);
-  glClearDepth(1.0);
-  glClearStencil(0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
+void Renderer::State::draw_ground(const FrameView& view, bool grid) {
+  set_lighting(ground, view);
+  glUniform3f(uniform(ground, "u_centre"), view.ground_centre.x, 0.0f, view.ground_centre.z);
+  glUniform1f(uniform(ground, "u_half_size"), view.ground_half);
+  glUniform3f(uniform(ground, "u_ground"), 0.58f, 0.60f, 0.56f);
+  glUniform3f(uniform(ground, "u_line"), 0.36f, 0.38f, 0.36f);
+  glUniform1i(uniform(ground, "u_grid"), grid ? 1 : 0);
+  glBindVertexArray(empty_vao.get());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+}
+
+void Renderer::State::draw_bins(const FrameView& view) {
+  glUseProgram(bins.get());
+  glUniformMatrix4fv(uniform(bins, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view.view_projection));
+  glUniform3f(uniform(bins, "u_centre"), view.ground_centre.x, 0.01f, view.ground_centre.z);
+  glUniform1f(uniform(bins, "u_half_size"), view.ground_half);
+  glUniform2f(uniform(bins, "u_min"), bins_meta.min.x, bins_meta.min.y);
+  glUniform1f(uniform(bins, "u_cell"), bins_meta.cell_size);
+  glUniform2i(uniform(bins, "u_cells"), bins_meta.columns, bins_meta.rows);
+  glUniform1f(uniform(bins, "u_saturate"), static_cast<float>(bins_meta.saturate_at));
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, bins_texture.get());
+  glUniform1i(uniform(bins, "u_counts"), 0);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glDepthMask(GL_FALSE);
+  glBindVertexArray(empty_vao.get());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
   glDepthMask(GL_TRUE);
   glDisable(GL_BLEND);
-  glDisable(GL_STENCIL_TEST);
+}
+
+void Renderer::State::draw_paths(const FrameView& view) {
+  glUseProgram(flat.get());
+  glUniformMatrix4fv(uniform(flat, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view.view_projection));
+  glUniform4f(uniform(flat, "u_colour"), 0.95f, 0.95f, 0.25f, 1.0f);
+  glBindVertexArray(paths_vao.get());
+  glMultiDrawArrays(GL_LINE_STRIP, path_first.data(), path_count.data(), static_cast<GLsizei>(path_first.size()));
+}
+
+void Renderer::State::draw_joint_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours, RenderStats& stats) {
+  // One instance per (visible character, bone); fine slots first. Both joint
+  // programs read the same storage buffers and colour uniforms.
+  const JointRig& rig = rigs.joints;
+  const Index fine_total = groups.slots[0], coarse_total = groups.slots[1], lines_total = groups.slots[2];
+  use_joint_program(joints, view, rig, lod_colours);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points_ssbo.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bones_ssbo.get());
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  const auto draw = [&](const GpuMesh& mesh, Index slot_base, Index slot_count) {
+    if (slot_count <= 0) return;
+    glUniform1i(uniform(joints, "u_slot_base"), static_cast<GLint>(slot_base));
+    glBindVertexArray(mesh.vao.get());
+    glDrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(slot_count * rig.bone_count()));
+    stats.triangles += slot_count * rig.bone_count() * (mesh.index_count / 3);
+  };
+  draw(fine_sphere, 0, fine_total);
+  draw(coarse_sphere, fine_total, coarse_total);
   glDisable(GL_CULL_FACE);
-  glEnable(GL_MULTISAMPLE);
+  if (lines_total > 0) {
+    // The smallest: one line per bone, two vertices, no instancing.
+    use_joint_program(joint_lines, view, rig, lod_colours);
+    glUniform1i(uniform(joint_lines, "u_slot_base"), static_cast<GLint>(fine_total + coarse_total));
+    glBindVertexArray(empty_vao.get());
+    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines_total * rig.bone_count() * 2));
+  }
+}
 
-  const auto set_lighting = [&](const GlProgram& p) {
-    glUseProgram(p.get());
-    glUniformMatrix4fv(uniform(p, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
-    glUniform3fv(uniform(p, "u_background"), 1, glm::value_ptr(options.background));
-    glUniform3fv(uniform(p, "u_camera"), 1, glm::value_ptr(camera.position));
-    glUniform1f(uniform(p, "u_fog_distance"), fog);
-  };
-  // The ground: a square under the camera reaching the far plane.
-  const glm::vec3 ground_centre(camera.position.x, 0.0f, camera.position.z);
-  const float ground_half = std::min(camera.far_plane, 5000.0f);
-  if (options.ground) {
-    set_lighting(s.ground);
-    glUniform3f(uniform(s.ground, "u_centre"), ground_centre.x, 0.0f, ground_centre.z);
-    glUniform1f(uniform(s.ground, "u_half_size"), ground_half);
-    glUniform3f(uniform(s.ground, "u_ground"), 0.58f, 0.60f, 0.56f);
-    glUniform3f(uniform(s.ground, "u_line"), 0.36f, 0.38f, 0.36f);
-    glUniform1i(uniform(s.ground, "u_grid"), options.grid ? 1 : 0);
-    glBindVertexArray(s.empty_vao.get());
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-  }
-  if (options.bins && s.has_bins) {
-    glUseProgram(s.bins.get());
-    glUniformMatrix4fv(uniform(s.bins, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
-    glUniform3f(uniform(s.bins, "u_centre"), ground_centre.x, 0.01f, ground_centre.z);
-    glUniform1f(uniform(s.bins, "u_half_size"), ground_half);
-    glUniform2f(uniform(s.bins, "u_min"), s.bins_meta.min.x, s.bins_meta.min.y);
-    glUniform1f(uniform(s.bins, "u_cell"), s.bins_meta.cell_size);
-    glUniform2i(uniform(s.bins, "u_cells"), s.bins_meta.columns, s.bins_meta.rows);
-    glUniform1f(uniform(s.bins, "u_saturate"), static_cast<float>(s.bins_meta.saturate_at));
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, s.bins_texture.get());
-    glUniform1i(uniform(s.bins, "u_counts"), 0);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glDepthMask(GL_FALSE);
-    glBindVertexArray(s.empty_vao.get());
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_BLEND);
-  }
-  if (options.paths && !s.path_first.empty()) {
-    glUseProgram(s.flat.get());
-    glUniformMatrix4fv(uniform(s.flat, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
-    glUniform4f(uniform(s.flat, "u_colour"), 0.95f, 0.95f, 0.25f, 1.0f);
-    glBindVertexArray(s.paths_vao.get());
-    glMultiDrawArrays(GL_LINE_STRIP, s.path_first.data(), s.path_count.data(), static_cast<GLsizei>(s.path_first.size()));
-  }
-
-  // Characters: one instance per (visible character, bone); fine slots first.
-  // Both joint programs read the same storage buffers and colour uniforms.
-  const auto use_joint_program = [&](const GlProgram& p) {
-    set_lighting(p);
-    glUniform1i(uniform(p, "u_bone_count"), rig.bone_count());
-    glUniform1i(uniform(p, "u_point_count"), static_cast<GLint>(P));
-    glUniform1i(uniform(p, "u_colour_by_lod"), options.lod_colours ? 1 : 0);
-    glUniform3fv(uniform(p, "u_lod_palette"), 16, &kLodPalette[0][0]);
-    glUniform3fv(uniform(p, "u_clothes"), 8, &kClothes[0][0]);
-  };
-  const Index fine_total = skinned ? 0 : groups.slots[0], coarse_total = skinned ? 0 : groups.slots[1],
-              lines_total = skinned ? 0 : groups.slots[2];
-  if (!skinned && stats.visible > 0) {
-    use_joint_program(s.joints);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.points_ssbo.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.bones_ssbo.get());
-    glEnable(GL_CULL_FACE);
+void Renderer::State::draw_skinned_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours, RenderStats& stats) {
+  set_lighting(skinned, view);
+  glUniform1i(uniform(skinned, "u_colour_by_lod"), lod_colours ? 1 : 0);
+  glUniform3fv(uniform(skinned, "u_lod_palette"), 16, &kLodPalette[0][0]);
+  glUniform3fv(uniform(skinned, "u_clothes"), 8, &kClothes[0][0]);
+  glUniform3fv(uniform(skinned, "u_trousers"), 4, &kTrouserColours[0][0]);
+  glUniform3fv(uniform(skinned, "u_skin"), 4, &kSkinTones[0][0]);
+  for (std::int32_t g = 0; g < groups.count; ++g) {
+    if (groups.slots[g] == 0) continue;
+    const GpuMesh& mesh = skin_meshes[static_cast<std::size_t>(g / kDrawTiers)][static_cast<std::size_t>(g % kDrawTiers)];
+    const bool lines = g % kDrawTiers == static_cast<int>(DrawTier::Lines);
+    if (lines) glDisable(GL_CULL_FACE);
+    else glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
-    const auto draw = [&](const GpuMesh& mesh, Index slot_base, Index slots) {
-      if (slots <= 0) return;
-      glUniform1i(uniform(s.joints, "u_slot_base"), static_cast<GLint>(slot_base));
-      glBindVertexArray(mesh.vao.get());
-      glDrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(slots * rig.bone_count()));
-      stats.triangles += slots * rig.bone_count() * (mesh.index_count / 3);
-    };
-    draw(s.fine_sphere, 0, fine_total);
-    draw(s.coarse_sphere, fine_total, coarse_total);
-    glDisable(GL_CULL_FACE);
-    if (lines_total > 0) {
-      // The smallest: one line per bone, two vertices, no instancing.
-      use_joint_program(s.joint_lines);
-      glUniform1i(uniform(s.joint_lines, "u_slot_base"), static_cast<GLint>(fine_total + coarse_total));
-      glBindVertexArray(s.empty_vao.get());
-      glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines_total * rig.bone_count() * 2));
+    glBindVertexArray(mesh.vao.get());
+    const Index per_draw = slots_per_draw(groups.joints[g]);
+    for (Index first = 0; first < groups.slots[g]; first += per_draw) {
+      const Index count = std::min(per_draw, groups.slots[g] - first);
+      bind_slot_range(skinned, groups, g, first, count);
+      glDrawElementsInstanced(lines ? GL_LINES : GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(count));
     }
+    if (!lines) stats.triangles += groups.slots[g] * (mesh.index_count / 3);
   }
+  glDisable(GL_CULL_FACE);
+}
 
-  if (skinned && stats.visible > 0) {
-    set_lighting(s.skinned);
-    glUniform1i(uniform(s.skinned, "u_colour_by_lod"), options.lod_colours ? 1 : 0);
-    glUniform3fv(uniform(s.skinned, "u_lod_palette"), 16, &kLodPalette[0][0]);
-    glUniform3fv(uniform(s.skinned, "u_clothes"), 8, &kClothes[0][0]);
-    glUniform3fv(uniform(s.skinned, "u_trousers"), 4, &kTrouserColours[0][0]);
-    glUniform3fv(uniform(s.skinned, "u_skin"), 4, &kSkinTones[0][0]);
-    for (std::int32_t g = 0; g < groups.count; ++g) {
-      if (groups.slots[g] == 0) continue;
-      const GpuMesh& mesh = s.skin_meshes[static_cast<std::size_t>(g / kDrawTiers)][static_cast<std::size_t>(g % kDrawTiers)];
-      const bool lines = g % kDrawTiers == static_cast<int>(DrawTier::Lines);
-      if (lines) glDisable(GL_CULL_FACE);
-      else glEnable(GL_CULL_FACE);
-      glCullFace(GL_BACK);
-      glBindVertexArray(mesh.vao.get());
-      const Index per_draw = s.slots_per_draw(groups.joints[g]);
-      for (Index first = 0; first < groups.slots[g]; first += per_draw) {
-        const Index count = std::min(per_draw, groups.slots[g] - first);
-        s.bind_slot_range(s.skinned, groups, g, first, count);
-        glDrawElementsInstanced(lines ? GL_LINES : GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(count));
-      }
-      if (!lines) stats.triangles += groups.slots[g] * (mesh.index_count / 3);
-    }
-    glDisable(GL_CULL_FACE);
-  }
+void Renderer::State::draw_obstacles(const FrameView& view) {
+  set_lighting(walls, view);
+  glUniform3f(uniform(walls, "u_colour"), 0.62f, 0.52f, 0.45f);
+  glBindVertexArray(obstacle_walls.vao.get());
+  glDrawElements(GL_TRIANGLES, obstacle_walls.index_count, GL_UNSIGNED_INT, nullptr);
+  // Tops: even-odd fill through the stencil buffer (holes and concave
+  // outlines need no triangulation), then one pass colours where odd.
+  glUseProgram(flat.get());
+  glUniformMatrix4fv(uniform(flat, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view.view_projection));
+  glBindVertexArray(caps_vao.get());
+  glEnable(GL_STENCIL_TEST);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthMask(GL_FALSE);
+  glStencilFunc(GL_ALWAYS, 0, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_INVERT);
+  glStencilMask(0x01);
+  glDrawArrays(GL_TRIANGLES, 0, cap_vertices);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  glStencilFunc(GL_EQUAL, 1, 0x01);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_ZERO);
+  const glm::vec3 top = glm::vec3(0.72f, 0.64f, 0.56f) * 0.95f;
+  glUniform4f(uniform(flat, "u_colour"), top.r, top.g, top.b, 1.0f);
+  glDrawArrays(GL_TRIANGLES, 0, cap_vertices);
+  glStencilMask(0xff);
+  glDisable(GL_STENCIL_TEST);
+}
 
-  if (options.obstacles && s.has_obstacles) {
-    set_lighting(s.walls);
-    glUniform3f(uniform(s.walls, "u_colour"), 0.62f, 0.52f, 0.45f);
-    glBindVertexArray(s.obstacle_walls.vao.get());
-    glDrawElements(GL_TRIANGLES, s.obstacle_walls.index_count, GL_UNSIGNED_INT, nullptr);
-    // Tops: even-odd fill through the stencil buffer (holes and concave
-    // outlines need no triangulation), then one pass colours where odd.
-    glUseProgram(s.flat.get());
-    glUniformMatrix4fv(uniform(s.flat, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
-    glBindVertexArray(s.caps_vao.get());
-    glEnable(GL_STENCIL_TEST);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glDepthMask(GL_FALSE);
-    glStencilFunc(GL_ALWAYS, 0, 0xff);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_INVERT);
-    glStencilMask(0x01);
-    glDrawArrays(GL_TRIANGLES, 0, s.cap_vertices);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthMask(GL_TRUE);
-    glStencilFunc(GL_EQUAL, 1, 0x01);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_ZERO);
-    const glm::vec3 top = glm::vec3(0.72f, 0.64f, 0.56f) * 0.95f;
-    glUniform4f(uniform(s.flat, "u_colour"), top.r, top.g, top.b, 1.0f);
-    glDrawArrays(GL_TRIANGLES, 0, s.cap_vertices);
-    glStencilMask(0xff);
-    glDisable(GL_STENCIL_TEST);
-  }
+RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options) {
+  camera.validate();
+  options.validate();
+  poses.validate(s_->rigs, options.mode);
+  State& s = *s_;
+  const bool skinned = options.mode == RenderMode::Skinned;
+  RenderStats stats;
+  stats.characters = poses.character_count();
+  const auto t0 = std::chrono::steady_clock::now();
+  const DrawGroups groups = s.prepare(camera, poses, options, stats);
+  stats.prepare_ms = ms_since(t0);
+
+  // Draw: ground and overlays, characters, obstacles.
+  const auto t1 = std::chrono::steady_clock::now();
+  ScopedTimer draw_timer("render.draw");
+  const FrameView view = frame_view(camera, options);
+  clear_frame(camera, options);
+  if (options.ground) s.draw_ground(view, options.grid);
+  if (options.bins && s.has_bins) s.draw_bins(view);
+  if (options.paths && !s.path_first.empty()) s.draw_paths(view);
+  if (!skinned && stats.visible > 0) s.draw_joint_characters(view, groups, options.lod_colours, stats);
+  if (skinned && stats.visible > 0) s.draw_skinned_characters(view, groups, options.lod_colours, stats);
+  if (options.obstacles && s.has_obstacles) s.draw_obstacles(view);
   glBindVertexArray(0);
   glUseProgram(0);
   check_gl("render.draw");

@@ -142,11 +142,11 @@ Image read_window(std::int32_t width, std::int32_t height) {
   return image;
 }
 
-}  // namespace
+using WindowPtr = std::unique_ptr<GLFWwindow, void (*)(GLFWwindow*)>;
 
-ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
-  options.validate();
-  GlfwSession glfw;
+// Window: an OpenGL 4.3 core window of options.width x options.height
+// pixels (4x multisampling, 24-bit depth, 8-bit stencil), its context current.
+WindowPtr open_window(const ViewerOptions& options) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
@@ -154,8 +154,7 @@ ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
   glfwWindowHint(GLFW_SAMPLES, 4);
   glfwWindowHint(GLFW_DEPTH_BITS, 24);
   glfwWindowHint(GLFW_STENCIL_BITS, 8);
-  std::unique_ptr<GLFWwindow, void (*)(GLFWwindow*)> window(
-      glfwCreateWindow(options.width, options.height, "throng", nullptr, nullptr), glfwDestroyWindow);
+  WindowPtr window(glfwCreateWindow(options.width, options.height, "throng", nullptr, nullptr), glfwDestroyWindow);
   if (!window) {
     const char* why = nullptr;
     glfwGetError(&why);
@@ -165,30 +164,31 @@ ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
   glfwSwapInterval(options.vsync && options.frames == 0 ? 1 : 0);
   check_gl_version();
   pin_gl_libraries();
-  ViewerResult result;
-  result.gl = gl_description();
-  spdlog::info("viewer: {}", result.gl);
+  return window;
+}
 
-  anim::CrowdAnimator& animator = scene.animator();
-  Renderer renderer(make_crowd_rigs(animator.blend_space().skeleton()));
-  scene.decorate(renderer);
-  const float extent = scene.extent();
-  const Index n = animator.count();
-  std::vector<float> thresholds = animator.config().lod_thresholds;
+// ImGui on a window (its GLFW and OpenGL 3 backends, GLSL 430, no
+// imgui.ini next to the user's files), shut down when this goes.
+struct ImGuiSession {
+  explicit ImGuiSession(GLFWwindow* window) {
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;
+    ImGui::StyleColorsDark();
+    ImGui_ImplGlfw_InitForOpenGL(window, true);
+    ImGui_ImplOpenGL3_Init("#version 430");
+  }
+  ~ImGuiSession() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+  ImGuiSession(const ImGuiSession&) = delete;
+  ImGuiSession& operator=(const ImGuiSession&) = delete;
+};
 
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
-  ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window.get(), true);
-  ImGui_ImplOpenGL3_Init("#version 430");
-  struct ImGuiShutdown {
-    ~ImGuiShutdown() {
-      ImGui_ImplOpenGL3_Shutdown();
-      ImGui_ImplGlfw_Shutdown();
-      ImGui::DestroyContext();
-    }
-  } imgui_shutdown;
-
+// The starting orbit: over the scene's centre, far enough to see `extent`
+// metres around it, or where the scene's own camera stands.
+OrbitControl initial_orbit(const ViewerScene& scene, float extent) {
   OrbitControl orbit;
   orbit.target = scene.centre() + glm::vec3(0.0f, 1.0f, 0.0f);
   orbit.distance = std::max(8.0f, 1.05f * extent / std::tan(0.5f * Camera{}.fov_y));
@@ -200,171 +200,255 @@ ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
     orbit.pitch = std::clamp(std::asin(d.y / glm::length(d)), 0.05f, 1.5f);
     orbit.yaw = std::atan2(d.x, d.z);
   }
-  InputState input;
-  input.orbit = &orbit;
-  input.paused = options.paused;
-  input.speed = options.speed;
-  input.mode = options.mode;
-  input.lod_colours = options.lod_colours;
-  glfwSetWindowUserPointer(window.get(), &input);
+  return orbit;
+}
+
+// Input: `input` (which must outlive the window) becomes the window's user
+// pointer and receives its keys, buttons, cursor and scroll.
+void install_input(GLFWwindow* window, InputState& input) {
+  glfwSetWindowUserPointer(window, &input);
   // ImGui's GLFW backend chains to callbacks installed before it; ours
   // are installed after, so they call it themselves via ImGui's handlers.
-  glfwSetKeyCallback(window.get(), [](GLFWwindow* w, int k, int s, int a, int m) {
+  glfwSetKeyCallback(window, [](GLFWwindow* w, int k, int s, int a, int m) {
     ImGui_ImplGlfw_KeyCallback(w, k, s, a, m);
     on_key(w, k, s, a, m);
   });
-  glfwSetMouseButtonCallback(window.get(), [](GLFWwindow* w, int b, int a, int m) {
+  glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int b, int a, int m) {
     ImGui_ImplGlfw_MouseButtonCallback(w, b, a, m);
     on_mouse_button(w, b, a, m);
   });
-  glfwSetCursorPosCallback(window.get(), [](GLFWwindow* w, double x, double y) {
+  glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
     // ImGui 1.86 polls the cursor position itself in NewFrame.
     on_cursor(w, x, y);
   });
-  glfwSetScrollCallback(window.get(), [](GLFWwindow* w, double x, double y) {
+  glfwSetScrollCallback(window, [](GLFWwindow* w, double x, double y) {
     ImGui_ImplGlfw_ScrollCallback(w, x, y);
     on_scroll(w, x, y);
   });
+}
 
+// What the frame loop keeps from one frame to the next; the panel shows it
+// and its controls edit it.
+struct LoopState {
+  InputState input;
   RenderOptions render_options;
-  render_options.bins = options.bins;
-  double t = 0.0;
-  auto last = std::chrono::steady_clock::now();
-  double frame_ms = 0.0;
-  RenderStats stats;
-  anim::LodHistogram histogram;
-  std::vector<std::int32_t> bin_counts;
+  std::vector<float> thresholds;  // joint LOD, square pixels, as the panel's sliders set them
+  double t = 0.0;                 // animation seconds shown
+  std::chrono::steady_clock::time_point last;  // when the previous frame began
+  double frame_ms = 0.0;                       // wall time per frame, smoothed
+  RenderStats stats;                           // of the last frame drawn
+  anim::LodHistogram histogram;                // of the last frame that measured one
+  std::vector<std::int32_t> bin_counts;        // agents per cell, row-major
+};
+
+// Clock: wall time since the previous frame smoothed into state.frame_ms;
+// returns the animation step in seconds (1/30 s per frame when scripted, the
+// wall time up to 0.1 s otherwise, times the speed; 0 while paused and not
+// stepping), added to state.t.
+double tick(LoopState& state, bool scripted) {
+  InputState& input = state.input;
+  const auto now = std::chrono::steady_clock::now();
+  const double wall = std::chrono::duration<double>(now - state.last).count();
+  state.last = now;
+  state.frame_ms = 0.9 * state.frame_ms + 0.1 * wall * 1000.0;
+  const double dt = !input.paused || input.step ? (scripted ? 1.0 / 30.0 : std::min(wall, 0.1)) * input.speed : 0.0;
+  state.t += dt;
+  input.step = false;
+  return dt;
+}
+
+// The camera of this frame: the orbit's, for a framebuffer of width x height
+// pixels, its far plane (m) at least 1000 m and four times the orbit's distance.
+Camera frame_camera(const OrbitControl& orbit, std::int32_t width, std::int32_t height) {
+  Camera lens;
+  lens.width = width;
+  lens.height = height;
+  lens.far_plane = std::max(1000.0f, 4.0f * orbit.distance);
+  return orbit.camera(lens);
+}
+
+// Bins overlay: counts the visible agents (ground positions, m) per cell of
+// the simulation's bin size around the scene's centre into state.bin_counts
+// and hands the grid to the renderer.
+void show_bins(const ViewerScene& scene, const anim::CrowdAnimator& animator, const CharacterPoses& poses, float extent, Index n,
+               std::vector<std::int32_t>& bin_counts, Renderer& renderer) {
+  // Agents per cell (the simulation's bin size), cells aligned with its bins.
+  const float cell = scene.bin_size();
+  const glm::vec2 corner = glm::floor((ground_from_world(scene.centre()) - glm::vec2(extent)) / cell) * cell;
+  const auto side = std::min<std::int32_t>(4096, static_cast<std::int32_t>(std::ceil(2.0f * extent / cell)) + 1);
+  std::vector<glm::vec3> ground(static_cast<std::size_t>(n));
+  std::vector<std::uint8_t> flags(static_cast<std::size_t>(poses.flags.size()));
+  if (n > 0)
+    throng::detail::copy_bytes(ground.data(), Memory::Host, animator.positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
+  if (!flags.empty()) throng::detail::copy_bytes(flags.data(), Memory::Host, poses.flags.data(), current_memory(), flags.size());
+  bin_counts.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side), 0);
+  for (std::size_t i = 0; i < ground.size(); ++i) {
+    if (!flags.empty() && (flags[i] & poses.visible_bits) != poses.visible_bits) continue;
+    const glm::vec2 m = (ground_from_world(ground[i]) - corner) / cell;
+    const auto x = static_cast<std::int32_t>(std::floor(m.x)), y = static_cast<std::int32_t>(std::floor(m.y));
+    if (x >= 0 && x < side && y >= 0 && y < side) ++bin_counts[static_cast<std::size_t>(y * side + x)];
+  }
+  BinsOverlay bins;
+  bins.min = corner;
+  bins.cell_size = cell;
+  bins.columns = side;
+  bins.rows = side;
+  bins.counts = bin_counts;
+  bins.saturate_at = 12;
+  renderer.set_bins(bins);
+}
+
+// Panel section "Joint LOD": sliders for state.thresholds (square pixels,
+// handed to the animator when moved), the share of n agents' body parts per
+// level, joints synthesised and the motion cache of the last frame.
+void draw_lod_section(LoopState& state, anim::CrowdAnimator& animator, const anim::FrameStats& animated, Index n) {
+  std::vector<float>& thresholds = state.thresholds;
+  const anim::LodHistogram& histogram = state.histogram;
+  bool changed = false;
+  for (std::size_t l = 0; l < thresholds.size(); ++l) {
+    const float lo = l + 1 < thresholds.size() ? thresholds[l + 1] + 1.0f : 1.0f;
+    const float hi = l > 0 ? thresholds[l - 1] - 1.0f : 50000.0f;
+    changed |= ImGui::SliderFloat(fmt::format("L{} from px^2", l).c_str(), &thresholds[l], lo, std::max(lo, hi), "%.0f",
+                                  ImGuiSliderFlags_Logarithmic);
+  }
+  if (changed) animator.set_lod_thresholds(thresholds);
+  for (std::int32_t l = 0; l < histogram.level_count; ++l) {
+    Index count = 0;
+    for (int p = 0; p < anim::kBodyPartCount; ++p) count += histogram.at_level(static_cast<anim::BodyPart>(p), l);
+    const glm::vec3 c = lod_level_colour(l);
+    ImGui::ColorButton(fmt::format("##level{}", l).c_str(), ImVec4(c.r, c.g, c.b, 1.0f), 0, ImVec2(12, 12));
+    ImGui::SameLine();
+    const float share = n > 0 ? static_cast<float>(count) / static_cast<float>(n * anim::kBodyPartCount) : 0.0f;
+    ImGui::ProgressBar(share, ImVec2(-1, 0), fmt::format("level {}: {:.0f}% of body parts", l, 100.0f * share).c_str());
+  }
+  ImGui::Text("joints synthesised: %.1f of %d per agent", histogram.mean_joints_synthesised(), animator.joint_count());
+  if (animator.cache() != nullptr)
+    ImGui::Text("motion cache: %.1f%% hits, %lld cycles, %lld read it this frame", 100.0 * animated.cache.hit_rate(),
+                static_cast<long long>(animated.cache.entries), static_cast<long long>(animated.from_cache));
+  else
+    ImGui::TextDisabled("motion cache off");
+}
+
+// Panel: the scene's title and status, counts of the last frame, frame time
+// (ms) and time shown (s); its controls edit state.input and state.render_options.
+void draw_panel(LoopState& state, ViewerScene& scene, anim::CrowdAnimator& animator, const anim::FrameStats& animated, Index n) {
+  InputState& input = state.input;
+  RenderOptions& render_options = state.render_options;
+  const RenderStats& stats = state.stats;
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+  ImGui::Begin(scene.title().c_str());
+  const std::string status = scene.status();
+  if (!status.empty()) ImGui::TextUnformatted(status.c_str());
+  ImGui::Text("agents %lld, visible %lld (%lld near)", static_cast<long long>(stats.characters), static_cast<long long>(stats.visible),
+              static_cast<long long>(stats.fine));
+  ImGui::Text("frame %.1f ms, time %.1f s, %.1fM triangles", state.frame_ms, state.t, static_cast<double>(stats.triangles) / 1e6);
+  ImGui::Checkbox("paused", &input.paused);
+  ImGui::SameLine();
+  if (ImGui::Button("step")) input.step = true;
+  float speed = static_cast<float>(input.speed);
+  if (ImGui::SliderFloat("speed", &speed, 0.0f, 4.0f, "%.2fx")) input.speed = speed;
+  const char* modes[] = {"joints", "skinned"};
+  int mode_index = input.mode == RenderMode::Joints ? 0 : 1;
+  if (ImGui::Combo("mode (M)", &mode_index, modes, 2)) input.mode = mode_index == 0 ? RenderMode::Joints : RenderMode::Skinned;
+  ImGui::Checkbox("LOD colours", &input.lod_colours);
+  ImGui::SameLine();
+  ImGui::Checkbox("grid", &render_options.grid);
+  ImGui::SameLine();
+  ImGui::Checkbox("cull", &render_options.cull);
+  ImGui::Checkbox("obstacles", &render_options.obstacles);
+  ImGui::SameLine();
+  ImGui::Checkbox("paths", &render_options.paths);
+  ImGui::SameLine();
+  ImGui::Checkbox("bins", &render_options.bins);
+  if (ImGui::CollapsingHeader("Joint LOD", ImGuiTreeNodeFlags_DefaultOpen)) draw_lod_section(state, animator, animated, n);
+  if (ImGui::CollapsingHeader("Stages (median ms)", ImGuiTreeNodeFlags_DefaultOpen)) {
+    const std::vector<KernelStat> kernels = KernelTimings::global().stats();  // largest total first
+    for (std::size_t k = 0; k < std::min<std::size_t>(kernels.size(), 10); ++k)
+      ImGui::Text("%-20s %8.3f", kernels[k].name.c_str(), kernels[k].median_ms);
+  }
+  ImGui::TextDisabled("drag: orbit, right drag: pan, wheel: zoom");
+  ImGui::End();
+}
+
+// Overlay: one ImGui frame (the panel when options.panel) drawn over the
+// bound framebuffer.
+void draw_overlay(const ViewerOptions& options, LoopState& state, ViewerScene& scene, anim::CrowdAnimator& animator,
+                  const anim::FrameStats& animated, Index n) {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  if (options.panel) draw_panel(state, scene, animator, animated, n);
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+// Present: counts the frame in result.frames, swaps; on the last scripted
+// frame saves options.screenshot (width x height pixels) first and closes the window after.
+void present(GLFWwindow* window, const ViewerOptions& options, bool scripted, std::int32_t width, std::int32_t height, ViewerResult& result) {
+  ++result.frames;
+  const bool last_frame = scripted && result.frames >= options.frames;
+  if (last_frame && !options.screenshot.empty()) write_png(options.screenshot, read_window(width, height));
+  glfwSwapBuffers(window);
+  if (last_frame) glfwSetWindowShouldClose(window, GLFW_TRUE);
+}
+
+}  // namespace
+
+ViewerResult run_viewer(ViewerScene& scene, const ViewerOptions& options) {
+  options.validate();
+  GlfwSession glfw;
+  const WindowPtr window = open_window(options);
+  ViewerResult result;
+  result.gl = gl_description();
+  spdlog::info("viewer: {}", result.gl);
+
+  anim::CrowdAnimator& animator = scene.animator();
+  Renderer renderer(make_crowd_rigs(animator.blend_space().skeleton()));
+  scene.decorate(renderer);
+  const float extent = scene.extent();
+  const Index n = animator.count();
+  LoopState state;
+  state.thresholds = animator.config().lod_thresholds;
+  const ImGuiSession imgui(window.get());
+
+  OrbitControl orbit = initial_orbit(scene, extent);
+  state.input.orbit = &orbit;
+  state.input.paused = options.paused;
+  state.input.speed = options.speed;
+  state.input.mode = options.mode;
+  state.input.lod_colours = options.lod_colours;
+  install_input(window.get(), state.input);
+
+  state.render_options.bins = options.bins;
+  state.last = std::chrono::steady_clock::now();
   const bool scripted = options.frames > 0;
 
   while (!glfwWindowShouldClose(window.get())) {
     glfwPollEvents();
-    const auto now = std::chrono::steady_clock::now();
-    const double wall = std::chrono::duration<double>(now - last).count();
-    last = now;
-    frame_ms = 0.9 * frame_ms + 0.1 * wall * 1000.0;
-    const double dt = !input.paused || input.step ? (scripted ? 1.0 / 30.0 : std::min(wall, 0.1)) * input.speed : 0.0;
-    t += dt;
-    input.step = false;
+    const double dt = tick(state, scripted);
 
     std::int32_t fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(window.get(), &fb_width, &fb_height);
     if (fb_width <= 0 || fb_height <= 0) continue;  // minimised
-    Camera lens;
-    lens.width = fb_width;
-    lens.height = fb_height;
-    lens.far_plane = std::max(1000.0f, 4.0f * orbit.distance);
-    const Camera camera = orbit.camera(lens);
+    const Camera camera = frame_camera(orbit, fb_width, fb_height);
 
     // Locomotion, LOD (for this camera), cache and pose.
     scene.advance(dt, camera);
     const anim::FrameStats& animated = animator.last_frame();
-    if (animated.lod) histogram = *animated.lod;
+    if (animated.lod) state.histogram = *animated.lod;
 
     const CharacterPoses poses = scene.poses();
-    if (render_options.bins) {
-      // Agents per cell (the simulation's bin size), cells aligned with its bins.
-      const float cell = scene.bin_size();
-      const glm::vec2 corner = glm::floor((ground_from_world(scene.centre()) - glm::vec2(extent)) / cell) * cell;
-      const auto side = std::min<std::int32_t>(4096, static_cast<std::int32_t>(std::ceil(2.0f * extent / cell)) + 1);
-      std::vector<glm::vec3> ground(static_cast<std::size_t>(n));
-      std::vector<std::uint8_t> flags(static_cast<std::size_t>(poses.flags.size()));
-      if (n > 0)
-        throng::detail::copy_bytes(ground.data(), Memory::Host, animator.positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
-      if (!flags.empty()) throng::detail::copy_bytes(flags.data(), Memory::Host, poses.flags.data(), current_memory(), flags.size());
-      bin_counts.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side), 0);
-      for (std::size_t i = 0; i < ground.size(); ++i) {
-        if (!flags.empty() && (flags[i] & poses.visible_bits) != poses.visible_bits) continue;
-        const glm::vec2 m = (ground_from_world(ground[i]) - corner) / cell;
-        const auto x = static_cast<std::int32_t>(std::floor(m.x)), y = static_cast<std::int32_t>(std::floor(m.y));
-        if (x >= 0 && x < side && y >= 0 && y < side) ++bin_counts[static_cast<std::size_t>(y * side + x)];
-      }
-      BinsOverlay bins;
-      bins.min = corner;
-      bins.cell_size = cell;
-      bins.columns = side;
-      bins.rows = side;
-      bins.counts = bin_counts;
-      bins.saturate_at = 12;
-      renderer.set_bins(bins);
-    }
-    render_options.lod_colours = input.lod_colours;
-    render_options.mode = input.mode;
+    if (state.render_options.bins) show_bins(scene, animator, poses, extent, n, state.bin_counts, renderer);
+    state.render_options.lod_colours = state.input.lod_colours;
+    state.render_options.mode = state.input.mode;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    stats = renderer.render(camera, poses, render_options);
+    state.stats = renderer.render(camera, poses, state.render_options);
 
-    ImGui_ImplOpenGL3_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    ImGui::NewFrame();
-    if (options.panel) {
-      ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-      ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
-      ImGui::Begin(scene.title().c_str());
-      const std::string status = scene.status();
-      if (!status.empty()) ImGui::TextUnformatted(status.c_str());
-      ImGui::Text("agents %lld, visible %lld (%lld near)", static_cast<long long>(stats.characters), static_cast<long long>(stats.visible),
-                  static_cast<long long>(stats.fine));
-      ImGui::Text("frame %.1f ms, time %.1f s, %.1fM triangles", frame_ms, t, static_cast<double>(stats.triangles) / 1e6);
-      ImGui::Checkbox("paused", &input.paused);
-      ImGui::SameLine();
-      if (ImGui::Button("step")) input.step = true;
-      float speed = static_cast<float>(input.speed);
-      if (ImGui::SliderFloat("speed", &speed, 0.0f, 4.0f, "%.2fx")) input.speed = speed;
-      const char* modes[] = {"joints", "skinned"};
-      int mode_index = input.mode == RenderMode::Joints ? 0 : 1;
-      if (ImGui::Combo("mode (M)", &mode_index, modes, 2)) input.mode = mode_index == 0 ? RenderMode::Joints : RenderMode::Skinned;
-      ImGui::Checkbox("LOD colours", &input.lod_colours);
-      ImGui::SameLine();
-      ImGui::Checkbox("grid", &render_options.grid);
-      ImGui::SameLine();
-      ImGui::Checkbox("cull", &render_options.cull);
-      ImGui::Checkbox("obstacles", &render_options.obstacles);
-      ImGui::SameLine();
-      ImGui::Checkbox("paths", &render_options.paths);
-      ImGui::SameLine();
-      ImGui::Checkbox("bins", &render_options.bins);
-      if (ImGui::CollapsingHeader("Joint LOD", ImGuiTreeNodeFlags_DefaultOpen)) {
-        bool changed = false;
-        for (std::size_t l = 0; l < thresholds.size(); ++l) {
-          const float lo = l + 1 < thresholds.size() ? thresholds[l + 1] + 1.0f : 1.0f;
-          const float hi = l > 0 ? thresholds[l - 1] - 1.0f : 50000.0f;
-          changed |= ImGui::SliderFloat(fmt::format("L{} from px^2", l).c_str(), &thresholds[l], lo, std::max(lo, hi), "%.0f",
-                                        ImGuiSliderFlags_Logarithmic);
-        }
-        if (changed) animator.set_lod_thresholds(thresholds);
-        for (std::int32_t l = 0; l < histogram.level_count; ++l) {
-          Index count = 0;
-          for (int p = 0; p < anim::kBodyPartCount; ++p) count += histogram.at_level(static_cast<anim::BodyPart>(p), l);
-          const glm::vec3 c = lod_level_colour(l);
-          ImGui::ColorButton(fmt::format("##level{}", l).c_str(), ImVec4(c.r, c.g, c.b, 1.0f), 0, ImVec2(12, 12));
-          ImGui::SameLine();
-          const float share = n > 0 ? static_cast<float>(count) / static_cast<float>(n * anim::kBodyPartCount) : 0.0f;
-          ImGui::ProgressBar(share, ImVec2(-1, 0), fmt::format("level {}: {:.0f}% of body parts", l, 100.0f * share).c_str());
-        }
-        ImGui::Text("joints synthesised: %.1f of %d per agent", histogram.mean_joints_synthesised(), animator.joint_count());
-        if (animator.cache() != nullptr)
-          ImGui::Text("motion cache: %.1f%% hits, %lld cycles, %lld read it this frame", 100.0 * animated.cache.hit_rate(),
-                      static_cast<long long>(animated.cache.entries), static_cast<long long>(animated.from_cache));
-        else
-          ImGui::TextDisabled("motion cache off");
-      }
-      if (ImGui::CollapsingHeader("Stages (median ms)", ImGuiTreeNodeFlags_DefaultOpen)) {
-        const std::vector<KernelStat> kernels = KernelTimings::global().stats();  // largest total first
-        for (std::size_t k = 0; k < std::min<std::size_t>(kernels.size(), 10); ++k)
-          ImGui::Text("%-20s %8.3f", kernels[k].name.c_str(), kernels[k].median_ms);
-      }
-      ImGui::TextDisabled("drag: orbit, right drag: pan, wheel: zoom");
-      ImGui::End();
-    }
-    ImGui::Render();
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-
-    ++result.frames;
-    const bool last_frame = scripted && result.frames >= options.frames;
-    if (last_frame && !options.screenshot.empty()) write_png(options.screenshot, read_window(fb_width, fb_height));
-    glfwSwapBuffers(window.get());
-    if (last_frame) glfwSetWindowShouldClose(window.get(), GLFW_TRUE);
+    draw_overlay(options, state, scene, animator, animated, n);
+    present(window.get(), options, scripted, fb_width, fb_height, result);
   }
-  result.seconds_shown = t;
+  result.seconds_shown = state.t;
   return result;
 }
 
