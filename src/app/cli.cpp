@@ -1,5 +1,6 @@
 // Shared pieces of the command line (app/commands.h): readable range checks,
-// the joint-LOD thresholds flag, options that need another option.
+// the joint-LOD thresholds flag, options that need another option, the BVH
+// writers' --order and --units.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -12,6 +13,9 @@
 #include "anim/lod.h"
 #include "app/commands.h"
 #include "core/error.h"
+#include "io/bvh_writer.h"
+#include "motion/rotation.h"
+#include "motion/units.h"
 
 namespace throng::app {
 
@@ -70,6 +74,17 @@ void refuse_unless(const CLI::App& cmd, bool given, const std::vector<std::strin
   if (given) return;
   for (const std::string& name : options)
     if (cmd.count(name) > 0) throw Error("needs " + needs, at_field(name));
+}
+
+io::BvhWriteOptions bvh_write_options(const std::string& order, const std::string& units) {
+  io::BvhWriteOptions w;
+  const auto o = motion::parse_euler_order(order);
+  if (!o) throw Error("unknown rotation order '" + order + "' (XYZ, XZY, YXZ, YZX, ZXY, ZYX)", at_field("--order"));
+  w.order = *o;
+  const auto u = motion::parse_length_unit(units);
+  if (!u) throw Error("unknown unit '" + units + "' (m, cm, mm, in, cmu)", at_field("--units"));
+  w.unit = *u;
+  return w;
 }
 
 }  // namespace throng::app

@@ -69,13 +69,7 @@ void add_convert_command(CLI::App& app, const GlobalOptions& g) {
   cmd->callback([&g] {
     const MotionWriter& writer = writer_for(output);  // before reading: nothing is written under a wrong name
     apply_global_options(g);
-    io::BvhWriteOptions w;
-    const auto o = motion::parse_euler_order(order);
-    if (!o) throw Error("unknown rotation order '" + order + "' (XYZ, XZY, YXZ, YZX, ZXY, ZYX)", at_field("--order"));
-    w.order = *o;
-    const auto u = motion::parse_length_unit(units);
-    if (!u) throw Error("unknown unit '" + units + "' (m, cm, mm, in, cmu)", at_field("--units"));
-    w.unit = *u;
+    io::BvhWriteOptions w = bvh_write_options(order, units);
     io::BvhReadOptions r;
     if (in_units != "auto") {
       r.unit = motion::parse_length_unit(in_units);

@@ -79,13 +79,7 @@ void add_export_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--units", units, "Unit of the written files: m, cm, mm, in or cmu (default cm)");
   cmd->callback([&g] {
     apply_global_options(g);
-    io::BvhWriteOptions w;
-    const auto o = motion::parse_euler_order(order);
-    if (!o) throw Error("unknown rotation order '" + order + "' (XYZ, XZY, YXZ, YZX, ZXY, ZYX)", at_field("--order"));
-    w.order = *o;
-    const auto u = motion::parse_length_unit(units);
-    if (!u) throw Error("unknown unit '" + units + "' (m, cm, mm, in, cmu)", at_field("--units"));
-    w.unit = *u;
+    io::BvhWriteOptions w = bvh_write_options(order, units);
     namespace fs = std::filesystem;
     std::error_code ec;
     fs::create_directories(dir, ec);

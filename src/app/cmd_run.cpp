@@ -232,11 +232,9 @@ nlohmann::json interrupted_setup_stats(const io::LoadedScenario& loaded, const I
   return stats;
 }
 
-void run_scenario(const RunOptions& o) {
-  // Ctrl-C from here on: set-up stops at its next check, the run after its frame.
-  const InterruptGuard guard;
-  io::LoadedScenario loaded = io::load_scenario(o.scenario);
-  sim::ScenarioSpec& spec = loaded.spec;
+// Applies --agents, --seed and --scheduler to the scenario; returns the
+// steps to run (--steps, else --seconds over dt rounded up, else the scenario's).
+std::int64_t apply_run_options(sim::ScenarioSpec& spec, const RunOptions& o) {
   if (o.agents > 0) sim::scale_agent_counts(spec, o.agents);
   if (o.seed) spec.seed = *o.seed;
   if (!o.scheduler.empty()) spec.scheduler = sim::parse_scheduler(o.scheduler, "--scheduler");
@@ -244,7 +242,13 @@ void run_scenario(const RunOptions& o) {
   if (o.steps > 0) max_steps = o.steps;
   if (o.seconds > 0) max_steps = static_cast<std::int64_t>(std::ceil(o.seconds / static_cast<double>(spec.dt) - 1e-9));
   if (max_steps > sim::ScenarioLimits{}.max_steps) throw Error("too many steps", at_field("--steps"));
+  return max_steps;
+}
 
+// Announces the run on stderr, makes the output folder (--out, else the
+// scenario's outputs.dir, else out/NAME) and returns it.
+std::string make_output_dir(const io::LoadedScenario& loaded, const RunOptions& o, std::int64_t max_steps) {
+  const sim::ScenarioSpec& spec = loaded.spec;
   std::fprintf(stderr, "throng run: %s (%s): %lld agents, up to %lld steps of %.3g s, %s model, %s, %s x%d\n", spec.name.c_str(),
                loaded.source.file.c_str(), static_cast<long long>(spec.total_agents()), static_cast<long long>(max_steps),
                static_cast<double>(spec.dt), to_string(spec.model.kind), to_string(spec.scheduler), to_string(current_backend()),
@@ -253,12 +257,22 @@ void run_scenario(const RunOptions& o) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create the output folder: " + ec.message(), at_field("--out", dir));
+  return dir;
+}
 
+// Memory budget before set-up: bytes per agent (simulation, plus locomotion
+// when it will run) times the scenario's agents.
+void check_run_budget(const sim::ScenarioSpec& spec, const RunOptions& o) {
   const std::int64_t total = spec.total_agents();
   const bool animate_planned = !o.no_animate && (o.animate || !o.render.empty() || total <= kAnimateUpTo);
   check_memory_budget(static_cast<double>(total) * (kSimBytesPerAgent + (animate_planned ? kLocomotionBytesPerAgent : 0.0)),
                       fmt::format("{} agents{}", total, animate_planned ? ", animated" : ""), o.agents > 0 ? "--agents" : "groups");
+}
 
+// Set-up: the world and the crowd, kernel timings reset. Interrupted, it
+// writes DIR/stats.json (when the scenario writes stats), says so and exits 130.
+std::unique_ptr<sim::Simulation> build_or_exit(const io::LoadedScenario& loaded, const std::string& dir) {
+  const sim::ScenarioSpec& spec = loaded.spec;
   const auto setup_start = std::chrono::steady_clock::now();
   KernelTimings::global().reset();
   std::unique_ptr<sim::Simulation> sim;
@@ -273,22 +287,35 @@ void run_scenario(const RunOptions& o) {
   }
   std::fprintf(stderr, "throng run: world and crowd ready in %.2f s\n",
                std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count());
+  return sim;
+}
 
-  sim::FrameLoop loop(*sim);
+// The output stages' results: the soak stage (null without --check-every),
+// the files written so far (", "-separated) and the geometry files.
+struct RunOutputs {
+  const sim::SoakCheckStage* soak = nullptr;
+  std::string written;
+  std::optional<io::GeometryFiles> geometry_files;
+};
+
+// Output stages: crowd metrics sampled once a simulated second, soak checks
+// every --check-every steps (DIR/soak.jsonl), trajectories every K-th frame
+// beside the walkable area (DIR/geometry.wkt, .geojson, written now).
+RunOutputs add_output_stages(sim::FrameLoop& loop, const sim::Simulation& sim, const io::LoadedScenario& loaded, const RunOptions& o,
+                             const std::string& dir, std::int64_t max_steps) {
+  const sim::ScenarioSpec& spec = loaded.spec;
+  RunOutputs out;
   sim::MetricsOptions metrics;
   metrics.sample_every = std::max<std::int64_t>(1, std::llround(1.0 / static_cast<double>(spec.dt)));
   metrics.measurement = spec.measurement;
-  loop.emplace<sim::CrowdMetricsStage>(*sim, metrics);
-  const sim::SoakCheckStage* soak = nullptr;
+  loop.emplace<sim::CrowdMetricsStage>(sim, metrics);
   if (o.check_every > 0) {
     sim::SoakOptions checks;
     checks.every = o.check_every;
     checks.max_steps = max_steps;
     checks.report = dir + "/soak.jsonl";
-    soak = &loop.emplace<sim::SoakCheckStage>(checks);
+    out.soak = &loop.emplace<sim::SoakCheckStage>(checks);
   }
-  std::string written;
-  std::optional<io::GeometryFiles> geometry_files;
   if (spec.outputs.trajectories && !o.no_trajectories) {
     io::TrajectoryOutput t;
     t.format = o.format.value_or(loaded.trajectory_format);
@@ -297,121 +324,172 @@ void run_scenario(const RunOptions& o) {
     t.dt = static_cast<double>(spec.dt);
     // The walkable area goes beside the trajectories (and into the SQLite
     // file): analysis tools need both.
-    const std::vector<sim::Polygon> area = io::walkable_area(*sim);
+    const std::vector<sim::Polygon> area = io::walkable_area(sim);
     t.geometry_wkt = io::to_wkt(area);
-    geometry_files = io::write_geometry_files(dir, area);
-    written = t.path + ", " + geometry_files->wkt + ", " + geometry_files->geojson;
+    out.geometry_files = io::write_geometry_files(dir, area);
+    out.written = t.path + ", " + out.geometry_files->wkt + ", " + out.geometry_files->geojson;
     loop.emplace<io::TrajectoryWriter>(std::move(t));
   }
+  return out;
+}
 
-  const Index n = sim->agent_count();
+// What rendering leaves for the end of the run: a call that ends the video
+// and returns what it wrote (empty without --render), and the median
+// character height (px) of each rendered frame.
+struct RenderHooks {
+  std::function<std::string()> finish_render;
+  std::shared_ptr<std::vector<float>> character_px = std::make_shared<std::vector<float>>();
+};
+
+#if defined(THRONG_HAVE_RENDER)
+// The rendering camera, from `start` (the scenario's, at the video's size):
+// --camera, else the scenario's camera.motion, else one that follows the
+// crowd; lo.camera returns it at each simulated time (s).
+void set_render_camera(LocomotionStageOptions& lo, const Camera& start, const RunOptions& o, const sim::ScenarioSpec& spec,
+                       const sim::Simulation* simulation) {
+  const std::string motion = !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : "follow");
+  const double speed = o.render_speed;
+  if (motion == "follow") {
+    const auto follow = std::make_shared<FollowCamera>(start, 0.5 * speed);  // eases over half a video second
+    lo.camera = [follow, simulation](double t) { return follow->at(*simulation, t); };
+  } else {
+    const double period = o.camera_period > 0.0 ? o.camera_period : (spec.camera_period_s > 0.0f ? spec.camera_period_s : 40.0);
+    const auto path = std::make_shared<render::CameraPath>(
+        render::animate_camera(start, render::parse_camera_kind(motion, "--camera"), static_cast<float>(period)));
+    lo.camera = [path, speed](double t) { return path->at(t / speed); };
+  }
+}
+
+// --render: a recorder of o.width x o.height pixels at o.fps writing into
+// `dir`, fed by lo.on_frame, its camera set by set_render_camera; hooks
+// receive its finish call and the characters' size per frame.
+void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const RunOptions& o, const sim::ScenarioSpec& spec,
+                     const sim::Simulation& sim, const std::string& dir, RenderHooks& hooks) {
+  render::RecordSpec record;
+  record.output = render::parse_record_output(o.render, "--render");
+  record.folder = dir;
+  record.width = o.width;
+  record.height = o.height;
+  record.fps = o.fps;
+  record.options.mode = render::parse_render_mode(o.render_mode, "--render-mode");
+  record.options.lod_colours = o.lod_colours;
+  record.validate();
+  Camera start = lod_camera;
+  start.width = o.width;
+  start.height = o.height;
+  const double speed = o.render_speed;
+  const sim::Simulation* simulation = &sim;
+  set_render_camera(lo, start, o, spec, simulation);
+  // A video frame every `speed / fps` simulated seconds; the animation
+  // runs at least once a step (feet stay planted in a time-lapse) and
+  // every `per_video`-th frame is drawn.
+  const double frame_time = speed / o.fps;
+  const auto per_video = std::max<std::int64_t>(1, std::llround(frame_time / static_cast<double>(spec.dt)));
+  lo.fps = static_cast<double>(per_video) / frame_time;
+  const double until = o.render_seconds > 0.0 ? o.render_seconds : std::numeric_limits<double>::infinity();
+  auto recorder = std::make_shared<std::unique_ptr<render::Recorder>>();
+  lo.on_frame = [recorder, record, per_video, until, simulation, character_px = hooks.character_px, anim_fps = lo.fps](
+                    double t, const Camera* camera, SimulationLocomotion& moved) {
+    if (std::llround(t * anim_fps) % per_video != 0 || t > until + 1e-9) return;
+    ScopedTimer timer("render.frame");
+    character_px->push_back(median_character_px(*camera, *simulation));
+    if (!*recorder) {
+      *recorder = std::make_unique<render::Recorder>(record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
+      (*recorder)->set_world(simulation->world());
+    }
+    (*recorder)->add_frame(*camera, render::poses_of(moved.animator(), simulation->crowd()));
+  };
+  hooks.finish_render = [recorder, record] {
+    if (!*recorder) return std::string();
+    const Index frames = (*recorder)->frames();
+    const std::string wrote = (*recorder)->finish();
+    return fmt::format("{} ({} frames, {}x{} at {:g} fps)", wrote, frames, record.width, record.height, record.fps);
+  };
+  std::fprintf(stderr, "throng run: rendering %s (%s, %dx%d, %g fps, %gx speed) into %s\n", o.render.c_str(), o.render_mode.c_str(), o.width,
+               o.height, o.fps, speed, dir.c_str());
+}
+#endif
+
+// The locomotion stage, on by default up to kAnimateUpTo agents: joint LOD
+// under the scenario's camera and, with --render, the recorder.
+RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec, const RunOptions& o,
+                                 const std::string& dir) {
+  RenderHooks hooks;
+  const Index n = sim.agent_count();
   if (o.no_animate && !o.render.empty()) throw Error("--render draws the animated agents: drop --no-animate", at_field("--render"));
   const bool animate = !o.no_animate && (o.animate || !o.render.empty() || n <= kAnimateUpTo);
   if (!animate && !o.no_animate)
     std::fprintf(stderr, "throng run: %lld agents: locomotion off above %lld agents (--animate turns it on; see docs/render.md for its cost)\n",
                  static_cast<long long>(n), static_cast<long long>(kAnimateUpTo));
-  std::function<std::string()> finish_render;  // ends the video; returns what it wrote
-  const auto character_px = std::make_shared<std::vector<float>>();  // per rendered frame (median_character_px)
-  if (animate) {
-    LocomotionStageOptions lo;
-    lo.locomotion.lod_thresholds = o.lod_thresholds;
-    const Camera lod_camera = scenario_camera(*sim);  // the camera that renders is the one LOD measures with
-    lo.camera = [lod_camera](double) { return lod_camera; };
-    lo.lod = !o.no_lod;
-    if (!o.render.empty()) {
+  if (!animate) return hooks;
+  LocomotionStageOptions lo;
+  lo.locomotion.lod_thresholds = o.lod_thresholds;
+  const Camera lod_camera = scenario_camera(sim);  // the camera that renders is the one LOD measures with
+  lo.camera = [lod_camera](double) { return lod_camera; };
+  lo.lod = !o.no_lod;
+  if (!o.render.empty()) {
 #if defined(THRONG_HAVE_RENDER)
-      render::RecordSpec record;
-      record.output = render::parse_record_output(o.render, "--render");
-      record.folder = dir;
-      record.width = o.width;
-      record.height = o.height;
-      record.fps = o.fps;
-      record.options.mode = render::parse_render_mode(o.render_mode, "--render-mode");
-      record.options.lod_colours = o.lod_colours;
-      record.validate();
-      Camera start = lod_camera;
-      start.width = o.width;
-      start.height = o.height;
-      // --camera, else the scenario's camera.motion, else one that follows the crowd.
-      const std::string motion = !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : "follow");
-      const double speed = o.render_speed;
-      const sim::Simulation* simulation = sim.get();
-      if (motion == "follow") {
-        const auto follow = std::make_shared<FollowCamera>(start, 0.5 * speed);  // eases over half a video second
-        lo.camera = [follow, simulation](double t) { return follow->at(*simulation, t); };
-      } else {
-        const double period = o.camera_period > 0.0 ? o.camera_period : (spec.camera_period_s > 0.0f ? spec.camera_period_s : 40.0);
-        const auto path = std::make_shared<render::CameraPath>(
-            render::animate_camera(start, render::parse_camera_kind(motion, "--camera"), static_cast<float>(period)));
-        lo.camera = [path, speed](double t) { return path->at(t / speed); };
-      }
-      // A video frame every `speed / fps` simulated seconds; the animation
-      // runs at least once a step (feet stay planted in a time-lapse) and
-      // every `per_video`-th frame is drawn.
-      const double frame_time = speed / o.fps;
-      const auto per_video = std::max<std::int64_t>(1, std::llround(frame_time / static_cast<double>(spec.dt)));
-      lo.fps = static_cast<double>(per_video) / frame_time;
-      const double until = o.render_seconds > 0.0 ? o.render_seconds : std::numeric_limits<double>::infinity();
-      auto recorder = std::make_shared<std::unique_ptr<render::Recorder>>();
-      lo.on_frame = [recorder, record, per_video, until, simulation, character_px, anim_fps = lo.fps](double t, const Camera* camera,
-                                                                                                    SimulationLocomotion& moved) {
-        if (std::llround(t * anim_fps) % per_video != 0 || t > until + 1e-9) return;
-        ScopedTimer timer("render.frame");
-        character_px->push_back(median_character_px(*camera, *simulation));
-        if (!*recorder) {
-          *recorder = std::make_unique<render::Recorder>(record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
-          (*recorder)->set_world(simulation->world());
-        }
-        (*recorder)->add_frame(*camera, render::poses_of(moved.animator(), simulation->crowd()));
-      };
-      finish_render = [recorder, record] {
-        if (!*recorder) return std::string();
-        const Index frames = (*recorder)->frames();
-        const std::string wrote = (*recorder)->finish();
-        return fmt::format("{} ({} frames, {}x{} at {:g} fps)", wrote, frames, record.width, record.height, record.fps);
-      };
-      std::fprintf(stderr, "throng run: rendering %s (%s, %dx%d, %g fps, %gx speed) into %s\n", o.render.c_str(), o.render_mode.c_str(), o.width,
-                   o.height, o.fps, speed, dir.c_str());
+    attach_recorder(lo, lod_camera, o, spec, sim, dir, hooks);
 #else
-      throw Error("this build has no renderer (configured with -DTHRONG_RENDER=OFF)", at_field("--render"));
+    throw Error("this build has no renderer (configured with -DTHRONG_RENDER=OFF)", at_field("--render"));
 #endif
-    }
-    loop.emplace<LocomotionStage>(*sim, std::move(lo));
   }
+  loop.emplace<LocomotionStage>(sim, std::move(lo));
+  return hooks;
+}
 
-  Progress progress(max_steps, sim->agent_count(), o.quiet);
+// The run: up to max_steps steps (fewer when everyone arrived and the
+// scenario stops then, or after Ctrl-C), progress on stderr unless quiet.
+sim::RunResult run_steps(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec, std::int64_t max_steps, bool quiet) {
+  Progress progress(max_steps, sim.agent_count(), quiet);
   sim::RunControl control;
   control.max_steps = max_steps;
   control.stop_when_arrived = spec.stop_when_arrived;
   control.interrupt = &interrupt_flag();
   control.progress = [&](const sim::Simulation& s, const sim::FrameInfo& f) { progress.update(s, f); };
-  const sim::RunResult result = loop.run(control);
+  return loop.run(control);
+}
 
+// stats.json's content: the stages' sections, the geometry files, the
+// rendered characters' median size (px) and the scenario; the video's
+// description joins outputs.written.
+nlohmann::json run_stats(sim::FrameLoop& loop, const io::LoadedScenario& loaded, RunOutputs& outputs, const RenderHooks& hooks) {
+  std::string& written = outputs.written;
   nlohmann::json stats;
   loop.finish(stats);
-  if (geometry_files) stats["trajectories"]["geometry"] = {{"wkt", geometry_files->wkt}, {"geojson", geometry_files->geojson}};
-  if (finish_render) {
-    const std::string rendered = finish_render();
+  if (outputs.geometry_files)
+    stats["trajectories"]["geometry"] = {{"wkt", outputs.geometry_files->wkt}, {"geojson", outputs.geometry_files->geojson}};
+  if (hooks.finish_render) {
+    const std::string rendered = hooks.finish_render();
     if (!rendered.empty()) written += (written.empty() ? "" : ", ") + rendered;
   }
-  if (!character_px->empty()) {
+  const std::vector<float>& character_px = *hooks.character_px;
+  if (!character_px.empty()) {
     // How large the characters came out: the median over rendered frames of
     // each frame's median (a 1.75 m character standing at each agent).
-    std::vector<float> px = *character_px;
+    std::vector<float> px = character_px;
     std::nth_element(px.begin(), px.begin() + static_cast<std::ptrdiff_t>(px.size() / 2), px.end());
-    stats["render"] = {{"frames", character_px->size()}, {"median_character_px", px[px.size() / 2]}};
+    stats["render"] = {{"frames", character_px.size()}, {"median_character_px", px[px.size() / 2]}};
     std::fprintf(stderr, "throng run: characters in the picture: a median %.0f px tall\n", static_cast<double>(px[px.size() / 2]));
   }
   stats["scenario"] = scenario_section(loaded);
+  return stats;
+}
+
+// Writes DIR/stats.json (when the scenario writes stats) and prints the
+// summary; exits 1 on a failed soak check, 130 after Ctrl-C.
+void write_and_report(const sim::Simulation& sim, const sim::RunResult& result, const nlohmann::json& stats, const sim::ScenarioSpec& spec,
+                      const std::string& dir, RunOutputs& outputs) {
+  std::string& written = outputs.written;
   if (spec.outputs.stats) {
     io::write_json_file(dir + "/stats.json", stats);
     written += (written.empty() ? "" : ", ") + dir + "/stats.json";
   }
-  if (soak != nullptr) written += (written.empty() ? "" : ", ") + dir + "/soak.jsonl";
-  print_summary(*sim, result, stats, written);
+  if (outputs.soak != nullptr) written += (written.empty() ? "" : ", ") + dir + "/soak.jsonl";
+  print_summary(sim, result, stats, written);
   std::fflush(stdout);
-  if (soak != nullptr && !soak->failure().empty()) {
-    std::fprintf(stderr, "throng: error: soak check: %s\n", soak->failure().c_str());
+  if (outputs.soak != nullptr && !outputs.soak->failure().empty()) {
+    std::fprintf(stderr, "throng: error: soak check: %s\n", outputs.soak->failure().c_str());
     std::exit(1);
   }
   if (result.interrupted) {
@@ -419,6 +497,24 @@ void run_scenario(const RunOptions& o) {
                  static_cast<long long>(result.steps));
     std::exit(130);
   }
+}
+
+void run_scenario(const RunOptions& o) {
+  // Ctrl-C from here on: set-up stops at its next check, the run after its frame.
+  const InterruptGuard guard;
+  io::LoadedScenario loaded = io::load_scenario(o.scenario);
+  sim::ScenarioSpec& spec = loaded.spec;
+  const std::int64_t max_steps = apply_run_options(spec, o);
+  const std::string dir = make_output_dir(loaded, o, max_steps);
+  check_run_budget(spec, o);
+  const std::unique_ptr<sim::Simulation> sim = build_or_exit(loaded, dir);
+
+  sim::FrameLoop loop(*sim);
+  RunOutputs outputs = add_output_stages(loop, *sim, loaded, o, dir, max_steps);
+  const RenderHooks hooks = add_locomotion_stage(loop, *sim, spec, o, dir);
+  const sim::RunResult result = run_steps(loop, *sim, spec, max_steps, o.quiet);
+  const nlohmann::json stats = run_stats(loop, loaded, outputs, hooks);
+  write_and_report(*sim, result, stats, spec, dir, outputs);
 }
 
 }  // namespace

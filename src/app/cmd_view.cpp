@@ -141,32 +141,33 @@ bool is_formation(const std::string& what) {
   return false;
 }
 
-}  // namespace
-#endif
+// The options of `throng view` (the viewer's own, and the offscreen recording's).
+struct ViewArgs {
+  render::ViewerOptions o;
+  std::string scenario = "circle";
+  std::string layout;
+  std::string mode = "skinned";
+  Index agents = 0;
+  std::vector<float> thresholds;
+  bool headless = false;
+  std::string render_output;
+  std::string out_dir = "out/view";
+  double fps = 30.0;
+  std::string camera_kind;  // empty: the scenario's camera.motion, else orbit
+  float camera_period = 0.0f;
+};
 
-void add_view_command(CLI::App& app, const GlobalOptions& g) {
-  auto* cmd = app.add_subcommand("view", "Open the viewer: the crowd in a window, orbit/pan/zoom, LOD panel");
-#if defined(THRONG_HAVE_RENDER)
-  static render::ViewerOptions o;
-  static std::string scenario = "circle";
-  static std::string layout;
-  static std::string mode = "skinned";
-  static Index agents = 0;
-  static std::vector<float> thresholds;
-  static bool headless = false;
-  static std::string render_output;
-  static std::string out_dir = "out/view";
-  static double fps = 30.0;
-  static std::string camera_kind;  // empty: the scenario's camera.motion, else orbit
-  static float camera_period = 0.0f;
+// Adds the command's options to cmd, bound to a.
+void add_view_options(CLI::App* cmd, ViewArgs& a) {
+  render::ViewerOptions& o = a.o;
   std::string names;
   for (const std::string& n : io::builtin_scenario_names()) names += n + ", ";
-  cmd->add_option("scenario", scenario, "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
+  cmd->add_option("scenario", a.scenario, "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
       ->capture_default_str();
-  cmd->add_option("--agents", agents, "How many agents (groups keep their proportions)")->check(between(1, static_cast<double>(Index{1} << 24)));
-  cmd->add_option("--layout", layout, "For formation: ring (walking round rings) or grid")
+  cmd->add_option("--agents", a.agents, "How many agents (groups keep their proportions)")->check(between(1, static_cast<double>(Index{1} << 24)));
+  cmd->add_option("--layout", a.layout, "For formation: ring (walking round rings) or grid")
       ->check(CLI::IsMember({"ring", "grid"}));
-  cmd->add_option("--mode", mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")->check(CLI::IsMember({"skinned", "joints"}));
+  cmd->add_option("--mode", a.mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")->check(CLI::IsMember({"skinned", "joints"}));
   cmd->add_flag("--lod-colours", o.lod_colours, "Joint-LOD level colours instead of clothes, a debug view (L toggles)");
   cmd->add_option("--width", o.width, "Window width, pixels")->check(between(16, 7680));
   cmd->add_option("--height", o.height, "Window height, pixels")->check(between(16, 4320));
@@ -176,67 +177,98 @@ void add_view_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_flag("--paused", o.paused, "Start paused (space toggles, period steps)");
   cmd->add_flag("!--no-panel", o.panel, "Hide the ImGui panel");
   cmd->add_flag("--bins", o.bins, "Show agents per cell (the simulation's bins; 4 m for the formation) as a heat map");
-  cmd->add_flag("--headless", headless, "No window: render --frames frames offscreen (EGL), for videos and screenshots");
-  cmd->add_option("--render", render_output, "With --headless: write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames)")
+  cmd->add_flag("--headless", a.headless, "No window: render --frames frames offscreen (EGL), for videos and screenshots");
+  cmd->add_option("--render", a.render_output, "With --headless: write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames)")
       ->check(CLI::IsMember({"video", "frames"}));
-  cmd->add_option("--out", out_dir, "Folder for --render (default out/view)");
-  cmd->add_option("--fps", fps, "With --headless: frames per second of the video")->check(between(1, 240));
-  cmd->add_option("--camera", camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over (default: the scenario's camera.motion, else orbit)")
+  cmd->add_option("--out", a.out_dir, "Folder for --render (default out/view)");
+  cmd->add_option("--fps", a.fps, "With --headless: frames per second of the video")->check(between(1, 240));
+  cmd->add_option("--camera", a.camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over (default: the scenario's camera.motion, else orbit)")
       ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
-  cmd->add_option("--camera-period", camera_period, "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")->check(greater_than(0));
-  cmd->add_option("--lod-thresholds", thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
+  cmd->add_option("--camera-period", a.camera_period, "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")->check(greater_than(0));
+  cmd->add_option("--lod-thresholds", a.thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
+}
+
+// Refuses combinations that would do nothing (recording options in a
+// window, a screenshot without --frames, ...); sets a.o.mode from --mode.
+void check_view_args(const CLI::App& cmd, ViewArgs& a) {
+  render::ViewerOptions& o = a.o;
+  // Options of the offscreen recording are refused in a window, not ignored.
+  refuse_unless(cmd, a.headless, {"--fps", "--camera", "--camera-period"}, "--headless (with --render video|frames or --screenshot)");
+  refuse_unless(cmd, !a.render_output.empty(), {"--out"}, "--render video|frames");
+  if (!o.screenshot.empty() && o.frames == 0) throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
+  if (a.headless && o.frames == 0) throw Error("--headless needs --frames N", at_field("--frames"));
+  check_lod_thresholds(a.thresholds, "--lod-thresholds");
+  if (!a.render_output.empty() && !a.headless) throw Error("--render needs --headless", at_field("--render"));
+  if (a.headless && a.render_output.empty() && o.screenshot.empty())
+    throw Error("--headless writes nothing without --render or --screenshot", at_field("--headless"));
+  o.mode = render::parse_render_mode(a.mode, "--mode");
+}
+
+// The scene: the formation (--agents, --layout, --lod-thresholds applied) or
+// a simulation scenario (--agents), whose camera motion and period fill in
+// --camera and --camera-period when not given. Global options are applied
+// after loading, so a bad name or file fails before any backend talk.
+std::unique_ptr<render::ViewerScene> make_scene(ViewArgs& a, const GlobalOptions& g) {
+  if (is_formation(a.scenario)) {
+    std::filesystem::path folder;
+    io::AnimateSpec spec = load_animate_spec(a.scenario, folder);
+    if (a.agents > 0) spec.characters = a.agents;
+    if (!a.layout.empty()) spec.shape = a.layout == "grid" ? io::AnimateSpec::Shape::Grid : io::AnimateSpec::Shape::Circle;
+    if (!a.thresholds.empty()) spec.lod_thresholds = a.thresholds;
+    apply_global_options(g);
+    return std::make_unique<FormationScene>(std::move(spec), folder);
+  }
+  if (!a.layout.empty()) throw Error("--layout is for the formation", at_field("--layout"));
+  io::LoadedScenario loaded = io::load_scenario(a.scenario);
+  if (a.agents > 0) sim::scale_agent_counts(loaded.spec, a.agents);
+  apply_global_options(g);
+  std::unique_ptr<render::ViewerScene> scene = std::make_unique<SimulationScene>(loaded, a.thresholds);
+  if (a.camera_kind.empty()) a.camera_kind = loaded.spec.camera_motion;
+  if (!(a.camera_period > 0.0f)) a.camera_period = loaded.spec.camera_period_s;
+  return scene;
+}
+
+// --headless: --frames frames offscreen into the video or frames under
+// --out and/or the screenshot; says on stdout what it wrote.
+void record_headless(render::ViewerScene& scene, const ViewArgs& a) {
+  const render::ViewerOptions& o = a.o;
+  render::HeadlessViewOptions h;
+  h.record.output = a.render_output.empty() ? render::RecordOutput::None : render::parse_record_output(a.render_output, "--render");
+  h.record.folder = a.out_dir;
+  h.record.width = o.width;
+  h.record.height = o.height;
+  h.record.fps = a.fps;
+  h.record.options.mode = o.mode;
+  h.record.options.lod_colours = o.lod_colours;
+  h.record.options.bins = false;
+  h.frames = o.frames;
+  h.screenshot = o.screenshot;
+  h.speed = o.speed;
+  h.camera_kind = render::parse_camera_kind(a.camera_kind.empty() ? "orbit" : a.camera_kind, "--camera");
+  h.camera_period = a.camera_period > 0.0f ? a.camera_period : 60.0f;
+  const render::HeadlessViewResult r = render::record_view(scene, h);
+  if (!r.output.empty()) std::printf("view: %lld frames in %s\n", static_cast<long long>(r.frames), r.output.c_str());
+  if (!h.screenshot.empty()) std::printf("view: screenshot %s\n", h.screenshot.c_str());
+}
+
+}  // namespace
+#endif
+
+void add_view_command(CLI::App& app, const GlobalOptions& g) {
+  auto* cmd = app.add_subcommand("view", "Open the viewer: the crowd in a window, orbit/pan/zoom, LOD panel");
+#if defined(THRONG_HAVE_RENDER)
+  static ViewArgs a;
+  add_view_options(cmd, a);
   cmd->callback([&g, cmd] {
-    // Options of the offscreen recording are refused in a window, not ignored.
-    refuse_unless(*cmd, headless, {"--fps", "--camera", "--camera-period"}, "--headless (with --render video|frames or --screenshot)");
-    refuse_unless(*cmd, !render_output.empty(), {"--out"}, "--render video|frames");
-    if (!o.screenshot.empty() && o.frames == 0) throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
-    if (headless && o.frames == 0) throw Error("--headless needs --frames N", at_field("--frames"));
-    check_lod_thresholds(thresholds, "--lod-thresholds");
-    if (!render_output.empty() && !headless) throw Error("--render needs --headless", at_field("--render"));
-    if (headless && render_output.empty() && o.screenshot.empty())
-      throw Error("--headless writes nothing without --render or --screenshot", at_field("--headless"));
-    o.mode = render::parse_render_mode(mode, "--mode");
+    check_view_args(*cmd, a);
     // A bad name or file fails before any window opens.
-    std::unique_ptr<render::ViewerScene> scene;
-    if (is_formation(scenario)) {
-      std::filesystem::path folder;
-      io::AnimateSpec spec = load_animate_spec(scenario, folder);
-      if (agents > 0) spec.characters = agents;
-      if (!layout.empty()) spec.shape = layout == "grid" ? io::AnimateSpec::Shape::Grid : io::AnimateSpec::Shape::Circle;
-      if (!thresholds.empty()) spec.lod_thresholds = thresholds;
-      apply_global_options(g);
-      scene = std::make_unique<FormationScene>(std::move(spec), folder);
-    } else {
-      if (!layout.empty()) throw Error("--layout is for the formation", at_field("--layout"));
-      io::LoadedScenario loaded = io::load_scenario(scenario);
-      if (agents > 0) sim::scale_agent_counts(loaded.spec, agents);
-      apply_global_options(g);
-      scene = std::make_unique<SimulationScene>(loaded, thresholds);
-      if (camera_kind.empty()) camera_kind = loaded.spec.camera_motion;
-      if (!(camera_period > 0.0f)) camera_period = loaded.spec.camera_period_s;
-    }
-    if (headless) {
-      render::HeadlessViewOptions h;
-      h.record.output = render_output.empty() ? render::RecordOutput::None : render::parse_record_output(render_output, "--render");
-      h.record.folder = out_dir;
-      h.record.width = o.width;
-      h.record.height = o.height;
-      h.record.fps = fps;
-      h.record.options.mode = o.mode;
-      h.record.options.lod_colours = o.lod_colours;
-      h.record.options.bins = false;
-      h.frames = o.frames;
-      h.screenshot = o.screenshot;
-      h.speed = o.speed;
-      h.camera_kind = render::parse_camera_kind(camera_kind.empty() ? "orbit" : camera_kind, "--camera");
-      h.camera_period = camera_period > 0.0f ? camera_period : 60.0f;
-      const render::HeadlessViewResult r = render::record_view(*scene, h);
-      if (!r.output.empty()) std::printf("view: %lld frames in %s\n", static_cast<long long>(r.frames), r.output.c_str());
-      if (!h.screenshot.empty()) std::printf("view: screenshot %s\n", h.screenshot.c_str());
+    const std::unique_ptr<render::ViewerScene> scene = make_scene(a, g);
+    if (a.headless) {
+      record_headless(*scene, a);
       return;
     }
-    const render::ViewerResult r = render::run_viewer(*scene, o);
-    if (!o.screenshot.empty()) spdlog::info("view: {} frames, screenshot {}", r.frames, o.screenshot);
+    const render::ViewerResult r = render::run_viewer(*scene, a.o);
+    if (!a.o.screenshot.empty()) spdlog::info("view: {} frames, screenshot {}", r.frames, a.o.screenshot);
   });
 #else
   cmd->callback([&g] {

@@ -5,6 +5,10 @@
 #include <string>
 #include <vector>
 
+namespace throng::io {
+struct BvhWriteOptions;
+}
+
 namespace throng::app {
 
 // Options every subcommand shares (set on the top-level command).
@@ -44,6 +48,11 @@ void check_lod_thresholds(const std::vector<float>& thresholds, const std::strin
 // Throws Error "OPTION: needs NEEDS" for the first of `options` given on
 // `cmd` when `given` is false (options that only matter with another one).
 void refuse_unless(const CLI::App& cmd, bool given, const std::vector<std::string>& options, const std::string& needs);
+
+// --order and --units of the BVH-writing commands (convert, export-default):
+// the write options with that rotation order and unit (frame time unset);
+// throws Error naming the flag on an unknown name.
+io::BvhWriteOptions bvh_write_options(const std::string& order, const std::string& units);
 
 
 void add_run_command(CLI::App& app, const GlobalOptions& g);
