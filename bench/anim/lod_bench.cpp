@@ -101,8 +101,8 @@ void register_anim(const Options& options) {
                   Buffer<std::uint32_t> masks(n * config.mask_words, current_memory());
                   LodJob job;
                   job.set_tables(tables);
-                  job.root_positions = crowd.positions.span();
-                  job.root_headings = crowd.headings.span();
+                  job.roots.positions = crowd.positions.span();
+                  job.roots.headings = crowd.headings.span();
                   job.template_spheres = parts.rest_spheres;
                   job.levels = levels.span();
                   job.joint_masks = masks.span();
@@ -159,8 +159,8 @@ void register_anim(const Options& options) {
                   LodJob job;
                   job.set_tables(tables);
                   job.camera = make_camera_view(orbit_at(crowd.half_extent, 0.0f));
-                  job.root_positions = crowd.positions.span();
-                  job.root_headings = crowd.headings.span();
+                  job.roots.positions = crowd.positions.span();
+                  job.roots.headings = crowd.headings.span();
                   job.template_spheres = parts.rest_spheres;
                   job.levels = levels.span();
                   job.joint_masks = masks.span();

@@ -50,6 +50,16 @@ void MapInputJob::validate() const {
   check_length("MapInputJob", "speeds", speeds.size(), n);
 }
 
+PoseJob make_pose_job(const motion::BlendSpaceView& blend, const CharacterGait& gait, Span<glm::vec3> joint_positions,
+                      Span<glm::quat> joint_rotations) {
+  PoseJob pose;
+  static_cast<CharacterGait&>(pose) = gait;
+  pose.blend = blend;
+  pose.joint_positions = joint_positions;
+  pose.joint_rotations = joint_rotations;
+  return pose;
+}
+
 void PoseJob::validate() const {
   check_blend("PoseJob", blend);
   const Index n = character_count();
@@ -59,18 +69,18 @@ void PoseJob::validate() const {
   check_length("PoseJob", "phases", phases.size(), n);
   check_length("PoseJob", "blend_speeds", blend_speeds.size(), n);
   check_optional_length("PoseJob", "joint_masks", joint_masks.size(), n * mask_word_count(blend.joint_count));
-  if (!cache_slots.empty()) {
-    if (bucket_count < 1 || !(bucket_width > 0.0f)) throw Error("must be positive", at_field("PoseJob.bucket_count"));
-    check_length("PoseJob", "cache_slots", cache_slots.size(), static_cast<Index>(blend.segment_count()) * bucket_count);
-    if (cache_frames < 1) throw Error("must be positive with a cache", at_field("PoseJob.cache_frames"));
-    if (cache_cycles.size() % (static_cast<Index>(cache_frames) * J) != 0)
-      throw Error("size must be a multiple of cache_frames * joints", at_field("PoseJob.cache_cycles"));
-    const Index slots = cache_cycles.size() / (static_cast<Index>(cache_frames) * J);
-    check_length("PoseJob", "cache_drops", cache_drops.size(), slots * cache_frames);
+  if (!cache.slots.empty()) {
+    if (cache.bucket_count < 1 || !(cache.bucket_width > 0.0f)) throw Error("must be positive", at_field("PoseJob.cache.bucket_count"));
+    check_length("PoseJob", "cache.slots", cache.slots.size(), static_cast<Index>(blend.segment_count()) * cache.bucket_count);
+    if (cache.frames < 1) throw Error("must be positive with a cache", at_field("PoseJob.cache.frames"));
+    if (cache.cycles.size() % (static_cast<Index>(cache.frames) * J) != 0)
+      throw Error("size must be a multiple of cache.frames * joints", at_field("PoseJob.cache.cycles"));
+    const Index slots = cache.cycles.size() / (static_cast<Index>(cache.frames) * J);
+    check_length("PoseJob", "cache.drops", cache.drops.size(), slots * cache.frames);
     // Every slot a key names must exist (a bad table must not read past the arena).
     if (current_memory() == Memory::Host)
-      for (Index k = 0; k < cache_slots.size(); ++k)
-        if (cache_slots[k] >= slots) throw Error("names slot " + std::to_string(cache_slots[k]) + " of " + std::to_string(slots), at_field("PoseJob.cache_slots"));
+      for (Index k = 0; k < cache.slots.size(); ++k)
+        if (cache.slots[k] >= slots) throw Error("names slot " + std::to_string(cache.slots[k]) + " of " + std::to_string(slots), at_field("PoseJob.cache.slots"));
   }
   check_length("PoseJob", "joint_positions", joint_positions.size(), n * J);
   check_length("PoseJob", "joint_rotations", joint_rotations.size(), n * J);
@@ -327,13 +337,7 @@ void CrowdAnimator::set_curvatures(std::span<const float> curvatures) {
 
 void CrowdAnimator::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> headings) {
   check_length("CrowdAnimator.drive_from_map", "positions", positions.size(), count_);
-  MapInputJob job;
-  job.map_positions = positions;
-  job.map_velocities = velocities;
-  job.map_headings = headings;
-  job.positions = position_.span();
-  job.yaws = yaw_.span();
-  job.speeds = speed_.span();
+  const MapInputJob job{positions, velocities, headings, position_.span(), yaw_.span(), speed_.span()};
   job.run();
 }
 
@@ -344,19 +348,16 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
     view.quantum = cache_->bucket_width();
     view.quantum_buckets = cache_->bucket_count();
   }
-  LocomoteJob locomote;
-  locomote.blend = view;
-  locomote.step.dt = input.dt;
-  locomote.step.hold_until_cycle_end = config_.hold_until_cycle_end;
-  locomote.step.integrate_root = input.integrate_root;
-  locomote.speeds = speed_.span();
-  locomote.turn_rates = turn_rate_.span();
-  locomote.curvatures = curvature_.span();
-  locomote.scales = scale_.span();
-  locomote.positions = position_.span();
-  locomote.yaws = yaw_.span();
-  locomote.phases = phase_.span();
-  locomote.blend_speeds = blend_speed_.span();
+  const LocomoteJob locomote{.blend = view,
+                             .step = {input.dt, config_.hold_until_cycle_end, input.integrate_root},
+                             .speeds = speed_.span(),
+                             .turn_rates = turn_rate_.span(),
+                             .curvatures = curvature_.span(),
+                             .scales = scale_.span(),
+                             .positions = position_.span(),
+                             .yaws = yaw_.span(),
+                             .phases = phase_.span(),
+                             .blend_speeds = blend_speed_.span()};
   locomote.run();
 
   stats_ = FrameStats{};
@@ -364,16 +365,7 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
   const bool lod = config_.lod && input.camera != nullptr;
   if (lod) {
     input.camera->validate();
-    LodJob job;
-    job.camera = make_camera_view(*input.camera);
-    job.set_tables(*lod_tables_);
-    job.root_positions = position_.span();
-    job.root_headings = yaw_.span();
-    job.root_scales = scale_.span();
-    job.template_spheres = parts_->rest_spheres;
-    job.levels = levels_.span();
-    job.joint_masks = masks_.span();
-    job.run();
+    make_lod_job(*input.camera, *lod_tables_, *parts_, {position_.span(), yaw_.span(), scale_.span()}, levels_.span(), masks_.span()).run();
     stats_.lod = lod_histogram(levels_.span(), masks_.span(), lod_config_->level_count, lod_config_->joint_count);
   }
   if (cache_) {
@@ -382,28 +374,14 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
     stats_.cycles_stored = cache_->update(counts, config_.max_new_cycles_per_frame);
   }
 
-  PoseJob pose;
-  pose.blend = view;
-  pose.positions = position_.span();
-  pose.yaws = yaw_.span();
-  pose.scales = scale_.span();
-  pose.phases = phase_.span();
-  pose.blend_speeds = blend_speed_.span();
+  PoseJob pose = make_pose_job(view, {position_.span(), yaw_.span(), scale_.span(), phase_.span(), blend_speed_.span()},
+                               joint_position_.span(), joint_rotation_.span());
   if (lod) pose.joint_masks = masks_.span();
-  if (cache_) {
-    pose.cache_slots = cache_->slots();
-    pose.cache_cycles = cache_->cycles();
-    pose.cache_drops = cache_->drops();
-    pose.cache_frames = cache_->frames();
-    pose.bucket_width = cache_->bucket_width();
-    pose.bucket_count = cache_->bucket_count();
-  }
+  if (cache_) pose.cache = cache_->view();
   if (config_.draw_matrices) {
     pose.joint_shapes = shapes_.span();
     pose.draw_matrices = draw_.span();
   }
-  pose.joint_positions = joint_position_.span();
-  pose.joint_rotations = joint_rotation_.span();
   pose.evaluated = evaluated_.span();
   pose.from_cache = from_cache_.span();
   pose.run();

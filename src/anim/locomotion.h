@@ -71,25 +71,34 @@ struct MapInputJob {
   void run() const;  // parallel_for "anim.from_map"
 };
 
+// The motion cache's device side as PoseJob reads it (CycleCacheTable::view()).
+struct CycleCacheView {
+  Span<const std::int32_t> slots;  // per key (segment * bucket_count + bucket): slot or -1; empty = no cache
+  Span<const glm::quat> cycles;    // slots * frames * J local rotations
+  Span<const float> drops;         // slots * frames pelvis drops (m, scale 1)
+  std::int32_t frames = 0;
+  float bucket_width = 0.05f;
+  std::int32_t bucket_count = 20;
+};
+
+// Characters as PoseJob poses them: root on the ground, heading (radians
+// about +Y), size (scales, or empty for 1), gait phase and the speed the
+// blend shows.
+struct CharacterGait {
+  Span<const glm::vec3> positions;
+  Span<const float> yaws, scales, phases, blend_speeds;
+};
+
 // Stage 7: the pose of every character in world space. Joints whose mask bit
 // is off are not synthesised (no sampling, no SLERP): they hold the mean
 // rotation of the clip with the larger weight. A character whose cache key
 // has a slot reads that cached cycle at its phase instead of synthesising.
-struct PoseJob {
+// Its characters are the CharacterGait it derives from (positions, yaws,
+// scales, phases, blend_speeds).
+struct PoseJob : CharacterGait {
   motion::BlendSpaceView blend;
-  Span<const glm::vec3> positions;
-  Span<const float> yaws;
-  Span<const float> scales;  // empty = 1
-  Span<const float> phases;
-  Span<const float> blend_speeds;
   Span<const std::uint32_t> joint_masks;  // characters * mask_word_count(J); empty = every joint
-  // The motion cache's device side (CycleCacheTable); empty slots = no cache.
-  Span<const std::int32_t> cache_slots;   // per key (segment * bucket_count + bucket): slot or -1
-  Span<const glm::quat> cache_cycles;     // slots * cache_frames * J local rotations
-  Span<const float> cache_drops;          // slots * cache_frames pelvis drops (m, scale 1)
-  std::int32_t cache_frames = 0;
-  float bucket_width = 0.05f;
-  std::int32_t bucket_count = 20;
+  CycleCacheView cache;  // empty slots = no cache
   // J = F * O (optional): per joint the fixed bone-aligned shape F (joint_shapes).
   Span<const glm::mat4x3> joint_shapes;
   // Outputs, character-major [c * J + j].
@@ -103,6 +112,12 @@ struct PoseJob {
   void validate() const;
   void run() const;  // parallel_for "anim.pose"
 };
+
+// The PoseJob of every joint of these characters (no LOD masks, no cache,
+// no draw matrices): what each pose source of the locomotion layer starts
+// from.
+PoseJob make_pose_job(const motion::BlendSpaceView& blend, const CharacterGait& gait, Span<glm::vec3> joint_positions,
+                      Span<glm::quat> joint_rotations);
 
 // Sums of PoseJob's per-character counters (deterministic).
 struct PoseTotals {
@@ -161,6 +176,7 @@ class CycleCacheTable {
   Span<const std::int32_t> slots() const { return slots_.span(); }
   Span<const glm::quat> cycles() const { return cycles_.span(); }
   Span<const float> drops() const { return drops_.span(); }
+  CycleCacheView view() const { return {slots(), cycles(), drops(), frames(), bucket_width(), bucket_count()}; }
 
   // One frame: counts[key] characters look their key up (hits and misses
   // count characters); up to max_new missing cycles are synthesised and

@@ -37,103 +37,74 @@ struct CachedJoint {
 
 void LocomoteJob::run() const {
   validate();
-  const motion::BlendSpaceView view = blend;
-  const motion::LocomotionStep s = step;
-  const auto speed = speeds;
-  const auto turn = turn_rates;
-  const auto curve = curvatures;
-  const auto scale = scales;
-  const auto pos = positions;
-  const auto yaw = yaws;
-  const auto phase = phases;
-  const auto shown = blend_speeds;
   parallel_for(
       "anim.locomote", character_count(),
-      THRONG_LAMBDA(Index c) {
-        glm::vec3 p = pos[c];
-        float y = yaw[c], ph = phase[c], b = shown[c];
-        motion::advance_locomotion(view, s, speed[c], turn.empty() ? 0.0f : turn[c], curve.empty() ? 0.0f : curve[c],
-                                   scale.empty() ? 1.0f : scale[c], p, y, ph, b);
-        pos[c] = p;
-        yaw[c] = y;
-        phase[c] = ph;
-        shown[c] = b;
+      THRONG_JOB_LAMBDA(Index c) {
+        glm::vec3 p = positions[c];
+        float y = yaws[c], ph = phases[c], b = blend_speeds[c];
+        motion::advance_locomotion(blend, step, speeds[c], turn_rates.empty() ? 0.0f : turn_rates[c],
+                                   curvatures.empty() ? 0.0f : curvatures[c], scales.empty() ? 1.0f : scales[c], p, y, ph, b);
+        positions[c] = p;
+        yaws[c] = y;
+        phases[c] = ph;
+        blend_speeds[c] = b;
       },
       256);
 }
 
 void MapInputJob::run() const {
   validate();
-  const auto mp = map_positions;
-  const auto mv = map_velocities;
-  const auto mh = map_headings;
-  const auto pos = positions;
-  const auto yaw = yaws;
-  const auto speed = speeds;
   parallel_for(
       "anim.from_map", character_count(),
-      THRONG_LAMBDA(Index c) {
-        pos[c] = world_from_ground(mp[c]);
-        yaw[c] = motion::wrap_angle(yaw_from_heading(mh[c]));
-        speed[c] = glm::length(mv[c]);
+      THRONG_JOB_LAMBDA(Index c) {
+        positions[c] = world_from_ground(map_positions[c]);
+        yaws[c] = motion::wrap_angle(yaw_from_heading(map_headings[c]));
+        speeds[c] = glm::length(map_velocities[c]);
       },
       1024);
 }
 
+namespace {
+
+// Character c's joints, from its cached cycle slot when the cache holds its
+// blend point, else synthesised; its counters and draw matrices.
+THRONG_HOST_DEVICE inline void pose_character(const PoseJob& job, Index c) {
+  const motion::BlendSpaceView& view = job.blend;
+  const CycleCacheView& cache = job.cache;
+  const std::int32_t J = view.joint_count;
+  const motion::CharacterFrame f = motion::character_frame(view, job.blend_speeds[c], job.phases[c], job.positions[c], job.yaws[c],
+                                                           job.scales.empty() ? 1.0f : job.scales[c]);
+  const std::uint32_t* mask = job.joint_masks.empty() ? nullptr : job.joint_masks.data() + c * mask_word_count(J);
+  const glm::quat* held = motion::held_rotations(view, f.point);
+  glm::vec3* joints_p = job.joint_positions.data() + c * J;
+  glm::quat* joints_r = job.joint_rotations.data() + c * J;
+  const std::int32_t slot = cache.slots.empty() ? -1 : cache.slots[cache_key(f.point, cache.bucket_width, cache.bucket_count)];
+  std::int32_t n = 0;
+  if (slot >= 0) {
+    const motion::CyclePoint cp = motion::cycle_point(cache.frames, f.phase);
+    const glm::quat* cycle = cache.cycles.data() + static_cast<Index>(slot) * cache.frames * J;
+    const CachedJoint e{cycle + static_cast<Index>(cp.f0) * J, cycle + static_cast<Index>(cp.f1) * J, cp.t, f.frame};
+    const float* drop = cache.drops.data() + static_cast<Index>(slot) * cache.frames;
+    const float lowered = f.scale * (drop[cp.f0] + cp.t * (drop[cp.f1] - drop[cp.f0]));
+    n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, lowered, 0.0f), joints_p, joints_r,
+                    f.scale);
+  } else {
+    const motion::PlantedLegs legs = motion::plant_legs(view, f, mask);
+    const SynthesisedJoint e{&view, &f, &legs};
+    n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f),
+                    joints_p, joints_r, f.scale);
+  }
+  if (!job.evaluated.empty()) job.evaluated[c] = n;
+  if (!job.from_cache.empty()) job.from_cache[c] = slot >= 0 ? 1 : 0;
+  if (!job.draw_matrices.empty())
+    for (std::int32_t j = 0; j < J; ++j) job.draw_matrices[c * J + j] = draw_matrix(joints_p[j], joints_r[j], f.scale, job.joint_shapes[j]);
+}
+
+}  // namespace
+
 void PoseJob::run() const {
   validate();
-  const motion::BlendSpaceView view = blend;
-  const std::int32_t J = blend.joint_count;
-  const std::int32_t W = mask_word_count(J);
-  const std::int32_t frames = cache_frames;
-  const float width = bucket_width;
-  const std::int32_t buckets = bucket_count;
-  const auto pos = positions;
-  const auto yaw = yaws;
-  const auto scale = scales;
-  const auto phase = phases;
-  const auto shown = blend_speeds;
-  const auto masks = joint_masks;
-  const auto slots = cache_slots;
-  const auto cycles = cache_cycles;
-  const auto drops = cache_drops;
-  const auto shapes = joint_shapes;
-  const auto out_p = joint_positions;
-  const auto out_r = joint_rotations;
-  const auto out_draw = draw_matrices;
-  const auto out_count = evaluated;
-  const auto out_cache = from_cache;
-  parallel_for(
-      "anim.pose", character_count(),
-      THRONG_LAMBDA(Index c) {
-        const motion::CharacterFrame f =
-            motion::character_frame(view, shown[c], phase[c], pos[c], yaw[c], scale.empty() ? 1.0f : scale[c]);
-        const std::uint32_t* mask = masks.empty() ? nullptr : masks.data() + c * W;
-        const glm::quat* held = motion::held_rotations(view, f.point);
-        glm::vec3* joints_p = out_p.data() + c * J;
-        glm::quat* joints_r = out_r.data() + c * J;
-        const std::int32_t slot = slots.empty() ? -1 : slots[cache_key(f.point, width, buckets)];
-        std::int32_t n = 0;
-        if (slot >= 0) {
-          const motion::CyclePoint cp = motion::cycle_point(frames, f.phase);
-          const glm::quat* cycle = cycles.data() + static_cast<Index>(slot) * frames * J;
-          const CachedJoint e{cycle + static_cast<Index>(cp.f0) * J, cycle + static_cast<Index>(cp.f1) * J, cp.t, f.frame};
-          const float* drop = drops.data() + static_cast<Index>(slot) * frames;
-          const float lowered = f.scale * (drop[cp.f0] + cp.t * (drop[cp.f1] - drop[cp.f0]));
-          n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, lowered, 0.0f), joints_p,
-                          joints_r, f.scale);
-        } else {
-          const motion::PlantedLegs legs = motion::plant_legs(view, f, mask);
-          const SynthesisedJoint e{&view, &f, &legs};
-          n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f),
-                          joints_p, joints_r, f.scale);
-        }
-        if (!out_count.empty()) out_count[c] = n;
-        if (!out_cache.empty()) out_cache[c] = slot >= 0 ? 1 : 0;
-        if (!out_draw.empty())
-          for (std::int32_t j = 0; j < J; ++j) out_draw[c * J + j] = draw_matrix(joints_p[j], joints_r[j], f.scale, shapes[j]);
-      },
-      32);
+  parallel_for("anim.pose", character_count(), THRONG_JOB_LAMBDA(Index c) { pose_character(*this, c); }, 32);
 }
 
 PoseTotals pose_totals(Span<const std::int32_t> evaluated, Span<const std::uint8_t> from_cache) {

@@ -178,15 +178,7 @@ void LocomotionStreams::manage_streams(const std::vector<Index>& counts) {
 std::vector<Index> LocomotionStreams::classify(const Camera* camera) {
   const bool lod = config_.exact_near_camera && camera != nullptr && count_ > 0;
   if (lod) {
-    LodJob job;
-    job.camera = make_camera_view(*camera);
-    job.set_tables(*lod_tables_);
-    job.root_positions = position_.span();
-    job.root_headings = yaw_.span();
-    job.template_spheres = parts_->rest_spheres;
-    job.levels = levels_.span();
-    job.joint_masks = masks_.span();
-    job.run();
+    make_lod_job(*camera, *lod_tables_, *parts_, {position_.span(), yaw_.span(), {}}, levels_.span(), masks_.span()).run();
   }
   StreamBucketJob buckets;
   buckets.blend = quantised_view(tables_.view(), config_.bucket_width, buckets_);
@@ -238,27 +230,22 @@ void LocomotionStreams::synthesise_exact() {
     joint_position_ = Buffer<glm::vec3>(cap * joints_, m);
     joint_rotation_ = Buffer<glm::quat>(cap * joints_, m);
   }
-  ExactGatherJob gather;
-  gather.exact = exact_.span();
-  gather.ranks = exact_rank_.span();
-  gather.positions = position_.span();
-  gather.yaws = yaw_.span();
-  gather.phases = phase_.span();
-  gather.speeds = speed_.span();
-  gather.agents = exact_agents_.span().subspan(0, n);
-  gather.out_positions = exact_position_.span();
-  gather.out_yaws = exact_yaw_.span();
-  gather.out_phases = exact_phase_.span();
-  gather.out_speeds = exact_speed_.span();
+  const ExactGatherJob gather{.exact = exact_.span(),
+                              .ranks = exact_rank_.span(),
+                              .positions = position_.span(),
+                              .yaws = yaw_.span(),
+                              .phases = phase_.span(),
+                              .speeds = speed_.span(),
+                              .agents = exact_agents_.span().subspan(0, n),
+                              .out_positions = exact_position_.span(),
+                              .out_yaws = exact_yaw_.span(),
+                              .out_phases = exact_phase_.span(),
+                              .out_speeds = exact_speed_.span()};
   gather.run();
-  PoseJob pose;
-  pose.blend = tables_.view();
-  pose.positions = exact_position_.span().subspan(0, n);
-  pose.yaws = exact_yaw_.span().subspan(0, n);
-  pose.phases = exact_phase_.span().subspan(0, n);
-  pose.blend_speeds = exact_speed_.span().subspan(0, n);
-  pose.joint_positions = joint_position_.span().subspan(0, n * joints_);
-  pose.joint_rotations = joint_rotation_.span().subspan(0, n * joints_);
+  const PoseJob pose = make_pose_job(tables_.view(),
+                                     {exact_position_.span().subspan(0, n), exact_yaw_.span().subspan(0, n), {},
+                                      exact_phase_.span().subspan(0, n), exact_speed_.span().subspan(0, n)},
+                                     joint_position_.span().subspan(0, n * joints_), joint_rotation_.span().subspan(0, n * joints_));
   pose.run();
   JointPaletteJob palettes;
   palettes.joint_count = joints_;

@@ -127,6 +127,7 @@ struct ExactGatherJob {
   Span<Index> agents;  // out, dense
   Span<glm::vec3> out_positions;
   Span<float> out_yaws, out_phases, out_speeds;
+  void validate() const;  // Error naming the field
   void run() const;
 };
 

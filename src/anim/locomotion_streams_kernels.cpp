@@ -25,30 +25,22 @@ void JointPaletteJob::validate() const {
 
 void JointPaletteJob::run() const {
   validate();
-  const std::int32_t J = joint_count;
-  const auto P = joint_positions;
-  const auto R = joint_rotations;
-  const auto IB = inverse_bind;
-  const auto S = scales;
-  const auto who = agents;
-  const auto offsets = palette_offsets;
-  const auto out = palettes;
-  const Index size = palettes.size();
   parallel_for(
       "anim.joint_palette", character_count(),
-      THRONG_LAMBDA(Index c) {
-        const Index a = who.empty() ? c : who[c];
-        const Index base = offsets.empty() ? a * J : offsets[a];
-        if (base < 0 || base + J > size) return;
-        const float s = S.empty() ? 1.0f : S[c];
+      THRONG_JOB_LAMBDA(Index c) {
+        const std::int32_t J = joint_count;
+        const Index a = agents.empty() ? c : agents[c];
+        const Index base = palette_offsets.empty() ? a * J : palette_offsets[a];
+        if (base < 0 || base + J > palettes.size()) return;
+        const float s = scales.empty() ? 1.0f : scales[c];
         for (std::int32_t j = 0; j < J; ++j) {
-          Mat3x4 m = mat3x4_from(R[c * J + j], P[c * J + j]);
+          Mat3x4 m = mat3x4_from(joint_rotations[c * J + j], joint_positions[c * J + j]);
           if (s != 1.0f) {
             m.r0 = glm::vec4(s * glm::vec3(m.r0), m.r0.w);
             m.r1 = glm::vec4(s * glm::vec3(m.r1), m.r1.w);
             m.r2 = glm::vec4(s * glm::vec3(m.r2), m.r2.w);
           }
-          out[base + j] = m * IB[j];
+          palettes[base + j] = m * inverse_bind[j];
         }
       },
       64);
@@ -67,23 +59,15 @@ void StreamBucketJob::validate() const {
 
 void StreamBucketJob::run() const {
   validate();
-  const motion::BlendSpaceView view = blend;
-  const float width = bucket_width;
-  const std::int32_t buckets = bucket_count;
-  const auto speed = speeds;
-  const auto level = levels;
-  const auto out_exact = exact;
-  const auto out_flags = exact_flags;
-  const auto out_key = keys;
   parallel_for(
       "anim.loco_streams_keys", agent_count(),
-      THRONG_LAMBDA(Index a) {
+      THRONG_JOB_LAMBDA(Index a) {
         bool near = false;
-        if (!level.empty())
-          for (int p = 0; p < kBodyPartCount; ++p) near = near || level[a * kBodyPartCount + p] == 0;
-        out_exact[a] = near ? 1 : 0;
-        out_flags[a] = near ? 1 : 0;
-        out_key[a] = near ? -1 : cache_key(motion::blend_point(view, motion::blend_coordinate(view, speed[a])), width, buckets);
+        if (!levels.empty())
+          for (int p = 0; p < kBodyPartCount; ++p) near = near || levels[a * kBodyPartCount + p] == 0;
+        exact[a] = near ? 1 : 0;
+        exact_flags[a] = near ? 1 : 0;
+        keys[a] = near ? -1 : cache_key(motion::blend_point(blend, motion::blend_coordinate(blend, speeds[a])), bucket_width, bucket_count);
       },
       1024);
 }
@@ -103,78 +87,72 @@ void StreamSelectJob::validate() const {
 
 void StreamSelectJob::run() const {
   validate();
-  const motion::BlendSpaceView view = blend;
-  const motion::BlendSpaceView view_q = quantised;
-  const float step = dt;
-  const auto speed = speeds;
-  const auto is_exact = exact;
-  const auto key = keys;
-  const auto head = key_phases;
-  const auto frames = key_frames;
-  const auto stream = streams;
-  const auto refs = clusters;
-  const std::int32_t stride = cluster_stride;
-  const std::int32_t first = cluster;
-  const auto phase = phases;
-  const auto source = sources;
-  const auto offset = offsets;
-  const auto key_count = key_phases.size();
   parallel_for(
       "anim.loco_streams_select", agent_count(),
-      THRONG_LAMBDA(Index a) {
-        const float v = speed[a];
-        float ph = phase[a];
-        const std::int32_t k = key[a];
-        if (is_exact[a] != 0 || k < 0 || k >= key_count) {  // synthesised: its own cadence at its own speed
-          ph += motion::cycle_rate(view, motion::blend_point(view, motion::blend_coordinate(view, v)), v) * step;
-          phase[a] = motion::wrap_phase(ph);
-          source[a] = kNoSource;
-          offset[a] = 0;
+      THRONG_JOB_LAMBDA(Index a) {
+        const float v = speeds[a];
+        float ph = phases[a];
+        const std::int32_t k = keys[a];
+        if (exact[a] != 0 || k < 0 || k >= key_phases.size()) {  // synthesised: its own cadence at its own speed
+          ph += motion::cycle_rate(blend, motion::blend_point(blend, motion::blend_coordinate(blend, v)), v) * dt;
+          phases[a] = motion::wrap_phase(ph);
+          sources[a] = kNoSource;
+          offsets[a] = 0;
           return;
         }
-        const float F = frames[k];
+        const float F = key_frames[k];
         std::int32_t o = 0;
-        if (refs[a * stride + first].source == k) {
-          o = refs[a * stride + first].offset;  // same bucket: keep the offset, play at the stream's cadence
+        const ClusterRef& ref = clusters[a * cluster_stride + cluster];
+        if (ref.source == k) {
+          o = ref.offset;  // same bucket: keep the offset, play at the stream's cadence
         } else {
           // Joining a stream: advance at the bucket's cadence, then take the
           // slot that shows this phase (the nearest; the phase snaps to it).
-          ph += motion::cycle_rate(view_q, motion::blend_point(view_q, motion::blend_coordinate(view_q, v)), v) * step;
-          o = static_cast<std::int32_t>(glm::floor(motion::wrap_phase(head[k] - ph) * F + 0.5f));
-          const std::int32_t top = stream[k].history - 1;
+          ph += motion::cycle_rate(quantised, motion::blend_point(quantised, motion::blend_coordinate(quantised, v)), v) * dt;
+          o = static_cast<std::int32_t>(glm::floor(motion::wrap_phase(key_phases[k] - ph) * F + 0.5f));
+          const std::int32_t top = streams[k].history - 1;
           o = o < 0 ? 0 : (o > top ? top : o);
         }
-        phase[a] = motion::wrap_phase(head[k] - static_cast<float>(o) / F);
-        source[a] = k;
-        offset[a] = o;
+        phases[a] = motion::wrap_phase(key_phases[k] - static_cast<float>(o) / F);
+        sources[a] = k;
+        offsets[a] = o;
       },
       1024);
 }
 
-void ExactGatherJob::run() const {
-  const auto is_exact = exact;
-  const auto rank = ranks;
-  const auto pos = positions;
-  const auto yaw = yaws;
-  const auto phase = phases;
-  const auto speed = speeds;
-  const auto who = agents;
-  const auto out_pos = out_positions;
-  const auto out_yaw = out_yaws;
-  const auto out_phase = out_phases;
-  const auto out_speed = out_speeds;
+void ExactGatherJob::validate() const {
+  const Index n = exact.size();
+  check_length("ExactGatherJob", "ranks", ranks.size(), n);
+  check_length("ExactGatherJob", "positions", positions.size(), n);
+  check_length("ExactGatherJob", "yaws", yaws.size(), n);
+  check_length("ExactGatherJob", "phases", phases.size(), n);
+  check_length("ExactGatherJob", "speeds", speeds.size(), n);
+  // The outputs may be longer than agents (buffers that keep their largest size).
   const Index room = agents.size();
+  const auto at_least_room = [room](const char* field, Index got) {
+    if (got < room)
+      throw Error("has " + std::to_string(got) + " elements, fewer than agents (" + std::to_string(room) + ")",
+                  at_field(std::string("ExactGatherJob.") + field));
+  };
+  at_least_room("out_positions", out_positions.size());
+  at_least_room("out_yaws", out_yaws.size());
+  at_least_room("out_phases", out_phases.size());
+  at_least_room("out_speeds", out_speeds.size());
+}
+
+void ExactGatherJob::run() const {
+  validate();
   parallel_for(
       "anim.loco_streams_gather", exact.size(),
-      THRONG_LAMBDA(Index a) {
-        if (is_exact[a] == 0) return;
-        const Index r = rank[a];
-        if (r < 0 || r >= room) return;
-        who[r] = a;
-        out_pos[r] = pos[a];
-        out_yaw[r] = yaw[a];
-        out_phase[r] = phase[a];
-        out_speed[r] = speed[a];
+      THRONG_JOB_LAMBDA(Index a) {
+        if (exact[a] == 0) return;
+        const Index r = ranks[a];
+        if (r < 0 || r >= agents.size()) return;
+        agents[r] = a;
+        out_positions[r] = positions[a];
+        out_yaws[r] = yaws[a];
+        out_phases[r] = phases[a];
+        out_speeds[r] = speeds[a];
       },
       1024);
 }
@@ -187,15 +165,7 @@ SharingError LocomotionStreams::sharing_error() const {
   const Memory m = current_memory();
   Buffer<glm::vec3> reference(count_ * joints_, m);
   Buffer<glm::quat> rotations(count_ * joints_, m);
-  PoseJob pose;
-  pose.blend = tables_.view();
-  pose.positions = position_.span();
-  pose.yaws = yaw_.span();
-  pose.phases = phase_.span();
-  pose.blend_speeds = speed_.span();
-  pose.joint_positions = reference.span();
-  pose.joint_rotations = rotations.span();
-  pose.run();
+  make_pose_job(tables_.view(), {position_.span(), yaw_.span(), {}, phase_.span(), speed_.span()}, reference.span(), rotations.span()).run();
   Buffer<float> errors(count_, m);
   const std::int32_t J = joints_;
   const auto exact = exact_.span();

@@ -172,6 +172,18 @@ void LodSpheresJob::validate() const {
   }
 }
 
+LodJob make_lod_job(const Camera& camera, const LodTables& tables, const BodyParts& parts, const CharacterRoots& roots,
+                    Span<std::uint8_t> levels, Span<std::uint32_t> joint_masks) {
+  LodJob job;
+  job.camera = make_camera_view(camera);
+  job.roots = roots;
+  job.template_spheres = parts.rest_spheres;
+  job.set_tables(tables);
+  job.levels = levels;
+  job.joint_masks = joint_masks;
+  return job;
+}
+
 void LodJob::set_tables(const LodTables& tables) {
   thresholds = tables.thresholds.span();
   part_masks = tables.masks.span();
@@ -193,13 +205,13 @@ void LodJob::validate() const {
   const Index n = character_count();
   check_length("LodJob", "joint_masks", joint_masks.size(), n * mask_words);
   if (!coverage.empty()) check_length("LodJob", "coverage", coverage.size(), n * kBodyPartCount);
-  const bool from_roots = !root_positions.empty() || !root_headings.empty();
+  const bool from_roots = !roots.positions.empty() || !roots.headings.empty();
   if (from_roots == !spheres.empty())
-    throw Error("give either spheres or root_positions and root_headings, not both or neither", at_field("LodJob.spheres"));
+    throw Error("give either spheres or roots.positions and roots.headings, not both or neither", at_field("LodJob.spheres"));
   if (from_roots) {
-    check_length("LodJob", "root_positions", root_positions.size(), n);
-    check_length("LodJob", "root_headings", root_headings.size(), n);
-    if (!root_scales.empty()) check_length("LodJob", "root_scales", root_scales.size(), n);
+    check_length("LodJob", "roots.positions", roots.positions.size(), n);
+    check_length("LodJob", "roots.headings", roots.headings.size(), n);
+    if (!roots.scales.empty()) check_length("LodJob", "roots.scales", roots.scales.size(), n);
   } else {
     check_length("LodJob", "spheres", spheres.size(), n * kBodyPartCount);
   }

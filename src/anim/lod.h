@@ -114,6 +114,13 @@ struct LodSpheresJob {
   void run() const;       // parallel_for "anim.lod_spheres"
 };
 
+// Characters standing at their roots, as LodJob places their spheres.
+struct CharacterRoots {
+  Span<const glm::vec3> positions;  // on the ground
+  Span<const float> headings;       // radians about +Y
+  Span<const float> scales;         // or empty for 1
+};
+
 // Levels and joint masks of N characters for one camera.
 struct LodJob {
   CameraView camera;
@@ -121,9 +128,7 @@ struct LodJob {
   Span<const glm::vec4> spheres;  // characters * 5: centre xyz, radius w
   // ... or placed from each character's root transform and the skeleton's
   // rest spheres: centre = position + scale * Ry(heading) * template.xyz.
-  Span<const glm::vec3> root_positions;  // characters, on the ground
-  Span<const float> root_headings;       // characters, radians about +Y
-  Span<const float> root_scales;         // characters, or empty for 1
+  CharacterRoots roots;
   std::array<glm::vec4, kBodyPartCount> template_spheres{};  // BodyParts::rest_spheres
 
   // Tables (set_tables), in current_memory().
@@ -142,6 +147,12 @@ struct LodJob {
   void validate() const;
   void run() const;  // parallel_for "anim.lod"
 };
+
+// The LodJob of characters at `roots` with a rig's body parts and level
+// tables under `camera`, writing levels and joint masks: what each pose
+// source of the locomotion layer runs once a frame.
+LodJob make_lod_job(const Camera& camera, const LodTables& tables, const BodyParts& parts, const CharacterRoots& roots,
+                    Span<std::uint8_t> levels, Span<std::uint32_t> joint_masks);
 
 // One frame's statistics over N characters.
 struct LodHistogram {

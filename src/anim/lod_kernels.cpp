@@ -24,77 +24,69 @@ void LodSpheresJob::run() const {
   validate();
   Anchors anchor_table{};
   for (int p = 0; p < kBodyPartCount; ++p) anchor_table.a[p] = anchors[static_cast<std::size_t>(p)];
-  const std::int32_t J = joint_count;
-  const auto positions = joint_positions;
-  const auto scale = scales;
-  const auto out = spheres;
   parallel_for(
       "anim.lod_spheres", character_count(),
-      THRONG_LAMBDA(Index c) {
-        const glm::vec3* joints = positions.data() + c * J;
-        const float s = scale.empty() ? 1.0f : scale[c];
+      THRONG_JOB_LAMBDA(Index c) {
+        const glm::vec3* joints = joint_positions.data() + c * joint_count;
+        const float s = scales.empty() ? 1.0f : scales[c];
         for (int p = 0; p < kBodyPartCount; ++p)
-          out[c * kBodyPartCount + p] = glm::vec4(anchor_centre(anchor_table.a[p], joints), s * anchor_table.a[p].radius);
+          spheres[c * kBodyPartCount + p] = glm::vec4(anchor_centre(anchor_table.a[p], joints), s * anchor_table.a[p].radius);
       },
       256);
 }
+
+namespace {
+
+// A character's root transform: rotation about +Y by the heading (as its
+// cosine and sine), then scale, then translation to the root.
+struct RootFrame {
+  float cos_h = 1.0f, sin_h = 0.0f, scale = 1.0f;
+  glm::vec3 root{0.0f};
+  THRONG_HOST_DEVICE glm::vec4 place(glm::vec4 t) const {
+    const glm::vec3 turned(cos_h * t.x + sin_h * t.z, t.y, -sin_h * t.x + cos_h * t.z);
+    return glm::vec4(root + scale * turned, scale * t.w);
+  }
+};
+
+// Character c's level per body part (from each part's sphere, given or
+// placed from its root, its screen coverage and thresholds), then its joint mask: the OR of its parts' masks at their
+// levels (parts partition the joints).
+THRONG_HOST_DEVICE inline void classify_character(const LodJob& job, const Templates& tmpl, Index c) {
+  const std::int32_t L = job.level_count;
+  const std::int32_t W = job.mask_words;
+  const bool from_roots = job.spheres.empty();
+  RootFrame frame;
+  if (from_roots) {
+    frame.cos_h = glm::cos(job.roots.headings[c]);
+    frame.sin_h = glm::sin(job.roots.headings[c]);
+    frame.scale = job.roots.scales.empty() ? 1.0f : job.roots.scales[c];
+    frame.root = job.roots.positions[c];
+  }
+  int level_of[kBodyPartCount];
+  for (int p = 0; p < kBodyPartCount; ++p) {
+    const glm::vec4 s = from_roots ? frame.place(tmpl.s[p]) : job.spheres[c * kBodyPartCount + p];
+    const float area = sphere_pixel_coverage(to_camera_space(job.camera, glm::vec3(s)), s.w, job.camera, job.cull_outside_view);
+    const float* part_thresholds = job.thresholds.data() + p * (L - 1);
+    int level = 0;
+    while (level < L - 1 && !(area >= part_thresholds[level])) ++level;
+    level_of[p] = level;
+    job.levels[c * kBodyPartCount + p] = static_cast<std::uint8_t>(level);
+    if (!job.coverage.empty()) job.coverage[c * kBodyPartCount + p] = area;
+  }
+  for (std::int32_t w = 0; w < W; ++w) {
+    std::uint32_t bits = 0u;
+    for (int p = 0; p < kBodyPartCount; ++p) bits |= job.part_masks[(static_cast<Index>(p) * L + level_of[p]) * W + w];
+    job.joint_masks[c * W + w] = bits;
+  }
+}
+
+}  // namespace
 
 void LodJob::run() const {
   validate();
   Templates tmpl{};
   for (int p = 0; p < kBodyPartCount; ++p) tmpl.s[p] = template_spheres[static_cast<std::size_t>(p)];
-  const CameraView cam = camera;
-  const bool from_roots = spheres.empty();
-  const bool cull = cull_outside_view;
-  const std::int32_t L = level_count;
-  const std::int32_t W = mask_words;
-  const auto given = spheres;
-  const auto positions = root_positions;
-  const auto headings = root_headings;
-  const auto scales = root_scales;
-  const auto thr = thresholds;
-  const auto masks = part_masks;
-  const auto out_levels = levels;
-  const auto out_masks = joint_masks;
-  const auto out_coverage = coverage;
-  parallel_for(
-      "anim.lod", character_count(),
-      THRONG_LAMBDA(Index c) {
-        float cos_h = 1.0f, sin_h = 0.0f, scale = 1.0f;
-        glm::vec3 root(0.0f);
-        if (from_roots) {
-          cos_h = glm::cos(headings[c]);
-          sin_h = glm::sin(headings[c]);
-          scale = scales.empty() ? 1.0f : scales[c];
-          root = positions[c];
-        }
-        int level_of[kBodyPartCount];
-        for (int p = 0; p < kBodyPartCount; ++p) {
-          glm::vec4 s;
-          if (from_roots) {
-            // Rotation about +Y by the heading, then scale, then translation.
-            const glm::vec4 t = tmpl.s[p];
-            const glm::vec3 turned(cos_h * t.x + sin_h * t.z, t.y, -sin_h * t.x + cos_h * t.z);
-            s = glm::vec4(root + scale * turned, scale * t.w);
-          } else {
-            s = given[c * kBodyPartCount + p];
-          }
-          const float area = sphere_pixel_coverage(to_camera_space(cam, glm::vec3(s)), s.w, cam, cull);
-          const float* part_thresholds = thr.data() + p * (L - 1);
-          int level = 0;
-          while (level < L - 1 && !(area >= part_thresholds[level])) ++level;
-          level_of[p] = level;
-          out_levels[c * kBodyPartCount + p] = static_cast<std::uint8_t>(level);
-          if (!out_coverage.empty()) out_coverage[c * kBodyPartCount + p] = area;
-        }
-        // Parts partition the joints, so the union is a plain OR.
-        for (std::int32_t w = 0; w < W; ++w) {
-          std::uint32_t bits = 0u;
-          for (int p = 0; p < kBodyPartCount; ++p) bits |= masks[(static_cast<Index>(p) * L + level_of[p]) * W + w];
-          out_masks[c * W + w] = bits;
-        }
-      },
-      256);
+  parallel_for("anim.lod", character_count(), THRONG_JOB_LAMBDA(Index c) { classify_character(*this, tmpl, c); }, 256);
 }
 
 LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint32_t> joint_masks, std::int32_t level_count,

@@ -36,28 +36,18 @@ void SkinJob::validate() const {
 void SkinJob::run() const {
   validate();
   const Index V = positions.size();
-  const auto P = positions;
-  const auto N = normals;
-  const auto Jn = joints;
-  const auto W = weights;
-  const auto pal = palettes;
-  const auto offsets = palette_offsets;
-  const auto outP = out_positions;
-  const auto outN = out_normals;
-  const bool normals_out = !out_normals.empty();
-  const std::int32_t J = joint_count;
-  const Index palette_size = palettes.size();
   parallel_for(
       "anim.skin", character_count() * V,
-      THRONG_LAMBDA(Index i) {
+      THRONG_JOB_LAMBDA(Index i) {
         const Index c = i / V;
         const Index v = i - c * V;
-        const Index base = offsets[c];
+        const Index base = palette_offsets[c];
         glm::vec3 p(0.0f), n(0.0f);
         // A palette that would run past the end leaves the vertex at the origin.
-        if (base >= 0 && base + J <= palette_size) skin_vertex(pal.data() + base, P[v], N[v], Jn[v], W[v], p, n);
-        outP[i] = p;
-        if (normals_out) outN[i] = n;
+        if (base >= 0 && base + joint_count <= palettes.size())
+          skin_vertex(palettes.data() + base, positions[v], normals[v], joints[v], weights[v], p, n);
+        out_positions[i] = p;
+        if (!out_normals.empty()) out_normals[i] = n;
       },
       256);
 }

@@ -453,15 +453,14 @@ void StreamCrowd::step() {
   streams_->step(frame_);
   uniques_->step(frame_);
 
-  StreamEventsJob events;
-  events.streams = streams_->views();
-  events.uniques = uniques_->views();
-  events.rigs = tables_->rigs.span();
-  events.agent_rigs = agent_rig_.span();
-  events.clusters = clusters_.span();
-  events.cluster_stride = cluster_stride_;
-  events.cluster_event_filter = event_filter_;
-  events.out_events = agent_events_.span();
+  const StreamEventsJob events{.streams = streams_->views(),
+                               .uniques = uniques_->views(),
+                               .rigs = tables_->rigs.span(),
+                               .agent_rigs = agent_rig_.span(),
+                               .clusters = clusters_.span(),
+                               .cluster_stride = cluster_stride_,
+                               .cluster_event_filter = event_filter_,
+                               .out_events = agent_events_.span()};
   events.run();
 
   // Unique animations that should hand back to a stream, arriving as they end.
@@ -481,18 +480,17 @@ void StreamCrowd::step() {
 Index StreamCrowd::retarget(Span<const std::int32_t> sources, Span<const std::int32_t> offsets, float blend_seconds, std::uint32_t cluster_mask) {
   if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f)) throw Error("must be in [0, 1e4) seconds", at_field("retarget.blend"));
   if (retarget_changed_.size() != agent_count_) retarget_changed_ = Buffer<std::uint8_t>(agent_count_, memory_);
-  StreamRetargetJob job;
-  job.sources = sources;
-  job.offsets = offsets;
-  job.streams = streams_->views();
-  job.rigs = tables_->rigs.span();
-  job.agent_rigs = agent_rig_.span();
-  job.clusters = clusters_.span();
-  job.cluster_stride = cluster_stride_;
-  job.cluster_mask = cluster_mask;
-  job.frame = frame_;
-  job.blend_frames = blend_seconds * config_.frame_rate;
-  job.changed = retarget_changed_.span();
+  const StreamRetargetJob job{.sources = sources,
+                              .offsets = offsets,
+                              .streams = streams_->views(),
+                              .rigs = tables_->rigs.span(),
+                              .agent_rigs = agent_rig_.span(),
+                              .clusters = clusters_.span(),
+                              .cluster_stride = cluster_stride_,
+                              .cluster_mask = cluster_mask,
+                              .frame = frame_,
+                              .blend_frames = blend_seconds * config_.frame_rate,
+                              .changed = retarget_changed_.span()};
   job.run();
   return count_nonzero(retarget_changed_.span());
 }

@@ -110,6 +110,7 @@ struct StreamCommandJob {
   Span<ClusterRef> clusters;
   std::int32_t cluster_stride = 1;
   std::int32_t frame = 0;
+  void validate() const;  // Error naming the field
   void run() const;
 };
 
@@ -157,6 +158,7 @@ struct StreamEventsJob {
   std::int32_t cluster_stride = 1;
   std::array<EventMask, kMaxClusters> cluster_event_filter{};
   Span<EventMask> out_events;  // per agent
+  void validate() const;  // Error naming the field
   void run() const;
 };
 

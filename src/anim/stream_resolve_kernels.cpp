@@ -11,10 +11,13 @@ namespace {
 
 // Where one cluster's joints come from this frame.
 struct SlotRead {
-  const glm::quat* rotations = nullptr;  // null: the rest pose (identity rotations)
-  const Mat3x4* skinning = nullptr;      // null: the rest pose (identity matrices)
-  glm::vec3 root{0.0f};
-  std::int32_t offset = -1;              // effective offset read, -1 for none
+  const glm::quat* rotations;  // null: the rest pose (identity rotations)
+  const Mat3x4* skinning;      // null: the rest pose (identity matrices)
+  glm::vec3 root;
+  std::int32_t offset;         // effective offset read, -1 for none
+  // Spelled out: with default member initialisers, nvcc 13 stops with an
+  // internal error ("Invalid bitcast") on the arrays of AgentPose below.
+  THRONG_HOST_DEVICE SlotRead() : rotations(nullptr), skinning(nullptr), root(0.0f), offset(-1) {}
 };
 
 // The view of a source id, or null for none (or an id out of range).
@@ -49,24 +52,24 @@ struct EventFilter {
 
 // ---- commands -----------------------------------------------------------------
 
+void StreamCommandJob::validate() const {
+  if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamCommandJob.cluster_stride"));
+  if (groups.empty()) throw Error("needs at least one entry (the end of the last group)", at_field("StreamCommandJob.groups"));
+}
+
 void StreamCommandJob::run() const {
-  const auto cmds = commands;
-  const auto grp = groups;
-  const auto refs = clusters;
-  const std::int32_t stride = cluster_stride;
-  const std::int32_t now = frame;
-  const Index group_count = groups.size() - 1;
+  validate();
   parallel_for(
-      "anim.stream_commands", group_count,
-      THRONG_LAMBDA(Index g) {
-        for (Index k = grp[g]; k < grp[g + 1]; ++k) {
-          const ClusterCommand& c = cmds[k];
-          ClusterRef* agent = refs.data() + c.agent * stride;
+      "anim.stream_commands", groups.size() - 1,
+      THRONG_JOB_LAMBDA(Index g) {
+        for (Index k = groups[g]; k < groups[g + 1]; ++k) {
+          const ClusterCommand& c = commands[k];
+          ClusterRef* agent = clusters.data() + c.agent * cluster_stride;
           ClusterRef& ref = agent[c.cluster];
           std::int32_t offset = c.offset;
           if (offset < 0) {
             offset = c.fallback_offset;
-            for (std::int32_t o = 0; o < stride; ++o)
+            for (std::int32_t o = 0; o < cluster_stride; ++o)
               if (o != c.cluster && agent[o].source == c.source) {
                 offset = agent[o].offset;
                 break;
@@ -75,7 +78,7 @@ void StreamCommandJob::run() const {
           if (c.transition != 0 && c.blend_frames > 0.0f) {
             ref.from_source = ref.source;
             ref.from_offset = ref.offset;
-            ref.t0 = now;
+            ref.t0 = frame;
             ref.blend_frames = c.blend_frames;
           } else {
             ref.from_source = kNoSource;
@@ -92,6 +95,44 @@ void StreamCommandJob::run() const {
 
 // ---- batch retargeting ------------------------------------------------------------
 
+namespace {
+
+// Points agent a's clusters (those in the job's mask, of the first
+// `count`, never a unique source's) at (source, offset), starting a
+// transition where a cluster changes source; returns 1 if one changed.
+THRONG_HOST_DEVICE inline std::uint8_t retarget_clusters(const StreamRetargetJob& job, Index a, std::int32_t source, std::int32_t offset,
+                                                         std::int32_t count) {
+  std::uint8_t changed = 0;
+  const std::int32_t stride = job.cluster_stride;
+  count = count < stride ? count : stride;
+  for (std::int32_t c = 0; c < count; ++c) {
+    if (((job.cluster_mask >> c) & 1u) == 0u) continue;
+    ClusterRef& ref = job.clusters[a * stride + c];
+    if (is_unique_source(ref.source)) continue;
+    if (ref.source == source) {
+      ref.offset = offset;
+      continue;
+    }
+    if (source >= 0 && ref.source >= 0 && job.blend_frames > 0.0f) {
+      ref.from_source = ref.source;
+      ref.from_offset = ref.offset;
+      ref.t0 = job.frame;
+      ref.blend_frames = job.blend_frames;
+    } else {
+      ref.from_source = kNoSource;
+      ref.from_offset = 0;
+      ref.blend_frames = 0.0f;
+    }
+    ref.source = source;
+    ref.offset = offset;
+    ref.last_read = kNeverRead;
+    changed = 1;
+  }
+  return changed;
+}
+
+}  // namespace
+
 void StreamRetargetJob::validate() const {
   const Index n = agent_count();
   if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamRetargetJob.cluster_stride"));
@@ -104,85 +145,50 @@ void StreamRetargetJob::validate() const {
 
 void StreamRetargetJob::run() const {
   validate();
-  const auto want = sources;
-  const auto want_offset = offsets;
-  const auto S = streams;
-  const auto R = rigs;
-  const auto AR = agent_rigs;
-  const auto refs = clusters;
-  const auto out_changed = changed;
-  const std::int32_t stride = cluster_stride;
-  const std::uint32_t mask = cluster_mask;
-  const std::int32_t now = frame;
-  const float blend = blend_frames;
   parallel_for(
       "anim.stream_retarget", agent_count(),
-      THRONG_LAMBDA(Index a) {
+      THRONG_JOB_LAMBDA(Index a) {
         std::uint8_t changed_here = 0;
-        const std::int32_t source = want[a];
-        const std::int32_t rig = AR[a];
-        bool valid = source >= kNoSource && rig >= 0 && rig < R.size();
+        const std::int32_t source = sources[a];
+        const std::int32_t rig = agent_rigs[a];
+        bool valid = source >= kNoSource && rig >= 0 && rig < rigs.size();
         std::int32_t offset = 0;
         if (valid && source >= 0) {
-          valid = source < S.size() && S[source].rig == rig;
+          valid = source < streams.size() && streams[source].rig == rig;
           if (valid) {
-            const std::int32_t top = S[source].history - 1;
-            offset = want_offset[a];
+            const std::int32_t top = streams[source].history - 1;
+            offset = offsets[a];
             offset = offset < 0 ? 0 : (offset > top ? top : offset);
           }
         }
-        if (valid) {
-          const std::int32_t count = R[rig].cluster_count < stride ? R[rig].cluster_count : stride;
-          for (std::int32_t c = 0; c < count; ++c) {
-            if (((mask >> c) & 1u) == 0u) continue;
-            ClusterRef& ref = refs[a * stride + c];
-            if (is_unique_source(ref.source)) continue;
-            if (ref.source == source) {
-              ref.offset = offset;
-              continue;
-            }
-            if (source >= 0 && ref.source >= 0 && blend > 0.0f) {
-              ref.from_source = ref.source;
-              ref.from_offset = ref.offset;
-              ref.t0 = now;
-              ref.blend_frames = blend;
-            } else {
-              ref.from_source = kNoSource;
-              ref.from_offset = 0;
-              ref.blend_frames = 0.0f;
-            }
-            ref.source = source;
-            ref.offset = offset;
-            ref.last_read = kNeverRead;
-            changed_here = 1;
-          }
-        }
-        if (!out_changed.empty()) out_changed[a] = changed_here;
+        if (valid) changed_here = retarget_clusters(*this, a, source, offset, rigs[rig].cluster_count);
+        if (!changed.empty()) changed[a] = changed_here;
       },
       1024);
 }
 
 // ---- events ---------------------------------------------------------------------
 
+void StreamEventsJob::validate() const {
+  const Index n = agent_rigs.size();
+  if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamEventsJob.cluster_stride"));
+  check_length("StreamEventsJob", "clusters", clusters.size(), n * cluster_stride);
+  check_length("StreamEventsJob", "out_events", out_events.size(), n);
+}
+
 void StreamEventsJob::run() const {
-  const auto S = streams;
-  const auto U = uniques;
-  const auto R = rigs;
-  const auto AR = agent_rigs;
-  const auto refs = clusters;
-  const auto out = out_events;
-  const std::int32_t stride = cluster_stride;
+  validate();
   EventFilter filter;
   for (std::int32_t c = 0; c < kMaxClusters; ++c) filter.allowed[c] = cluster_event_filter[static_cast<std::size_t>(c)];
   parallel_for(
       "anim.stream_events", agent_rigs.size(),
-      THRONG_LAMBDA(Index a) {
-        const std::int32_t rig = AR[a];
-        const std::int32_t count = rig >= 0 && rig < R.size() ? R[rig].cluster_count : 0;
+      THRONG_JOB_LAMBDA(Index a) {
+        const std::int32_t rig = agent_rigs[a];
+        const std::int32_t count = rig >= 0 && rig < rigs.size() ? rigs[rig].cluster_count : 0;
         EventMask mask = 0;
-        for (std::int32_t c = 0; c < count && c < stride; ++c) {
-          ClusterRef& ref = refs[a * stride + c];
-          const SourceView* v = find_source(S, U, ref.source);
+        for (std::int32_t c = 0; c < count && c < cluster_stride; ++c) {
+          ClusterRef& ref = clusters[a * cluster_stride + c];
+          const SourceView* v = find_source(streams, uniques, ref.source);
           if (v == nullptr || v->newest < 0) continue;
           const std::int32_t read = v->newest - effective_offset(*v, ref.offset);
           if (ref.last_read != kNeverRead && read > ref.last_read) {
@@ -200,7 +206,7 @@ void StreamEventsJob::run() const {
           }
           if (ref.last_read == kNeverRead || read > ref.last_read) ref.last_read = read;
         }
-        out[a] = mask;
+        out_events[a] = mask;
       },
       256);
 }
@@ -224,153 +230,185 @@ void StreamResolveJob::validate() const {
   check_length("StreamResolveJob", "tables.bind_positions", tables.bind_positions.size(), tables.parents.size());
 }
 
+namespace {
+
+// One agent as the resolve kernel poses it: its rig, where its palette
+// starts, its world transform (yaw about +Y, then translation), and per
+// cluster the target and transition source slots, the transition weight
+// and whether the cluster is culled.
+struct AgentPose {
+  RigView rig;
+  Index base = 0;
+  std::int32_t clusters = 0;
+  glm::quat world_q;
+  glm::vec3 world_t;
+  SlotRead to[kMaxClusters], from[kMaxClusters];
+  float alpha[kMaxClusters];
+  bool culled[kMaxClusters];
+
+  // Cluster of rig-local joint j, the first one for a cluster beyond the stride.
+  THRONG_HOST_DEVICE std::int32_t cluster_of(const RigTablesView& T, std::int32_t j) const {
+    const std::int32_t c = T.joint_cluster[rig.joint_base + j];
+    return c < clusters ? c : 0;
+  }
+};
+
+// Reads agent a's cluster slots and world transform into `pose`; writes
+// the offsets read when the job asks for them.
+THRONG_HOST_DEVICE inline void read_agent(const StreamResolveJob& job, Index a, AgentPose& pose) {
+  const RigView& rig = pose.rig;
+  const std::int32_t stride = job.cluster_stride;
+  pose.clusters = rig.cluster_count < stride ? rig.cluster_count : stride;
+  for (std::int32_t c = 0; c < pose.clusters; ++c) {
+    const ClusterRef& ref = job.clusters[a * stride + c];
+    pose.to[c] = read_source(job.streams, job.uniques, ref.source, ref.offset, rig.joint_count, rig.rest_root);
+    pose.alpha[c] = transition_alpha(ref, job.frame);
+    if (pose.alpha[c] < 1.0f)
+      pose.from[c] = read_source(job.streams, job.uniques, ref.from_source, ref.from_offset, rig.joint_count, rig.rest_root);
+    pose.culled[c] = (ref.flags & kClusterCulled) != 0u;
+    if (!job.read_offsets.empty()) job.read_offsets[a * stride + c] = pose.to[c].offset;
+  }
+  pose.world_q = job.yaws.empty() ? glm::quat(1.0f, 0.0f, 0.0f, 0.0f) : glm::angleAxis(job.yaws[a], glm::vec3(0.0f, 1.0f, 0.0f));
+  pose.world_t = job.positions.empty() ? glm::vec3(0.0f) : job.positions[a];
+}
+
+// The fast path: each joint's palette entry is its segment's transform
+// times the skinning matrix of its source slot.
+THRONG_HOST_DEVICE inline void pose_from_skinning(const StreamResolveJob& job, const AgentPose& pose) {
+  const RigTablesView& T = job.tables;
+  const RigView& rig = pose.rig;
+  Mat3x4 W[kMaxSegments];
+  for (std::int32_t j = 0; j < rig.joint_count; ++j) {
+    const Index tj = rig.joint_base + j;
+    const std::int32_t c = pose.cluster_of(T, j);
+    const std::int32_t seg = T.joint_segment[tj];
+    const Mat3x4* slot = pose.to[c].skinning;
+    const std::int32_t p = T.parents[tj];
+    if (p < 0) {
+      W[seg] = mat3x4_from(pose.world_q, pose.world_t);
+    } else if (T.joint_cluster[rig.joint_base + p] != T.joint_cluster[tj]) {
+      const Mat3x4 hooked = job.palettes[pose.base + p] * T.segment_hooks[rig.segment_base + seg];
+      W[seg] = slot != nullptr ? hooked * inverse_rigid(slot[p]) : hooked;
+    }
+    job.palettes[pose.base + j] = slot != nullptr ? W[seg] * slot[j] : W[seg];
+  }
+}
+
+// Turns world rotation R of a joint at P towards o's target about o's aim
+// axis, by at most o.max_angle, weighted.
+THRONG_HOST_DEVICE inline void look_at(const BoneOverride& o, glm::quat& R, glm::vec3 P) {
+  const glm::vec3 f = glm::normalize(R * o.aim_axis);
+  glm::vec3 d = o.target - P;
+  const float dl = glm::length(d);
+  if (!(dl > 1e-6f)) return;
+  d = d / dl;
+  glm::vec3 axis = glm::cross(f, d);
+  const float s = glm::length(axis);
+  if (!(s > 1e-6f)) return;
+  float cosang = glm::dot(f, d);
+  cosang = cosang < -1.0f ? -1.0f : (cosang > 1.0f ? 1.0f : cosang);
+  float angle = glm::acos(cosang);
+  angle = (angle < o.max_angle ? angle : o.max_angle) * o.weight;
+  R = glm::normalize(glm::angleAxis(angle, axis / s) * R);
+}
+
+// Joint j's local rotation: its cluster's slot, SLERPed from the
+// transition source by alpha, then a rotation override o (or null).
+THRONG_HOST_DEVICE inline glm::quat local_rotation(const AgentPose& pose, std::int32_t c, std::int32_t j, const BoneOverride* o) {
+  glm::quat local = pose.to[c].rotations != nullptr ? pose.to[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  if (pose.alpha[c] < 1.0f) {
+    const glm::quat src = pose.from[c].rotations != nullptr ? pose.from[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    local = glm::slerp(src, local, pose.alpha[c]);
+  }
+  if (o != nullptr && o->kind == OverrideKind::Rotation) local = glm::slerp(local, o->rotation, o->weight);
+  return local;
+}
+
+// The blended path: per joint the local rotation (local_rotation), forward
+// kinematics through the cluster hooks, look-at overrides, times the
+// agent's world transform and the inverse bind matrix. Overrides
+// [ov, ov_end) are sorted by joint.
+THRONG_HOST_DEVICE inline void pose_blended(const StreamResolveJob& job, const AgentPose& pose, Index ov, Index ov_end) {
+  const RigTablesView& T = job.tables;
+  const RigView& rig = pose.rig;
+  glm::quat R[kMaxRigJoints];
+  glm::vec3 P[kMaxRigJoints];
+  for (std::int32_t j = 0; j < rig.joint_count; ++j) {
+    const Index tj = rig.joint_base + j;
+    const std::int32_t c = pose.cluster_of(T, j);
+    while (ov < ov_end && job.overrides[ov].joint < j) ++ov;
+    const BoneOverride* o = ov < ov_end && job.overrides[ov].joint == j ? &job.overrides[ov] : nullptr;
+    const glm::quat local = local_rotation(pose, c, j, o);
+    const std::int32_t p = T.parents[tj];
+    if (p < 0) {
+      glm::vec3 root = pose.to[c].root;
+      if (pose.alpha[c] < 1.0f) root = glm::mix(pose.from[c].root, root, pose.alpha[c]);
+      R[j] = pose.world_q * local;
+      P[j] = pose.world_t + pose.world_q * root;
+    } else {
+      glm::quat pq = R[p];
+      glm::vec3 pt = P[p];
+      if (T.joint_cluster[rig.joint_base + p] != T.joint_cluster[tj]) {
+        // Entering another cluster: hang it from its hook.
+        const Index h = rig.cluster_base + c;
+        pt = pt + pq * T.hook_translations[h];
+        pq = pq * T.hook_rotations[h];
+      }
+      R[j] = pq * local;
+      P[j] = pt + pq * T.offsets[tj];
+    }
+    if (o != nullptr && o->kind == OverrideKind::LookAt) look_at(*o, R[j], P[j]);
+    job.palettes[pose.base + j] = mat3x4_from(R[j], P[j]) * T.inverse_bind[tj];
+  }
+}
+
+// Culled clusters' joints collapse onto their hook, children first so that
+// every hook read is still posed.
+THRONG_HOST_DEVICE inline void collapse_culled(const StreamResolveJob& job, const AgentPose& pose) {
+  bool any_culled = false;
+  for (std::int32_t c = 0; c < pose.clusters; ++c) any_culled = any_culled || pose.culled[c];
+  if (!any_culled) return;
+  const RigTablesView& T = job.tables;
+  const RigView& rig = pose.rig;
+  for (std::int32_t j = rig.joint_count - 1; j >= 0; --j) {
+    const std::int32_t c = pose.cluster_of(T, j);
+    if (!pose.culled[c]) continue;
+    std::int32_t hook = T.hook_joints[rig.cluster_base + c];
+    hook = hook >= 0 ? hook : 0;
+    job.palettes[pose.base + j] = collapse_to(transform_point(job.palettes[pose.base + hook], T.bind_positions[rig.joint_base + hook]));
+  }
+}
+
+// Agent a's palette, unless it is skipped or its rig or palette range is invalid.
+THRONG_HOST_DEVICE inline void resolve_agent(const StreamResolveJob& job, Index a) {
+  if (!job.skip.empty() && job.skip[a] != 0) return;
+  const std::int32_t r = job.agent_rigs[a];
+  if (r < 0 || r >= job.tables.rigs.size()) return;
+  AgentPose pose;
+  pose.rig = job.tables.rigs[r];
+  pose.base = job.palette_offsets[a];
+  if (pose.rig.joint_count > kMaxRigJoints || pose.base < 0 || pose.base + pose.rig.joint_count > job.palettes.size()) return;
+  read_agent(job, a, pose);
+  Index ov = 0, ov_end = 0;
+  if (!job.override_begin.empty()) {
+    ov = job.override_begin[a];
+    ov_end = job.override_begin[a + 1];
+  }
+  bool fast = ov == ov_end;
+  for (std::int32_t c = 0; c < pose.clusters; ++c) fast = fast && pose.alpha[c] >= 1.0f;
+  if (fast) {
+    pose_from_skinning(job, pose);
+  } else {
+    pose_blended(job, pose, ov, ov_end);
+  }
+  collapse_culled(job, pose);
+}
+
+}  // namespace
+
 void StreamResolveJob::run() const {
   validate();
-  const RigTablesView T = tables;
-  const auto S = streams;
-  const auto U = uniques;
-  const auto AR = agent_rigs;
-  const auto PO = palette_offsets;
-  const auto refs = clusters;
-  const std::int32_t stride = cluster_stride;
-  const auto OB = override_begin;
-  const auto OV = overrides;
-  const auto pos = positions;
-  const auto yaw = yaws;
-  const std::int32_t now = frame;
-  const auto out = palettes;
-  const auto read_out = read_offsets;
-  const auto skipped = skip;
-  const Index palette_size = palettes.size();
-  parallel_for(
-      "anim.stream_resolve", agent_count(),
-      THRONG_LAMBDA(Index a) {
-        if (!skipped.empty() && skipped[a] != 0) return;
-        const std::int32_t r = AR[a];
-        if (r < 0 || r >= T.rigs.size()) return;
-        const RigView rig = T.rigs[r];
-        const std::int32_t J = rig.joint_count;
-        const Index base = PO[a];
-        if (J > kMaxRigJoints || base < 0 || base + J > palette_size) return;
-
-        // Each cluster's target and transition source slots.
-        SlotRead to[kMaxClusters], from[kMaxClusters];
-        float alpha[kMaxClusters];
-        bool culled[kMaxClusters];
-        const std::int32_t clusters_here = rig.cluster_count < stride ? rig.cluster_count : stride;
-        for (std::int32_t c = 0; c < clusters_here; ++c) {
-          const ClusterRef& ref = refs[a * stride + c];
-          to[c] = read_source(S, U, ref.source, ref.offset, J, rig.rest_root);
-          alpha[c] = transition_alpha(ref, now);
-          if (alpha[c] < 1.0f) from[c] = read_source(S, U, ref.from_source, ref.from_offset, J, rig.rest_root);
-          culled[c] = (ref.flags & kClusterCulled) != 0u;
-          if (!read_out.empty()) read_out[a * stride + c] = to[c].offset;
-        }
-
-        // The agent's world transform (yaw about +Y, then translation).
-        glm::quat world_q(1.0f, 0.0f, 0.0f, 0.0f);
-        glm::vec3 world_t(0.0f);
-        if (!yaw.empty()) world_q = glm::angleAxis(yaw[a], glm::vec3(0.0f, 1.0f, 0.0f));
-        if (!pos.empty()) world_t = pos[a];
-
-        Index ov = 0, ov_end = 0;
-        if (!OB.empty()) {
-          ov = OB[a];
-          ov_end = OB[a + 1];
-        }
-
-        bool fast = ov == ov_end;
-        for (std::int32_t c = 0; c < clusters_here; ++c) fast = fast && alpha[c] >= 1.0f;
-        if (fast) {
-          // Each joint: its segment's transform times the skinning matrix of its source slot.
-          Mat3x4 W[kMaxSegments];
-          for (std::int32_t j = 0; j < J; ++j) {
-            const Index tj = rig.joint_base + j;
-            std::int32_t c = T.joint_cluster[tj];
-            c = c < clusters_here ? c : 0;
-            const std::int32_t seg = T.joint_segment[tj];
-            const Mat3x4* slot = to[c].skinning;
-            const std::int32_t p = T.parents[tj];
-            if (p < 0) {
-              W[seg] = mat3x4_from(world_q, world_t);
-            } else if (T.joint_cluster[rig.joint_base + p] != T.joint_cluster[tj]) {
-              const Mat3x4 hooked = out[base + p] * T.segment_hooks[rig.segment_base + seg];
-              W[seg] = slot != nullptr ? hooked * inverse_rigid(slot[p]) : hooked;
-            }
-            out[base + j] = slot != nullptr ? W[seg] * slot[j] : W[seg];
-          }
-        } else {
-          glm::quat R[kMaxRigJoints];
-          glm::vec3 P[kMaxRigJoints];
-          for (std::int32_t j = 0; j < J; ++j) {
-            const Index tj = rig.joint_base + j;
-            std::int32_t c = T.joint_cluster[tj];
-            c = c < clusters_here ? c : 0;
-            glm::quat local = to[c].rotations != nullptr ? to[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-            if (alpha[c] < 1.0f) {
-              const glm::quat src = from[c].rotations != nullptr ? from[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-              local = glm::slerp(src, local, alpha[c]);
-            }
-            while (ov < ov_end && OV[ov].joint < j) ++ov;
-            const BoneOverride* o = ov < ov_end && OV[ov].joint == j ? &OV[ov] : nullptr;
-            if (o != nullptr && o->kind == OverrideKind::Rotation) local = glm::slerp(local, o->rotation, o->weight);
-
-            const std::int32_t p = T.parents[tj];
-            if (p < 0) {
-              glm::vec3 root = to[c].root;
-              if (alpha[c] < 1.0f) root = glm::mix(from[c].root, root, alpha[c]);
-              R[j] = world_q * local;
-              P[j] = world_t + world_q * root;
-            } else {
-              glm::quat pq = R[p];
-              glm::vec3 pt = P[p];
-              if (T.joint_cluster[rig.joint_base + p] != T.joint_cluster[tj]) {
-                // Entering another cluster: hang it from its hook.
-                const Index h = rig.cluster_base + c;
-                pt = pt + pq * T.hook_translations[h];
-                pq = pq * T.hook_rotations[h];
-              }
-              R[j] = pq * local;
-              P[j] = pt + pq * T.offsets[tj];
-            }
-
-            if (o != nullptr && o->kind == OverrideKind::LookAt) {
-              const glm::vec3 f = glm::normalize(R[j] * o->aim_axis);
-              glm::vec3 d = o->target - P[j];
-              const float dl = glm::length(d);
-              if (dl > 1e-6f) {
-                d = d / dl;
-                glm::vec3 axis = glm::cross(f, d);
-                const float s = glm::length(axis);
-                if (s > 1e-6f) {
-                  float cosang = glm::dot(f, d);
-                  cosang = cosang < -1.0f ? -1.0f : (cosang > 1.0f ? 1.0f : cosang);
-                  float angle = glm::acos(cosang);
-                  angle = (angle < o->max_angle ? angle : o->max_angle) * o->weight;
-                  R[j] = glm::normalize(glm::angleAxis(angle, axis / s) * R[j]);
-                }
-              }
-            }
-            out[base + j] = mat3x4_from(R[j], P[j]) * T.inverse_bind[tj];
-          }
-        }
-
-        // Culled clusters, children first so that every hook read is still posed.
-        bool any_culled = false;
-        for (std::int32_t c = 0; c < clusters_here; ++c) any_culled = any_culled || culled[c];
-        if (any_culled) {
-          for (std::int32_t j = J - 1; j >= 0; --j) {
-            const Index tj = rig.joint_base + j;
-            std::int32_t c = T.joint_cluster[tj];
-            c = c < clusters_here ? c : 0;
-            if (!culled[c]) continue;
-            std::int32_t hook = T.hook_joints[rig.cluster_base + c];
-            hook = hook >= 0 ? hook : 0;
-            out[base + j] = collapse_to(transform_point(out[base + hook], T.bind_positions[rig.joint_base + hook]));
-          }
-        }
-      },
-      64);
+  parallel_for("anim.stream_resolve", agent_count(), THRONG_JOB_LAMBDA(Index a) { resolve_agent(*this, a); }, 64);
 }
 
 }  // namespace throng::anim

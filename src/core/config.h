@@ -13,6 +13,12 @@
 //   parallel_for("saxpy", n, THRONG_LAMBDA(int64_t i) { y[i] += a * x[i]; });
 #define THRONG_LAMBDA(...) [=] THRONG_HOST_DEVICE(__VA_ARGS__)
 
+// A job's kernel body, inside its run(): the job travels by value (it owns
+// nothing: spans and parameters), so the body reads its members by name
+// with no local copies first.
+//   void SaxpyJob::run() const { parallel_for("saxpy", x.size(), THRONG_JOB_LAMBDA(Index i) { y[i] += a * x[i]; }); }
+#define THRONG_JOB_LAMBDA(...) [=, *this] THRONG_HOST_DEVICE(__VA_ARGS__)
+
 #include <cstdint>
 
 namespace throng {

@@ -270,9 +270,9 @@ LodOutput run_lod(const CameraView& view, const LodConfig& config, const std::ve
   if (spheres != nullptr) {
     job.spheres = *spheres;
   } else {
-    job.root_positions = crowd->positions;
-    job.root_headings = crowd->headings;
-    job.root_scales = crowd->scales;
+    job.roots.positions = crowd->positions;
+    job.roots.headings = crowd->headings;
+    job.roots.scales = crowd->scales;
     job.template_spheres = parts.rest_spheres;
   }
   job.levels = out.levels;
@@ -428,7 +428,7 @@ TEST(LodJob, BadSpansAreNamed) {
   masks.resize(2);
   job.joint_masks = masks;
   std::vector<float> headings(2);
-  job.root_headings = headings;  // both inputs given
+  job.roots.headings = headings;  // both inputs given
   EXPECT_THROW(job.run(), Error);
 }
 

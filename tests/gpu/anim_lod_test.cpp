@@ -75,9 +75,9 @@ TEST(CudaLod, SpheresLevelsAndHistogramMatchCpu) {
       job.camera = view;
       job.set_tables(tables);
       if (from_roots) {
-        job.root_positions = b_roots.span();
-        job.root_headings = b_headings.span();
-        job.root_scales = b_scales.span();
+        job.roots.positions = b_roots.span();
+        job.roots.headings = b_headings.span();
+        job.roots.scales = b_scales.span();
         job.template_spheres = parts.rest_spheres;
       } else {
         job.spheres = spheres.span();
