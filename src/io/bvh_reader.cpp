@@ -312,6 +312,14 @@ class Parser {
     }
   }
 
+  // The value glued to keyword token t after its first `length` characters
+  // ("Frames:12"), else the next token ("Frames: 12").
+  Token glued_value(Token t, int length) {
+    t.text.remove_prefix(static_cast<std::size_t>(length));
+    t.col += length;
+    return t.text.empty() ? s_.next() : t;
+  }
+
   void parse_motion_header() {
     const Token m = s_.next();
     if (iequals(m.text, "ROOT")) s_.fail(m, "a second ROOT hierarchy is not supported");
@@ -319,10 +327,7 @@ class Parser {
     // "Frames: N" (also "Frames:N").
     const Token f = s_.next();
     if (!istarts_with(f.text, "Frames:")) s_.expected("'Frames:'", f);
-    Token count = f;
-    count.text.remove_prefix(7);
-    count.col += 7;
-    if (count.text.empty()) count = s_.next();
+    const Token count = glued_value(f, 7);
     frames_token_ = count;
     frames_ = s_.integer(count, "frame count");
     if (frames_ < 0) s_.fail(count, "frame count must not be negative");
@@ -333,10 +338,7 @@ class Parser {
     s_.expect("Frame");
     const Token tt = s_.next();
     if (!istarts_with(tt.text, "Time:")) s_.expected("'Time:' after 'Frame'", tt);
-    Token value = tt;
-    value.text.remove_prefix(5);
-    value.col += 5;
-    if (value.text.empty()) value = s_.next();
+    const Token value = glued_value(tt, 5);
     frame_time_ = s_.number(value, "frame time");
     if (!(frame_time_ > 0.0)) s_.fail(value, "frame time must be positive, found " + shown(value.text));
     s_.skip_blanks();

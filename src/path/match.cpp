@@ -77,17 +77,17 @@ MatchGrid::MatchGrid(const StateMachine& machine, const CurveSet& curves, const 
   cost_ = Buffer<float>(Index{curves_} * motions_, mem);
   best_ = Buffer<std::int32_t>(curves_, mem);
   best_cost_ = Buffer<float>(curves_, mem);
-  job_.k = machine.k();
-  job_.motions = motions_;
-  job_.speed_weight = options.speed_weight;
-  job_.motion_points = motion_points_.span();
-  job_.motion_state = motion_state_.span();
-  job_.motion_speed = motion_speed_.span();
-  job_.curve_points = curve_points_.span();
-  job_.curve_tangents = curve_tangents_.span();
-  job_.curve_state = curve_state_.span();
-  job_.curve_speed = curve_speed_.span();
-  job_.cost = cost_.span();
+  job_ = {.k = machine.k(),
+          .motions = motions_,
+          .speed_weight = options.speed_weight,
+          .motion_points = motion_points_.span(),
+          .motion_state = motion_state_.span(),
+          .motion_speed = motion_speed_.span(),
+          .curve_points = curve_points_.span(),
+          .curve_tangents = curve_tangents_.span(),
+          .curve_state = curve_state_.span(),
+          .curve_speed = curve_speed_.span(),
+          .cost = cost_.span()};
 }
 
 void MatchGrid::match() {

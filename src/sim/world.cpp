@@ -281,37 +281,24 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
 }
 
 WorldView World::view() const {
-  WorldView v;
-  v.cell_size = cell_size_;
-  v.has_walkable = has_walkable_;
-  v.walkable_outer = walkable_outer_;
-  v.vertices = d_vertices_.span();
-  v.rings = d_rings_.span();
-  v.polygons = d_polygons_.span();
-  v.segments = d_segments_.span();
-  v.circles = d_circles_.span();
-  v.segment_grid = segment_grid_.view();
-  v.long_walls = d_long_walls_.span();
-  v.circle_grid = circle_grid_.view();
-  v.polygon_grid = polygon_grid_.view();
-  return v;
+  return {cell_size_,           has_walkable_,           walkable_outer_,           d_vertices_.span(),
+          d_rings_.span(),      d_polygons_.span(),      d_segments_.span(),        d_circles_.span(),
+          segment_grid_.view(), d_long_walls_.span(),    circle_grid_.view(),       polygon_grid_.view()};
 }
 
 WorldView World::host_view() const {
-  WorldView v;
-  v.cell_size = cell_size_;
-  v.has_walkable = has_walkable_;
-  v.walkable_outer = walkable_outer_;
-  v.vertices = Span<const glm::vec2>(vertices_.data(), static_cast<Index>(vertices_.size()));
-  v.rings = Span<const RingRef>(rings_.data(), static_cast<Index>(rings_.size()));
-  v.polygons = Span<const PolygonRef>(polygon_refs_.data(), static_cast<Index>(polygon_refs_.size()));
-  v.segments = Span<const Segment>(segments_.data(), static_cast<Index>(segments_.size()));
-  v.circles = Span<const Circle>(circles_.data(), static_cast<Index>(circles_.size()));
-  v.segment_grid = segment_grid_.host_view();
-  v.long_walls = Span<const std::int32_t>(long_walls_.data(), static_cast<Index>(long_walls_.size()));
-  v.circle_grid = circle_grid_.host_view();
-  v.polygon_grid = polygon_grid_.host_view();
-  return v;
+  return {cell_size_,
+          has_walkable_,
+          walkable_outer_,
+          Span<const glm::vec2>(vertices_.data(), static_cast<Index>(vertices_.size())),
+          Span<const RingRef>(rings_.data(), static_cast<Index>(rings_.size())),
+          Span<const PolygonRef>(polygon_refs_.data(), static_cast<Index>(polygon_refs_.size())),
+          Span<const Segment>(segments_.data(), static_cast<Index>(segments_.size())),
+          Span<const Circle>(circles_.data(), static_cast<Index>(circles_.size())),
+          segment_grid_.host_view(),
+          Span<const std::int32_t>(long_walls_.data(), static_cast<Index>(long_walls_.size())),
+          circle_grid_.host_view(),
+          polygon_grid_.host_view()};
 }
 
 bool World::in_free_space(glm::vec2 p) const { return sim::in_free_space(host_view(), p); }
