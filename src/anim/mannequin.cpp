@@ -8,13 +8,12 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/math.h"
 #include "motion/fk.h"
 
 namespace throng::anim {
 
 namespace {
-
-constexpr float kPi = 3.14159265358979f;
 
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -47,12 +46,12 @@ void add_capsule(SkinnedMesh& mesh, const Bone& bone, const MannequinOptions& o)
   };
   std::vector<Ring> rings;
   for (int i = 1; i <= o.cap_rings; ++i) {
-    const float phi = -0.5f * kPi + 0.5f * kPi * static_cast<float>(i) / static_cast<float>(o.cap_rings);
+    const float phi = -0.5f * kPiF + 0.5f * kPiF * static_cast<float>(i) / static_cast<float>(o.cap_rings);
     rings.push_back({r * std::sin(phi), r * std::cos(phi), std::sin(phi)});
   }
   for (int i = 1; i < o.body_rings - 1; ++i) rings.push_back({len * static_cast<float>(i) / static_cast<float>(o.body_rings - 1), r, 0.0f});
   for (int i = o.cap_rings; i >= 1; --i) {
-    const float phi = 0.5f * kPi - 0.5f * kPi * static_cast<float>(i) / static_cast<float>(o.cap_rings);
+    const float phi = 0.5f * kPiF - 0.5f * kPiF * static_cast<float>(i) / static_cast<float>(o.cap_rings);
     rings.push_back({len + r * std::sin(phi), r * std::cos(phi), std::sin(phi)});
   }
 
@@ -71,7 +70,7 @@ void add_capsule(SkinnedMesh& mesh, const Bone& bone, const MannequinOptions& o)
   const int S = o.sides;
   for (const Ring& ring : rings)
     for (int k = 0; k < S; ++k) {
-      const float alpha = 2.0f * kPi * static_cast<float>(k) / static_cast<float>(S);
+      const float alpha = 2.0f * kPiF * static_cast<float>(k) / static_cast<float>(S);
       const glm::vec3 radial = std::cos(alpha) * v + std::sin(alpha) * w;
       const float nr = std::sqrt(std::max(0.0f, 1.0f - ring.nu * ring.nu));
       add_vertex(bone.a + ring.h * u + ring.rr * radial, nr * radial + ring.nu * u);

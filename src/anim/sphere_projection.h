@@ -22,6 +22,7 @@
 
 #include "core/camera.h"
 #include "core/config.h"
+#include "core/math.h"
 
 namespace throng::anim {
 
@@ -59,8 +60,7 @@ THRONG_HOST_DEVICE inline T sphere_ellipse_area(glm::vec<3, T> centre_cam, T rad
   if (kind != nullptr) *kind = c;
   if (c != SphereImage::Ellipse) return T(0);
   const T e = d * d - r2;
-  constexpr T kPi = T(3.14159265358979323846);
-  return kPi * focal_px * focal_px * r2 * glm::sqrt(k / e) / e;  // = ... sqrt(k) / e^(3/2)
+  return T(kPi) * focal_px * focal_px * r2 * glm::sqrt(k / e) / e;  // = ... sqrt(k) / e^(3/2)
 }
 
 // The full ellipse (centre, axes, angle) in pixel coordinates of a viewport

@@ -22,6 +22,7 @@
 #include "app/locomotion_stats.h"
 #include "core/camera.h"
 #include "core/error.h"
+#include "core/math.h"
 #include "core/memory_budget.h"
 #include "core/timing.h"
 #include "io/animate_yaml.h"
@@ -33,7 +34,6 @@ namespace throng::app {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr float kPi = std::numbers::pi_v<float>;
 
 template <class T>
 std::vector<T> to_host(Span<const T> s) {
@@ -59,7 +59,7 @@ void animate_frames(FormationCrowd& formation_crowd, const io::AnimateSpec& spec
   Camera lens;
   lens.width = spec.width;
   lens.height = spec.height;
-  lens.fov_y = spec.camera_fov_deg * kPi / 180.0f;
+  lens.fov_y = spec.camera_fov_deg * kPiF / 180.0f;
   lens.far_plane = 10000.0f;
   CameraOrbit orbit;
   orbit.radius = spec.camera_radius > 0.0f ? spec.camera_radius : formation_crowd.formation().extent + 15.0f;

@@ -8,15 +8,12 @@
 #include <numbers>
 
 #include "core/error.h"
+#include "core/math.h"
 #include "io/bvh_reader.h"
 
 namespace throng::app {
 
 namespace fs = std::filesystem;
-
-namespace {
-constexpr float kPi = std::numbers::pi_v<float>;
-}  // namespace
 
 io::AnimateSpec load_animate_spec(const std::string& what, fs::path& folder) {
   std::error_code ec;
@@ -60,14 +57,14 @@ Formation make_formation(const io::AnimateSpec& s) {
     std::size_t placed = 0;
     for (int ring = 0; placed < n; ++ring) {
       const float r = s.radius + static_cast<float>(ring) * s.ring_spacing;
-      const auto capacity = std::max<std::size_t>(1, static_cast<std::size_t>(2.0f * kPi * r / s.spacing));
+      const auto capacity = std::max<std::size_t>(1, static_cast<std::size_t>(2.0f * kPiF * r / s.spacing));
       const std::size_t here = std::min(capacity, n - placed);
       for (std::size_t k = 0; k < here; ++k) {
-        const float a = 2.0f * kPi * (static_cast<float>(k) + 0.5f * static_cast<float>(ring % 2)) / static_cast<float>(here);
+        const float a = 2.0f * kPiF * (static_cast<float>(k) + 0.5f * static_cast<float>(ring % 2)) / static_cast<float>(here);
         // Counter-clockwise seen from above: angle a at (cos a, -sin a) in XZ,
         // walking along (-sin a, -cos a), a left turn of curvature 1 / r.
         f.positions.emplace_back(r * std::cos(a), 0.0f, -r * std::sin(a));
-        f.yaws.push_back(s.clockwise ? a : a + kPi);
+        f.yaws.push_back(s.clockwise ? a : a + kPiF);
         f.curvatures.push_back(s.clockwise ? -1.0f / r : 1.0f / r);
         f.rings.push_back(r);
       }

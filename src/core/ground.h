@@ -13,10 +13,9 @@
 #include <glm/vec3.hpp>
 
 #include "core/config.h"
+#include "core/math.h"
 
 namespace throng {
-
-inline constexpr float kHalfPi = 1.57079632679489661923f;
 
 // Map (x, y, z-up) -> world (x, y-up, z).
 THRONG_HOST_DEVICE inline glm::vec3 world_from_map(glm::vec3 m) { return glm::vec3(m.x, m.z, -m.y); }

@@ -3,24 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <string>
 
 #include "core/error.h"
+#include "core/math.h"
 
 namespace throng::motion {
 
 namespace {
-
-constexpr double kPi = std::numbers::pi;
-
-double wrap_angle(double a) {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a < 0) a += 2.0 * kPi;
-  return a - kPi;
-}
-
-glm::dquat yaw_rotation(double psi) { return glm::angleAxis(psi, glm::dvec3(0, 1, 0)); }
 
 std::vector<glm::dvec3> rest_positions(const Skeleton& s) {
   std::vector<glm::dvec3> p(static_cast<std::size_t>(s.joint_count()));
@@ -279,31 +269,26 @@ ContactReport detect_foot_contacts(const Skeleton& skeleton, const ModelSpaceCli
   return r;
 }
 
-CycleReport analyze_cycle(const Skeleton& skeleton, const Clip& input, const CycleOptions& o) {
-  o.validate();
-  skeleton.validate();
-  if (input.joint_count != skeleton.joint_count()) throw Error("clip and skeleton differ in joint count");
-  check_frame_time(input.frame_time);
-  // Features take 2 x 24 bytes per joint and frame, the search frames x
-  // periods x joints: refuse what would not fit before allocating.
-  auto check_size = [&](std::int64_t frames) {
-    if (frames * (input.joint_count + 1) > o.max_frame_joints)
-      throw Error("clip too long for cycle analysis: " + std::to_string(frames) + " frames x " +
-                      std::to_string(input.joint_count + 1) + " points exceeds " + std::to_string(o.max_frame_joints),
-                  at_field("max_frame_joints"));
-  };
-  check_size(input.frame_count);
-  const double dt = input.frame_time;
-  const double leg = leg_length(skeleton);
-  CycleReport rep;
-  const std::int32_t N = input.frame_count;
-  if (N < 3) return rep;
+namespace {
 
-  // Is the clip itself one loop? Compare frame 0 with the last frame
-  // extrapolated by one step, in the heading frame.
+// Error unless `frames` frames of the clip, times (joints + 1) points, fit
+// max_frame_joints: features take 2 x 24 bytes per point and frame, the
+// search frames x periods x points.
+void check_analysis_size(std::int64_t frames, std::int32_t joint_count, const CycleOptions& o) {
+  if (frames * (joint_count + 1) > o.max_frame_joints)
+    throw Error("clip too long for cycle analysis: " + std::to_string(frames) + " frames x " + std::to_string(joint_count + 1) +
+                    " points exceeds " + std::to_string(o.max_frame_joints),
+                at_field("max_frame_joints"));
+}
+
+// Whether analyze_cycle takes the clip as one loop: Always yes, Never no;
+// Auto, for clips shorter than two of the longest periods (max_p frames)
+// plus 2, when frame 0 matches the last frame extrapolated by one step in
+// the heading frame (RMS over the feature points below 2% of the leg
+// length `leg`, m; dt in s).
+bool is_loop(const Skeleton& skeleton, const Clip& input, const CycleOptions& o, double dt, double leg, std::int32_t max_p) {
+  const std::int32_t N = input.frame_count;
   bool loop = o.loop == CycleOptions::Loop::Always;
-  const std::int32_t max_p = frames_floor(o.max_period_s, dt);
-  const std::int32_t min_p = std::max<std::int32_t>(1, frames_ceil(o.min_period_s, dt));
   if (o.loop == CycleOptions::Loop::Auto && N < 2 * max_p + 2) {
     const ModelSpaceClip m = forward_kinematics(skeleton, input);
     const Features f = compute_features(m, dt, leg);
@@ -315,45 +300,58 @@ CycleReport analyze_cycle(const Skeleton& skeleton, const Clip& input, const Cyc
     }
     loop = std::sqrt(sum / f.points) < 0.02 * leg;
   }
-  rep.input_is_loop = loop;
-  const std::int32_t copies = std::max<std::int32_t>(2, std::min<std::int32_t>(max_p / N + 2, 4096));
-  if (loop) check_size(static_cast<std::int64_t>(N) * copies);
-  const Clip clip = loop ? repeat_cycle(input, copies) : input;
-  const ModelSpaceClip m = forward_kinematics(skeleton, clip);
-  const Features f = compute_features(m, dt, leg);
-  const std::int32_t F = clip.frame_count;
+  return loop;
+}
 
-  // Contacts (when the feet are known).
-  bool have_feet = skeleton.role(Role::LeftAnkle) >= 0 && skeleton.role(Role::RightAnkle) >= 0;
-  if (have_feet) rep.contacts = detect_foot_contacts(skeleton, m, dt, FeetJoints::from_roles(skeleton), o.contacts);
-
-  // Cost of every (a, a + p); c(p) = best over a.
+// The cost of every (a, a + p) over the analysed frames (model m, features
+// f): best[p] the lowest pair cost of period p (frames, min_p..p_hi) over
+// starts a from skip_frames (loops of N frames: a in the first copy, p <= N)
+// whose root covers at least min_mean_speed (m/s) times p dt; best_a[p] that
+// start. Periods without one keep cost infinity and start -1.
+struct PeriodCosts {
+  std::int32_t p_hi = 0;
+  std::vector<double> best;
+  std::vector<std::int32_t> best_a;
+};
+PeriodCosts period_costs(const ModelSpaceClip& m, const Features& f, const CycleOptions& o, bool loop, std::int32_t N,
+                         std::int32_t min_p, std::int32_t max_p, double dt) {
+  const std::int32_t F = m.frame_count;
   const std::int32_t first = std::min(o.skip_frames, F - 1);
   const std::int32_t a_end = loop ? std::min(N, F) : F;  // loops: start in the first copy
-  const std::int32_t p_hi = loop ? std::min(max_p, N) : max_p;
-  std::vector<double> best(static_cast<std::size_t>(std::max(p_hi + 1, 1)), std::numeric_limits<double>::infinity());
-  std::vector<std::int32_t> best_a(best.size(), -1);
-  for (std::int32_t p = min_p; p <= p_hi; ++p) {
+  PeriodCosts c;
+  c.p_hi = loop ? std::min(max_p, N) : max_p;
+  std::vector<double>& best = c.best;
+  best.assign(static_cast<std::size_t>(std::max(c.p_hi + 1, 1)), std::numeric_limits<double>::infinity());
+  c.best_a.assign(best.size(), -1);
+  for (std::int32_t p = min_p; p <= c.p_hi; ++p) {
     for (std::int32_t a = first; a < a_end && a + p < F; ++a) {
       const glm::vec3& ra = m.positions[at(a, m.joint_count, 0)];
       const glm::vec3& rb = m.positions[at(a + p, m.joint_count, 0)];
       if (horizontal_distance(ra, rb) < o.min_mean_speed * p * dt) continue;
-      const double c = pair_cost(f, a, a + p, o).total;
-      if (c < best[static_cast<std::size_t>(p)]) best[static_cast<std::size_t>(p)] = c, best_a[static_cast<std::size_t>(p)] = a;
+      const double cost = pair_cost(f, a, a + p, o).total;
+      if (cost < best[static_cast<std::size_t>(p)]) best[static_cast<std::size_t>(p)] = cost, c.best_a[static_cast<std::size_t>(p)] = a;
     }
   }
+  return c;
+}
+
+// The fundamental period (frames): the shortest local minimum of the costs
+// within fundamental_tolerance of the best (plus 1e-6 m^2), else the
+// shortest period with the best cost; -1 when no period has a finite cost.
+std::int32_t fundamental_period(const PeriodCosts& c, std::int32_t min_p, const CycleOptions& o) {
+  const std::vector<double>& best = c.best;
+  const std::int32_t p_hi = c.p_hi;
   double overall = std::numeric_limits<double>::infinity();
   for (std::int32_t p = min_p; p <= p_hi; ++p) overall = std::min(overall, best[static_cast<std::size_t>(p)]);
-  if (!std::isfinite(overall)) return rep;
-  // The fundamental period: the shortest local minimum nearly as good as the best.
+  if (!std::isfinite(overall)) return -1;
   const double accept = o.fundamental_tolerance * overall + 1e-6;
   std::int32_t period = -1;
   for (std::int32_t p = min_p; p <= p_hi && period < 0; ++p) {
-    const double c = best[static_cast<std::size_t>(p)];
-    if (!(c <= accept)) continue;
+    const double c_p = best[static_cast<std::size_t>(p)];
+    if (!(c_p <= accept)) continue;
     const double left = p > min_p ? best[static_cast<std::size_t>(p - 1)] : std::numeric_limits<double>::infinity();
     const double right = p < p_hi ? best[static_cast<std::size_t>(p + 1)] : std::numeric_limits<double>::infinity();
-    if (c <= left && c <= right) period = p;
+    if (c_p <= left && c_p <= right) period = p;
   }
   if (period < 0) {
     for (std::int32_t p = min_p; p <= p_hi; ++p)
@@ -362,7 +360,15 @@ CycleReport analyze_cycle(const Skeleton& skeleton, const Clip& input, const Cyc
         break;
       }
   }
-  const std::int32_t a = best_a[static_cast<std::size_t>(period)];
+  return period;
+}
+
+// The loop (a, a + period) found: frames, seconds (dt in s), cost and pose
+// RMS (m), and the root's travel: the chord between a and b (m), turned into
+// the arc of a circle when the heading changes (a turning walk), its mean
+// speed (m/s) and turn rate (rad/s).
+void describe_loop(CycleReport& rep, const ModelSpaceClip& m, const Features& f, const CycleOptions& o, std::int32_t a,
+                   std::int32_t period, double dt) {
   const std::int32_t b = a + period;
   const PairCost pc = pair_cost(f, a, b, o);
   rep.found = true;
@@ -372,37 +378,75 @@ CycleReport analyze_cycle(const Skeleton& skeleton, const Clip& input, const Cyc
   rep.period_s = period * dt;
   rep.cost = pc.total;
   rep.pose_rms_m = std::sqrt(pc.pose);
-
-  // Root travel: the chord between a and b, turned into the arc of a
-  // circle when the heading changes (a turning walk).
   const double turn = f.heading[static_cast<std::size_t>(b)] - f.heading[static_cast<std::size_t>(a)];
   const double chord = horizontal_distance(m.positions[at(a, m.joint_count, 0)], m.positions[at(b, m.joint_count, 0)]);
   const double half = 0.5 * std::abs(turn);
   rep.displacement = half > 1e-4 && half < kPi ? chord * half / std::sin(half) : chord;
   rep.mean_speed = rep.displacement / rep.period_s;
   rep.turn_rate = turn / rep.period_s;
-  if (have_feet) {
-    // Count contact onsets over one period. The motion repeats, so any
-    // window of length p near [a, b) counts the same, except that detected
-    // onsets wander by a frame between strides: place the window's ends as
-    // far from every onset as possible. A contact running at frame 0 may
-    // have begun before the clip, so it is no onset.
-    std::vector<std::int32_t> onsets;
-    for (const FootContacts& fc : rep.contacts.feet)
-      for (const ContactInterval& c : fc.intervals)
-        if (c.begin > 0) onsets.push_back(c.begin);
-    const std::int32_t lo = std::max(1, a - period / 2), hi = std::min(F - period, a + period / 2);
-    std::int32_t w0 = std::clamp(a, std::min(lo, hi), std::max(lo, hi)), best_margin = -1;
-    for (std::int32_t w = lo; w <= hi; ++w) {
-      std::int32_t margin = period;
-      for (std::int32_t on : onsets) margin = std::min({margin, std::abs(on - w), std::abs(on - (w + period))});
-      if (margin > best_margin) best_margin = margin, w0 = w;
-    }
-    for (std::int32_t on : onsets)
-      if (on >= w0 && on < w0 + period) ++rep.steps;
-    rep.cadence = rep.steps * 60.0 / rep.period_s;
-    rep.stride_length = rep.steps > 0 ? rep.displacement * 2.0 / rep.steps : 0.0;
+}
+
+// Steps (contact onsets of both feet) in one period of rep.contacts over F
+// analysed frames, and from them cadence (steps per minute) and stride
+// length (m per two steps). The motion repeats, so any window of length
+// `period` near [a, a + period) counts the same, except that detected onsets
+// wander by a frame between strides: the window's ends go as far from every
+// onset as possible. A contact running at frame 0 may have begun before the
+// clip, so it is no onset.
+void count_steps(CycleReport& rep, std::int32_t a, std::int32_t period, std::int32_t F) {
+  std::vector<std::int32_t> onsets;
+  for (const FootContacts& fc : rep.contacts.feet)
+    for (const ContactInterval& c : fc.intervals)
+      if (c.begin > 0) onsets.push_back(c.begin);
+  const std::int32_t lo = std::max(1, a - period / 2), hi = std::min(F - period, a + period / 2);
+  std::int32_t w0 = std::clamp(a, std::min(lo, hi), std::max(lo, hi)), best_margin = -1;
+  for (std::int32_t w = lo; w <= hi; ++w) {
+    std::int32_t margin = period;
+    for (std::int32_t on : onsets) margin = std::min({margin, std::abs(on - w), std::abs(on - (w + period))});
+    if (margin > best_margin) best_margin = margin, w0 = w;
   }
+  for (std::int32_t on : onsets)
+    if (on >= w0 && on < w0 + period) ++rep.steps;
+  rep.cadence = rep.steps * 60.0 / rep.period_s;
+  rep.stride_length = rep.steps > 0 ? rep.displacement * 2.0 / rep.steps : 0.0;
+}
+
+}  // namespace
+
+CycleReport analyze_cycle(const Skeleton& skeleton, const Clip& input, const CycleOptions& o) {
+  o.validate();
+  skeleton.validate();
+  if (input.joint_count != skeleton.joint_count()) throw Error("clip and skeleton differ in joint count");
+  check_frame_time(input.frame_time);
+  // Refuse what would not fit before allocating.
+  check_analysis_size(input.frame_count, input.joint_count, o);
+  const double dt = input.frame_time;
+  const double leg = leg_length(skeleton);
+  CycleReport rep;
+  const std::int32_t N = input.frame_count;
+  if (N < 3) return rep;
+
+  const std::int32_t max_p = frames_floor(o.max_period_s, dt);
+  const std::int32_t min_p = std::max<std::int32_t>(1, frames_ceil(o.min_period_s, dt));
+  const bool loop = is_loop(skeleton, input, o, dt, leg, max_p);
+  rep.input_is_loop = loop;
+  const std::int32_t copies = std::max<std::int32_t>(2, std::min<std::int32_t>(max_p / N + 2, 4096));
+  if (loop) check_analysis_size(static_cast<std::int64_t>(N) * copies, input.joint_count, o);
+  const Clip clip = loop ? repeat_cycle(input, copies) : input;
+  const ModelSpaceClip m = forward_kinematics(skeleton, clip);
+  const Features f = compute_features(m, dt, leg);
+  const std::int32_t F = clip.frame_count;
+
+  // Contacts (when the feet are known).
+  const bool have_feet = skeleton.role(Role::LeftAnkle) >= 0 && skeleton.role(Role::RightAnkle) >= 0;
+  if (have_feet) rep.contacts = detect_foot_contacts(skeleton, m, dt, FeetJoints::from_roles(skeleton), o.contacts);
+
+  const PeriodCosts costs = period_costs(m, f, o, loop, N, min_p, max_p, dt);
+  const std::int32_t period = fundamental_period(costs, min_p, o);
+  if (period < 0) return rep;
+  const std::int32_t a = costs.best_a[static_cast<std::size_t>(period)];
+  describe_loop(rep, m, f, o, a, period, dt);
+  if (have_feet) count_steps(rep, a, period, F);
   return rep;
 }
 

@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <glm/gtc/quaternion.hpp>
 #include <limits>
-#include <numbers>
 
 #include "core/error.h"
+#include "core/math.h"
 
 namespace throng::motion {
 
@@ -16,7 +16,6 @@ namespace {
 
 using glm::dquat;
 using glm::dvec3;
-constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 constexpr double kGravity = 9.81;
 

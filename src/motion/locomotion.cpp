@@ -3,28 +3,23 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <numbers>
 #include <span>
 #include <string>
 #include <utility>
 
 #include "core/error.h"
+#include "core/math.h"
 #include "motion/default_set.h"
 
 namespace throng::motion {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 std::size_t at(std::int64_t i) { return static_cast<std::size_t>(i); }
 
-glm::dquat yaw_rotation(double psi) { return glm::angleAxis(psi, glm::dvec3(0, 1, 0)); }
-
-double wrap_pi(double a) {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a < 0) a += 2.0 * kPi;
-  return a - kPi;
+// Element (frame i, joint j) of a ModelSpaceClip's arrays.
+std::size_t frame_joint(const ModelSpaceClip& m, std::int32_t i, std::int32_t j) {
+  return at(static_cast<std::int64_t>(i) * m.joint_count + j);
 }
 
 double wrap_unit(double p) {
@@ -134,11 +129,10 @@ Clip cycle_in_world(const LocomotionClip& c, std::int32_t copies) {
   return w;
 }
 
-}  // namespace
-
-LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cycle, std::string name, const LocomotionOptions& o) {
-  o.validate();
-  skeleton.validate();
+// Error (naming the clip's field) unless `cycle` has the skeleton's joints,
+// at least 4 frames, a positive frame time and arrays of its frame and joint
+// counts.
+void check_cycle(const Skeleton& skeleton, const Clip& cycle, const std::string& name) {
   const std::int32_t J = skeleton.joint_count();
   const std::int32_t F = cycle.frame_count;
   if (cycle.joint_count != J)
@@ -148,108 +142,120 @@ LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cy
     throw Error("frame time must be positive", clip_field(name, "frame_time"));
   if (cycle.rotations.size() != at(static_cast<std::int64_t>(F) * J) || cycle.root_positions.size() != at(F))
     throw Error("arrays do not match its frame and joint counts", clip_field(name, ""));
+}
 
-  // Three copies with the root carried on: frame F is frame 0 one cycle on.
-  const Clip ext = repeat_cycle(cycle, 3);
-  std::vector<double> psi(at(3 * F));
-  for (std::int32_t i = 0; i < 3 * F; ++i) {
-    const double h = heading_of(ext.rotation(i, 0));
-    psi[at(i)] = i == 0 ? h : psi[at(i - 1)] + wrap_pi(h - psi[at(i - 1)]);
-  }
-  double turn = psi[at(F)] - psi[0];
-  const glm::dvec3 r0(ext.root_positions[0]), rF(ext.root_positions[at(F)]);
-  const double chord = std::hypot(rF.x - r0.x, rF.z - r0.z);
-  const bool stationary = chord < o.stationary_below_m;
+// The path of a cycle: a line or an arc through the cycle's start and end,
+// heading psi0 + turn * phase; stationary clips stay at the root's mean
+// ground point (stride 0).
+struct CyclePath {
+  bool stationary = false;
+  double turn = 0.0;       // heading change per cycle (rad)
+  double psi0 = 0.0;       // heading at phase 0 (rad)
+  double stride = 0.0;     // path length per cycle (m)
+  glm::dvec3 origin{0.0};  // path point at phase 0 (m, y = 0)
 
-  // The path: a line or an arc through the cycle's start and end, heading
-  // psi0 + turn * phase; stationary clips stay at the root's mean ground point.
-  double psi0 = 0.0, stride = 0.0;
-  glm::dvec3 origin(r0.x, 0.0, r0.z);
-  if (stationary) {
-    double c = 0.0, s = 0.0;
-    origin = glm::dvec3(0.0);
-    for (std::int32_t i = 0; i < F; ++i) {
-      const double h = psi[at(i)] - turn * i / F;
-      c += std::cos(h);
-      s += std::sin(h);
-      origin += glm::dvec3(ext.root_positions[at(i)].x, 0.0, ext.root_positions[at(i)].z) / static_cast<double>(F);
-    }
-    psi0 = std::atan2(s, c);
-  } else {
-    psi0 = std::atan2(rF.x - r0.x, rF.z - r0.z) - 0.5 * turn;
-    const double half = 0.5 * turn;
-    stride = std::abs(half) > 1e-9 ? chord * half / std::sin(half) : chord;
-  }
-  const auto path_point = [&](double phi) {
+  // The path point at phase phi (one cycle per unit), m.
+  glm::dvec3 point(double phi) const {
     glm::dvec3 local(0.0, 0.0, stride * phi);
     if (!stationary && std::abs(turn) > 1e-9) {
       const double r = stride / turn;
       local = glm::dvec3(r * (1.0 - std::cos(turn * phi)), 0.0, r * std::sin(turn * phi));
     }
     return origin + yaw_rotation(psi0) * local;
-  };
+  }
+};
 
-  // The root relative to the path frame at its phase.
-  std::vector<glm::dvec3> offset(at(F));
-  std::vector<glm::quat> root_rotation(at(F));
+// Fits the path to `ext`, three copies of a cycle of F frames with the root
+// carried on (frame F is frame 0 one cycle on): the turn from the root's
+// unwrapped heading (rad), the chord from its ground positions (m); a chord
+// below stationary_below_m (m) makes the clip stationary.
+CyclePath fit_cycle_path(const Clip& ext, std::int32_t F, double stationary_below_m) {
+  std::vector<double> psi(at(3 * F));
+  for (std::int32_t i = 0; i < 3 * F; ++i) {
+    const double h = heading_of(ext.rotation(i, 0));
+    psi[at(i)] = i == 0 ? h : psi[at(i - 1)] + wrap_angle(h - psi[at(i - 1)]);
+  }
+  CyclePath path;
+  const double turn = psi[at(F)] - psi[0];
+  path.turn = turn;
+  const glm::dvec3 r0(ext.root_positions[0]), rF(ext.root_positions[at(F)]);
+  const double chord = std::hypot(rF.x - r0.x, rF.z - r0.z);
+  path.stationary = chord < stationary_below_m;
+  path.origin = glm::dvec3(r0.x, 0.0, r0.z);
+  if (path.stationary) {
+    double c = 0.0, s = 0.0;
+    path.origin = glm::dvec3(0.0);
+    for (std::int32_t i = 0; i < F; ++i) {
+      const double h = psi[at(i)] - turn * i / F;
+      c += std::cos(h);
+      s += std::sin(h);
+      path.origin += glm::dvec3(ext.root_positions[at(i)].x, 0.0, ext.root_positions[at(i)].z) / static_cast<double>(F);
+    }
+    path.psi0 = std::atan2(s, c);
+  } else {
+    path.psi0 = std::atan2(rF.x - r0.x, rF.z - r0.z) - 0.5 * turn;
+    const double half = 0.5 * turn;
+    path.stride = std::abs(half) > 1e-9 ? chord * half / std::sin(half) : chord;
+  }
+  return path;
+}
+
+// The root of the first F frames of `ext` relative to the path frame at its
+// phase: offsets (m; x left, y up, z forward) and root rotations. Centres the
+// path under the root (offsets of mean 0 in x and z): a parallel curve, so
+// path.stride changes by the lateral shift times the turn.
+struct RootOnPath {
+  std::vector<glm::dvec3> offset;
+  std::vector<glm::quat> rotation;
+};
+RootOnPath root_on_path(const Clip& ext, std::int32_t F, CyclePath& path) {
+  RootOnPath root;
+  root.offset.resize(at(F));
+  root.rotation.resize(at(F));
   glm::dvec2 mean(0.0);
   for (std::int32_t i = 0; i < F; ++i) {
     const double phi = static_cast<double>(i) / F;
-    const glm::dquat to_path = yaw_rotation(-(psi0 + turn * phi));
-    offset[at(i)] = to_path * (glm::dvec3(ext.root_positions[at(i)]) - path_point(phi));
-    root_rotation[at(i)] = glm::quat(glm::normalize(to_path * glm::dquat(ext.rotation(i, 0))));
-    mean += glm::dvec2(offset[at(i)].x, offset[at(i)].z) / static_cast<double>(F);
+    const glm::dquat to_path = yaw_rotation(-(path.psi0 + path.turn * phi));
+    root.offset[at(i)] = to_path * (glm::dvec3(ext.root_positions[at(i)]) - path.point(phi));
+    root.rotation[at(i)] = glm::quat(glm::normalize(to_path * glm::dquat(ext.rotation(i, 0))));
+    mean += glm::dvec2(root.offset[at(i)].x, root.offset[at(i)].z) / static_cast<double>(F);
   }
-  // Centre the path under the root (a parallel curve: an arc's length
-  // changes by the lateral shift times the turn).
-  for (glm::dvec3& d : offset) d -= glm::dvec3(mean.x, 0.0, mean.y);
-  if (!stationary) stride -= mean.x * turn;
+  for (glm::dvec3& d : root.offset) d -= glm::dvec3(mean.x, 0.0, mean.y);
+  if (!path.stationary) path.stride -= mean.x * path.turn;
+  return root;
+}
 
-  LocomotionClip out;
-  out.name = std::move(name);
-  out.cycle.resize(F, J);
-  out.cycle.frame_time = cycle.frame_time;
-  for (std::int32_t i = 0; i < F; ++i) {
-    for (std::int32_t j = 1; j < J; ++j) out.cycle.rotation(i, j) = cycle.rotation(i, j);
-    out.cycle.rotation(i, 0) = root_rotation[at(i)];
-    out.cycle.root_positions[at(i)] = glm::vec3(offset[at(i)]);
-  }
-  out.period_s = static_cast<double>(F) * cycle.frame_time;
-  out.stride_m = stride;
-  out.turn_rad = turn;
-  if (o.straighten) {
-    out.turn_removed_rad = turn;
-    out.turn_rad = 0.0;
-  }
-  out.speed = stride / out.period_s;
-  const bool have_feet = skeleton.role(Role::LeftAnkle) >= 0 && skeleton.role(Role::RightAnkle) >= 0;
-  if (o.clean_contacts && have_feet && !stationary) out.contact_cleanup_m = clean_foot_contacts(skeleton, out, o);
-
-  // Foot events: contacts of the (cleaned) cycle in its own motion, over
-  // the middle of three copies.
+// Frames of the foot events of a prepared cycle (in FootEvent order), from
+// the contacts of the cycle in its own motion over the middle of three
+// copies; -1 for a foot without exactly one touchdown and one liftoff there.
+std::array<std::int32_t, kFootEvents> foot_event_frames(const Skeleton& skeleton, const LocomotionClip& out, const ContactOptions& o) {
+  const std::int32_t F = out.cycle.frame_count;
   std::array<std::int32_t, kFootEvents> event_frame{-1, -1, -1, -1};
-  if (have_feet) {
-    const ModelSpaceClip model = forward_kinematics(skeleton, cycle_in_world(out, 3));
-    const ContactReport contacts = detect_foot_contacts(skeleton, model, cycle.frame_time, FeetJoints::from_roles(skeleton), o.contacts);
-    for (int f = 0; f < 2; ++f) {
-      std::int32_t downs = 0, ups = 0, down = -1, up = -1;
-      for (const ContactInterval& c : contacts.feet[at(f)].intervals) {
-        if (c.begin >= F && c.begin < 2 * F) ++downs, down = c.begin - F;
-        if (c.end >= F && c.end < 2 * F) ++ups, up = c.end - F;
-      }
-      if (downs == 1 && ups == 1) {
-        event_frame[at(f == 0 ? 0 : 2)] = down;
-        event_frame[at(f == 0 ? 1 : 3)] = up;
-      }
+  const ModelSpaceClip model = forward_kinematics(skeleton, cycle_in_world(out, 3));
+  const ContactReport contacts = detect_foot_contacts(skeleton, model, out.cycle.frame_time, FeetJoints::from_roles(skeleton), o);
+  for (int f = 0; f < 2; ++f) {
+    std::int32_t downs = 0, ups = 0, down = -1, up = -1;
+    for (const ContactInterval& c : contacts.feet[at(f)].intervals) {
+      if (c.begin >= F && c.begin < 2 * F) ++downs, down = c.begin - F;
+      if (c.end >= F && c.end < 2 * F) ++ups, up = c.end - F;
+    }
+    if (downs == 1 && ups == 1) {
+      event_frame[at(f == 0 ? 0 : 2)] = down;
+      event_frame[at(f == 0 ? 1 : 3)] = up;
     }
   }
+  return event_frame;
+}
+
+// Sets the events' phases and re-phases the cycle so that frame 0 is the
+// left touchdown (event_frame[0]; frame 0 stays when there is none). The
+// offsets are periodic, so rotating the frame order is exact.
+void start_at_left_touchdown(LocomotionClip& out, const std::array<std::int32_t, kFootEvents>& event_frame) {
+  const std::int32_t F = out.cycle.frame_count, J = out.cycle.joint_count;
   const std::int32_t k0 = event_frame[0] >= 0 ? event_frame[0] : 0;
   for (int e = 0; e < kFootEvents; ++e)
     if (event_frame[at(e)] >= 0)
       out.events[at(e)] = static_cast<float>(wrap_unit(static_cast<double>(event_frame[at(e)] - k0) / F));
-
-  // Re-phase: frame 0 at the left touchdown. The offsets are periodic, so
-  // rotating the frame order is exact.
   if (k0 != 0) {
     const Clip before = out.cycle;
     for (std::int32_t i = 0; i < F; ++i) {
@@ -259,17 +265,191 @@ LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cy
     }
   }
   out.source_start_frame = k0;
-  out.mean_rotations.resize(at(J));
-  for (std::int32_t j = 0; j < J; ++j) out.mean_rotations[at(j)] = mean_rotation(out.cycle.rotations, F, J, j);
-  if (have_feet) {
-    const ModelSpaceClip model = forward_kinematics(skeleton, out.cycle);
-    for (std::size_t f = 0; f < 2; ++f) {
-      const std::int32_t ankle = skeleton.role(f == 0 ? Role::LeftAnkle : Role::RightAnkle);
-      float lowest = model.position(0, ankle).y;
-      for (std::int32_t i = 1; i < F; ++i) lowest = std::min(lowest, model.position(i, ankle).y);
-      out.ankle_ground[f] = lowest;
+}
+
+// Lowest height of each ankle over the cycle (m): [0] left, [1] right.
+std::array<float, 2> ankle_ground(const Skeleton& skeleton, const Clip& cycle) {
+  std::array<float, 2> ground{0.0f, 0.0f};
+  const ModelSpaceClip model = forward_kinematics(skeleton, cycle);
+  for (std::size_t f = 0; f < 2; ++f) {
+    const std::int32_t ankle = skeleton.role(f == 0 ? Role::LeftAnkle : Role::RightAnkle);
+    float lowest = model.position(0, ankle).y;
+    for (std::int32_t i = 1; i < cycle.frame_count; ++i) lowest = std::min(lowest, model.position(i, ankle).y);
+    ground[f] = lowest;
+  }
+  return ground;
+}
+
+// Contacts of one foot (clean_foot_contacts), in frames of `model` (three
+// copies of the cycle in its own motion), run on while the ball of the foot
+// stays low (contacts' height threshold above its ground, m) and rolls
+// slower than cleanup_speed_factor times the contacts' speed threshold
+// (m/s; frame_time in s) until the foot leaves or the next contact begins:
+// mocap feet roll about toes the skeleton lacks, so the ball moves faster
+// than the strict speed limit allows.
+std::vector<ContactInterval> rolled_contacts(const ModelSpaceClip& model, const LegChain& chain, const FootContacts& fc,
+                                             const ContactReport& contacts, float frame_time, const LocomotionOptions& o) {
+  const std::int32_t ankle = chain.joints[chain.count - 1];
+  const glm::vec3 ball(chain.ball[0], chain.ball[1], chain.ball[2]);
+  std::vector<ContactInterval> intervals = fc.intervals;
+  const double ball_ground = fc.ground[1];
+  for (std::size_t k = 0; k < intervals.size() && chain.has_ball; ++k) {
+    const std::int32_t limit = k + 1 < intervals.size() ? intervals[k + 1].begin : model.frame_count;
+    std::int32_t& e = intervals[k].end;
+    while (e < limit) {
+      const glm::dvec3 b = glm::dvec3(model.position(e, ankle) + model.rotations[frame_joint(model, e, ankle)] * ball);
+      const glm::dvec3 b0 = glm::dvec3(model.position(e - 1, ankle) + model.rotations[frame_joint(model, e - 1, ankle)] * ball);
+      const double speed = std::hypot(b.x - b0.x, b.z - b0.z) / frame_time;
+      if (!(b.y - ball_ground < contacts.height_threshold && speed < o.cleanup_speed_factor * contacts.speed_threshold)) break;
+      ++e;
     }
   }
+  return intervals;
+}
+
+// The ankle's correction (m, world) on the frames of `model` where a foot is
+// pinned, and which frames those are.
+struct AnklePins {
+  std::vector<glm::dvec3> correction;
+  std::vector<std::uint8_t> pinned;
+};
+
+// Pins one contact of a foot whose ankle's ground level is `ground` (m).
+// Heel down while the ankle is within half kHeelLift of its ground (from
+// its first such frame until it rises): the ankle is pinned at its mean
+// position there; from then on the ball, where it was with the foot as on
+// the last heel-down frame. No heel-down frame (forefoot contact): the ball
+// at its mean position. A frame whose correction would exceed max_cleanup_m
+// stays free; past the contact's middle it ends the pinning (the foot has
+// left, or the data disagrees with a plant).
+void pin_contact(const ModelSpaceClip& model, const LegChain& chain, double ground, const ContactInterval& in, double max_cleanup_m,
+                 AnklePins& pins) {
+  const std::int32_t ankle = chain.joints[chain.count - 1];
+  const glm::vec3 ball(chain.ball[0], chain.ball[1], chain.ball[2]);
+  const auto rotation = [&](std::int32_t i) { return model.rotations[frame_joint(model, i, ankle)]; };
+  glm::dvec3 anchor(0.0);
+  std::int32_t down = 0, rise = in.end;
+  for (std::int32_t i = in.begin; i < in.end && rise == in.end; ++i) {
+    const glm::dvec3 a(model.position(i, ankle));
+    if (a.y - ground < 0.5 * kHeelLift) {
+      anchor += a;
+      ++down;
+    } else if (down > 0) {
+      rise = i;
+    }
+  }
+  glm::dvec3 ball_anchor(0.0);
+  if (down > 0) {
+    anchor /= static_cast<double>(down);
+    ball_anchor = anchor + glm::dvec3(rotation(rise - 1) * ball);
+  } else {
+    for (std::int32_t i = in.begin; i < in.end; ++i) ball_anchor += glm::dvec3(model.position(i, ankle) + rotation(i) * ball);
+    ball_anchor /= static_cast<double>(in.end - in.begin);
+  }
+  for (std::int32_t i = in.begin; i < in.end; ++i) {
+    const bool on_heel = down > 0 && (i < rise || !chain.has_ball);
+    const glm::dvec3 target = on_heel ? anchor : ball_anchor - glm::dvec3(rotation(i) * ball);
+    const glm::dvec3 corr = target - glm::dvec3(model.position(i, ankle));
+    if (glm::length(corr) > max_cleanup_m) {
+      if (i > in.begin + (in.end - in.begin) / 2) break;
+      continue;
+    }
+    pins.correction[at(i)] = corr;
+    pins.pinned[at(i)] = 1;
+  }
+}
+
+// Fades corrections in and out: a free frame within `ramp` frames of a
+// pinned one takes the nearest pinned frame's correction (the mean of both
+// when two are as near), scaled by 1 - d / (ramp + 1) at distance d.
+std::vector<glm::dvec3> faded_corrections(const AnklePins& pins, std::int32_t ramp) {
+  const auto frames = static_cast<std::int32_t>(pins.pinned.size());
+  const std::vector<glm::dvec3>& correction = pins.correction;
+  std::vector<glm::dvec3> faded = correction;
+  for (std::int32_t i = 0; i < frames; ++i) {
+    if (pins.pinned[at(i)]) continue;
+    for (std::int32_t d = 1; d <= ramp; ++d) {
+      const std::int32_t before = i - d, after = i + d;
+      const bool b = before >= 0 && pins.pinned[at(before)], a = after < frames && pins.pinned[at(after)];
+      if (!a && !b) continue;
+      const glm::dvec3 near = b && a ? 0.5 * (correction[at(before)] + correction[at(after)]) : correction[at(b ? before : after)];
+      faded[at(i)] = near * (1.0 - static_cast<double>(d) / (ramp + 1));
+      break;
+    }
+  }
+  return faded;
+}
+
+// Moves one leg's ankle by its faded corrections (m) on the middle copy's
+// frames, which are the cycle's: two-bone IK turns thigh and knee, the foot
+// keeps its world rotation; writes the local rotations of thigh, knee and
+// ankle into c.cycle. Returns `largest` raised to the largest correction.
+double correct_leg(const Skeleton& skeleton, const LegChain& chain, const ModelSpaceClip& model, const std::vector<glm::dvec3>& faded,
+                   LocomotionClip& c, double largest) {
+  const std::int32_t F = c.cycle.frame_count;
+  const std::int32_t thigh = chain.joints[chain.count - 3], knee = chain.joints[chain.count - 2], ankle = chain.joints[chain.count - 1];
+  const auto rotation = [&](std::int32_t i, std::int32_t j) { return model.rotations[frame_joint(model, i, j)]; };
+  const std::int32_t hip_parent = skeleton.parents[at(thigh)];
+  const glm::vec3 hinge = knee_hinge(skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], {&c.cycle}, knee);
+  for (std::int32_t k = 0; k < F; ++k) {
+    const std::int32_t i = F + k;
+    const glm::dvec3& corr = faded[at(i)];
+    if (glm::length(corr) < 1e-7) continue;
+    largest = std::max(largest, glm::length(corr));
+    const glm::vec3 target = model.position(i, ankle) + glm::vec3(corr);
+    glm::quat r_thigh = rotation(i, thigh);
+    glm::quat r_knee = rotation(i, knee);
+    const glm::quat r_foot = rotation(i, ankle);
+    if (!two_bone_ik(model.position(i, thigh), skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], hinge, target, r_thigh, r_knee))
+      continue;
+    c.cycle.rotation(k, thigh) = glm::normalize(glm::inverse(rotation(i, hip_parent)) * r_thigh);
+    c.cycle.rotation(k, knee) = glm::normalize(glm::inverse(r_thigh) * r_knee);
+    c.cycle.rotation(k, ankle) = glm::normalize(glm::inverse(r_knee) * r_foot);
+  }
+  return largest;
+}
+
+}  // namespace
+
+LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cycle, std::string name, const LocomotionOptions& o) {
+  o.validate();
+  skeleton.validate();
+  check_cycle(skeleton, cycle, name);
+  const std::int32_t J = skeleton.joint_count();
+  const std::int32_t F = cycle.frame_count;
+
+  // Three copies with the root carried on: frame F is frame 0 one cycle on.
+  const Clip ext = repeat_cycle(cycle, 3);
+  CyclePath path = fit_cycle_path(ext, F, o.stationary_below_m);
+  const RootOnPath root = root_on_path(ext, F, path);
+
+  LocomotionClip out;
+  out.name = std::move(name);
+  out.cycle.resize(F, J);
+  out.cycle.frame_time = cycle.frame_time;
+  for (std::int32_t i = 0; i < F; ++i) {
+    for (std::int32_t j = 1; j < J; ++j) out.cycle.rotation(i, j) = cycle.rotation(i, j);
+    out.cycle.rotation(i, 0) = root.rotation[at(i)];
+    out.cycle.root_positions[at(i)] = glm::vec3(root.offset[at(i)]);
+  }
+  out.period_s = static_cast<double>(F) * cycle.frame_time;
+  out.stride_m = path.stride;
+  out.turn_rad = path.turn;
+  if (o.straighten) {
+    out.turn_removed_rad = path.turn;
+    out.turn_rad = 0.0;
+  }
+  out.speed = path.stride / out.period_s;
+  const bool have_feet = skeleton.role(Role::LeftAnkle) >= 0 && skeleton.role(Role::RightAnkle) >= 0;
+  if (o.clean_contacts && have_feet && !path.stationary) out.contact_cleanup_m = clean_foot_contacts(skeleton, out, o);
+
+  // Foot events of the (cleaned) cycle; frame 0 at the left touchdown.
+  std::array<std::int32_t, kFootEvents> event_frame{-1, -1, -1, -1};
+  if (have_feet) event_frame = foot_event_frames(skeleton, out, o.contacts);
+  start_at_left_touchdown(out, event_frame);
+  out.mean_rotations.resize(at(J));
+  for (std::int32_t j = 0; j < J; ++j) out.mean_rotations[at(j)] = mean_rotation(out.cycle.rotations, F, J, j);
+  if (have_feet) out.ankle_ground = ankle_ground(skeleton, out.cycle);
   return out;
 }
 
@@ -284,106 +464,16 @@ double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& c, const Lo
   const ContactReport contacts = detect_foot_contacts(skeleton, model, c.cycle.frame_time, FeetJoints::from_roles(skeleton), o.contacts);
   const std::int32_t ramp = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::lround(o.contact_ramp_s / c.cycle.frame_time)));
   const std::size_t frames = at(3 * F);
-  const auto index = [&](std::int32_t i, std::int32_t j) { return at(static_cast<std::int64_t>(i) * J + j); };
   double largest = 0.0;
   for (std::size_t leg = 0; leg < 2; ++leg) {
     const LegChain& chain = legs[leg];
     if (chain.count < 4) continue;
-    const std::int32_t thigh = chain.joints[chain.count - 3], knee = chain.joints[chain.count - 2], ankle = chain.joints[chain.count - 1];
-    const glm::vec3 ball(chain.ball[0], chain.ball[1], chain.ball[2]);
     const FootContacts& fc = contacts.feet[leg];
-    const double ground = fc.ground[0];
-    // The ankle's correction on every contact frame.
-    std::vector<glm::dvec3> correction(frames, glm::dvec3(0.0));
-    std::vector<std::uint8_t> pinned(frames, 0);
-    // A contact goes on while the ball stays low and rolls (mocap feet roll
-    // about toes the skeleton lacks, so the ball moves faster than the
-    // strict speed limit allows) until the foot leaves.
-    std::vector<ContactInterval> intervals = fc.intervals;
-    const double ball_ground = fc.ground[1];
-    for (std::size_t k = 0; k < intervals.size() && chain.has_ball; ++k) {
-      const std::int32_t limit = k + 1 < intervals.size() ? intervals[k + 1].begin : 3 * F;
-      std::int32_t& e = intervals[k].end;
-      while (e < limit) {
-        const glm::dvec3 b = glm::dvec3(model.positions[index(e, ankle)] + model.rotations[index(e, ankle)] * ball);
-        const glm::dvec3 b0 = glm::dvec3(model.positions[index(e - 1, ankle)] + model.rotations[index(e - 1, ankle)] * ball);
-        const double speed = std::hypot(b.x - b0.x, b.z - b0.z) / c.cycle.frame_time;
-        if (!(b.y - ball_ground < contacts.height_threshold && speed < o.cleanup_speed_factor * contacts.speed_threshold)) break;
-        ++e;
-      }
-    }
-    for (const ContactInterval& in : intervals) {
-      // Heel down while the ankle is within half kHeelLift of its ground (from
-      // its first such frame until it rises): the ankle is pinned at its mean
-      // position there; from then on the ball, where it was with the foot as
-      // on the last heel-down frame. No heel-down frame (forefoot contact):
-      // the ball at its mean position.
-      glm::dvec3 anchor(0.0);
-      std::int32_t down = 0, rise = in.end;
-      for (std::int32_t i = in.begin; i < in.end && rise == in.end; ++i) {
-        const glm::dvec3 a(model.positions[index(i, ankle)]);
-        if (a.y - ground < 0.5 * kHeelLift) {
-          anchor += a;
-          ++down;
-        } else if (down > 0) {
-          rise = i;
-        }
-      }
-      glm::dvec3 ball_anchor(0.0);
-      if (down > 0) {
-        anchor /= static_cast<double>(down);
-        ball_anchor = anchor + glm::dvec3(model.rotations[index(rise - 1, ankle)] * ball);
-      } else {
-        for (std::int32_t i = in.begin; i < in.end; ++i)
-          ball_anchor += glm::dvec3(model.positions[index(i, ankle)] + model.rotations[index(i, ankle)] * ball);
-        ball_anchor /= static_cast<double>(in.end - in.begin);
-      }
-      for (std::int32_t i = in.begin; i < in.end; ++i) {
-        const bool on_heel = down > 0 && (i < rise || !chain.has_ball);
-        const glm::dvec3 target = on_heel ? anchor : ball_anchor - glm::dvec3(model.rotations[index(i, ankle)] * ball);
-        const glm::dvec3 corr = target - glm::dvec3(model.positions[index(i, ankle)]);
-        // The foot has left (or the data disagrees with a plant): stop here.
-        if (glm::length(corr) > o.max_cleanup_m) {
-          if (i > in.begin + (in.end - in.begin) / 2) break;
-          continue;
-        }
-        correction[at(i)] = corr;
-        pinned[at(i)] = 1;
-      }
-    }
-    // Fade in and out: a free frame takes the nearest pinned frame's
-    // correction, scaled down with the distance.
-    std::vector<glm::dvec3> faded = correction;
-    for (std::int32_t i = 0; i < 3 * F; ++i) {
-      if (pinned[at(i)]) continue;
-      for (std::int32_t d = 1; d <= ramp; ++d) {
-        const std::int32_t before = i - d, after = i + d;
-        const bool b = before >= 0 && pinned[at(before)], a = after < 3 * F && pinned[at(after)];
-        if (!a && !b) continue;
-        const glm::dvec3 near = b && a ? 0.5 * (correction[at(before)] + correction[at(after)]) : correction[at(b ? before : after)];
-        faded[at(i)] = near * (1.0 - static_cast<double>(d) / (ramp + 1));
-        break;
-      }
-    }
-    // IK on the middle copy's frames, which are the cycle's.
-    const std::int32_t hip_parent = skeleton.parents[at(thigh)];
-    const glm::vec3 hinge = knee_hinge(skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], {&c.cycle}, knee);
-    for (std::int32_t k = 0; k < F; ++k) {
-      const std::int32_t i = F + k;
-      const glm::dvec3& corr = faded[at(i)];
-      if (glm::length(corr) < 1e-7) continue;
-      largest = std::max(largest, glm::length(corr));
-      const glm::vec3 target = model.positions[index(i, ankle)] + glm::vec3(corr);
-      glm::quat r_thigh = model.rotations[index(i, thigh)];
-      glm::quat r_knee = model.rotations[index(i, knee)];
-      const glm::quat r_foot = model.rotations[index(i, ankle)];
-      if (!two_bone_ik(model.positions[index(i, thigh)], skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], hinge, target, r_thigh,
-                       r_knee))
-        continue;
-      c.cycle.rotation(k, thigh) = glm::normalize(glm::inverse(model.rotations[index(i, hip_parent)]) * r_thigh);
-      c.cycle.rotation(k, knee) = glm::normalize(glm::inverse(r_thigh) * r_knee);
-      c.cycle.rotation(k, ankle) = glm::normalize(glm::inverse(r_knee) * r_foot);
-    }
+    // The ankle's correction on every contact frame, then faded in and out.
+    AnklePins pins{std::vector<glm::dvec3>(frames, glm::dvec3(0.0)), std::vector<std::uint8_t>(frames, 0)};
+    for (const ContactInterval& in : rolled_contacts(model, chain, fc, contacts, c.cycle.frame_time, o))
+      pin_contact(model, chain, fc.ground[0], in, o.max_cleanup_m, pins);
+    largest = correct_leg(skeleton, chain, model, faded_corrections(pins, ramp), c, largest);
   }
   return largest;
 }

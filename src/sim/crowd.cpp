@@ -11,13 +11,12 @@
 
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/math.h"
 #include "core/random.h"
 
 namespace throng::sim {
 
 namespace {
-
-constexpr double kPi = 3.141592653589793;
 
 Aabb region_bounds(const Region& r) {
   Aabb b;

@@ -1,0 +1,75 @@
+// A character's synthesised pose (host and device): the blend's local
+// rotations with the leg IK's in place (synthesised_rotation), world joints
+// (synthesise_pose); and host drivers of one character for the reference
+// and tests (animate_character, locomotion_foot_skating).
+#pragma once
+
+#include <cstdint>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/config.h"
+#include "motion/blend_space.h"
+#include "motion/cycle.h"
+#include "motion/fk.h"
+#include "motion/foot_skating.h"
+#include "motion/leg_ik.h"
+#include "motion/locomotion_step.h"
+
+namespace throng::motion {
+
+// The synthesised local rotation of a joint: the blend, or the leg IK's.
+THRONG_HOST_DEVICE inline glm::quat synthesised_rotation(const BlendSpaceView& v, const CharacterFrame& f, const PlantedLegs& legs,
+                                                         std::int32_t joint) {
+  for (int leg = 0; leg < 2; ++leg) {
+    if (!legs.active[leg]) continue;
+    const LegChain& chain = v.legs[leg];
+    for (int k = 0; k < 3; ++k)
+      if (chain.joints[chain.count - 3 + k] == joint) return legs.corrected[leg][k];
+  }
+  return joint_rotation(v, f, joint);
+}
+
+// World position and rotation of every joint (reference: every joint
+// synthesised; the batch stage adds LOD masks and the cache).
+THRONG_HOST_DEVICE inline void synthesise_pose(const BlendSpaceView& v, const CharacterFrame& f, glm::vec3* out_positions,
+                                               glm::quat* out_rotations) {
+  const PlantedLegs legs = plant_legs(v, f, nullptr);
+  for (std::int32_t j = 0; j < v.joint_count; ++j) {
+    const glm::quat local = synthesised_rotation(v, f, legs, j);
+    const std::int32_t p = v.parents[j];
+    if (p < 0) {
+      out_positions[j] = f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f);
+      out_rotations[j] = f.frame * local;
+    } else {
+      out_positions[j] = out_positions[p] + out_rotations[p] * (f.scale * v.offsets[j]);
+      out_rotations[j] = out_rotations[p] * local;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Host helpers
+
+// One character's state for the host reference and tests.
+struct LocomotionCharacter {
+  glm::vec3 position{0.0f};
+  float yaw = 0.0f;
+  float scale = 1.0f;
+  float phase = 0.0f;
+  float blend_speed = -1.0f;
+};
+
+// Drives one character at a constant speed (and turn rate) for `frames`
+// frames, recording its world joints each frame after advancing:
+// [frame * joints + joint] (a ModelSpaceClip in world space).
+ModelSpaceClip animate_character(const BlendSpace1D& space, LocomotionCharacter character, float speed, float turn_rate,
+                                 const LocomotionStep& step, std::int32_t frames);
+
+// Foot skating of one character walking straight at a constant speed for
+// `seconds` (sampled every step.dt): contacts found on the synthesised
+// motion (low and slow feet), slide per contact (motion/foot_skating.h).
+FootSkatingReport locomotion_foot_skating(const BlendSpace1D& space, float speed, double seconds,
+                                          const LocomotionStep& step = {}, const ContactOptions& contacts = {});
+
+}  // namespace throng::motion
