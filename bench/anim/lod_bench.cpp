@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "anim/lod.h"
 #include "anim/motion_cache.h"
 #include "bench/registry.h"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "anim/blend_controller.h"
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "anim/locomotion_streams.h"
 #include "anim/stream_crowd.h"
 #include "bench/registry.h"

@@ -28,7 +28,7 @@ namespace {
 constexpr Index kMaxCurves = 1000;
 
 struct Scene {
-  path::StateMachine machine;
+  path::MotionGraph machine;
   path::Planner planner;
   std::vector<path::PathQuery> queries;
   std::vector<path::ResampledPath> paths;  // found paths, resampled
@@ -40,7 +40,7 @@ const Scene& scene() {
   static const Scene s = [] {
     ScopedExecution cpu(Backend::Cpu, 0);
     Scene sc;
-    sc.machine = path::StateMachine::build(io::default_state_machine_spec(), motion::default_skeleton());
+    sc.machine = path::MotionGraph::build(io::default_state_machine_spec(), motion::default_skeleton());
     path::PlanOptions po;
     po.radius = 0.3f;
     sc.planner = path::Planner::build(path::random_obstacle_world({}), po);

@@ -9,7 +9,7 @@
 #include <memory>
 #include <random>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "bench/registry.h"
 #include "core/buffer.h"
 #include "core/reduce.h"

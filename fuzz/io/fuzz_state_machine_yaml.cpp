@@ -18,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
     const path::StateMachineSpec spec = io::parse_state_machine(text, "fuzz.yaml");
-    const path::StateMachine m = path::StateMachine::build(spec, motion::default_skeleton());
+    const path::MotionGraph m = path::MotionGraph::build(spec, motion::default_skeleton());
     if (m.states().empty() || !std::isfinite(m.segment_length())) std::abort();
   } catch (const Error& e) {
     if (e.location().line <= 0 && e.location().file.empty() && e.location().field.empty()) std::abort();  // every error says where

@@ -266,7 +266,7 @@ void LocomotionStreams::record_tracks() {
   const Rig& r = rig();
   std::vector<Mat3x4> palette(J);
   for (std::size_t t = 0; t < skating_.tracked().size(); ++t) {
-    detail::copy_bytes(palette.data(), Memory::Host, palettes_.data() + skating_.tracked()[t] * joints_, palettes_.memory(), J * sizeof(Mat3x4));
+    palettes_.read(skating_.tracked()[t] * joints_, std::span<Mat3x4>(palette));
     const motion::FootSkatingRecorder::Frame f = skating_.append(t);
     for (std::size_t j = 0; j < J; ++j) {
       // The palette maps the bind pose to the world; the bind rotations are

@@ -41,7 +41,7 @@
 #include <vector>
 
 #include "anim/blend_controller.h"
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "anim/lod.h"
 #include "anim/stream_crowd.h"
 #include "core/buffer.h"

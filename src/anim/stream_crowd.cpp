@@ -261,9 +261,9 @@ void StreamCrowd::set_culled(Index agent, std::int32_t cluster, bool culled) {
   check_agent_cluster(agent, cluster);
   const Index i = agent * cluster_stride_ + cluster;
   ClusterRef ref;
-  detail::copy_bytes(&ref, Memory::Host, clusters_.data() + i, clusters_.memory(), sizeof(ClusterRef));
+  clusters_.read(i, std::span<ClusterRef>(&ref, 1));
   ref.flags = culled ? (ref.flags | kClusterCulled) : (ref.flags & ~kClusterCulled);
-  detail::copy_bytes(clusters_.data() + i, clusters_.memory(), &ref, Memory::Host, sizeof(ClusterRef));
+  clusters_.write(i, std::span<const ClusterRef>(&ref, 1));
 }
 
 void StreamCrowd::set_event_filter(std::int32_t cluster, EventMask allowed) {
@@ -274,8 +274,7 @@ void StreamCrowd::set_event_filter(std::int32_t cluster, EventMask allowed) {
 std::vector<ClusterRef> StreamCrowd::clusters_of(Index agent) const {
   agent_rig(agent);
   std::vector<ClusterRef> out(static_cast<std::size_t>(cluster_stride_));
-  detail::copy_bytes(out.data(), Memory::Host, clusters_.data() + agent * cluster_stride_, clusters_.memory(),
-                     sizeof(ClusterRef) * out.size());
+  clusters_.read(agent * cluster_stride_, std::span<ClusterRef>(out));
   return out;
 }
 

@@ -13,11 +13,11 @@ namespace {
 // Host data into part of a buffer in any memory.
 template <class T>
 void upload(Buffer<T>& dst, Index first, const T* src, Index count) {
-  if (count > 0) detail::copy_bytes(dst.data() + first, dst.memory(), src, Memory::Host, static_cast<std::size_t>(count) * sizeof(T));
+  dst.write(first, std::span<const T>(src, static_cast<std::size_t>(count)));
 }
 template <class T>
 void download(const Buffer<T>& src, Index first, T* dst, Index count) {
-  if (count > 0) detail::copy_bytes(dst, Memory::Host, src.data() + first, src.memory(), static_cast<std::size_t>(count) * sizeof(T));
+  src.read(first, std::span<T>(dst, static_cast<std::size_t>(count)));
 }
 
 void apply_root_motion(RootMotion mode, Pose& pose) {

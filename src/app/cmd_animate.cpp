@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "app/commands.h"
 #include "app/formation.h"
 #include "app/locomotion_stats.h"
@@ -38,7 +38,7 @@ namespace fs = std::filesystem;
 template <class T>
 std::vector<T> to_host(Span<const T> s) {
   std::vector<T> out(static_cast<std::size_t>(s.size()));
-  if (s.size() > 0) detail::copy_bytes(out.data(), Memory::Host, s.data(), current_memory(), out.size() * sizeof(T));
+  copy_to_host(s, std::span<T>(out));
   return out;
 }
 

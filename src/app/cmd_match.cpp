@@ -160,7 +160,7 @@ MatchInputs gather_paths(const MatchArgs& a, const io::PathsFile& file, nlohmann
 
 // The summary on stdout: paths, grid, the three sequencings' errors, the
 // playback's deviation (m) and the stages' times (ms).
-void print_match_summary(const path::MatchRun& run, const path::StateMachine& machine, const MatchInputs& in, double machine_ms) {
+void print_match_summary(const path::MatchRun& run, const path::MotionGraph& machine, const MatchInputs& in, double machine_ms) {
   double length = 0;
   for (const auto& p : run.paths) length += p.length;
   std::printf("paths            %zu (%lld not planned), %.1f m in all\n", run.paths.size(), static_cast<long long>(in.unplanned), length);
@@ -196,7 +196,7 @@ nlohmann::json paths_json(const path::MatchRun& run) {
 
 // match.json beside report["roadmap"]: the input, the machine, the grid, the
 // sequencings, the playback, the timings (ms) and the paths.
-void fill_match_report(nlohmann::json& report, const MatchArgs& a, const path::StateMachineSpec& spec, const path::StateMachine& machine,
+void fill_match_report(nlohmann::json& report, const MatchArgs& a, const path::StateMachineSpec& spec, const path::MotionGraph& machine,
                        const path::MatchRun& run, const MatchInputs& in, double machine_ms) {
   report["input"] = a.random > 0 ? nlohmann::json{{"random", a.random}, {"seed", a.seed}} : nlohmann::json{{"file", a.file}};
   report["machine"] = {{"name", spec.name},
@@ -221,7 +221,7 @@ void fill_match_report(nlohmann::json& report, const MatchArgs& a, const path::S
 }
 
 // Writes --out/match.json and a BVH clip per kept playback (path name.bvh).
-void write_match_outputs(const MatchArgs& a, const nlohmann::json& report, const path::MatchRun& run, const path::StateMachine& machine) {
+void write_match_outputs(const MatchArgs& a, const nlohmann::json& report, const path::MatchRun& run, const path::MotionGraph& machine) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(a.out, ec);
@@ -246,7 +246,7 @@ void run_match(const MatchArgs& a) {
   if (!a.file.empty()) file = io::read_paths(a.file);
   const std::string machine_file = !a.machine.empty() ? a.machine : file.machine;
   const path::StateMachineSpec spec = machine_file.empty() ? io::default_state_machine_spec() : io::read_state_machine(machine_file);
-  const path::StateMachine machine = path::StateMachine::build(spec, motion::default_skeleton());
+  const path::MotionGraph machine = path::MotionGraph::build(spec, motion::default_skeleton());
   const double machine_ms = ms_since(t0);
   spdlog::info("state machine '{}': {} states, {} motion segments ({} locomotion), d = {} x {} m = {:.2f} m", spec.name,
                machine.states().size(), machine.segment_count(), machine.locomotion_segments().size(), machine.k(), machine.spacing(),

@@ -112,8 +112,8 @@ class SimulationScene final : public render::ViewerScene {
   }
 
  private:
-  static LocomotionOptions locomotion_options(const std::vector<float>& thresholds) {
-    LocomotionOptions o;
+  static SimulationLocomotionOptions locomotion_options(const std::vector<float>& thresholds) {
+    SimulationLocomotionOptions o;
     o.lod_thresholds = thresholds;
     o.skating_agents = 0;  // measured by throng run, not here
     return o;

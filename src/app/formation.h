@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "core/camera.h"
 #include "io/animate_yaml.h"
 #include "motion/locomotion.h"

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "core/thinned_series.h"
 
 namespace throng::app {

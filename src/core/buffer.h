@@ -75,6 +75,9 @@ class Buffer {
     if (n != size_) resize_discard(n);
     if (n > 0) detail::copy_bytes(data_, memory_, values.data(), Memory::Host, bytes(n));
   }
+  // Elements [first, first + out.size()) into host memory, and back from it.
+  void read(Index first, std::span<T> out) const { copy_range(out.data(), Memory::Host, data_ + first, memory_, out.size()); }
+  void write(Index first, std::span<const T> values) { copy_range(data_ + first, memory_, values.data(), Memory::Host, values.size()); }
   std::vector<T> to_vector() const {
     std::vector<T> out(static_cast<std::size_t>(size_));
     if (size_ > 0) detail::copy_bytes(out.data(), Memory::Host, data_, memory_, bytes(size_));
@@ -95,6 +98,9 @@ class Buffer {
 
  private:
   static std::size_t bytes(Index n) { return static_cast<std::size_t>(n) * sizeof(T); }
+  static void copy_range(T* dst, Memory dst_m, const T* src, Memory src_m, std::size_t n) {
+    if (n > 0) detail::copy_bytes(dst, dst_m, src, src_m, n * sizeof(T));
+  }
   void allocate(Index n) {
     size_ = n < 0 ? 0 : n;
     data_ = size_ > 0 ? static_cast<T*>(detail::allocate_bytes(bytes(size_), memory_)) : nullptr;
@@ -109,5 +115,18 @@ class Buffer {
   Index size_ = 0;
   Memory memory_ = Memory::Host;
 };
+
+// Copies to.size() elements from a span that kernels of the current
+// backend read (current_memory()) into host memory, or into another such span.
+template <class From, class To>
+void copy_to_host(Span<From> from, std::span<To> to) {
+  static_assert(std::is_same_v<std::remove_const_t<From>, To>, "copy_to_host: element types differ");
+  if (!to.empty()) detail::copy_bytes(to.data(), Memory::Host, from.data(), current_memory(), to.size() * sizeof(To));
+}
+template <class From, class To>
+void copy_span(Span<From> from, Span<To> to) {
+  static_assert(std::is_same_v<std::remove_const_t<From>, To>, "copy_span: element types differ");
+  if (!to.empty()) detail::copy_bytes(to.data(), current_memory(), from.data(), current_memory(), static_cast<std::size_t>(to.size()) * sizeof(To));
+}
 
 }  // namespace throng

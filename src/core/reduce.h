@@ -85,6 +85,9 @@ struct CountBlocks {
 };
 }  // namespace detail
 
+// The sum as parallel_reduce's `combine`.
+using Plus = detail::Plus;
+
 // Folds map(i) for i in [0, n) with `combine` (associative), deterministically.
 template <class T, class Map, class Combine>
 T parallel_reduce(const char* description, Index n, T identity, const Map& map, const Combine& combine) {

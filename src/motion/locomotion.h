@@ -16,7 +16,7 @@
 //   phase, synchronised by foot events), blended_rotation (SLERP of the two
 //   clips' samples), advance_locomotion (phase and Eq. 10), character_frame,
 //   plant_legs, synthesise_pose (world joints). Per-frame work is sampling
-//   only. The batch stage for N characters is anim/locomotion.h.
+//   only. The batch stage for N characters is anim/crowd_animator.h.
 //
 // Conventions: Y up, metres, seconds, characters face +Z at yaw 0 and turn
 // left (towards +X) for positive yaw (core/ground.h). The path frame of a

@@ -11,7 +11,7 @@
 
 namespace throng::path {
 
-CurveSet cut_paths(std::span<const ResampledPath> paths, const StateMachine& machine, std::span<const float> desired_speed) {
+CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& machine, std::span<const float> desired_speed) {
   if (!desired_speed.empty() && desired_speed.size() != paths.size())
     throw Error("one desired speed per path expected", at_field("match.speed"));
   CurveSet out;
@@ -52,7 +52,7 @@ void MatchOptions::validate() const {
   if (!(speed_weight >= 0 && std::isfinite(speed_weight))) throw Error("speed weight must be >= 0", at_field("match.speed_weight"));
 }
 
-MatchGrid::MatchGrid(const StateMachine& machine, const CurveSet& curves, const MatchOptions& options) {
+MatchGrid::MatchGrid(const MotionGraph& machine, const CurveSet& curves, const MatchOptions& options) {
   options.validate();
   const Memory mem = current_memory();
   const std::vector<std::int32_t>& loco = machine.locomotion_segments();
@@ -111,7 +111,7 @@ double pair_cost(std::span<const float> cost, std::int32_t motions, std::int32_t
 }
 
 // Cheapest legal way into segment b from the start state (seg, cost), or (-1, inf).
-std::pair<std::int32_t, double> best_start(const StateMachine& m, std::int32_t b) {
+std::pair<std::int32_t, double> best_start(const MotionGraph& m, std::int32_t b) {
   if (m.start_state() < 0) return {-1, 0.0};
   std::pair<std::int32_t, double> best{-1, kInf};
   for (std::int32_t a : m.states()[static_cast<std::size_t>(m.start_state())].segments) {
@@ -120,7 +120,7 @@ std::pair<std::int32_t, double> best_start(const StateMachine& m, std::int32_t b
   }
   return best;
 }
-std::pair<std::int32_t, double> best_end(const StateMachine& m, std::int32_t a) {
+std::pair<std::int32_t, double> best_end(const MotionGraph& m, std::int32_t a) {
   if (m.end_state() < 0) return {-1, 0.0};
   std::pair<std::int32_t, double> best{-1, kInf};
   for (std::int32_t b : m.states()[static_cast<std::size_t>(m.end_state())].segments) {
@@ -132,7 +132,7 @@ std::pair<std::int32_t, double> best_end(const StateMachine& m, std::int32_t a) 
 
 }  // namespace
 
-Sequence score_sequence(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost, std::int32_t path,
+Sequence score_sequence(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost, std::int32_t path,
                         std::span<const std::int32_t> grid_motions) {
   const auto& loco = machine.locomotion_segments();
   const auto motions = static_cast<std::int32_t>(loco.size());
@@ -187,7 +187,7 @@ Sequence score_sequence(const StateMachine& machine, const CurveSet& curves, std
   return s;
 }
 
-std::vector<Sequence> greedy_sequences(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost,
+std::vector<Sequence> greedy_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost,
                                        std::span<const std::int32_t> best) {
   std::vector<Sequence> out(static_cast<std::size_t>(curves.path_count()));
   for (std::int32_t p = 0; p < curves.path_count(); ++p) {
@@ -198,7 +198,7 @@ std::vector<Sequence> greedy_sequences(const StateMachine& machine, const CurveS
   return out;
 }
 
-std::vector<Sequence> repaired_greedy_sequences(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost) {
+std::vector<Sequence> repaired_greedy_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost) {
   const auto& loco = machine.locomotion_segments();
   const auto motions = static_cast<std::int32_t>(loco.size());
   std::vector<Sequence> out(static_cast<std::size_t>(curves.path_count()));
@@ -231,7 +231,7 @@ std::vector<Sequence> repaired_greedy_sequences(const StateMachine& machine, con
   return out;
 }
 
-std::vector<Sequence> dp_sequences(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost) {
+std::vector<Sequence> dp_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost) {
   const auto& loco = machine.locomotion_segments();
   const auto M = static_cast<std::int32_t>(loco.size());
   std::vector<Sequence> out(static_cast<std::size_t>(curves.path_count()));

@@ -67,7 +67,7 @@ struct CurveSet {
 // Cuts every path into whole curves of machine.k() points (the tail shorter
 // than d is left out). Marks must name states of the machine (Error otherwise).
 // desired_speed: one per path, or empty (0 = any).
-CurveSet cut_paths(std::span<const ResampledPath> paths, const StateMachine& machine, std::span<const float> desired_speed = {});
+CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& machine, std::span<const float> desired_speed = {});
 
 // The grid job: cost[c * motions + m] = E(c, m) (+ speed term), or kNoMatch.
 struct MatchGridJob {
@@ -105,7 +105,7 @@ struct MatchOptions {
 // current_memory(); match() fills the grid and the greedy choice.
 class MatchGrid {
  public:
-  MatchGrid(const StateMachine& machine, const CurveSet& curves, const MatchOptions& options = {});
+  MatchGrid(const MotionGraph& machine, const CurveSet& curves, const MatchOptions& options = {});
   void match();
   std::int32_t motions() const { return motions_; }
   std::int32_t curves() const { return curves_; }
@@ -140,19 +140,19 @@ struct Sequence {
 // Scores a given sequence of grid motion indices for the curves of path p.
 // start/end segments are chosen as the cheapest legal ones (or the cheapest
 // at all, counted illegal, when none is legal).
-Sequence score_sequence(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost, std::int32_t path,
+Sequence score_sequence(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost, std::int32_t path,
                         std::span<const std::int32_t> grid_motions);
 
 // Greedy: each curve's best motion (the grid's argmin).
-std::vector<Sequence> greedy_sequences(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost,
+std::vector<Sequence> greedy_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost,
                                        std::span<const std::int32_t> best);
 // Greedy repaired to legality: each curve takes its best motion among those
 // its predecessor may be followed by (the last also must reach the end
 // state); illegal > 0 when even that fails.
-std::vector<Sequence> repaired_greedy_sequences(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost);
+std::vector<Sequence> repaired_greedy_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost);
 // Dynamic programming over the machine's transitions, per path in parallel
 // ("path.match_dp"): the legal sequence of least total cost (illegal > 0
 // only when no legal sequence exists).
-std::vector<Sequence> dp_sequences(const StateMachine& machine, const CurveSet& curves, std::span<const float> cost);
+std::vector<Sequence> dp_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost);
 
 }  // namespace throng::path

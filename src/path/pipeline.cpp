@@ -24,7 +24,7 @@ void add(SequenceStats& s, const Sequence& q, std::int32_t curves, std::int32_t 
 }
 }  // namespace
 
-MatchRun match_paths(const StateMachine& machine, const std::vector<PathInput>& inputs, const MatchRunOptions& options) {
+MatchRun match_paths(const MotionGraph& machine, const std::vector<PathInput>& inputs, const MatchRunOptions& options) {
   MatchRun run;
   const auto n = static_cast<Index>(inputs.size());
   ResampleOptions ro;

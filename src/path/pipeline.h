@@ -60,7 +60,7 @@ struct MatchRun {
   std::vector<motion::Clip> clips;  // the kept playback clips
 };
 
-MatchRun match_paths(const StateMachine& machine, const std::vector<PathInput>& inputs, const MatchRunOptions& options = {});
+MatchRun match_paths(const MotionGraph& machine, const std::vector<PathInput>& inputs, const MatchRunOptions& options = {});
 
 // A walkable rectangle with obstacles scattered by the simulation's own
 // scatter (circles and rotated boxes) and an L-shaped wall.

@@ -22,7 +22,7 @@ struct Item {
 
 }  // namespace
 
-Playback play(const StateMachine& machine, const ResampledPath& path, const Sequence& sequence) {
+Playback play(const MotionGraph& machine, const ResampledPath& path, const Sequence& sequence) {
   const std::int32_t k = machine.k();
   const auto curves = static_cast<std::int32_t>(sequence.segments.size());
   if (static_cast<std::size_t>(curves) * static_cast<std::size_t>(k) > path.points.size())

@@ -37,6 +37,6 @@ struct Playback {
 
 // `sequence` from greedy_sequences / dp_sequences for this path (its curves
 // are the first sequence.segments.size() * k points of `path`).
-Playback play(const StateMachine& machine, const ResampledPath& path, const Sequence& sequence);
+Playback play(const MotionGraph& machine, const ResampledPath& path, const Sequence& sequence);
 
 }  // namespace throng::path

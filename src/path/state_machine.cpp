@@ -46,13 +46,13 @@ glm::vec2 MachineClip::smoothed_root(double t) const {
   return glm::vec2(acc / static_cast<double>(P));
 }
 
-std::int32_t StateMachine::state_index(const std::string& name) const {
+std::int32_t MotionGraph::state_index(const std::string& name) const {
   for (std::size_t i = 0; i < states_.size(); ++i)
     if (states_[i].name == name) return static_cast<std::int32_t>(i);
   return -1;
 }
 
-void StateMachine::pose(std::int32_t seg, double t, std::vector<glm::quat>& rotations, glm::vec3& root) const {
+void MotionGraph::pose(std::int32_t seg, double t, std::vector<glm::quat>& rotations, glm::vec3& root) const {
   const MotionSegment& s = segments_[static_cast<std::size_t>(seg)];
   const MachineClip& c = clips_[static_cast<std::size_t>(s.clip)];
   const FramePos p = frame_pos(c.clip, c.time_of_first_frame, c.fps, s.start_time + t);
@@ -288,7 +288,7 @@ void expand_edges(const StateMachineSpec& spec, const Names& names, const std::v
 // Joint positions (m) of segment `seg` at t seconds after its start,
 // relative to the root and turned into its heading frame (heading = twist
 // of the root rotation about +Y).
-std::vector<glm::vec3> heading_frame_pose(const StateMachine& m, const motion::Skeleton& skeleton, std::int32_t seg, double t) {
+std::vector<glm::vec3> heading_frame_pose(const MotionGraph& m, const motion::Skeleton& skeleton, std::int32_t seg, double t) {
   const std::int32_t J = skeleton.joint_count();
   std::vector<glm::quat> rot;
   glm::vec3 root;
@@ -304,7 +304,7 @@ std::vector<glm::vec3> heading_frame_pose(const StateMachine& m, const motion::S
 // Transition costs, M x M row-major over m's segments: INFINITY where the
 // states may not follow, else edge cost + pose_weight * k * mean joint
 // mismatch (m) between a's last pose and b's first.
-std::vector<float> transition_costs(const StateMachine& m, const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
+std::vector<float> transition_costs(const MotionGraph& m, const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
   const std::int32_t J = skeleton.joint_count();
   const std::vector<MotionSegment>& segments = m.segments();
   const std::size_t M = segments.size();
@@ -330,9 +330,9 @@ std::vector<float> transition_costs(const StateMachine& m, const StateMachineSpe
 
 // Stages: limits, names (groups, clips, states), clips sampled, segments
 // (standing or locomotion), edges, start and end states, transition costs.
-StateMachine StateMachine::build(const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
+MotionGraph MotionGraph::build(const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
   check_limits(spec);
-  StateMachine m;
+  MotionGraph m;
   m.spec_ = spec;
   m.skeleton_ = skeleton;
   const double fps = spec.fps;

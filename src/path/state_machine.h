@@ -135,11 +135,11 @@ struct MachineClip {
   glm::vec2 raw_root(double t) const;
 };
 
-class StateMachine {
+class MotionGraph {
  public:
   // Generates the clips and every segment's trajectory; throws Error with
   // the file location of the offending entry.
-  static StateMachine build(const StateMachineSpec& spec, const motion::Skeleton& skeleton);
+  static MotionGraph build(const StateMachineSpec& spec, const motion::Skeleton& skeleton);
 
   const StateMachineSpec& spec() const { return spec_; }
   const motion::Skeleton& skeleton() const { return skeleton_; }

@@ -51,7 +51,7 @@ DrawGroups draw_groups(const CullJob& job, Span<const std::uint32_t> slots, Inde
   Index starts[kMaxDrawGroups + 1] = {};
   for (std::int32_t g = 1; g < groups.count && n > 0; ++g) {
     std::uint32_t start = 0;
-    throng::detail::copy_bytes(&start, Memory::Host, slots.data() + g * n, current_memory(), sizeof start);
+    copy_to_host(slots.subspan(g * n, 1), std::span<std::uint32_t>(&start, 1));
     starts[g] = start;
   }
   starts[groups.count] = visible;

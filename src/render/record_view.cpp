@@ -5,7 +5,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "core/error.h"
 #include "render/viewer.h"
 

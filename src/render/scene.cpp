@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "anim/lod.h"
 #include "anim/rig.h"
 #include "anim/stream_crowd.h"

@@ -15,7 +15,7 @@
 #include <cmath>
 #include <memory>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "anim/lod.h"
 #include "core/buffer.h"
 #include "core/error.h"
@@ -278,9 +278,8 @@ void show_bins(const ViewerScene& scene, const anim::CrowdAnimator& animator, co
   const auto side = std::min<std::int32_t>(4096, static_cast<std::int32_t>(std::ceil(2.0f * extent / cell)) + 1);
   std::vector<glm::vec3> ground(static_cast<std::size_t>(n));
   std::vector<std::uint8_t> flags(static_cast<std::size_t>(poses.flags.size()));
-  if (n > 0)
-    throng::detail::copy_bytes(ground.data(), Memory::Host, animator.positions().data(), current_memory(), ground.size() * sizeof(glm::vec3));
-  if (!flags.empty()) throng::detail::copy_bytes(flags.data(), Memory::Host, poses.flags.data(), current_memory(), flags.size());
+  copy_to_host(animator.positions(), std::span<glm::vec3>(ground));
+  copy_to_host(poses.flags, std::span<std::uint8_t>(flags));
   bin_counts.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side), 0);
   for (std::size_t i = 0; i < ground.size(); ++i) {
     if (!flags.empty() && (flags[i] & poses.visible_bits) != poses.visible_bits) continue;

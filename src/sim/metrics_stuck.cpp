@@ -106,7 +106,7 @@ void StuckTracker::update(const World& world, Span<const glm::vec2> positions, S
   // Rare (agents become stuck once): the host copy is paid only then.
   const std::vector<std::uint8_t> s = state_.to_vector();
   std::vector<glm::vec2> p(static_cast<std::size_t>(n));
-  detail::copy_bytes(p.data(), Memory::Host, positions.data(), current_memory(), p.size() * sizeof(glm::vec2));
+  copy_to_host(positions, std::span<glm::vec2>(p));
   for (std::size_t i = 0; i < s.size() && stats_.examples.size() < kStuckExamples; ++i)
     if ((s[i] & kStuckFirst) != 0) stats_.examples.push_back({static_cast<Index>(i), time, p[i]});
 }

@@ -13,7 +13,7 @@
 #include <iterator>
 #include <unistd.h>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "anim/rig.h"
 #include "core/error.h"
 #include "tests/anim/crowd_fixture.h"

@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 std::string error_of(const std::string& yaml) {
   try {
     const path::StateMachineSpec spec = parse_state_machine(yaml, "m.yaml");
-    path::StateMachine::build(spec, motion::default_skeleton());
+    path::MotionGraph::build(spec, motion::default_skeleton());
   } catch (const Error& e) {
     return e.what();
   }
@@ -32,7 +32,7 @@ std::string error_of(const std::string& yaml) {
 
 TEST(StateMachineYaml, DefaultMachineHasTheRequiredStates) {
   const path::StateMachineSpec spec = default_state_machine_spec();
-  const path::StateMachine m = path::StateMachine::build(spec, motion::default_skeleton());
+  const path::MotionGraph m = path::MotionGraph::build(spec, motion::default_skeleton());
   for (const char* s : {"idle", "walk_forward", "run_forward", "walk_left", "walk_right", "run_left", "run_right"})
     EXPECT_GE(m.state_index(s), 0) << s;
   EXPECT_EQ(m.k(), 64);
@@ -119,7 +119,7 @@ void truncations_and_flips(const std::string& text, std::size_t prefix_stride, s
 TEST(StateMachineYaml, TruncationsAndByteFlipsNeverCrash) {
   const std::string text(default_state_machine_yaml());
   truncations_and_flips(text, 211, 149, [](const std::string& t) {
-    path::StateMachine::build(parse_state_machine(t, "m.yaml"), motion::default_skeleton());
+    path::MotionGraph::build(parse_state_machine(t, "m.yaml"), motion::default_skeleton());
   });
 }
 

@@ -34,8 +34,8 @@ ResampledPath random_path(std::uint64_t seed, int n, float turn = 0.6f, std::vec
   return resample_path(p, o, marks);
 }
 
-TEST(StateMachine, SegmentsHaveEqualArcLengthAndTurnTheRightWay) {
-  const StateMachine& m = small_machine();
+TEST(MotionGraph, SegmentsHaveEqualArcLengthAndTurnTheRightWay) {
+  const MotionGraph& m = small_machine();
   const float s = m.spacing();
   ASSERT_EQ(m.locomotion_segments().size(), 7u);
   for (std::int32_t id : m.locomotion_segments()) {
@@ -70,8 +70,8 @@ TEST(StateMachine, SegmentsHaveEqualArcLengthAndTurnTheRightWay) {
   EXPECT_NEAR(m.segments()[static_cast<std::size_t>(run)].speed, 2.7f, 0.06f);
 }
 
-TEST(StateMachine, ChildrenInheritTheirGroupsEdges) {
-  const StateMachine& m = small_machine();
+TEST(MotionGraph, ChildrenInheritTheirGroupsEdges) {
+  const MotionGraph& m = small_machine();
   auto s = [&](const char* n) { return m.state_index(n); };
   EXPECT_TRUE(m.allowed(s("walk_forward"), s("walk_right")));  // F -> locomotion
   EXPECT_TRUE(m.allowed(s("run_forward"), s("walk_left")));
@@ -93,11 +93,11 @@ TEST(StateMachine, ChildrenInheritTheirGroupsEdges) {
   EXPECT_LT(m.transition_cost(w0, w1), m.transition_cost(w0, w0));
 }
 
-TEST(StateMachine, BadSpecsNameTheProblem) {
+TEST(MotionGraph, BadSpecsNameTheProblem) {
   auto spec = testing::small_machine_spec();
   spec.edges.push_back({"walk_left", "nowhere", 0, at_line("m.yaml", 7, 3)});
   try {
-    StateMachine::build(spec, motion::default_skeleton());
+    MotionGraph::build(spec, motion::default_skeleton());
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("m.yaml:7:3"), std::string::npos) << e.what();
@@ -106,10 +106,10 @@ TEST(StateMachine, BadSpecsNameTheProblem) {
   spec = testing::small_machine_spec();
   spec.groups.push_back({"loop_a", "loop_b", {}});
   spec.groups.push_back({"loop_b", "loop_a", {}});
-  EXPECT_THROW(StateMachine::build(spec, motion::default_skeleton()), Error);
+  EXPECT_THROW(MotionGraph::build(spec, motion::default_skeleton()), Error);
   spec = testing::small_machine_spec();
   spec.states[0].segments[0].clip = "missing";
-  EXPECT_THROW(StateMachine::build(spec, motion::default_skeleton()), Error);
+  EXPECT_THROW(MotionGraph::build(spec, motion::default_skeleton()), Error);
 }
 
 // ---- the grid ------------------------------------------------------------------
@@ -117,7 +117,7 @@ TEST(StateMachine, BadSpecsNameTheProblem) {
 struct Reference {
   std::vector<double> cost;  // [curves * motions]
 };
-Reference exhaustive(const StateMachine& m, const CurveSet& cs, double speed_weight) {
+Reference exhaustive(const MotionGraph& m, const CurveSet& cs, double speed_weight) {
   const auto& loco = m.locomotion_segments();
   Reference r;
   for (std::int32_t c = 0; c < cs.curve_count(); ++c)
@@ -157,7 +157,7 @@ CurveSet random_curves(int paths, std::uint64_t seed, std::vector<float>* speeds
 }
 
 TEST(MatchGrid, GreedyEqualsExhaustiveReference) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   const CurveSet cs = random_curves(12, 3);
   ASSERT_GT(cs.curve_count(), 100);
   MatchOptions o;
@@ -183,7 +183,7 @@ TEST(MatchGrid, GreedyEqualsExhaustiveReference) {
 }
 
 TEST(MatchGrid, SameCostsForAnyThreadCount) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   const CurveSet cs = random_curves(10, 4);
   std::vector<std::vector<float>> costs;
   for (int threads : {1, 2, 3}) {
@@ -197,7 +197,7 @@ TEST(MatchGrid, SameCostsForAnyThreadCount) {
 }
 
 TEST(MatchGrid, AMotionsOwnTrajectoryMatchesItself) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   for (std::int32_t id : m.locomotion_segments()) {
     const MotionSegment& seg = m.segments()[static_cast<std::size_t>(id)];
     // The trajectory, rotated and moved, then resampled again.
@@ -224,7 +224,7 @@ TEST(MatchGrid, AMotionsOwnTrajectoryMatchesItself) {
 }
 
 TEST(MatchGrid, MarkedStretchesOnlyAcceptTheirState) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   const ResampledPath rp = random_path(9, 6, 0.6f, {{2.0f, 6.0f, "run_forward"}});
   const CurveSet cs = cut_paths(std::vector<ResampledPath>{rp}, m);
   MatchGrid grid(m, cs);
@@ -244,7 +244,7 @@ TEST(MatchGrid, MarkedStretchesOnlyAcceptTheirState) {
 // ---- sequences -------------------------------------------------------------------
 
 TEST(Sequences, DpIsLegalOptimalAndBeatsRepairedGreedy) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   // Sharp S-bends: greedy follows a left turn with a right turn.
   std::vector<ResampledPath> ps;
   for (int i = 0; i < 16; ++i) ps.push_back(random_path(700 + static_cast<std::uint64_t>(i), 10, 1.2f));
@@ -273,7 +273,7 @@ TEST(Sequences, DpIsLegalOptimalAndBeatsRepairedGreedy) {
 }
 
 TEST(Sequences, SameSequencesForAnyThreadCount) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   const CurveSet cs = random_curves(20, 8);
   MatchGrid grid(m, cs);
   grid.match();
@@ -290,7 +290,7 @@ TEST(Sequences, SameSequencesForAnyThreadCount) {
 }
 
 TEST(Sequences, DpEqualsBruteForceOnShortPaths) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   const auto& loco = m.locomotion_segments();
   const auto M = static_cast<std::int32_t>(loco.size());
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
@@ -335,7 +335,7 @@ TEST(Sequences, DpEqualsBruteForceOnShortPaths) {
 // ---- playback --------------------------------------------------------------------
 
 TEST(Playback, FollowsThePathAndReportsDeviation) {
-  const StateMachine& m = small_machine();
+  const MotionGraph& m = small_machine();
   std::vector<ResampledPath> ps = {random_path(31, 10, 0.4f)};
   const CurveSet cs = cut_paths(ps, m);
   MatchGrid grid(m, cs);

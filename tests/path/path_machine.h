@@ -56,8 +56,8 @@ inline StateMachineSpec small_machine_spec(std::int32_t k = 32) {
   return m;
 }
 
-inline const StateMachine& small_machine() {
-  static const StateMachine m = StateMachine::build(small_machine_spec(), motion::default_skeleton());
+inline const MotionGraph& small_machine() {
+  static const MotionGraph m = MotionGraph::build(small_machine_spec(), motion::default_skeleton());
   return m;
 }
 

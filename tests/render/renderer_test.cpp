@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "anim/controller.h"
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "anim/rig.h"
 #include "anim/skin.h"
 #include "anim/stream_crowd.h"

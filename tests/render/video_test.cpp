@@ -13,7 +13,7 @@
 #include <sys/wait.h>
 #include <vector>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "core/error.h"
 #include "motion/locomotion.h"
 #include "render/camera_path.h"

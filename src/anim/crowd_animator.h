@@ -4,7 +4,7 @@
 // that LOD keeps, written as world transforms for the renderer.
 //
 // The per-character work is motion/locomotion.h's; here it runs as
-// parallel_for kernels over structure-of-arrays spans (locomotion_kernels.cpp,
+// parallel_for kernels over structure-of-arrays spans (crowd_animator_kernels.cpp,
 // CUDA-compatible), and CrowdAnimator owns the buffers and runs a frame:
 //
 //   const motion::BlendSpace1D space = motion::make_default_blend_space();

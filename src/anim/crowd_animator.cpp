@@ -1,4 +1,4 @@
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -210,11 +210,8 @@ std::int32_t CycleCacheTable::update(const std::vector<Index>& counts, std::int3
     if (held == nullptr || free_slots_.empty()) continue;
     const std::int32_t slot = free_slots_.back();
     free_slots_.pop_back();
-    const std::size_t bytes = held->rotations.size() * sizeof(glm::quat);
-    detail::copy_bytes(cycles_.data() + static_cast<Index>(slot) * frames_ * J, cycles_.memory(), held->rotations.data(), Memory::Host,
-                       bytes);
-    detail::copy_bytes(drops_.data() + static_cast<Index>(slot) * frames_, drops_.memory(), drops.data(), Memory::Host,
-                       drops.size() * sizeof(float));
+    cycles_.write(static_cast<Index>(slot) * frames_ * J, std::span<const glm::quat>(held->rotations));
+    drops_.write(static_cast<Index>(slot) * frames_, std::span<const float>(drops));
     host_slots_[at(key)] = slot;
     changed = true;
   }
@@ -397,8 +394,8 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
     for (std::size_t t = 0; t < skating_.tracked().size(); ++t) {
       const motion::FootSkatingRecorder::Frame f = skating_.append(t);
       const Index first = skating_.tracked()[t] * joints_;
-      detail::copy_bytes(f.positions.data(), Memory::Host, joint_position_.data() + first, joint_position_.memory(), J * sizeof(glm::vec3));
-      detail::copy_bytes(f.rotations.data(), Memory::Host, joint_rotation_.data() + first, joint_rotation_.memory(), J * sizeof(glm::quat));
+      joint_position_.read(first, f.positions.first(J));
+      joint_rotation_.read(first, f.rotations.first(J));
     }
     skating_.end_frame();
   }

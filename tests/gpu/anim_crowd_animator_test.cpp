@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "core/camera.h"
 #include "tests/anim/crowd_fixture.h"
 #include "tests/gpu/gpu_test.h"

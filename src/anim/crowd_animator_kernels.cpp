@@ -1,5 +1,5 @@
 // Locomotion and pose kernels: compiled by nvcc in CUDA builds, by g++ otherwise.
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 #include "core/error.h"
 #include "core/ground.h"
 #include "core/parallel.h"
@@ -111,10 +111,10 @@ PoseTotals pose_totals(Span<const std::int32_t> evaluated, Span<const std::uint8
   PoseTotals t;
   t.joints_synthesised = parallel_reduce(
       "anim.pose_totals", evaluated.size(), Index{0}, THRONG_LAMBDA(Index c) { return static_cast<Index>(evaluated[c]); },
-      detail::Plus{});
+      Plus{});
   t.from_cache = parallel_reduce(
       "anim.pose_totals", from_cache.size(), Index{0}, THRONG_LAMBDA(Index c) { return static_cast<Index>(from_cache[c]); },
-      detail::Plus{});
+      Plus{});
   return t;
 }
 

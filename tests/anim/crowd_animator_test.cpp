@@ -1,7 +1,7 @@
 // The batch locomotion and pose stages against the per-character reference
 // (motion/locomotion.h), across thread counts, under LOD masks and with the
 // motion cache.
-#include "anim/locomotion.h"
+#include "anim/crowd_animator.h"
 
 #include <gtest/gtest.h>
 
