@@ -1,5 +1,5 @@
 // Controllers that blend locomotion clips by parameters, on the locomotion
-// issue's blend space (motion/locomotion.h): the pose is what per-character
+// blend space (motion/blend_space.h): the pose is what per-character
 // synthesis gives (the same blend_point, warp_phase, blended_rotation and
 // leg IK), so a stream played by one of these shows exactly what an agent
 // synthesised at the same speed and phase would show.

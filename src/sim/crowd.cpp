@@ -154,62 +154,71 @@ double region_area(const Region& r) {
 
 std::string point_text(glm::vec2 p) { return fmt::format("({:.3g}, {:.3g})", p.x, p.y); }
 
-}  // namespace
+// The goal or waypoint `goal` (field gf) within the scenario's limits.
+void check_goal(const GoalSpec& goal, const std::string& gf, const ScenarioLimits& limits) {
+  if (!std::isfinite(goal.value.x) || !std::isfinite(goal.value.y) || std::fabs(goal.value.x) > limits.max_extent ||
+      std::fabs(goal.value.y) > limits.max_extent)
+    throw Error("goal coordinates must be finite numbers within the extent limit", at_field(gf));
+  if (goal.kind == GoalSpec::Kind::Random) {
+    check_region(goal.region, gf + ".random", limits.max_extent);
+    if (goal.region.kind == Region::Kind::ring) throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
+    if (goal.region.kind == Region::Kind::points) throw Error("a list of points is not an area to draw goals from", at_field(gf + ".random"));
+  }
+}
 
-CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits, const RoutePlanner* planner) {
+// Group G (field groups[g]) against the model: radius and speeds (m, m/s)
+// within what its time step and bins of side `cell` (m) allow.
+void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::string& field, float cell) {
+  if (G.count < 0) throw Error(fmt::format("count must be >= 0 (got {})", G.count), at_field(field + ".count"));
+  if (!std::isfinite(G.radius) || !(G.radius > 0))
+    throw Error(fmt::format("radius must be a positive number (got {})", G.radius), at_field(field + ".radius"));
+  const float step = spec.model.max_speed * spec.dt;
+  if (step > 0.9f * G.radius)
+    throw Error(fmt::format("dt * model.max_speed = {:.3g} m must stay below 0.9 * radius = {:.3g} m, else agents could step "
+                            "through walls: lower dt or max_speed",
+                            step, 0.9f * G.radius),
+                at_field(field + ".radius"));
+  if (2.0f * G.radius + 2.0f * step > cell || G.radius > spec.model.max_radius())
+    throw Error(fmt::format("radius {} m is too large for the {} model (at most {:.3g} m, and 2 * radius + 2 * dt * max_speed within its "
+                            "bins of side {:.3g} m)",
+                            G.radius, to_string(spec.model.kind), spec.model.max_radius(), cell),
+                at_field(field + ".radius"));
+  const SpeedSpec& S = G.speed;
+  if (!std::isfinite(S.mean) || !(S.mean > 0)) throw Error(fmt::format("mean speed must be > 0 (got {})", S.mean), at_field(field + ".speed.mean"));
+  if (!std::isfinite(S.stddev) || S.stddev < 0) throw Error(fmt::format("stddev must be >= 0 (got {})", S.stddev), at_field(field + ".speed.stddev"));
+  if (!std::isfinite(S.min) || !(S.min > 0)) throw Error(fmt::format("min speed must be > 0 (got {})", S.min), at_field(field + ".speed.min"));
+  if (!std::isfinite(S.max) || S.max < S.min) throw Error("max speed must be >= min speed", at_field(field + ".speed.max"));
+  if (S.max > spec.model.max_speed)
+    throw Error(fmt::format("speed.max {} exceeds model.max_speed {}", S.max, spec.model.max_speed), at_field(field + ".speed.max"));
+  if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
+    throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius), at_field(field + ".arrival_radius"));
+}
+
+// Group G (field groups[g]): its body, spawn region and route points.
+void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string& field, float cell, const ScenarioLimits& limits) {
+  check_group_body(spec, G, field, cell);
+  if (static_cast<std::int64_t>(G.waypoints.size()) > limits.max_waypoints)
+    throw Error(fmt::format("more than {} waypoints", limits.max_waypoints), at_field(field + ".waypoints"));
+  check_region(G.spawn, field + ".spawn", limits.max_extent);
+  if (G.spawn.kind == Region::Kind::points && static_cast<std::int64_t>(G.spawn.points.size()) != G.count)
+    throw Error(fmt::format("{} points for a count of {}: give one point per agent", G.spawn.points.size(), G.count),
+                at_field(field + ".spawn.points"));
+  for (std::size_t w = 0; w < G.waypoints.size(); ++w) check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w), limits);
+  check_goal(G.goal, field + ".goal", limits);
+}
+
+// Validates the whole spec against the world and limits (errors name the
+// field); returns the largest agent radius, m.
+float check_scenario(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits) {
   spec.model.validate();
   if (!(spec.dt > 0) || !(spec.dt <= 10.0f)) throw Error(fmt::format("time step must be in (0, 10] s (got {})", spec.dt), at_field("dt"));
-  const float cell = world.cell_size();
   const std::int64_t total = spec.total_agents();
   if (total > limits.max_agents) throw Error(fmt::format("{} agents exceed the limit of {}", total, limits.max_agents), at_field("groups"));
   if (spec.groups.empty()) throw Error("a scenario needs at least one group", at_field("groups"));
-
   float max_radius = 0.0f;
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
-    const GroupSpec& G = spec.groups[g];
-    const std::string field = fmt::format("groups[{}]", g);
-    if (G.count < 0) throw Error(fmt::format("count must be >= 0 (got {})", G.count), at_field(field + ".count"));
-    if (!std::isfinite(G.radius) || !(G.radius > 0))
-      throw Error(fmt::format("radius must be a positive number (got {})", G.radius), at_field(field + ".radius"));
-    const float step = spec.model.max_speed * spec.dt;
-    if (step > 0.9f * G.radius)
-      throw Error(fmt::format("dt * model.max_speed = {:.3g} m must stay below 0.9 * radius = {:.3g} m, else agents could step "
-                              "through walls: lower dt or max_speed",
-                              step, 0.9f * G.radius),
-                  at_field(field + ".radius"));
-    if (2.0f * G.radius + 2.0f * step > cell || G.radius > spec.model.max_radius())
-      throw Error(fmt::format("radius {} m is too large for the {} model (at most {:.3g} m, and 2 * radius + 2 * dt * max_speed within its "
-                              "bins of side {:.3g} m)",
-                              G.radius, to_string(spec.model.kind), spec.model.max_radius(), cell),
-                  at_field(field + ".radius"));
-    const SpeedSpec& S = G.speed;
-    if (!std::isfinite(S.mean) || !(S.mean > 0)) throw Error(fmt::format("mean speed must be > 0 (got {})", S.mean), at_field(field + ".speed.mean"));
-    if (!std::isfinite(S.stddev) || S.stddev < 0) throw Error(fmt::format("stddev must be >= 0 (got {})", S.stddev), at_field(field + ".speed.stddev"));
-    if (!std::isfinite(S.min) || !(S.min > 0)) throw Error(fmt::format("min speed must be > 0 (got {})", S.min), at_field(field + ".speed.min"));
-    if (!std::isfinite(S.max) || S.max < S.min) throw Error("max speed must be >= min speed", at_field(field + ".speed.max"));
-    if (S.max > spec.model.max_speed)
-      throw Error(fmt::format("speed.max {} exceeds model.max_speed {}", S.max, spec.model.max_speed), at_field(field + ".speed.max"));
-    if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
-      throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius), at_field(field + ".arrival_radius"));
-    if (static_cast<std::int64_t>(G.waypoints.size()) > limits.max_waypoints)
-      throw Error(fmt::format("more than {} waypoints", limits.max_waypoints), at_field(field + ".waypoints"));
-    check_region(G.spawn, field + ".spawn", limits.max_extent);
-    if (G.spawn.kind == Region::Kind::points && static_cast<std::int64_t>(G.spawn.points.size()) != G.count)
-      throw Error(fmt::format("{} points for a count of {}: give one point per agent", G.spawn.points.size(), G.count),
-                  at_field(field + ".spawn.points"));
-    auto check_goal = [&](const GoalSpec& goal, const std::string& gf) {
-      if (!std::isfinite(goal.value.x) || !std::isfinite(goal.value.y) || std::fabs(goal.value.x) > limits.max_extent ||
-          std::fabs(goal.value.y) > limits.max_extent)
-        throw Error("goal coordinates must be finite numbers within the extent limit", at_field(gf));
-      if (goal.kind == GoalSpec::Kind::Random) {
-        check_region(goal.region, gf + ".random", limits.max_extent);
-        if (goal.region.kind == Region::Kind::ring) throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
-        if (goal.region.kind == Region::Kind::points) throw Error("a list of points is not an area to draw goals from", at_field(gf + ".random"));
-      }
-    };
-    for (std::size_t w = 0; w < G.waypoints.size(); ++w) check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w));
-    check_goal(G.goal, field + ".goal");
-    max_radius = std::max(max_radius, G.radius);
+    check_group(spec, spec.groups[g], fmt::format("groups[{}]", g), world.cell_size(), limits);
+    max_radius = std::max(max_radius, spec.groups[g].radius);
   }
   std::int64_t total_waypoints = 0;
   for (const GroupSpec& G : spec.groups)
@@ -217,249 +226,348 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
   if (total_waypoints > 4 * limits.max_agents)
     throw Error(fmt::format("{} waypoints in all (agents x route points) exceed the limit of {}", total_waypoints, 4 * limits.max_agents),
                 at_field("groups"));
+  return max_radius;
+}
 
-  // Reachability raster over everything the agents could need.
-  std::unique_ptr<Reachability> reach;
-  if (world.has_walkable() || !world.polygons().empty() || !world.circles().empty()) {
-    Aabb extent = world.bounds();
-    if (!world.has_walkable()) {
-      for (const GroupSpec& G : spec.groups) {
-        const Aabb sb = region_bounds(G.spawn);
-        extent.add(sb);
-        std::vector<const GoalSpec*> goals;
-        for (const GoalSpec& w : G.waypoints) goals.push_back(&w);
-        goals.push_back(&G.goal);
-        for (const GoalSpec* goal_ptr : goals) {
-          const GoalSpec& goal = *goal_ptr;
-          switch (goal.kind) {
-            case GoalSpec::Kind::Point: extent.add(goal.value); break;
-            case GoalSpec::Kind::Offset:
-              extent.add(sb.min + goal.value);
-              extent.add(sb.max + goal.value);
-              break;
-            case GoalSpec::Kind::Mirror:
-              extent.add(2.0f * goal.value - sb.min);
-              extent.add(2.0f * goal.value - sb.max);
-              break;
-            case GoalSpec::Kind::Random: extent.add(region_bounds(goal.region)); break;
-          }
-        }
-      }
-      const glm::vec2 margin = extent.size() * 0.05f + glm::vec2(5.0f);
-      extent.min -= margin;
-      extent.max += margin;
+// Grows `extent` by everything group G could need: its spawn region and
+// every place its goals and waypoints can lie.
+void add_group_extent(const GroupSpec& G, Aabb& extent) {
+  const Aabb sb = region_bounds(G.spawn);
+  extent.add(sb);
+  std::vector<const GoalSpec*> goals;
+  for (const GoalSpec& w : G.waypoints) goals.push_back(&w);
+  goals.push_back(&G.goal);
+  for (const GoalSpec* goal_ptr : goals) {
+    const GoalSpec& goal = *goal_ptr;
+    switch (goal.kind) {
+      case GoalSpec::Kind::Point: extent.add(goal.value); break;
+      case GoalSpec::Kind::Offset:
+        extent.add(sb.min + goal.value);
+        extent.add(sb.max + goal.value);
+        break;
+      case GoalSpec::Kind::Mirror:
+        extent.add(2.0f * goal.value - sb.min);
+        extent.add(2.0f * goal.value - sb.max);
+        break;
+      case GoalSpec::Kind::Random: extent.add(region_bounds(goal.region)); break;
     }
-    reach = std::make_unique<Reachability>(world, extent, limits.raster_resolution);
   }
+}
 
+// The reachability raster over everything the agents could need, or null
+// in an open world (no walkable area, no obstacle).
+std::unique_ptr<Reachability> make_reachability(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits) {
+  if (!world.has_walkable() && world.polygons().empty() && world.circles().empty()) return nullptr;
+  Aabb extent = world.bounds();
+  if (!world.has_walkable()) {
+    for (const GroupSpec& G : spec.groups) add_group_extent(G, extent);
+    const glm::vec2 margin = extent.size() * 0.05f + glm::vec2(5.0f);
+    extent.min -= margin;
+    extent.max += margin;
+  }
+  return std::make_unique<Reachability>(world, extent, limits.raster_resolution);
+}
+
+// Where one group is placed: its agents of radius r (m) keep `gap` (m) from
+// each other and wall_clearance (m) from walls; `placed` holds the agents
+// of earlier groups, `out` their spawn data.
+struct Placement {
+  const World& world;
+  const Occupancy& placed;
+  const CrowdHost& out;
+  const GroupSpec& G;
+  std::string field;
+  float r, gap, wall_clearance;
+};
+
+// G.count agents evenly on a ring (spawn: ring), in order round it.
+std::vector<glm::vec2> place_on_ring(const Placement& at) {
+  const GroupSpec& G = at.G;
+  const float r = at.r;
+  const double R = G.spawn.radius > 0 ? G.spawn.radius : static_cast<double>(G.count) * G.spawn.spacing / (2.0 * kPi);
+  if (!(R > 0)) throw Error("a ring needs radius > 0 or spacing > 0", at_field(at.field + ".spawn.ring"));
+  const double chord = G.count > 1 ? 2.0 * R * std::sin(kPi / static_cast<double>(G.count)) : 2.0 * R + 2.0 * r;
+  if (chord < 2.0 * r + at.gap)
+    throw Error(fmt::format("{} agents of radius {} do not fit on a ring of radius {:.3g} m (neighbours {:.3g} m apart)", G.count, r, R, chord),
+                at_field(at.field + ".spawn"));
+  std::vector<glm::vec2> chosen;
+  for (std::int64_t k = 0; k < G.count; ++k) {
+    const double a = 2.0 * kPi * static_cast<double>(k) / static_cast<double>(G.count);
+    const glm::vec2 p = G.spawn.center + glm::vec2(static_cast<float>(R * std::cos(a)), static_cast<float>(R * std::sin(a)));
+    if (!at.world.disc_fits(p, at.wall_clearance)) {
+      const std::string blocked = at.world.what_blocks(p);
+      throw Error(fmt::format("agent {} at {} does not fit: {}", k, point_text(p), blocked.empty() ? "too close to a wall" : blocked),
+                  at_field(at.field + ".spawn"));
+    }
+    if (at.placed.overlaps(p, r, at.gap))
+      throw Error(fmt::format("agent {} at {} overlaps an agent of an earlier group", k, point_text(p)), at_field(at.field + ".spawn"));
+    chosen.push_back(p);
+  }
+  return chosen;
+}
+
+// The exact positions of spawn: points. Each must be free and apart from
+// every agent so far (discs may touch); the group's own points are checked
+// among themselves.
+std::vector<glm::vec2> place_at_points(const Placement& at) {
+  const GroupSpec& G = at.G;
+  const float r = at.r;
+  Occupancy own(std::max(2.0f * r * 1.2f, 0.1f));
+  std::vector<glm::vec2> chosen;
+  for (std::size_t k = 0; k < G.spawn.points.size(); ++k) {
+    const glm::vec2 p = G.spawn.points[k];
+    const std::string pf = fmt::format("{}.spawn.points[{}]", at.field, k);
+    if (!at.world.disc_fits(p, at.wall_clearance)) {
+      const std::string blocked = at.world.what_blocks(p);
+      throw Error(fmt::format("an agent of radius {} m at {} does not fit: {}", r, point_text(p),
+                              blocked.empty() ? fmt::format("closer than {:.3g} m to a wall", at.wall_clearance) : "it lies " + blocked),
+                  at_field(pf));
+    }
+    if (const std::int64_t other = own.find(p, r, 0.0f); other >= 0)
+      throw Error(fmt::format("an agent at {} overlaps the one at points[{}] {}: centres {:.3g} m apart, less than 2 * radius = {:.3g} m",
+                              point_text(p), other, point_text(G.spawn.points[static_cast<std::size_t>(other)]),
+                              length_of(p - G.spawn.points[static_cast<std::size_t>(other)]), 2.0f * r),
+                  at_field(pf));
+    if (const std::int64_t other = at.placed.find(p, r, 0.0f); other >= 0)
+      throw Error(fmt::format("an agent at {} overlaps agent {} of groups[{}] at {}", point_text(p), other,
+                              at.out.group[static_cast<std::size_t>(other)], point_text(at.out.position[static_cast<std::size_t>(other)])),
+                  at_field(pf));
+    own.add(p, r, static_cast<std::int64_t>(k));
+    chosen.push_back(p);
+  }
+  return chosen;
+}
+
+// Free sites of jittered hexagonal lattices over the spawn region of group
+// g, made denser until they hold at least G.count (see place_on_lattice).
+std::vector<glm::vec2> lattice_candidates(const Placement& at, std::uint64_t seed, std::size_t g) {
+  const GroupSpec& G = at.G;
+  const Aabb b = region_bounds(G.spawn);
+  const double d = 2.0 * at.r + at.gap;
+  const double max_sites = 8.0 * static_cast<double>(G.count) + 4.0e6;
+  if (hex_site_count(b, d) < static_cast<double>(G.count))
+    throw Error(fmt::format("{} agents of radius {} m cannot fit in the spawn region ({:.3g} x {:.3g} m)", G.count, at.r, b.size().x, b.size().y),
+                at_field(at.field + ".spawn"));
+  const double wanted = 3.0 * static_cast<double>(G.count);
+  const double area = region_area(G.spawn);
+  double a = area > 0 ? std::max(d, hex_spacing(wanted / area)) : d;
+  if (hex_site_count(b, a) > max_sites)
+    throw Error(fmt::format("the spawn region ({:.3g} x {:.3g} m) is too elongated for agents of radius {} m", b.size().x, b.size().y, at.r),
+                at_field(at.field + ".spawn"));
+  std::vector<glm::vec2> candidates;
+  for (int pass = 0;; ++pass) {
+    Rng rng(seed, 0x59a3000000ull + g + (static_cast<std::uint64_t>(pass) << 32));
+    candidates.clear();
+    // Against earlier groups with 0.99 * gap: a group of the same radius
+    // on the same lattice has its sites exactly d from ours, which
+    // rounding must not reject.
+    std::int64_t visited = 0;
+    const std::int64_t sites = hex_sites(b, a, (a - d) * 0.5, rng, [&](glm::vec2 p) {
+      if ((++visited & 4095) == 0) setup_checkpoint("placing agents");
+      if (region_contains(G.spawn, p) && at.world.disc_fits(p, at.wall_clearance) && !at.placed.overlaps(p, at.r, 0.99f * at.gap))
+        candidates.push_back(p);
+    });
+    if (static_cast<std::int64_t>(candidates.size()) >= G.count || a <= d) break;
+    // Free area as seen by this lattice; at least a 20 % denser lattice next.
+    const double free_area = static_cast<double>(b.size().x) * b.size().y * static_cast<double>(candidates.size()) / static_cast<double>(sites);
+    double next = free_area > 0 ? hex_spacing(wanted / free_area) : d;
+    next = std::max(d, std::min(next, 0.8 * a));
+    if (hex_site_count(b, next) > max_sites) break;
+    a = next;
+  }
+  return candidates;
+}
+
+// Sites of a hexagonal lattice (the densest packing of equal discs), of
+// which count are chosen at random. Sites of spacing a >= d = 2r + gap stay
+// d apart when each moves less than (a - d) / 2, so jitter within that disc
+// never makes an overlap. a is chosen so that the free part of the region
+// holds about 3 * count sites: the random choice of a third of them and the
+// jitter make sparse spawns look random; a dense spawn gets a = d, up to
+// 2 / (sqrt(3) d^2) agents per m^2 (6.5 at r = 0.2 m; random sequential
+// placement would jam near 4.3). The free area is not known in advance
+// (obstacles, walls, other groups): when a lattice holds fewer than count
+// free sites, the next one is made denser from the free fraction it found,
+// down to a = d.
+std::vector<glm::vec2> place_on_lattice(const Placement& at, std::uint64_t seed, std::size_t g) {
+  const GroupSpec& G = at.G;
+  const std::vector<glm::vec2> candidates = lattice_candidates(at, seed, g);
+  if (static_cast<std::int64_t>(candidates.size()) < G.count) {
+    const Aabb b = region_bounds(G.spawn);
+    const glm::vec2 centre = (b.min + b.max) * 0.5f;
+    const std::string blocked = at.world.what_blocks(centre);
+    if (candidates.empty() && !blocked.empty())
+      throw Error(fmt::format("the spawn region lies {}: no free place for an agent", blocked), at_field(at.field + ".spawn"));
+    throw Error(fmt::format("room for only {} of {} agents of radius {} m in the spawn region (obstacles, walls and other groups "
+                            "take the rest)",
+                            candidates.size(), G.count, at.r),
+                at_field(at.field + ".spawn"));
+  }
+  Rng rng(seed, 0x5e1ec7000000ull + g);
+  // Choose count of them at random, then keep lattice order (neighbours
+  // in space get neighbouring indices: better memory locality).
+  std::vector<std::uint32_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), 0u);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(G.count); ++k) {
+    const std::size_t pick = k + static_cast<std::size_t>(rng.below(order.size() - k));
+    std::swap(order[k], order[pick]);
+  }
+  order.resize(static_cast<std::size_t>(G.count));
+  std::sort(order.begin(), order.end());
+  std::vector<glm::vec2> chosen;
+  for (std::uint32_t k : order) chosen.push_back(candidates[k]);
+  return chosen;
+}
+
+// The spawn positions of group g, by its spawn region's kind.
+std::vector<glm::vec2> place_group(const Placement& at, std::uint64_t seed, std::size_t g) {
+  if (at.G.count == 0) return {};
+  if (at.G.spawn.kind == Region::Kind::ring) return place_on_ring(at);
+  if (at.G.spawn.kind == Region::Kind::points) return place_at_points(at);
+  return place_on_lattice(at, seed, g);
+}
+
+// What resolving one agent's route points needs.
+struct RouteContext {
+  const World& world;
+  const Reachability* reach;
+  const ScenarioLimits& limits;
+  float r;
+};
+
+// Route point `goal` (field gf) of an agent that spawned at p and comes
+// from `from`: a point, or one drawn from a region with arng (free for a
+// disc of radius r and reachable from `from`).
+glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std::string& gf, glm::vec2 p, glm::vec2 from, std::int64_t agent,
+                       Rng& arng) {
+  glm::vec2 q(0.0f);
+  switch (goal.kind) {
+    case GoalSpec::Kind::Point: q = goal.value; break;
+    case GoalSpec::Kind::Offset: q = p + goal.value; break;
+    case GoalSpec::Kind::Mirror: q = 2.0f * goal.value - p; break;
+    case GoalSpec::Kind::Random: {
+      const Aabb rb = region_bounds(goal.region);
+      bool found = false;
+      for (int attempt = 0; attempt < 200 && !found; ++attempt) {
+        q = glm::vec2(static_cast<float>(arng.uniform(rb.min.x, rb.max.x)), static_cast<float>(arng.uniform(rb.min.y, rb.max.y)));
+        found = region_contains(goal.region, q) && ctx.world.disc_fits(q, ctx.r) && (!ctx.reach || ctx.reach->connected(from, q));
+      }
+      if (!found)
+        throw Error(fmt::format("found no free place reachable from {} for agent {} in the goal region", point_text(from), agent),
+                    at_field(gf + ".random"));
+      break;
+    }
+  }
+  return q;
+}
+
+// Errors unless route point q (field gf) of `agent` lies in the world, free
+// and reachable from `from`. Planned routes go around obstacles; only a
+// missing path is an error.
+void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std::int64_t agent, const std::string& gf) {
+  const float max_extent = ctx.limits.max_extent;
+  if (!std::isfinite(q.x) || !std::isfinite(q.y) || std::fabs(q.x) > max_extent || std::fabs(q.y) > max_extent)
+    throw Error(fmt::format("goal {} of agent {} is beyond the extent limit", point_text(q), agent), at_field(gf));
+  if (const std::string blocked = ctx.world.what_blocks(q); !blocked.empty())
+    throw Error(fmt::format("goal {} of agent {} lies {}", point_text(q), agent, blocked), at_field(gf));
+  if (ctx.reach && !ctx.reach->connected(from, q))
+    throw Error(fmt::format("goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
+                            point_text(q), agent, point_text(from), ctx.reach->cell_size()),
+                at_field(gf));
+}
+
+// Appends group g's agents at `chosen` to `out` (position, radius, speed
+// drawn per agent, group) and to `placed`; returns every agent's waypoints
+// and goal resolved, stride waypoints + 1.
+std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& spec, std::size_t g, const std::vector<glm::vec2>& chosen,
+                                  Occupancy& placed, CrowdHost& out) {
+  const GroupSpec& G = spec.groups[g];
+  const std::string field = fmt::format("groups[{}]", g);
+  const auto first_agent = static_cast<std::int64_t>(out.position.size());
+  const std::size_t W = G.waypoints.size();
+  std::vector<glm::vec2> resolved(chosen.size() * (W + 1));
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    const glm::vec2 p = chosen[k];
+    const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
+    if ((k & 4095) == 4095) setup_checkpoint("choosing goals", static_cast<double>(k) / static_cast<double>(chosen.size()));
+    placed.add(p, ctx.r, agent);
+    Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
+    const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
+                                    static_cast<double>(G.speed.min), static_cast<double>(G.speed.max));
+    out.position.push_back(p);
+    out.radius.push_back(ctx.r);
+    out.pref_speed.push_back(static_cast<float>(speed));
+    out.group.push_back(static_cast<std::int32_t>(g));
+    glm::vec2 from = p;
+    for (std::size_t w = 0; w <= W; ++w) {
+      const GoalSpec& goal = w < W ? G.waypoints[w] : G.goal;
+      const std::string gf = w < W ? fmt::format("{}.waypoints[{}]", field, w) : field + ".goal";
+      const glm::vec2 q = resolve_goal(ctx, goal, gf, p, from, agent, arng);
+      check_route_point(ctx, q, from, agent, gf);
+      resolved[k * (W + 1) + w] = q;
+      from = q;
+    }
+  }
+  return resolved;
+}
+
+// Appends the routes of the agents at `chosen` (group G, field) to `out`:
+// their waypoints (or, for a goal without waypoints, the planner's points
+// in between, when there is a planner), the goal, the way back for a loop,
+// and the heading towards the first point.
+void add_routes(const GroupSpec& G, const std::string& field, const std::vector<glm::vec2>& chosen, const std::vector<glm::vec2>& resolved,
+                const World& world, const RoutePlanner* planner, const ScenarioLimits& limits, float r, CrowdHost& out) {
+  const std::size_t W = G.waypoints.size();
+  std::vector<std::vector<glm::vec2>> planned;
+  if (planner != nullptr && W == 0 && !chosen.empty()) {
+    planned = planner->plan(world, chosen, resolved, r);
+    if (planned.size() != chosen.size())
+      throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()), at_field(field + ".goal"));
+  }
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    const glm::vec2 p = chosen[k];
+    const auto begin = static_cast<std::int32_t>(out.waypoints.size());
+    out.waypoint_begin.push_back(begin);
+    std::span<const glm::vec2> via(resolved.data() + k * (W + 1), W);
+    if (!planned.empty()) via = planned[k];
+    if (static_cast<std::int64_t>(via.size()) > limits.max_waypoints)
+      throw Error(fmt::format("a planned route has {} points, more than {}", via.size(), limits.max_waypoints), at_field(field + ".goal"));
+    out.waypoints.insert(out.waypoints.end(), via.begin(), via.end());
+    out.waypoints.push_back(resolved[k * (W + 1) + W]);
+    out.waypoint_goal.push_back(static_cast<std::int32_t>(out.waypoints.size()) - 1 - begin);
+    // A loop walks back along the route to where the agent started.
+    if (G.arrival == ArrivalBehaviour::Loop) {
+      for (std::size_t v = via.size(); v-- > 0;) out.waypoints.push_back(via[v]);
+      out.waypoints.push_back(p);
+    }
+    out.waypoint_count.push_back(static_cast<std::int32_t>(out.waypoints.size()) - begin);
+    const glm::vec2 to = out.waypoints[static_cast<std::size_t>(begin)] - p;
+    out.heading.push_back(length2(to) > 0 ? std::atan2(to.y, to.x) : 0.0f);
+  }
+}
+
+}  // namespace
+
+CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits, const RoutePlanner* planner) {
+  const float max_radius = check_scenario(spec, world, limits);
+  const std::unique_ptr<Reachability> reach = make_reachability(spec, world, limits);
   CrowdHost out;
-  const auto n = static_cast<std::size_t>(total);
-  out.position.reserve(n);
+  out.position.reserve(static_cast<std::size_t>(spec.total_agents()));
   Occupancy placed(std::max(2.0f * max_radius * 1.2f, 0.1f));
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
     check_interrupt("placing agents");
     const GroupSpec& G = spec.groups[g];
     const std::string field = fmt::format("groups[{}]", g);
     const float r = G.radius;
-    const float gap = 0.1f * r;
-    const float wall_clearance = 1.05f * r;
-    std::vector<glm::vec2> chosen;
-    if (G.count == 0) {
-      // nothing to place
-    } else if (G.spawn.kind == Region::Kind::ring) {
-      const double R = G.spawn.radius > 0 ? G.spawn.radius : static_cast<double>(G.count) * G.spawn.spacing / (2.0 * kPi);
-      if (!(R > 0)) throw Error("a ring needs radius > 0 or spacing > 0", at_field(field + ".spawn.ring"));
-      const double chord = G.count > 1 ? 2.0 * R * std::sin(kPi / static_cast<double>(G.count)) : 2.0 * R + 2.0 * r;
-      if (chord < 2.0 * r + gap)
-        throw Error(fmt::format("{} agents of radius {} do not fit on a ring of radius {:.3g} m (neighbours {:.3g} m apart)", G.count, r, R, chord),
-                    at_field(field + ".spawn"));
-      for (std::int64_t k = 0; k < G.count; ++k) {
-        const double a = 2.0 * kPi * static_cast<double>(k) / static_cast<double>(G.count);
-        const glm::vec2 p = G.spawn.center + glm::vec2(static_cast<float>(R * std::cos(a)), static_cast<float>(R * std::sin(a)));
-        if (!world.disc_fits(p, wall_clearance)) {
-          const std::string blocked = world.what_blocks(p);
-          throw Error(fmt::format("agent {} at {} does not fit: {}", k, point_text(p), blocked.empty() ? "too close to a wall" : blocked),
-                      at_field(field + ".spawn"));
-        }
-        if (placed.overlaps(p, r, gap)) throw Error(fmt::format("agent {} at {} overlaps an agent of an earlier group", k, point_text(p)), at_field(field + ".spawn"));
-        chosen.push_back(p);
-      }
-    } else if (G.spawn.kind == Region::Kind::points) {
-      // Exact positions: each must be free and apart from every agent so far
-      // (discs may touch); the group's own points are checked among themselves.
-      Occupancy own(std::max(2.0f * r * 1.2f, 0.1f));
-      for (std::size_t k = 0; k < G.spawn.points.size(); ++k) {
-        const glm::vec2 p = G.spawn.points[k];
-        const std::string pf = fmt::format("{}.spawn.points[{}]", field, k);
-        if (!world.disc_fits(p, wall_clearance)) {
-          const std::string blocked = world.what_blocks(p);
-          throw Error(fmt::format("an agent of radius {} m at {} does not fit: {}", r, point_text(p),
-                                  blocked.empty() ? fmt::format("closer than {:.3g} m to a wall", wall_clearance) : "it lies " + blocked),
-                      at_field(pf));
-        }
-        if (const std::int64_t other = own.find(p, r, 0.0f); other >= 0)
-          throw Error(fmt::format("an agent at {} overlaps the one at points[{}] {}: centres {:.3g} m apart, less than 2 * radius = {:.3g} m",
-                                  point_text(p), other, point_text(G.spawn.points[static_cast<std::size_t>(other)]),
-                                  length_of(p - G.spawn.points[static_cast<std::size_t>(other)]), 2.0f * r),
-                      at_field(pf));
-        if (const std::int64_t other = placed.find(p, r, 0.0f); other >= 0)
-          throw Error(fmt::format("an agent at {} overlaps agent {} of groups[{}] at {}", point_text(p), other,
-                                  out.group[static_cast<std::size_t>(other)], point_text(out.position[static_cast<std::size_t>(other)])),
-                      at_field(pf));
-        own.add(p, r, static_cast<std::int64_t>(k));
-        chosen.push_back(p);
-      }
-    } else {
-      // Sites of a hexagonal lattice (the densest packing of equal discs),
-      // of which count are chosen at random. Sites of spacing a >= d = 2r +
-      // gap stay d apart when each moves less than (a - d) / 2, so jitter
-      // within that disc never makes an overlap. a is chosen so that the
-      // free part of the region holds about 3 * count sites: the random
-      // choice of a third of them and the jitter make sparse spawns look
-      // random; a dense spawn gets a = d, up to 2 / (sqrt(3) d^2) agents per
-      // m^2 (6.5 at r = 0.2 m; random sequential placement would jam near
-      // 4.3). The free area is not known in advance (obstacles, walls, other
-      // groups): when a lattice holds fewer than count free sites, the next
-      // one is made denser from the free fraction it found, down to a = d.
-      const Aabb b = region_bounds(G.spawn);
-      const double d = 2.0 * r + gap;
-      const double max_sites = 8.0 * static_cast<double>(G.count) + 4.0e6;
-      if (hex_site_count(b, d) < static_cast<double>(G.count))
-        throw Error(fmt::format("{} agents of radius {} m cannot fit in the spawn region ({:.3g} x {:.3g} m)", G.count, r, b.size().x, b.size().y),
-                    at_field(field + ".spawn"));
-      const double wanted = 3.0 * static_cast<double>(G.count);
-      const double area = region_area(G.spawn);
-      double a = area > 0 ? std::max(d, hex_spacing(wanted / area)) : d;
-      if (hex_site_count(b, a) > max_sites)
-        throw Error(fmt::format("the spawn region ({:.3g} x {:.3g} m) is too elongated for agents of radius {} m", b.size().x, b.size().y, r),
-                    at_field(field + ".spawn"));
-      std::vector<glm::vec2> candidates;
-      for (int pass = 0;; ++pass) {
-        Rng rng(spec.seed, 0x59a3000000ull + g + (static_cast<std::uint64_t>(pass) << 32));
-        candidates.clear();
-        // Against earlier groups with 0.99 * gap: a group of the same radius
-        // on the same lattice has its sites exactly d from ours, which
-        // rounding must not reject.
-        std::int64_t visited = 0;
-        const std::int64_t sites = hex_sites(b, a, (a - d) * 0.5, rng, [&](glm::vec2 p) {
-          if ((++visited & 4095) == 0) setup_checkpoint("placing agents");
-          if (region_contains(G.spawn, p) && world.disc_fits(p, wall_clearance) && !placed.overlaps(p, r, 0.99f * gap)) candidates.push_back(p);
-        });
-        if (static_cast<std::int64_t>(candidates.size()) >= G.count || a <= d) break;
-        // Free area as seen by this lattice; at least a 20 % denser lattice next.
-        const double free_area = static_cast<double>(b.size().x) * b.size().y * static_cast<double>(candidates.size()) / static_cast<double>(sites);
-        double next = free_area > 0 ? hex_spacing(wanted / free_area) : d;
-        next = std::max(d, std::min(next, 0.8 * a));
-        if (hex_site_count(b, next) > max_sites) break;
-        a = next;
-      }
-      if (static_cast<std::int64_t>(candidates.size()) < G.count) {
-        const glm::vec2 centre = (b.min + b.max) * 0.5f;
-        const std::string blocked = world.what_blocks(centre);
-        if (candidates.empty() && !blocked.empty())
-          throw Error(fmt::format("the spawn region lies {}: no free place for an agent", blocked), at_field(field + ".spawn"));
-        throw Error(fmt::format("room for only {} of {} agents of radius {} m in the spawn region (obstacles, walls and other groups "
-                                "take the rest)",
-                                candidates.size(), G.count, r),
-                    at_field(field + ".spawn"));
-      }
-      Rng rng(spec.seed, 0x5e1ec7000000ull + g);
-      // Choose count of them at random, then keep lattice order (neighbours
-      // in space get neighbouring indices: better memory locality).
-      std::vector<std::uint32_t> order(candidates.size());
-      std::iota(order.begin(), order.end(), 0u);
-      for (std::size_t k = 0; k < static_cast<std::size_t>(G.count); ++k) {
-        const std::size_t pick = k + static_cast<std::size_t>(rng.below(order.size() - k));
-        std::swap(order[k], order[pick]);
-      }
-      order.resize(static_cast<std::size_t>(G.count));
-      std::sort(order.begin(), order.end());
-      for (std::uint32_t k : order) chosen.push_back(candidates[k]);
-    }
-
+    const Placement at{world, placed, out, G, field, r, 0.1f * r, 1.05f * r};
+    const std::vector<glm::vec2> chosen = place_group(at, spec.seed, g);
     GroupRuntime rt;
     rt.arrival = G.arrival;
     rt.arrival_radius = G.arrival_radius;
     out.groups.push_back(rt);
-    const auto first_agent = static_cast<std::int64_t>(out.position.size());
-    // Resolve every agent's waypoints and goal (stride W + 1).
-    const std::size_t W = G.waypoints.size();
-    std::vector<glm::vec2> resolved(chosen.size() * (W + 1));
-    for (std::size_t k = 0; k < chosen.size(); ++k) {
-      const glm::vec2 p = chosen[k];
-      const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
-      if ((k & 4095) == 4095) setup_checkpoint("choosing goals", static_cast<double>(k) / static_cast<double>(chosen.size()));
-      placed.add(p, r, agent);
-      Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
-      const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
-                                      static_cast<double>(G.speed.min), static_cast<double>(G.speed.max));
-      out.position.push_back(p);
-      out.radius.push_back(r);
-      out.pref_speed.push_back(static_cast<float>(speed));
-      out.group.push_back(static_cast<std::int32_t>(g));
-      glm::vec2 from = p;
-      for (std::size_t w = 0; w <= W; ++w) {
-        const GoalSpec& goal = w < W ? G.waypoints[w] : G.goal;
-        const std::string gf = w < W ? fmt::format("{}.waypoints[{}]", field, w) : field + ".goal";
-        glm::vec2 q(0.0f);
-        switch (goal.kind) {
-          case GoalSpec::Kind::Point: q = goal.value; break;
-          case GoalSpec::Kind::Offset: q = p + goal.value; break;
-          case GoalSpec::Kind::Mirror: q = 2.0f * goal.value - p; break;
-          case GoalSpec::Kind::Random: {
-            const Aabb rb = region_bounds(goal.region);
-            bool found = false;
-            for (int attempt = 0; attempt < 200 && !found; ++attempt) {
-              q = glm::vec2(static_cast<float>(arng.uniform(rb.min.x, rb.max.x)), static_cast<float>(arng.uniform(rb.min.y, rb.max.y)));
-              found = region_contains(goal.region, q) && world.disc_fits(q, r) && (!reach || reach->connected(from, q));
-            }
-            if (!found)
-              throw Error(fmt::format("found no free place reachable from {} for agent {} in the goal region", point_text(from), agent),
-                          at_field(gf + ".random"));
-            break;
-          }
-        }
-        if (!std::isfinite(q.x) || !std::isfinite(q.y) || std::fabs(q.x) > limits.max_extent || std::fabs(q.y) > limits.max_extent)
-          throw Error(fmt::format("goal {} of agent {} is beyond the extent limit", point_text(q), agent), at_field(gf));
-        if (const std::string blocked = world.what_blocks(q); !blocked.empty())
-          throw Error(fmt::format("goal {} of agent {} lies {}", point_text(q), agent, blocked), at_field(gf));
-        // Planned routes go around obstacles; only a missing path is an error.
-        if (reach && !reach->connected(from, q))
-          throw Error(fmt::format("goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
-                                  point_text(q), agent, point_text(from), reach->cell_size()),
-                      at_field(gf));
-        resolved[k * (W + 1) + w] = q;
-        from = q;
-      }
-    }
-    // A goal without waypoints: the planner (when there is one) gives the
-    // points in between.
-    std::vector<std::vector<glm::vec2>> planned;
-    if (planner != nullptr && W == 0 && !chosen.empty()) {
-      planned = planner->plan(world, chosen, resolved, r);
-      if (planned.size() != chosen.size())
-        throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()), at_field(field + ".goal"));
-    }
-    for (std::size_t k = 0; k < chosen.size(); ++k) {
-      const glm::vec2 p = chosen[k];
-      const auto begin = static_cast<std::int32_t>(out.waypoints.size());
-      out.waypoint_begin.push_back(begin);
-      std::span<const glm::vec2> via(resolved.data() + k * (W + 1), W);
-      if (!planned.empty()) via = planned[k];
-      if (static_cast<std::int64_t>(via.size()) > limits.max_waypoints)
-        throw Error(fmt::format("a planned route has {} points, more than {}", via.size(), limits.max_waypoints), at_field(field + ".goal"));
-      out.waypoints.insert(out.waypoints.end(), via.begin(), via.end());
-      out.waypoints.push_back(resolved[k * (W + 1) + W]);
-      out.waypoint_goal.push_back(static_cast<std::int32_t>(out.waypoints.size()) - 1 - begin);
-      // A loop walks back along the route to where the agent started.
-      if (G.arrival == ArrivalBehaviour::Loop) {
-        for (std::size_t v = via.size(); v-- > 0;) out.waypoints.push_back(via[v]);
-        out.waypoints.push_back(p);
-      }
-      out.waypoint_count.push_back(static_cast<std::int32_t>(out.waypoints.size()) - begin);
-      const glm::vec2 to = out.waypoints[static_cast<std::size_t>(begin)] - p;
-      out.heading.push_back(length2(to) > 0 ? std::atan2(to.y, to.x) : 0.0f);
-    }
+    const RouteContext ctx{world, reach.get(), limits, r};
+    const std::vector<glm::vec2> resolved = add_agents(ctx, spec, g, chosen, placed, out);
+    add_routes(G, field, chosen, resolved, world, planner, limits, r, out);
   }
   return out;
 }

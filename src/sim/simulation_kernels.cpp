@@ -53,7 +53,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_priority(const StepContext& ctx, const
   const Probe probe = make_probe(p, v, a.heading[i], r, m);
   // Priority: agent avoidance is only computed when no obstacle force applies.
   const glm::vec2 obstacle = sense_obstacles(ctx.world, probe, m.max_force).force;
-  if (length2(obstacle) > 1e-12f) return obstacle;
+  if (force_applies(obstacle)) return obstacle;
   return avoidance_force(probe.forward, neighbours(p, v, probe.forward, r), m.max_force);
 }
 
@@ -140,7 +140,7 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
   } else {
     // Priority: path following only when no avoidance force was sensed.
     const glm::vec2 force =
-        length2(sensed) > 1e-12f ? sensed : path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
+        force_applies(sensed) ? sensed : path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
     // Forces turn and brake; none makes an agent walk faster than it prefers.
     out_v = clamp_length(v + force * ctx.dt, a.pref_speed[i]);
   }
@@ -175,15 +175,13 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const 
   return acceptable_move(ctx, cells, anchor, p, r, clear) ? p : anchor;
 }
 
-// Agents are visited in bin order (k -> items[k]): neighbours in space are
-// sensed one after another, so their cells and neighbours stay in cache.
-// Inactive agents are not binned and keep a zero sensed force.
+// Agents are visited in index order; each finds its neighbours in the 3x3
+// bins around it. Inactive agents are not binned and keep a zero sensed force.
 struct Sense {
   StepContext ctx;
   AgentArrays a;
   Span<glm::vec2> sensed;
-  THRONG_HOST_DEVICE void operator()(Index k) const {
-    const Index i = k;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
     if ((a.flags[i] & kAgentActive) == 0) return;
     const glm::vec2 p = a.position[i];
     sensed[i] = sense_binned(ctx, a, i, cell_coord(p.x, ctx.bins.cell_size), cell_coord(p.y, ctx.bins.cell_size));
@@ -235,8 +233,7 @@ struct FindMoveCells {
   StepContext ctx;
   Span<const glm::vec2> anchor;
   Span<MoveCells> cells;
-  THRONG_HOST_DEVICE void operator()(Index k) const {  // in contact-bin order, like Sense
-    const Index i = k;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
     const glm::vec2 b = anchor[i];
     const float side = ctx.contact_bins.cell_size;
     cells[i] = {cells_3x3(ctx.contact_bins, cell_coord(b.x, side), cell_coord(b.y, side)), obstacle_cell(ctx.world, b)};

@@ -1,6 +1,6 @@
 // The paper's three steering forces, in priority order, as plain host+device
 // functions of one agent and one candidate (an obstacle or a neighbour). The
-// kernels (sim_kernels.cpp) loop over the candidates found in the 3x3 bins;
+// kernels (simulation_kernels.cpp) loop over the candidates found in the 3x3 bins;
 // tests call these directly on hand-computed cases.
 //
 // Forces are accelerations (m/s^2). Priority: obstacle avoidance, when
@@ -246,9 +246,14 @@ THRONG_HOST_DEVICE inline glm::vec2 path_following_force(glm::vec2 p, glm::vec2 
 
 // ---- priority ----------------------------------------------------------------------
 
+// Whether a force takes priority over the ones below it: it is not zero.
+// The kernels apply the rule stage by stage (a lower force is computed only
+// when no higher one applies); prioritized() is the whole rule at once.
+THRONG_HOST_DEVICE inline bool force_applies(glm::vec2 force) { return length2(force) > 1e-12f; }
+
 THRONG_HOST_DEVICE inline glm::vec2 prioritized(glm::vec2 obstacle, glm::vec2 agents, glm::vec2 path) {
-  if (length2(obstacle) > 1e-12f) return obstacle;
-  if (length2(agents) > 1e-12f) return agents;
+  if (force_applies(obstacle)) return obstacle;
+  if (force_applies(agents)) return agents;
   return path;
 }
 
