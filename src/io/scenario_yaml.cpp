@@ -3,7 +3,6 @@
 #include <fmt/ranges.h>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
-#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -16,8 +15,8 @@
 #include <sstream>
 
 #include "core/ground.h"
-#include "core/spelling.h"
 #include "io/embedded.h"
+#include "io/yaml_reader.h"
 #include "path/route_planner.h"
 
 namespace throng::io {
@@ -29,174 +28,13 @@ using sim::Region;
 
 constexpr double kDegrees = 0.017453292519943295;
 
-std::string shown(std::string_view s) {
-  constexpr std::size_t kShown = 40;
-  std::string out;
-  // Printable ASCII only: messages stay one readable line whatever the file holds.
-  for (char c : s.substr(0, kShown)) out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) ? '?' : c;
-  return "'" + out + (s.size() > kShown ? "...'" : "'");
-}
-
-std::string child(const std::string& path, std::string_view key) { return path.empty() ? std::string(key) : path + "." + std::string(key); }
-std::string item(const std::string& path, std::size_t i) { return fmt::format("{}[{}]", path, i); }
-
-class Reader {
+// The scenario schema over the shared vocabulary (io/yaml_reader.h), plus
+// what only scenarios have: points and rings within the extent limit, and
+// the positions of spawn points kept for errors found later.
+class Reader : public YamlReader {
  public:
-  Reader(const std::string& file, const ScenarioReadLimits& limits, ScenarioSource& source) : file_(file), limits_(limits), source_(source) {}
-
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& path, const std::string& message) const {
-    const YAML::Mark m = n.Mark();
-    throw Error(message, Location{file_, m.is_null() ? 0 : m.line + 1, m.is_null() ? 0 : m.column + 1, path});
-  }
-  [[noreturn]] void fail_at(const YAML::Mark& m, const std::string& path, const std::string& message) const {
-    throw Error(message, Location{file_, m.line + 1, m.column + 1, path});
-  }
-
-  // Every node read passes here: counted against the budget (aliases make a
-  // small file look big) and its position recorded for later errors.
-  void visit(const YAML::Node& n, const std::string& path) {
-    if (++nodes_ > limits_.max_nodes) fail(n, path, fmt::format("the file has more than {} YAML values", limits_.max_nodes));
-    const YAML::Mark m = n.Mark();
-    if (!m.is_null()) source_.marks.emplace(path, std::make_pair(m.line + 1, m.column + 1));
-  }
-
-  static std::string kind(const YAML::Node& n) {
-    if (n.IsMap()) return "a map";
-    if (n.IsSequence()) return "a list";
-    if (n.IsNull()) return "nothing";
-    return "the value " + shown(n.Scalar());
-  }
-
-  // The keys of map n, each in `allowed` and none twice; an unknown key is
-  // an error at the key, with the nearest allowed key as a hint.
-  std::vector<std::string> keys_of(const YAML::Node& n, const std::string& path, const std::vector<std::string_view>& allowed) const {
-    std::vector<std::string> keys;
-    for (auto it = n.begin(); it != n.end(); ++it) {
-      const YAML::Node key = it->first;
-      if (!key.IsScalar()) fail(key, path, "keys must be plain words, got " + kind(key));
-      const std::string& k = key.Scalar();
-      const std::string where = child(path, k);
-      if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
-        const std::string close = closest_name(k, allowed);
-        const std::string hint = close.empty() ? "" : fmt::format(" (did you mean '{}'?)", close);
-        fail_at(key.Mark(), where, fmt::format("unknown key {}{}; expected one of {}", shown(k), hint, join(allowed)));
-      }
-      if (std::find(keys.begin(), keys.end(), k) != keys.end()) fail_at(key.Mark(), where, fmt::format("duplicate key {}", shown(k)));
-      keys.push_back(k);
-    }
-    return keys;
-  }
-
-  // A map whose keys are all in `allowed`.
-  void expect_map(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> allowed) {
-    visit(n, path);
-    if (!n.IsMap()) fail(n, path, "expected a map with keys " + join(allowed) + ", got " + kind(n));
-    keys_of(n, path, std::vector<std::string_view>(allowed));
-  }
-
-  // A map with exactly one of the keys `kinds` (and optionally some of `extra`); returns that key.
-  std::string one_of(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> kinds,
-                     std::initializer_list<std::string_view> extra = {}) {
-    visit(n, path);
-    if (!n.IsMap()) fail(n, path, "expected a map with one of the keys " + join(kinds) + ", got " + kind(n));
-    std::vector<std::string_view> allowed(kinds);
-    allowed.insert(allowed.end(), extra.begin(), extra.end());
-    std::string found;
-    for (const std::string& k : keys_of(n, path, allowed)) {
-      if (std::find(kinds.begin(), kinds.end(), k) == kinds.end()) continue;
-      if (!found.empty()) fail(n, child(path, k), fmt::format("give only one of {} (found '{}' and '{}')", join(kinds), found, k));
-      found = k;
-    }
-    if (found.empty()) fail(n, path, "needs one of the keys " + join(kinds));
-    return found;
-  }
-
-  template <class Words>
-  static std::string join(const Words& words) {
-    std::string s;
-    for (std::string_view w : words) s += (s.empty() ? "" : ", ") + std::string(w);
-    return s;
-  }
-
-  const YAML::Node required(const YAML::Node& map, const std::string& path, const char* key) {
-    const YAML::Node n = map[key];
-    if (!n) fail(map, path, fmt::format("missing required key '{}'", key));
-    return n;
-  }
-
-  // Why n is not a finite number, or "" when it is (then *out holds it).
-  static std::string number_problem(const YAML::Node& n, double* out) {
-    if (!n.IsScalar()) return "expected a number, got " + kind(n);
-    if (n.Tag() == "!") return "expected a number, got the quoted string " + shown(n.Scalar());
-    std::string_view text = n.Scalar();
-    std::string_view bare = text;
-    if (!bare.empty() && (bare[0] == '+' || bare[0] == '-')) bare.remove_prefix(1);
-    for (std::string_view special : {".inf", ".Inf", ".INF", ".nan", ".NaN", ".NAN"})
-      if (bare == special) return "the number must be finite, got " + shown(text);
-    if (!text.empty() && text[0] == '+') text.remove_prefix(1);
-    double v = 0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return "expected a number, got " + shown(n.Scalar());
-    if (!std::isfinite(v) || std::fabs(v) > 3.0e38)
-      return "the number " + shown(n.Scalar()) + " is too large: values are single precision (up to 3.4e38), and positions must lie within the extent limit";
-    *out = v;
-    return {};
-  }
-
-  double number(const YAML::Node& n, const std::string& path) {
-    visit(n, path);
-    double v = 0;
-    if (const std::string problem = number_problem(n, &v); !problem.empty()) fail(n, path, problem);
-    return v;
-  }
-  float real(const YAML::Node& n, const std::string& path) { return static_cast<float>(number(n, path)); }
-  float real_in(const YAML::Node& n, const std::string& path, double lo, double hi) {
-    const double v = number(n, path);
-    if (v < lo || v > hi) fail(n, path, fmt::format("must be in [{}, {}], got {}", lo, hi, v));
-    return static_cast<float>(v);
-  }
-
-  std::int64_t integer(const YAML::Node& n, const std::string& path, std::int64_t lo, std::int64_t hi) {
-    const double v = number(n, path);
-    // Integers written as 1e6 are fine; 2.5 is not.
-    if (v != std::floor(v) || std::fabs(v) > 9.0e15) fail(n, path, "expected a whole number, got " + shown(n.Scalar()));
-    const auto i = static_cast<std::int64_t>(v);
-    if (i < lo || i > hi) fail(n, path, fmt::format("must be in [{}, {}], got {}", lo, hi, i));
-    return i;
-  }
-
-  bool boolean(const YAML::Node& n, const std::string& path) {
-    visit(n, path);
-    if (n.IsScalar() && n.Tag() != "!") {
-      const std::string& s = n.Scalar();
-      if (s == "true" || s == "True" || s == "TRUE") return true;
-      if (s == "false" || s == "False" || s == "FALSE") return false;
-    }
-    fail(n, path, "expected true or false, got " + kind(n));
-  }
-
-  std::string text(const YAML::Node& n, const std::string& path) {
-    visit(n, path);
-    if (!n.IsScalar()) fail(n, path, "expected a string, got " + kind(n));
-    if (n.Scalar().size() > 4096) fail(n, path, "the string is longer than 4096 characters");
-    return n.Scalar();
-  }
-
-  std::string word(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> choices) {
-    const std::string s = text(n, path);
-    if (std::find(choices.begin(), choices.end(), s) == choices.end())
-      fail(n, path, fmt::format("expected one of {}, got {}", join(choices), shown(s)));
-    return s;
-  }
-
-  void expect_list(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size, const char* what) {
-    visit(n, path);
-    if (!n.IsSequence()) fail(n, path, fmt::format("expected a list of {}, got {}", what, kind(n)));
-    if (n.size() < min_size)
-      fail(n, path, min_size == 1 ? fmt::format("must not be empty: give at least one of the {}", what)
-                                  : fmt::format("needs at least {} {}, got {}", min_size, what, n.size()));
-    if (n.size() > max_size) fail(n, path, fmt::format("has more than {} {}", max_size, what));
-  }
+  Reader(const std::string& file, const ScenarioReadLimits& limits, ScenarioSource& source)
+      : YamlReader(file, YamlReadRules{limits.max_nodes, kMaxText, false}, &source.marks), limits_(limits), source_(source) {}
 
   glm::vec2 point(const YAML::Node& n, const std::string& path) {
     visit(n, path);
@@ -209,8 +47,7 @@ class Reader {
   template <class PathFn>
   glm::vec2 coordinates(const YAML::Node& n, const PathFn& path) {
     if (!n.IsSequence() || n.size() != 2) fail(n, path(), "expected a point [x, y], got " + kind(n));
-    nodes_ += 2;
-    if (nodes_ > limits_.max_nodes) fail(n, path(), fmt::format("the file has more than {} YAML values", limits_.max_nodes));
+    spend(n, 2, path);
     double xy[2];
     for (int k = 0; k < 2; ++k) {
       const YAML::Node c = n[k];
@@ -236,7 +73,7 @@ class Reader {
     sim::Ring r;
     r.reserve(n.size());
     for (std::size_t i = 0; i < n.size(); ++i) {
-      ++nodes_;
+      count(1);
       r.push_back(coordinates(n[i], [&] { return item(path, i); }));
     }
     return r;
@@ -253,7 +90,7 @@ class Reader {
     marks.clear();
     marks.reserve(n.size());
     for (std::size_t i = 0; i < n.size(); ++i) {
-      ++nodes_;
+      count(1);
       const YAML::Node p = n[i];
       out.push_back(coordinates(p, [&] { return item(path, i); }));
       const YAML::Mark m = p.Mark();
@@ -691,10 +528,10 @@ class Reader {
   }
 
  private:
-  std::string file_;
+  static constexpr std::size_t kMaxText = 4096;  // characters of one string
+
   ScenarioReadLimits limits_;
   ScenarioSource& source_;
-  std::int64_t nodes_ = 0;
   std::int64_t vertices_ = 0;
 };
 
@@ -737,22 +574,13 @@ LoadedScenario parse_scenario(std::string_view text, const std::string& name, co
     throw Error(fmt::format("the file is larger than {} bytes", limits.max_file_bytes), Location{name, 1, 1, {}});
   LoadedScenario out;
   out.source.file = name;
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::DeepRecursion& e) {
-    throw Error("lists and maps nested too deeply", Location{name, e.mark.line + 1, e.mark.column + 1, {}});
-  } catch (const YAML::Exception& e) {
-    const int line = e.mark.is_null() ? 1 : e.mark.line + 1, column = e.mark.is_null() ? 0 : e.mark.column + 1;
-    throw Error("YAML syntax: " + e.msg, Location{name, line, column, {}});
-  }
+  const YAML::Node root = load_yaml(std::string(text), name);
   if (!root || root.IsNull()) throw Error("the file is empty; a scenario needs at least 'groups'", Location{name, 1, 1, {}});
   try {
     Reader reader(name, limits, out.source);
     out.spec = reader.scenario(root, stem_of(name), out.trajectory_format);
   } catch (const YAML::Exception& e) {
-    // yaml-cpp's own checks (e.g. a bad conversion) still get a position.
-    throw Error("YAML: " + e.msg, Location{name, e.mark.is_null() ? 1 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1, {}});
+    throw yaml_error(e, name);  // yaml-cpp's own checks (e.g. a bad conversion) still get a position
   } catch (const Error& e) {
     throw out.source.located(e);
   }

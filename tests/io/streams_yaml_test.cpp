@@ -105,7 +105,7 @@ TEST(StreamsYaml, ErrorsNameLineAndColumn) {
   const std::vector<Case> cases = {
       {rig + "streams:\n  - name: s\n    rig: h\n    histroy: 8\n", "t.yaml:6:5", "unknown key 'histroy'"},
       {clip + "streams:\n  - {name: s, rig: h, controller: {clip: nope}}\n", "t.yaml:6:42", "no clip named 'nope'"},
-      {clip + "streams:\n  - {name: s, rig: h, history: -3, controller: {clip: w}}\n", "t.yaml:6:32", "out of range [1, 65536]"},
+      {clip + "streams:\n  - {name: s, rig: h, history: -3, controller: {clip: w}}\n", "t.yaml:6:32", "must be in [1, 65536], got -3"},
       {clip + "streams:\n  - {name: s, rig: h, history: 64, time_to_dilate: 1, controller: {clip: w}}\n", "t.yaml:6:5",
        "time_to_dilate: must be at least"},
       {clip + "streams:\n  - name: s\n    rig: h\n    controller:\n      state_machine:\n        states: [{name: a, controller: {clip: w}}]\n"
@@ -118,7 +118,7 @@ TEST(StreamsYaml, ErrorsNameLineAndColumn) {
       {"rigs: [{name: h, bvh: /no/such/file.bvh}]\n", "t.yaml:1:23", "cannot read '/no/such/file.bvh'"},
       {"rigs: [{name: h, skeleton: default}\n", "t.yaml:", "end of sequence flow"},
       {rig + "clips:\n  - {name: w, rig: h, default: sprint}\n", "t.yaml:4:32", "no default motion 'sprint'"},
-      {rig + "clips:\n  - {name: w, rig: h, default: walk, events: [{name: e, time: 9}]}\n", "t.yaml:4:63", "out of range [0,"},
+      {rig + "clips:\n  - {name: w, rig: h, default: walk, events: [{name: e, time: 9}]}\n", "t.yaml:4:63", "must be in [0, "},
       {rig + "clips:\n  - {name: w, rig: h, default: walk}\nstreams:\n  - {name: s, rig: h, controller: {layered: {base: {clip: w}, "
              "layers: [{controller: {clip: w}, mask: [Tail]}]}}}\n",
        "t.yaml:6:102", "no joint named 'Tail'"},
@@ -128,8 +128,8 @@ TEST(StreamsYaml, ErrorsNameLineAndColumn) {
       {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, nope]}}}\n", "t.yaml:6:57", "no clip named 'nope'"},
       {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, w]}}}\n", "t.yaml:6:53", "have the same speed"},
       {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: mine}}}\n", "t.yaml:6:53", "the only built-in blend space"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: default, speed: -1}}}\n", "t.yaml:6:69", "out of range"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {clips: [w]}}}\n", "t.yaml:6:45", "missing key 'turn_left'"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: default, speed: -1}}}\n", "t.yaml:6:69", "must be in [0, 100], got -1"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {clips: [w]}}}\n", "t.yaml:6:45", "missing required key 'turn_left'"},
       {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {space: default, turn_left: w, turn_right: w}}}\n", "t.yaml:",
        "must turn"},
   };
