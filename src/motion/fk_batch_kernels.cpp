@@ -22,22 +22,14 @@ void BatchFkJob::validate() const {
 
 void BatchFkJob::run() const {
   validate();
-  const std::int32_t J = joint_count;
-  const std::int32_t last = frame_count - 1;
-  const auto P = parents;
-  const auto O = offsets;
-  const auto L = clip_rotations;
-  const auto roots = clip_roots;
-  const auto F = frames;
-  const auto outP = out_positions;
-  const auto outR = out_rotations;
   parallel_for(
       "motion.fk_batch", character_count(),
-      THRONG_LAMBDA(Index c) {
-        std::int32_t f = F[c];
-        f = f < 0 ? 0 : (f > last ? last : f);
-        fk_pose(J, P.data(), O.data(), L.data() + static_cast<Index>(f) * J, nullptr, roots[f], outP.data() + c * J,
-                outR.data() + c * J);
+      THRONG_JOB_LAMBDA(Index c) {
+        const std::int32_t J = joint_count;
+        std::int32_t f = frames[c];
+        f = f < 0 ? 0 : (f > frame_count - 1 ? frame_count - 1 : f);
+        fk_pose(J, parents.data(), offsets.data(), clip_rotations.data() + static_cast<Index>(f) * J, nullptr, clip_roots[f],
+                out_positions.data() + c * J, out_rotations.data() + c * J);
       },
       64);
 }

@@ -20,17 +20,14 @@ struct Item {
   std::int32_t curve;  // -1 for the start and end segments
 };
 
-}  // namespace
-
-Playback play(const MotionGraph& machine, const ResampledPath& path, const Sequence& sequence) {
+// The segments of `sequence` laid end to end along `path`: where each
+// segment's origin goes, the turn applied to it and its start (s); `total`
+// gets the length of them all (s).
+std::vector<Item> lay_out(const MotionGraph& machine, const ResampledPath& path, const Sequence& sequence, double& total) {
   const std::int32_t k = machine.k();
   const auto curves = static_cast<std::int32_t>(sequence.segments.size());
-  if (static_cast<std::size_t>(curves) * static_cast<std::size_t>(k) > path.points.size())
-    throw Error("the sequence has more curves than the path", at_field("playback.sequence"));
-  if (path.points.empty()) throw Error("empty path", at_field("playback.path"));
   const auto& segs = machine.segments();
   auto seg_of = [&](std::int32_t id) -> const MotionSegment& { return segs[static_cast<std::size_t>(id)]; };
-
   std::vector<Item> items;
   double t = 0;
   auto add = [&](std::int32_t seg, glm::vec2 place, float heading, std::int32_t curve) {
@@ -51,6 +48,34 @@ Playback play(const MotionGraph& machine, const ResampledPath& path, const Seque
     end_heading = theta + m.end_heading;
   }
   if (sequence.end_segment >= 0) add(sequence.end_segment, end_place, end_heading, -1);
+  total = t;
+  return items;
+}
+
+// Distance (m) from ground point g to the path's polyline around curve
+// `curve` (k points a curve, the curves either side included).
+double deviation(const ResampledPath& path, std::int32_t k, std::int32_t curve, glm::vec2 g) {
+  const std::int64_t lo = std::max<std::int64_t>(0, (static_cast<std::int64_t>(curve) - 1) * k);
+  const std::int64_t hi = std::min<std::int64_t>(static_cast<std::int64_t>(path.points.size()) - 1, (static_cast<std::int64_t>(curve) + 2) * k);
+  double d = INFINITY;
+  for (std::int64_t i = lo; i < hi; ++i)
+    d = std::min(d, static_cast<double>(sim::distance_to_segment(g, path.points[static_cast<std::size_t>(i)], path.points[static_cast<std::size_t>(i) + 1])));
+  if (hi <= lo) d = sim::length_of(g - path.points[static_cast<std::size_t>(lo)]);
+  return d;
+}
+
+}  // namespace
+
+Playback play(const MotionGraph& machine, const ResampledPath& path, const Sequence& sequence) {
+  const std::int32_t k = machine.k();
+  const auto curves = static_cast<std::int32_t>(sequence.segments.size());
+  if (static_cast<std::size_t>(curves) * static_cast<std::size_t>(k) > path.points.size())
+    throw Error("the sequence has more curves than the path", at_field("playback.sequence"));
+  if (path.points.empty()) throw Error("empty path", at_field("playback.path"));
+  const auto& segs = machine.segments();
+  auto seg_of = [&](std::int32_t id) -> const MotionSegment& { return segs[static_cast<std::size_t>(id)]; };
+  double t = 0;
+  const std::vector<Item> items = lay_out(machine, path, sequence, t);
   if (items.empty()) throw Error("nothing to play: no segments", at_field("playback.sequence"));
 
   const double fps = machine.spec().fps;
@@ -104,12 +129,7 @@ Playback play(const MotionGraph& machine, const ResampledPath& path, const Seque
     if (it.curve >= 0) {
       if (out.first_matched_frame < 0) out.first_matched_frame = f;
       ++out.matched_frames;
-      const std::int64_t lo = std::max<std::int64_t>(0, (static_cast<std::int64_t>(it.curve) - 1) * k);
-      const std::int64_t hi = std::min<std::int64_t>(static_cast<std::int64_t>(path.points.size()) - 1, (static_cast<std::int64_t>(it.curve) + 2) * k);
-      double d = INFINITY;
-      for (std::int64_t i = lo; i < hi; ++i)
-        d = std::min(d, static_cast<double>(sim::distance_to_segment(g, path.points[static_cast<std::size_t>(i)], path.points[static_cast<std::size_t>(i) + 1])));
-      if (hi <= lo) d = sim::length_of(g - path.points[static_cast<std::size_t>(lo)]);
+      const double d = deviation(path, k, it.curve, g);
       dev_sum += d;
       out.deviation_max = std::max(out.deviation_max, d);
     }
