@@ -71,8 +71,14 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
       if (r.run_type != Run::RT_Aggregate || r.aggregate_name != "median") continue;
       auto it = metas().find(r.run_name.function_name);
       if (it == metas().end()) continue;
-      Row row{it->second.name, to_string(it->second.backend), it->second.n, it->second.threads, r.GetAdjustedRealTime(), 0,
-              static_cast<int>(r.repetitions), {}};
+      Row row{it->second.name,
+              to_string(it->second.backend),
+              it->second.n,
+              it->second.threads,
+              r.GetAdjustedRealTime(),
+              0,
+              static_cast<int>(r.repetitions),
+              {}};
       for (const auto& [key, counter] : r.counters) {
         if (key == "items_per_second")
           row.items_per_second = counter.value;
@@ -121,11 +127,11 @@ std::vector<Row> run(const Options& options) {
 std::string table(const std::vector<Row>& rows) {
   std::size_t width = 9;
   for (const auto& r : rows) width = std::max(width, r.name.size());
-  std::string s = fmt::format("{:<{}}  {:>7}  {:>10}  {:>7}  {:>14}  {:>14}\n", "benchmark", width, "backend", "N", "threads",
-                              "median ns", "items/s");
+  std::string s = fmt::format("{:<{}}  {:>7}  {:>10}  {:>7}  {:>14}  {:>14}\n", "benchmark", width, "backend", "N",
+                              "threads", "median ns", "items/s");
   for (const auto& r : rows) {
-    s += fmt::format("{:<{}}  {:>7}  {:>10}  {:>7}  {:>14.0f}  {:>14.4g}", r.name, width, r.backend, r.n, r.threads, r.median_ns,
-                     r.items_per_second);
+    s += fmt::format("{:<{}}  {:>7}  {:>10}  {:>7}  {:>14.0f}  {:>14.4g}", r.name, width, r.backend, r.n, r.threads,
+                     r.median_ns, r.items_per_second);
     for (const auto& [key, value] : r.counters) s += fmt::format("  {}={:.4g}", key, value);
     s += "\n";
   }

@@ -16,7 +16,7 @@
 namespace throng::bench {
 
 struct Options {
-  bool quick = false;         // short runs, sizes up to quick_max_n
+  bool quick = false;  // short runs, sizes up to quick_max_n
   Index quick_max_n = 100000;
   std::vector<int> threads;   // CPU thread counts; empty = {1, all}
   std::string filter = ".*";  // regular expression on row names
@@ -27,11 +27,11 @@ struct Options {
 using Body = std::function<void(benchmark::State&, Index n)>;
 
 struct CaseSpec {
-  std::string name;           // "family/what", e.g. "core/saxpy"
+  std::string name;  // "family/what", e.g. "core/saxpy"
   std::vector<Index> sizes;
   Body body;
-  bool cuda = false;          // also run on the CUDA backend when usable
-  bool single_thread = false; // the case is serial by nature: threads = 1 only
+  bool cuda = false;           // also run on the CUDA backend when usable
+  bool single_thread = false;  // the case is serial by nature: threads = 1 only
 };
 void add(const Options& options, CaseSpec spec);
 
@@ -46,8 +46,8 @@ struct Row {
   std::string backend;
   Index n = 0;
   int threads = 1;
-  double median_ns = 0;        // per iteration, wall clock
-  double items_per_second = 0; // median over repetitions
+  double median_ns = 0;         // per iteration, wall clock
+  double items_per_second = 0;  // median over repetitions
   int repetitions = 0;
   // A case's other counters (state.counters, e.g. bytes of pose data), medians.
   std::vector<std::pair<std::string, double>> counters;

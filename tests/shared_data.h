@@ -38,23 +38,25 @@ inline bool shared_data_required() {
 
 inline std::string missing_shared_data_message() {
   const char* dir = std::getenv("THRONG_SHARED_DIR");
-  return std::string("../shared not found: ") +
-         (dir == nullptr ? std::string("THRONG_SHARED_DIR is unset (ctest sets it)") : "no data/bvh under THRONG_SHARED_DIR=" + std::string(dir));
+  return std::string("../shared not found: ") + (dir == nullptr
+                                                     ? std::string("THRONG_SHARED_DIR is unset (ctest sets it)")
+                                                     : "no data/bvh under THRONG_SHARED_DIR=" + std::string(dir));
 }
 
 }  // namespace throng::test
 
 // Skips (or, with THRONG_REQUIRE_SHARED=1, fails) the test unless `found`.
-#define THRONG_REQUIRE_SHARED_DATA(found)                                                                                        \
-  do {                                                                                                                            \
-    if (!(found)) {                                                                                                               \
-      if (::throng::test::shared_data_required())                                                                              \
-        GTEST_FAIL() << ::throng::test::missing_shared_data_message() << " (THRONG_REQUIRE_SHARED=1: the data must be present)"; \
-      GTEST_SKIP() << ::throng::test::missing_shared_data_message();                                                           \
-    }                                                                                                                             \
+#define THRONG_REQUIRE_SHARED_DATA(found)                                       \
+  do {                                                                          \
+    if (!(found)) {                                                             \
+      if (::throng::test::shared_data_required())                               \
+        GTEST_FAIL() << ::throng::test::missing_shared_data_message()           \
+                     << " (THRONG_REQUIRE_SHARED=1: the data must be present)"; \
+      GTEST_SKIP() << ::throng::test::missing_shared_data_message();            \
+    }                                                                           \
   } while (0)
 
 // `const auto dir = shared_bvh_dir();` then THRONG_REQUIRE_SHARED_DATA(dir).
-#define THRONG_NEED_SHARED_BVH(dir)                    \
+#define THRONG_NEED_SHARED_BVH(dir)                  \
   const auto dir = ::throng::test::shared_bvh_dir(); \
   THRONG_REQUIRE_SHARED_DATA(dir)

@@ -147,29 +147,30 @@ void register_anim(const Options& options) {
                 true});
 
   // The per-frame statistics over the LOD output.
-  add(options, {"anim/lod_histogram", sizes,
-                [](benchmark::State& state, Index n) {
-                  const motion::Skeleton skeleton = bench_skeleton();
-                  const BodyParts parts = make_body_parts(skeleton);
-                  const LodConfig config = make_lod_config(parts, default_lod_thresholds());
-                  const LodTables tables(config, current_memory());
-                  GridCrowd crowd(n);
-                  Buffer<std::uint8_t> levels(n * kBodyPartCount, current_memory());
-                  Buffer<std::uint32_t> masks(n * config.mask_words, current_memory());
-                  LodJob job;
-                  job.set_tables(tables);
-                  job.camera = make_camera_view(orbit_at(crowd.half_extent, 0.0f));
-                  job.roots.positions = crowd.positions.span();
-                  job.roots.headings = crowd.headings.span();
-                  job.template_spheres = parts.rest_spheres;
-                  job.levels = levels.span();
-                  job.joint_masks = masks.span();
-                  job.run();
-                  for (auto _ : state)
-                    benchmark::DoNotOptimize(lod_histogram(levels.span(), masks.span(), config.level_count, config.joint_count));
-                  state.SetItemsProcessed(state.iterations() * n);
-                },
-                true});
+  add(options,
+      {"anim/lod_histogram", sizes,
+       [](benchmark::State& state, Index n) {
+         const motion::Skeleton skeleton = bench_skeleton();
+         const BodyParts parts = make_body_parts(skeleton);
+         const LodConfig config = make_lod_config(parts, default_lod_thresholds());
+         const LodTables tables(config, current_memory());
+         GridCrowd crowd(n);
+         Buffer<std::uint8_t> levels(n * kBodyPartCount, current_memory());
+         Buffer<std::uint32_t> masks(n * config.mask_words, current_memory());
+         LodJob job;
+         job.set_tables(tables);
+         job.camera = make_camera_view(orbit_at(crowd.half_extent, 0.0f));
+         job.roots.positions = crowd.positions.span();
+         job.roots.headings = crowd.headings.span();
+         job.template_spheres = parts.rest_spheres;
+         job.levels = levels.span();
+         job.joint_masks = masks.span();
+         job.run();
+         for (auto _ : state)
+           benchmark::DoNotOptimize(lod_histogram(levels.span(), masks.span(), config.level_count, config.joint_count));
+         state.SetItemsProcessed(state.iterations() * n);
+       },
+       true});
 
   // The 2019 paper's Figures 10 and 11: one frame of locomotion for N
   // characters (speed -> blend, phase, root motion, pose of every joint as
@@ -181,9 +182,11 @@ void register_anim(const Options& options) {
     const char* name;
     bool lod, cache;
   };
-  for (const Variant variant : {Variant{"anim/locomotion_full", false, false}, Variant{"anim/locomotion_lod", true, false},
-                                Variant{"anim/locomotion_lod_cache", true, true}}) {
-    add(options, {variant.name, {1000, 5000, 10000, 50000, 100000, 1000000},
+  for (const Variant variant :
+       {Variant{"anim/locomotion_full", false, false}, Variant{"anim/locomotion_lod", true, false},
+        Variant{"anim/locomotion_lod_cache", true, true}}) {
+    add(options, {variant.name,
+                  {1000, 5000, 10000, 50000, 100000, 1000000},
                   [variant](benchmark::State& state, Index n) {
                     static const motion::BlendSpace1D space = motion::make_default_blend_space();
                     GridCrowd crowd(n);
@@ -219,13 +222,15 @@ void register_anim(const Options& options) {
                     state.SetItemsProcessed(state.iterations() * n);
                     state.counters["joints_per_character"] =
                         static_cast<double>(animator.last_frame().joints_synthesised) / static_cast<double>(n);
-                    state.counters["from_cache"] = static_cast<double>(animator.last_frame().from_cache) / static_cast<double>(n);
+                    state.counters["from_cache"] =
+                        static_cast<double>(animator.last_frame().from_cache) / static_cast<double>(n);
                   },
                   true});
   }
 
   // Cache reads: a bucket lookup plus a SLERP pose at the character's phase.
-  add(options, {"anim/motion_cache_sample", {1000, 100000},
+  add(options, {"anim/motion_cache_sample",
+                {1000, 100000},
                 [](benchmark::State& state, Index n) {
                   const std::int32_t joints = 31;
                   const auto synthesise = [joints](float w) {
@@ -235,8 +240,9 @@ void register_anim(const Options& options) {
                     c.duration = 1.2f - 0.5f * w;
                     for (std::int32_t f = 0; f < c.frame_count; ++f)
                       for (std::int32_t j = 0; j < joints; ++j)
-                        c.rotations.push_back(glm::angleAxis(0.5f * std::sin(0.3f * static_cast<float>(f + j)) * (1.0f + w),
-                                                             glm::normalize(glm::vec3(1.0f, 0.1f * static_cast<float>(j), 0.3f))));
+                        c.rotations.push_back(
+                            glm::angleAxis(0.5f * std::sin(0.3f * static_cast<float>(f + j)) * (1.0f + w),
+                                           glm::normalize(glm::vec3(1.0f, 0.1f * static_cast<float>(j), 0.3f))));
                     return c;
                   };
                   MotionCache cache;
@@ -251,15 +257,18 @@ void register_anim(const Options& options) {
                   for (Index i = 0; i < n; ++i) cache.get(w[static_cast<std::size_t>(i)], synthesise);  // warm
                   for (auto _ : state) {
                     for (Index i = 0; i < n; ++i)
-                      cache.sample(w[static_cast<std::size_t>(i)], phase[static_cast<std::size_t>(i)], synthesise, pose);
+                      cache.sample(w[static_cast<std::size_t>(i)], phase[static_cast<std::size_t>(i)], synthesise,
+                                   pose);
                     benchmark::DoNotOptimize(pose.data());
                   }
                   state.SetItemsProcessed(state.iterations() * n);
                 },
-                false, true});
+                false,
+                true});
 
   // Cache bucket lookups alone.
-  add(options, {"anim/motion_cache_find", {1000, 100000},
+  add(options, {"anim/motion_cache_find",
+                {1000, 100000},
                 [](benchmark::State& state, Index n) {
                   MotionCache cache;
                   for (std::int32_t b = 0; b < cache.bucket_count(); ++b) {
@@ -278,7 +287,8 @@ void register_anim(const Options& options) {
                     for (float x : w) benchmark::DoNotOptimize(cache.find(x));
                   state.SetItemsProcessed(state.iterations() * n);
                 },
-                false, true});
+                false,
+                true});
 }
 
 }  // namespace

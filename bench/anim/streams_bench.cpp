@@ -253,7 +253,8 @@ void register_streams(const Options& options) {
   add(options, {"anim/streams_resolve", sizes,
                 [](benchmark::State& state, Index n) {
                   StreamsFixture& f = cached<StreamsFixture>(n);
-                  for (auto _ : state) f.crowd->resolve(f.placement->positions.span(), f.placement->yaws.span(), f.palettes.span());
+                  for (auto _ : state)
+                    f.crowd->resolve(f.placement->positions.span(), f.placement->yaws.span(), f.palettes.span());
                   state.SetItemsProcessed(state.iterations() * n);
                   f.counters(state);
                 },

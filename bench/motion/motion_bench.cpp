@@ -76,15 +76,18 @@ void register_motion(const Options& options) {
   const fs::path bvh = largest_shared_bvh();
   if (!bvh.empty()) {
     const auto bytes = static_cast<Index>(fs::file_size(bvh));
-    add(options, {"motion/bvh_parse", {bytes},
+    add(options, {"motion/bvh_parse",
+                  {bytes},
                   [bvh](benchmark::State& state, Index n) {
                     const std::string text = slurp(bvh);
                     for (auto _ : state) benchmark::DoNotOptimize(io::parse_bvh(text, bvh.string()));
                     state.SetBytesProcessed(state.iterations() * n);
                     state.SetItemsProcessed(state.iterations() * n);  // items/s column = bytes/s
                   },
-                  false, true});
-    add(options, {"motion/bvh_write", {bytes},
+                  false,
+                  true});
+    add(options, {"motion/bvh_write",
+                  {bytes},
                   [bvh](benchmark::State& state, Index) {
                     const io::BvhFile file = io::read_bvh(bvh.string());
                     std::size_t written = 0;
@@ -95,16 +98,19 @@ void register_motion(const Options& options) {
                     }
                     state.SetItemsProcessed(state.iterations() * static_cast<Index>(written));  // bytes written/s
                   },
-                  false, true});
+                  false,
+                  true});
   }
 
   // FK for N characters, each at its own frame: items = characters * joints.
-  add(options, {"motion/fk_batch_31j", {10000, 100000},
+  add(options, {"motion/fk_batch_31j",
+                {10000, 100000},
                 [](benchmark::State& state, Index n) {
                   const Character c = make_character(31, 120);
                   const Memory m = current_memory();
                   std::vector<std::int32_t> frames(static_cast<std::size_t>(n));
-                  for (std::size_t i = 0; i < frames.size(); ++i) frames[i] = static_cast<std::int32_t>((i * 7919) % 120);
+                  for (std::size_t i = 0; i < frames.size(); ++i)
+                    frames[i] = static_cast<std::int32_t>((i * 7919) % 120);
                   const Buffer<std::int32_t> parents(std::span<const std::int32_t>(c.skeleton.parents), m);
                   const Buffer<glm::vec3> offsets(std::span<const glm::vec3>(c.skeleton.offsets), m);
                   const Buffer<glm::quat> rotations(std::span<const glm::quat>(c.clip.rotations), m);
@@ -128,10 +134,10 @@ void register_motion(const Options& options) {
                 true});
 
   // FK of every row of an fp16 motion texture: items = frames * joints.
-  add(options, {"motion/fk_texture_f16_31j", {1000, 10000},
-                [](benchmark::State& state, Index n) {
+  add(options, {"motion/fk_texture_f16_31j", {1000, 10000}, [](benchmark::State& state, Index n) {
                   const Character c = make_character(31, static_cast<int>(n));
-                  const motion::MotionTexture t = motion::make_motion_texture(c.skeleton, c.clip, motion::TexelFormat::Float16);
+                  const motion::MotionTexture t =
+                      motion::make_motion_texture(c.skeleton, c.clip, motion::TexelFormat::Float16);
                   for (auto _ : state) benchmark::DoNotOptimize(motion::forward_kinematics(t));
                   state.SetItemsProcessed(state.iterations() * n * 31);
                 }});

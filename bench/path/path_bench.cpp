@@ -123,7 +123,8 @@ Body route_plan(const char* scene_name) {
     for (auto _ : state) benchmark::DoNotOptimize(s.planner.plan(s.world, s.starts, s.goals, s.radius));
     state.SetItemsProcessed(state.iterations() * n);
     const path::RoutePlannerStats st = s.planner.stats();
-    state.counters["routed_fraction"] = static_cast<double>(st.planned) / static_cast<double>(std::max<std::int64_t>(1, st.queries));
+    state.counters["routed_fraction"] =
+        static_cast<double>(st.planned) / static_cast<double>(std::max<std::int64_t>(1, st.queries));
   };
 }
 
@@ -143,8 +144,7 @@ void register_path(const Options& options) {
                 true});
 
   // Past the paper: the dynamic program over the machine's transitions.
-  add(options, {"path/match_dp", table1,
-                [](benchmark::State& state, Index n) {
+  add(options, {"path/match_dp", table1, [](benchmark::State& state, Index n) {
                   const path::CurveSet cs = curves_of(n);
                   path::MatchGrid grid(scene().machine, cs);
                   grid.match();
@@ -154,8 +154,7 @@ void register_path(const Options& options) {
                 }});
 
   // A* on the roadmap plus shortcuts and corner rounding, per query.
-  add(options, {"path/plan", {100, 1000},
-                [](benchmark::State& state, Index n) {
+  add(options, {"path/plan", {100, 1000}, [](benchmark::State& state, Index n) {
                   const Scene& s = scene();
                   const std::span<const path::PathQuery> q(s.queries.data(), static_cast<std::size_t>(n));
                   for (auto _ : state) benchmark::DoNotOptimize(s.planner.plan_all(q));
@@ -163,7 +162,8 @@ void register_path(const Options& options) {
                 }});
 
   // Voronoi roadmap of the 60 x 40 m field (N = obstacles).
-  add(options, {"path/roadmap", {70},
+  add(options, {"path/roadmap",
+                {70},
                 [](benchmark::State& state, Index n) {
                   path::RandomWorldOptions wo;
                   wo.obstacles = n;
@@ -173,12 +173,14 @@ void register_path(const Options& options) {
                   for (auto _ : state) benchmark::DoNotOptimize(path::Planner::build(world, po));
                   state.SetItemsProcessed(state.iterations() * n);
                 },
-                false, true});
+                false,
+                true});
 
   // Set-up of a walkable square 2n m across holding one 1 x 10 m wall: the
   // world index, the free space, its roadmap and routes round the wall for
   // ten agents. The cost must follow what the world holds, not n.
-  add(options, {"path/huge_world_setup", {1000, 1000000},
+  add(options, {"path/huge_world_setup",
+                {1000, 1000000},
                 [](benchmark::State& state, Index n) {
                   const auto h = static_cast<float>(n);
                   sim::WorldSpec spec;
@@ -197,7 +199,8 @@ void register_path(const Options& options) {
                   }
                   state.SetItemsProcessed(state.iterations());
                 },
-                false, true});
+                false,
+                true});
 
   // Routes for n agents (see RouteScene).
   add(options, {"path/route_plan/field", {1000, 10000}, route_plan("field")});

@@ -49,7 +49,8 @@ struct Scene {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     for (Index i = 0; i < n; ++i) {
-      positions.emplace_back(spacing * static_cast<float>(i % side) - half, 0.0f, spacing * static_cast<float>(i / side) - half);
+      positions.emplace_back(spacing * static_cast<float>(i % side) - half, 0.0f,
+                             spacing * static_cast<float>(i / side) - half);
       yaws.push_back(6.2831853f * unit(rng));
       phases.push_back(unit(rng));
       speeds.push_back(0.8f + 1.6f * unit(rng));
@@ -94,15 +95,19 @@ void frame_case(benchmark::State& state, Index n, RenderMode mode) {
 void register_render(const Options& options) {
   const std::vector<Index> sizes = {1000, 10000, 100000};
 
-  add(options, {"render/joints_frame", sizes, [](benchmark::State& state, Index n) { frame_case(state, n, RenderMode::Joints); }});
-  add(options, {"render/skinned_frame", sizes, [](benchmark::State& state, Index n) { frame_case(state, n, RenderMode::Skinned); }});
+  add(options, {"render/joints_frame", sizes,
+                [](benchmark::State& state, Index n) { frame_case(state, n, RenderMode::Joints); }});
+  add(options, {"render/skinned_frame", sizes,
+                [](benchmark::State& state, Index n) { frame_case(state, n, RenderMode::Skinned); }});
 
   // The CPU stages alone (cull, slots, pack into host arrays), no OpenGL.
-  add(options, {"render/joints_prepare", sizes, [](benchmark::State& state, Index n) {
+  add(options, {"render/joints_prepare", sizes,
+                [](benchmark::State& state, Index n) {
                   Scene scene(n);
                   const JointRig rig = make_joint_rig(blend_space().skeleton());
                   const Buffer<RigPoint> points(std::span<const RigPoint>(rig.points), current_memory());
-                  Buffer<std::uint32_t> flags(kDrawTiers * n, current_memory()), slots(kDrawTiers * n, current_memory());
+                  Buffer<std::uint32_t> flags(kDrawTiers * n, current_memory()),
+                      slots(kDrawTiers * n, current_memory());
                   Buffer<glm::vec4> packed(n * rig.point_count(), current_memory());
                   const CharacterPoses poses = poses_of(scene.crowd);
                   double t = 0.0;
@@ -131,44 +136,46 @@ void register_render(const Options& options) {
                 },
                 true});
 
-  add(options, {"render/skinned_prepare", sizes, [](benchmark::State& state, Index n) {
-                  Scene scene(n);
-                  const CrowdRigs rigs = make_crowd_rigs(blend_space().skeleton());
-                  const SkinRig& skin = rigs.skins.front();
-                  const Buffer<anim::Mat3x4> inverse_bind(std::span<const anim::Mat3x4>(skin.inverse_bind), current_memory());
-                  Buffer<std::uint32_t> flags(kDrawTiers * n, current_memory()), slots(kDrawTiers * n, current_memory());
-                  Buffer<anim::Mat3x4> palettes(n * skin.joint_count, current_memory());
-                  Buffer<glm::uvec2> tags(n, current_memory());
-                  const CharacterPoses poses = poses_of(scene.crowd);
-                  double t = 0.0;
-                  for (auto _ : state) {
-                    CullJob cull;
-                    cull.camera = make_camera_view(scene.path.at(t));
-                    cull.rigs.rig[0] = {skin.bounding_radius, skin.bind_positions.front(), skin.joint_count};
-                    cull.joint_count = poses.joint_count;
-                    cull.joint_positions = poses.joint_positions;
-                    cull.scales = poses.scales;
-                    cull.group_flags = flags.span();
-                    cull.run();
-                    const Index visible = scan_draw_slots(flags.span(), slots.span());
-                    PalettePackJob pack;
-                    pack.groups = draw_groups(cull, slots.span(), visible);
-                    pack.joint_count = poses.joint_count;
-                    pack.joint_positions = poses.joint_positions;
-                    pack.joint_rotations = poses.joint_rotations;
-                    pack.scales = poses.scales;
-                    pack.inverse_bind = inverse_bind.span();
-                    pack.lod_levels = poses.lod_levels;
-                    pack.group_flags = flags.span();
-                    pack.slots = slots.span();
-                    pack.out_palettes = palettes.span().subspan(0, pack.groups.matrices());
-                    pack.out_tags = tags.span().subspan(0, pack.groups.visible());
-                    pack.run();
-                    t += 1.0 / 30.0;
-                  }
-                  state.SetItemsProcessed(state.iterations() * n);
-                },
-                true});
+  add(options,
+      {"render/skinned_prepare", sizes,
+       [](benchmark::State& state, Index n) {
+         Scene scene(n);
+         const CrowdRigs rigs = make_crowd_rigs(blend_space().skeleton());
+         const SkinRig& skin = rigs.skins.front();
+         const Buffer<anim::Mat3x4> inverse_bind(std::span<const anim::Mat3x4>(skin.inverse_bind), current_memory());
+         Buffer<std::uint32_t> flags(kDrawTiers * n, current_memory()), slots(kDrawTiers * n, current_memory());
+         Buffer<anim::Mat3x4> palettes(n * skin.joint_count, current_memory());
+         Buffer<glm::uvec2> tags(n, current_memory());
+         const CharacterPoses poses = poses_of(scene.crowd);
+         double t = 0.0;
+         for (auto _ : state) {
+           CullJob cull;
+           cull.camera = make_camera_view(scene.path.at(t));
+           cull.rigs.rig[0] = {skin.bounding_radius, skin.bind_positions.front(), skin.joint_count};
+           cull.joint_count = poses.joint_count;
+           cull.joint_positions = poses.joint_positions;
+           cull.scales = poses.scales;
+           cull.group_flags = flags.span();
+           cull.run();
+           const Index visible = scan_draw_slots(flags.span(), slots.span());
+           PalettePackJob pack;
+           pack.groups = draw_groups(cull, slots.span(), visible);
+           pack.joint_count = poses.joint_count;
+           pack.joint_positions = poses.joint_positions;
+           pack.joint_rotations = poses.joint_rotations;
+           pack.scales = poses.scales;
+           pack.inverse_bind = inverse_bind.span();
+           pack.lod_levels = poses.lod_levels;
+           pack.group_flags = flags.span();
+           pack.slots = slots.span();
+           pack.out_palettes = palettes.span().subspan(0, pack.groups.matrices());
+           pack.out_tags = tags.span().subspan(0, pack.groups.visible());
+           pack.run();
+           t += 1.0 / 30.0;
+         }
+         state.SetItemsProcessed(state.iterations() * n);
+       },
+       true});
 }
 
 const bool registered = register_suite("render", &register_render);

@@ -31,7 +31,8 @@ sim::Simulation& plaza(Index n, sim::ModelKind model, Variant variant) {
     io::LoadedScenario s = io::load_builtin_scenario("plaza");
     sim::scale_agent_counts(s.spec, n);
     s.spec.model.kind = model;
-    s.spec.scheduler = variant == Variant::FourColour ? sim::SchedulerKind::FourColour : sim::SchedulerKind::DoubleBuffer;
+    s.spec.scheduler =
+        variant == Variant::FourColour ? sim::SchedulerKind::FourColour : sim::SchedulerKind::DoubleBuffer;
     sim::SimulationOptions options;
     if (variant == Variant::AllPairs) options.neighbours = sim::NeighbourSearch::AllPairs;
     slot = io::build_simulation(s, options);
@@ -51,7 +52,7 @@ Body step(sim::ModelKind model, Variant variant) {
 void register_sim(const Options& options) {
   const std::vector<Index> sizes = {1000, 10000, 100000, 1000000};
   for (const sim::ModelKind model : {sim::ModelKind::Priority, sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Ttc,
-                                    sim::ModelKind::SocialForce}) {
+                                     sim::ModelKind::SocialForce}) {
     const std::string prefix = std::string("sim/plaza_step/") + sim::to_string(model);
     add(options, {prefix + "/double_buffer", sizes, step(model, Variant::DoubleBuffer), true});
     add(options, {prefix + "/four_colour", sizes, step(model, Variant::FourColour), true});

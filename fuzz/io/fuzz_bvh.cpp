@@ -33,8 +33,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   w.frame_time = file.frame_time;
   io::BvhReadOptions again_options = options;
   again_options.unit = file.unit;
-  const io::BvhFile again = io::parse_bvh(io::write_bvh_string(file.skeleton, file.clip, w), "again.bvh", again_options);
-  if (again.skeleton.joint_count() != file.skeleton.joint_count() || again.clip.frame_count != file.clip.frame_count) std::abort();
+  const io::BvhFile again =
+      io::parse_bvh(io::write_bvh_string(file.skeleton, file.clip, w), "again.bvh", again_options);
+  if (again.skeleton.joint_count() != file.skeleton.joint_count() || again.clip.frame_count != file.clip.frame_count)
+    std::abort();
   if (file.clip.frame_count > 0 && file.clip.frame_count * file.skeleton.joint_count() < 4096) {
     const motion::ModelSpaceClip ms = motion::forward_kinematics(file.skeleton, file.clip);
     for (const auto& p : ms.positions)

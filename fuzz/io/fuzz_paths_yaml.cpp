@@ -32,8 +32,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     path::PlanOptions o;
     o.radius = file.radius;
     o.free_space.resolution = 0.01f;  // coarser snapping: large fuzzed worlds stay quick
-    const path::Planner planner =
-        path::Planner::build(path::FreeSpace::build(file.has_walkable ? &file.walkable : nullptr, file.polygons, file.circles, o.free_space), o);
+    const path::Planner planner = path::Planner::build(
+        path::FreeSpace::build(file.has_walkable ? &file.walkable : nullptr, file.polygons, file.circles, o.free_space),
+        o);
     int queries = 0;
     for (const io::PathEntry& p : file.paths) {
       if (!p.planned || ++queries > 4) continue;

@@ -51,21 +51,21 @@ std::string point(FuzzedDataProvider& in, const Box& b) {
 std::string rect(FuzzedDataProvider& in, const Box& b, float max_side) {
   const float x = coordinate(in, b.x0, b.x1 - 0.2f), y = coordinate(in, b.y0, b.y1 - 0.2f);
   const float w = 0.2f + coordinate(in, 0, max_side), h = 0.2f + coordinate(in, 0, max_side);
-  return fmt::format("{{rect: {{min: [{:g}, {:g}], max: [{:g}, {:g}]}}}}", x, y, std::min(x + w, b.x1), std::min(y + h, b.y1));
+  return fmt::format("{{rect: {{min: [{:g}, {:g}], max: [{:g}, {:g}]}}}}", x, y, std::min(x + w, b.x1),
+                     std::min(y + h, b.y1));
 }
 
 std::string obstacle(FuzzedDataProvider& in, const Box& b) {
   switch (in.ConsumeIntegralInRange(0, 2)) {
-    case 0:
-      return rect(in, b, 4);
-    case 1:
-      return fmt::format("{{circle: {{center: {}, radius: {:g}}}}}", point(in, b), 0.1f + coordinate(in, 0, 2));
+    case 0: return rect(in, b, 4);
+    case 1: return fmt::format("{{circle: {{center: {}, radius: {:g}}}}}", point(in, b), 0.1f + coordinate(in, 0, 2));
     default: {  // star-shaped round a centre (angles in order): simple, maybe thin or concave
       const float cx = coordinate(in, b.x0, b.x1), cy = coordinate(in, b.y0, b.y1);
       const int n = in.ConsumeIntegralInRange(3, 7);
       std::string ring;
       for (int i = 0; i < n; ++i) {
-        const float angle = 6.2831853f * (static_cast<float>(i) + 0.9f * in.ConsumeProbability<float>()) / static_cast<float>(n);
+        const float angle =
+            6.2831853f * (static_cast<float>(i) + 0.9f * in.ConsumeProbability<float>()) / static_cast<float>(n);
         const float r = 0.2f + coordinate(in, 0, 3);
         ring += fmt::format("{}[{:.2f}, {:.2f}]", i ? ", " : "", cx + r * std::cos(angle), cy + r * std::sin(angle));
       }
@@ -76,14 +76,11 @@ std::string obstacle(FuzzedDataProvider& in, const Box& b) {
 
 std::string goal(FuzzedDataProvider& in, const Box& b) {
   switch (in.ConsumeIntegralInRange(0, 3)) {
-    case 0:
-      return fmt::format("{{point: {}}}", point(in, b));
-    case 1:
-      return fmt::format("{{random: {}}}", rect(in, b, 6));
+    case 0: return fmt::format("{{point: {}}}", point(in, b));
+    case 1: return fmt::format("{{random: {}}}", rect(in, b, 6));
     case 2:  // the start reflected through a point: crowds that meet head-on
       return fmt::format("{{mirror: [{:g}, {:g}]}}", 0.5f * (b.x0 + b.x1), 0.5f * (b.y0 + b.y1));
-    default:
-      return fmt::format("{{offset: [{:g}, {:g}]}}", coordinate(in, -5, 5), coordinate(in, -5, 5));
+    default: return fmt::format("{{offset: [{:g}, {:g}]}}", coordinate(in, -5, 5), coordinate(in, -5, 5));
   }
 }
 
@@ -102,21 +99,26 @@ std::string model(FuzzedDataProvider& in, float dt) {
                      0.01f * static_cast<float>(in.ConsumeIntegralInRange(1, 10)));
   switch (type) {
     case 0:
-      if (in.ConsumeBool()) m += fmt::format("  personal_space: {:g}\n  probe_margin: {:g}\n", 0.05f * in.ConsumeIntegralInRange(0, 6), 0.05f * in.ConsumeIntegralInRange(0, 4));
+      if (in.ConsumeBool())
+        m += fmt::format("  personal_space: {:g}\n  probe_margin: {:g}\n", 0.05f * in.ConsumeIntegralInRange(0, 6),
+                         0.05f * in.ConsumeIntegralInRange(0, 4));
       break;
     case 1:
       if (in.ConsumeBool())
-        m += fmt::format("  time_gap: {:g}\n  avoid_strength: {:g}\n  turn_time: {:g}\n", 0.25f * in.ConsumeIntegralInRange(1, 8),
-                         0.5f * in.ConsumeIntegralInRange(0, 10), 0.1f * in.ConsumeIntegralInRange(0, 10));
+        m += fmt::format("  time_gap: {:g}\n  avoid_strength: {:g}\n  turn_time: {:g}\n",
+                         0.25f * in.ConsumeIntegralInRange(1, 8), 0.5f * in.ConsumeIntegralInRange(0, 10),
+                         0.1f * in.ConsumeIntegralInRange(0, 10));
       break;
     case 2:
       if (in.ConsumeBool())
-        m += fmt::format("  ttc_strength: {:g}\n  ttc_side_bias: {:g}\n", 0.5f * in.ConsumeIntegralInRange(0, 10), 0.25f * in.ConsumeIntegralInRange(0, 8));
+        m += fmt::format("  ttc_strength: {:g}\n  ttc_side_bias: {:g}\n", 0.5f * in.ConsumeIntegralInRange(0, 10),
+                         0.25f * in.ConsumeIntegralInRange(0, 8));
       break;
     default:
       if (in.ConsumeBool())
-        m += fmt::format("  sf_anisotropy: {:g}\n  sf_side_bias: {:g}\n  sf_max_substep: {:g}\n", 0.25f * in.ConsumeIntegralInRange(0, 4),
-                         0.5f * in.ConsumeIntegralInRange(0, 10), 0.005f * in.ConsumeIntegralInRange(1, 4));
+        m += fmt::format("  sf_anisotropy: {:g}\n  sf_side_bias: {:g}\n  sf_max_substep: {:g}\n",
+                         0.25f * in.ConsumeIntegralInRange(0, 4), 0.5f * in.ConsumeIntegralInRange(0, 10),
+                         0.005f * in.ConsumeIntegralInRange(1, 4));
       break;
   }
   return m;
@@ -127,8 +129,10 @@ std::string scenario_yaml(FuzzedDataProvider& in) {
   const Box b{0, 0, w, h};
   const char* schedulers[] = {"double_buffer", "four_colour"};
   const float dt = in.ConsumeBool() ? 0.1f : 0.05f;
-  std::string y = fmt::format("name: structured\nseed: {}\ndt: {:g}\nscheduler: {}\nplanning: {}\nstop_when_arrived: false\n",
-                              in.ConsumeIntegralInRange(0, 1000), dt, schedulers[in.ConsumeIntegralInRange(0, 1)], in.ConsumeBool() ? "roadmap" : "none");
+  std::string y =
+      fmt::format("name: structured\nseed: {}\ndt: {:g}\nscheduler: {}\nplanning: {}\nstop_when_arrived: false\n",
+                  in.ConsumeIntegralInRange(0, 1000), dt, schedulers[in.ConsumeIntegralInRange(0, 1)],
+                  in.ConsumeBool() ? "roadmap" : "none");
   y += model(in, dt);
   y += fmt::format("world:\n  walkable: {{rect: {{min: [0, 0], max: [{:g}, {:g}]}}}}\n", w, h);
   const int obstacles = in.ConsumeIntegralInRange(0, 8);
@@ -145,9 +149,14 @@ std::string scenario_yaml(FuzzedDataProvider& in) {
     const float sx = std::min(1.0f + coordinate(in, 0, 10), w - x), sy = std::min(1.0f + coordinate(in, 0, 10), h - y0);
     // Up to about half of what a square packing holds: usually placeable.
     const int room = static_cast<int>(sx * sy / (8.0f * radius * radius));
-    y += fmt::format("  - name: g{}\n    count: {}\n    radius: {:g}\n    spawn: {{rect: {{min: [{:g}, {:g}], max: [{:g}, {:g}]}}}}\n    goal: {}\n    on_arrival: {}\n", g,
-                     in.ConsumeIntegralInRange(0, std::clamp(room, 1, 60)), radius, x, y0, x + sx, y0 + sy, goal(in, b), arrivals[in.ConsumeIntegralInRange(0, 2)]);
-    if (in.ConsumeBool()) y += fmt::format("    speed: {{mean: {:g}, stddev: 0.2, min: 0.5, max: 1.0}}\n", 0.5f + 0.1f * in.ConsumeIntegralInRange(0, 5));
+    y += fmt::format(
+        "  - name: g{}\n    count: {}\n    radius: {:g}\n    spawn: {{rect: {{min: [{:g}, {:g}], max: [{:g}, "
+        "{:g}]}}}}\n    goal: {}\n    on_arrival: {}\n",
+        g, in.ConsumeIntegralInRange(0, std::clamp(room, 1, 60)), radius, x, y0, x + sx, y0 + sy, goal(in, b),
+        arrivals[in.ConsumeIntegralInRange(0, 2)]);
+    if (in.ConsumeBool())
+      y += fmt::format("    speed: {{mean: {:g}, stddev: 0.2, min: 0.5, max: 1.0}}\n",
+                       0.5f + 0.1f * in.ConsumeIntegralInRange(0, 5));
     if (in.ConsumeBool()) y += fmt::format("    waypoints:\n      - {{point: {}}}\n", point(in, b));
   }
   return y;
@@ -195,7 +204,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // checks hold.
   const sim::ModelParams& model = sim->spec().model;
   const sim::ModelParams defaults;
-  if (model.contact_iterations < defaults.contact_iterations || model.contact_extra_iterations < defaults.contact_extra_iterations ||
+  if (model.contact_iterations < defaults.contact_iterations ||
+      model.contact_extra_iterations < defaults.contact_extra_iterations ||
       model.contact_tolerance > defaults.contact_tolerance)
     checks.overlap_bound = INFINITY;
   sim::SoakCheckStage stage(checks);

@@ -21,7 +21,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const path::MotionGraph m = path::MotionGraph::build(spec, motion::default_skeleton());
     if (m.states().empty() || !std::isfinite(m.segment_length())) std::abort();
   } catch (const Error& e) {
-    if (e.location().line <= 0 && e.location().file.empty() && e.location().field.empty()) std::abort();  // every error says where
+    if (e.location().line <= 0 && e.location().file.empty() && e.location().field.empty())
+      std::abort();  // every error says where
   }
   return 0;
 }

@@ -22,7 +22,8 @@ void InterpolateAgentsJob::validate() const {
   check(out_headings.size(), "interpolate.out_headings");
   if (!out_velocities.empty()) {
     check(out_velocities.size(), "interpolate.out_velocities");
-    if (!(step_seconds > 0.0f) || !std::isfinite(step_seconds)) throw Error("must be positive seconds", at_field("interpolate.step_seconds"));
+    if (!(step_seconds > 0.0f) || !std::isfinite(step_seconds))
+      throw Error("must be positive seconds", at_field("interpolate.step_seconds"));
   }
 }
 

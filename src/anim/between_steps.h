@@ -14,13 +14,13 @@
 namespace throng::anim {
 
 struct InterpolateAgentsJob {
-  float alpha = 1.0f;  // 0: the previous step, 1: the current one
+  float alpha = 1.0f;                        // 0: the previous step, 1: the current one
   Span<const glm::vec2> previous_positions;  // map coordinates (core/ground.h)
   Span<const glm::vec2> positions;
-  Span<const float> previous_headings;       // radians, CCW from +x
+  Span<const float> previous_headings;  // radians, CCW from +x
   Span<const float> headings;
-  Span<glm::vec2> out_positions;             // lerp
-  Span<float> out_headings;                  // the shorter way round, in [-pi, pi)
+  Span<glm::vec2> out_positions;  // lerp
+  Span<float> out_headings;       // the shorter way round, in [-pi, pi)
   // Optional: the velocity that moves an agent along the segment, its
   // displacement over the step divided by step_seconds (> 0). Contacts and
   // wall projections move agents by more or less than their steering

@@ -22,12 +22,15 @@ void synthesise_local(const BlendSpaceView& v, const BlendPoint& p, float phase,
   const motion::CharacterFrame f = motion::character_frame_at(v, p, phase, glm::vec3(0.0f), 0.0f, 1.0f);
   const motion::PlantedLegs legs = motion::plant_legs(v, f, nullptr);
   out.local.resize(static_cast<std::size_t>(v.joint_count));
-  for (std::int32_t j = 0; j < v.joint_count; ++j) out.local[static_cast<std::size_t>(j)] = motion::synthesised_rotation(v, f, legs, j);
+  for (std::int32_t j = 0; j < v.joint_count; ++j)
+    out.local[static_cast<std::size_t>(j)] = motion::synthesised_rotation(v, f, legs, j);
   out.local[0] = f.frame * out.local[0];
   out.root = f.root_position - glm::vec3(0.0f, legs.pelvis_drop, 0.0f);
 }
 
-BlendPoint point_at(const BlendSpaceView& v, float speed) { return motion::blend_point(v, motion::blend_coordinate(v, speed)); }
+BlendPoint point_at(const BlendSpaceView& v, float speed) {
+  return motion::blend_point(v, motion::blend_coordinate(v, speed));
+}
 
 // The canonical phase of a foot's touchdown in a blend: the clips' event
 // phases lerped by w along the shorter way round (a clip without the event,
@@ -42,9 +45,10 @@ float touchdown_phase(const motion::BlendSpace1D& space, const BlendPoint& p, mo
 }
 
 // ORs the footstep events whose phase lies in (from, from + advanced].
-void footsteps(const motion::BlendSpace1D& space, const BlendPoint& p, float from, float advanced, std::int32_t left, std::int32_t right,
-               EventMask& events) {
-  const std::pair<std::int32_t, motion::FootEvent> feet[2] = {{left, motion::FootEvent::LeftDown}, {right, motion::FootEvent::RightDown}};
+void footsteps(const motion::BlendSpace1D& space, const BlendPoint& p, float from, float advanced, std::int32_t left,
+               std::int32_t right, EventMask& events) {
+  const std::pair<std::int32_t, motion::FootEvent> feet[2] = {{left, motion::FootEvent::LeftDown},
+                                                              {right, motion::FootEvent::RightDown}};
   for (const auto& [id, e] : feet) {
     if (id < 0) continue;
     const float at = touchdown_phase(space, p, e);
@@ -125,20 +129,29 @@ void Blend2DOptions::validate() const {
   check_event(footstep_right, "blend2d.footstep_right");
 }
 
-Blend2DController::Blend2DController(std::shared_ptr<const motion::BlendSpace1D> speeds, std::shared_ptr<const motion::BlendSpace1D> turn_left,
+Blend2DController::Blend2DController(std::shared_ptr<const motion::BlendSpace1D> speeds,
+                                     std::shared_ptr<const motion::BlendSpace1D> turn_left,
                                      std::shared_ptr<const motion::BlendSpace1D> turn_right, Blend2DOptions options)
-    : speeds_(std::move(speeds)), left_(std::move(turn_left)), right_(std::move(turn_right)), options_(std::move(options)) {
+    : speeds_(std::move(speeds)),
+      left_(std::move(turn_left)),
+      right_(std::move(turn_right)),
+      options_(std::move(options)) {
   if (!speeds_) throw Error("needs a speed blend space", at_field("blend2d.clips"));
-  if (!left_ || !right_) throw Error("needs a turning clip to each side", at_field(!left_ ? "blend2d.turn_left" : "blend2d.turn_right"));
+  if (!left_ || !right_)
+    throw Error("needs a turning clip to each side", at_field(!left_ ? "blend2d.turn_left" : "blend2d.turn_right"));
   options_.validate();
   const std::int32_t J = speeds_->joint_count();
-  for (const auto& [space, field] : {std::pair{left_.get(), "blend2d.turn_left"}, std::pair{right_.get(), "blend2d.turn_right"}}) {
+  for (const auto& [space, field] :
+       {std::pair{left_.get(), "blend2d.turn_left"}, std::pair{right_.get(), "blend2d.turn_right"}}) {
     if (space->joint_count() != J)
-      throw Error("has " + std::to_string(space->joint_count()) + " joints, the speed clips " + std::to_string(J), at_field(field));
+      throw Error("has " + std::to_string(space->joint_count()) + " joints, the speed clips " + std::to_string(J),
+                  at_field(field));
     if (space->clip_count() != 1) throw Error("must be one turning clip", at_field(field));
   }
-  if (!(left_->clip_infos()[0].turn > 0.0f)) throw Error("must turn left (positive turn per cycle)", at_field("blend2d.turn_left"));
-  if (!(right_->clip_infos()[0].turn < 0.0f)) throw Error("must turn right (negative turn per cycle)", at_field("blend2d.turn_right"));
+  if (!(left_->clip_infos()[0].turn > 0.0f))
+    throw Error("must turn left (positive turn per cycle)", at_field("blend2d.turn_left"));
+  if (!(right_->clip_infos()[0].turn < 0.0f))
+    throw Error("must turn right (negative turn per cycle)", at_field("blend2d.turn_right"));
   reset();
 }
 
@@ -190,7 +203,8 @@ void Blend2DController::evaluate(Pose& out) const {
   if (u <= 0.0f) return;
   Pose turning;
   synthesise_local(turn_space().view(), BlendPoint{}, phase_, turning);
-  for (std::size_t j = 0; j < out.local.size(); ++j) out.local[j] = motion::slerp_shortest(out.local[j], turning.local[j], u);
+  for (std::size_t j = 0; j < out.local.size(); ++j)
+    out.local[j] = motion::slerp_shortest(out.local[j], turning.local[j], u);
   out.root += u * (turning.root - out.root);
 }
 
@@ -217,7 +231,8 @@ const DefaultBlendSpaces& default_blend_spaces() {
       if (m.spec.name == "walk_turn_left") s.turn_left = make_turn_space(skeleton, m.clip, m.spec.name, true);
       if (m.spec.name == "walk_turn_right") s.turn_right = make_turn_space(skeleton, m.clip, m.spec.name, true);
     }
-    if (!s.turn_left || !s.turn_right) throw Error("the default set has no walk_turn_left / walk_turn_right", at_field("default_blend_spaces"));
+    if (!s.turn_left || !s.turn_right)
+      throw Error("the default set has no walk_turn_left / walk_turn_right", at_field("default_blend_spaces"));
     return s;
   }();
   return spaces;

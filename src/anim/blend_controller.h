@@ -81,7 +81,8 @@ class Blend2DController final : public Controller {
   // speeds: straight clips by speed. turn_left / turn_right: one turning
   // clip each (single-clip blend spaces, make_turn_space), turning left
   // (positive turn per cycle) and right (negative); same skeleton.
-  Blend2DController(std::shared_ptr<const motion::BlendSpace1D> speeds, std::shared_ptr<const motion::BlendSpace1D> turn_left,
+  Blend2DController(std::shared_ptr<const motion::BlendSpace1D> speeds,
+                    std::shared_ptr<const motion::BlendSpace1D> turn_left,
                     std::shared_ptr<const motion::BlendSpace1D> turn_right, Blend2DOptions options = {});
 
   std::int32_t joint_count() const override { return speeds_->joint_count(); }

@@ -17,7 +17,8 @@ std::int32_t EventNames::intern(const std::string& name) {
   const std::int32_t found = find(name);
   if (found >= 0) return found;
   if (size() >= kMaxEventNames)
-    throw Error("event '" + name + "': at most " + std::to_string(kMaxEventNames) + " event names per crowd", at_field("events"));
+    throw Error("event '" + name + "': at most " + std::to_string(kMaxEventNames) + " event names per crowd",
+                at_field("events"));
   names_.push_back(name);
   return size() - 1;
 }
@@ -75,15 +76,18 @@ void AnimClip::validate() const {
   const std::string at = "clips." + (name.empty() ? std::string("?") : name);
   if (!clip) throw Error("has no samples", at_field(at));
   if (clip->frame_count <= 0 || clip->joint_count <= 0) throw Error("has no frames or no joints", at_field(at));
-  if (clip->rotations.size() != static_cast<std::size_t>(clip->frame_count) * static_cast<std::size_t>(clip->joint_count) ||
+  if (clip->rotations.size() !=
+          static_cast<std::size_t>(clip->frame_count) * static_cast<std::size_t>(clip->joint_count) ||
       clip->root_positions.size() != static_cast<std::size_t>(clip->frame_count))
     throw Error("arrays do not match frame and joint counts", at_field(at));
-  if (!(clip->frame_time > 0.0f) || !std::isfinite(clip->frame_time)) throw Error("frame time must be positive", at_field(at + ".frame_time"));
+  if (!(clip->frame_time > 0.0f) || !std::isfinite(clip->frame_time))
+    throw Error("frame time must be positive", at_field(at + ".frame_time"));
   const double d = duration();
   for (std::size_t i = 0; i < events.size(); ++i) {
     const std::string ef = at + ".events[" + std::to_string(i) + "]";
     if (!(events[i].time >= 0.0f && (events[i].time < d || (d == 0.0 && events[i].time == 0.0f))))
-      throw Error("time " + std::to_string(events[i].time) + " s is outside [0, " + std::to_string(d) + ")", at_field(ef));
+      throw Error("time " + std::to_string(events[i].time) + " s is outside [0, " + std::to_string(d) + ")",
+                  at_field(ef));
     if (i > 0 && events[i].time < events[i - 1].time) throw Error("events must be sorted by time", at_field(ef));
     if (events[i].id < 0 || events[i].id >= kMaxEventNames) throw Error("event id out of range", at_field(ef));
   }
@@ -109,7 +113,8 @@ void sample_clip(const AnimClip& anim, double t, Pose& out) {
     f1 = std::min(f0 + 1, N - 1);
     a = static_cast<float>(x - f0);
   }
-  for (std::int32_t j = 0; j < J; ++j) out.local[static_cast<std::size_t>(j)] = glm::slerp(c.rotation(f0, j), c.rotation(f1, j), a);
+  for (std::int32_t j = 0; j < J; ++j)
+    out.local[static_cast<std::size_t>(j)] = glm::slerp(c.rotation(f0, j), c.rotation(f1, j), a);
   const glm::vec3 r0 = c.root_positions[static_cast<std::size_t>(f0)];
   glm::vec3 r1 = c.root_positions[static_cast<std::size_t>(f1)];
   if (anim.loop && f1 == 0 && N >= 2) r1 = r0 + (r0 - c.root_positions[static_cast<std::size_t>(N - 2)]);
@@ -133,13 +138,16 @@ std::vector<ClipEvent> footstep_events(const motion::Skeleton& skeleton, const A
       out.push_back({static_cast<float>(onset) * clip.clip->frame_time, id});
     }
   }
-  std::sort(out.begin(), out.end(), [](const ClipEvent& a, const ClipEvent& b) { return a.time < b.time || (a.time == b.time && a.id < b.id); });
+  std::sort(out.begin(), out.end(), [](const ClipEvent& a, const ClipEvent& b) {
+    return a.time < b.time || (a.time == b.time && a.id < b.id);
+  });
   return out;
 }
 
 // ---- clip player ------------------------------------------------------------
 
-ClipPlayer::ClipPlayer(AnimClip clip, float rate, double start_time) : clip_(std::move(clip)), start_(start_time), time_(start_time) {
+ClipPlayer::ClipPlayer(AnimClip clip, float rate, double start_time)
+    : clip_(std::move(clip)), start_(start_time), time_(start_time) {
   clip_.validate();
   set_rate(rate);
   if (!std::isfinite(start_time)) throw Error("must be finite", at_field("clip_player.start_time"));
@@ -227,16 +235,21 @@ void LayeredController::add_layer(Layer layer) {
   const auto J = static_cast<std::size_t>(joint_count());
   if (!layer.controller) throw Error("a layer needs a controller", at_field(at + ".controller"));
   if (layer.controller->joint_count() != joint_count())
-    throw Error("controller has " + std::to_string(layer.controller->joint_count()) + " joints, the base " + std::to_string(J),
-                at_field(at + ".controller"));
+    throw Error(
+        "controller has " + std::to_string(layer.controller->joint_count()) + " joints, the base " + std::to_string(J),
+        at_field(at + ".controller"));
   if (!(layer.weight >= 0.0f && layer.weight <= 1.0f)) throw Error("must be in [0, 1]", at_field(at + ".weight"));
   if (layer.mask.weights.empty()) layer.mask = BoneMask::all(joint_count());
-  if (layer.mask.weights.size() != J) throw Error("has " + std::to_string(layer.mask.weights.size()) + " weights, expected " + std::to_string(J), at_field(at + ".mask"));
+  if (layer.mask.weights.size() != J)
+    throw Error("has " + std::to_string(layer.mask.weights.size()) + " weights, expected " + std::to_string(J),
+                at_field(at + ".mask"));
   for (float w : layer.mask.weights)
     if (!(w >= 0.0f && w <= 1.0f)) throw Error("weights must be in [0, 1]", at_field(at + ".mask"));
-  if (layer.mode == LayerMode::Override && !layer.reference.empty()) throw Error("only additive layers take a reference", at_field(at + ".reference"));
+  if (layer.mode == LayerMode::Override && !layer.reference.empty())
+    throw Error("only additive layers take a reference", at_field(at + ".reference"));
   if (!layer.reference.empty() && layer.reference.size() != J)
-    throw Error("has " + std::to_string(layer.reference.size()) + " rotations, expected " + std::to_string(J), at_field(at + ".reference"));
+    throw Error("has " + std::to_string(layer.reference.size()) + " rotations, expected " + std::to_string(J),
+                at_field(at + ".reference"));
   layers_.push_back(std::move(layer));
   weights_.push_back(layers_.back().weight);
 }
@@ -269,11 +282,13 @@ void LayeredController::evaluate(Pose& out) const {
       if (l.mode == LayerMode::Override) {
         out.local[j] = glm::slerp(out.local[j], scratch_.local[j], w);
       } else {
-        const glm::quat delta = l.reference.empty() ? scratch_.local[j] : glm::inverse(l.reference[j]) * scratch_.local[j];
+        const glm::quat delta =
+            l.reference.empty() ? scratch_.local[j] : glm::inverse(l.reference[j]) * scratch_.local[j];
         out.local[j] = glm::normalize(out.local[j] * glm::slerp(glm::quat(1, 0, 0, 0), delta, w));
       }
     }
-    if (l.mode == LayerMode::Override && !l.mask.weights.empty()) out.root = glm::mix(out.root, scratch_.root, weights_[i] * l.mask.weights[0]);
+    if (l.mode == LayerMode::Override && !l.mask.weights.empty())
+      out.root = glm::mix(out.root, scratch_.root, weights_[i] * l.mask.weights[0]);
   }
 }
 
@@ -316,13 +331,15 @@ StateMachine::StateMachine(const StateMachine& other)
   for (const State& s : other.states_) states_.push_back({s.name, s.controller->clone(), s.enter_event});
 }
 
-std::int32_t StateMachine::add_state(std::string name, std::unique_ptr<Controller> controller, std::int32_t enter_event) {
+std::int32_t StateMachine::add_state(std::string name, std::unique_ptr<Controller> controller,
+                                     std::int32_t enter_event) {
   const std::string at = "states[" + std::to_string(states_.size()) + "]";
   if (name.empty()) throw Error("a state needs a name", at_field(at + ".name"));
   if (find_state(name) >= 0) throw Error("state '" + name + "' defined twice", at_field(at + ".name"));
   if (!controller) throw Error("a state needs a controller", at_field(at + ".controller"));
   if (!states_.empty() && controller->joint_count() != joint_count())
-    throw Error("controller has " + std::to_string(controller->joint_count()) + " joints, the first state " + std::to_string(joint_count()),
+    throw Error("controller has " + std::to_string(controller->joint_count()) + " joints, the first state " +
+                    std::to_string(joint_count()),
                 at_field(at + ".controller"));
   if (enter_event >= kMaxEventNames) throw Error("event id out of range", at_field(at + ".enter_event"));
   states_.push_back({std::move(name), std::move(controller), enter_event});
@@ -368,8 +385,12 @@ float StateMachine::fade_weight() const {
   return std::clamp(fade_elapsed_ / fade_time_, 0.0f, 1.0f);
 }
 
-double StateMachine::duration() const { return states_.empty() ? 0.0 : states_[static_cast<std::size_t>(current_)].controller->duration(); }
-bool StateMachine::finished() const { return !states_.empty() && states_[static_cast<std::size_t>(current_)].controller->finished(); }
+double StateMachine::duration() const {
+  return states_.empty() ? 0.0 : states_[static_cast<std::size_t>(current_)].controller->duration();
+}
+bool StateMachine::finished() const {
+  return !states_.empty() && states_[static_cast<std::size_t>(current_)].controller->finished();
+}
 
 float StateMachine::read(const std::string& parameter, const ParameterSet& params) const {
   const Controller& c = *states_[static_cast<std::size_t>(current_)].controller;

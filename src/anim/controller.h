@@ -133,7 +133,8 @@ struct BoneMask {
   std::vector<float> weights;
   static BoneMask all(std::int32_t joints, float weight = 1.0f);
   // The subtrees of the named joints (Error naming an unknown joint).
-  static BoneMask subtrees(const motion::Skeleton& skeleton, const std::vector<std::string>& roots, float weight = 1.0f);
+  static BoneMask subtrees(const motion::Skeleton& skeleton, const std::vector<std::string>& roots,
+                           float weight = 1.0f);
 };
 
 enum class LayerMode : std::uint8_t {
@@ -216,7 +217,7 @@ class StateMachine final : public Controller {
   const std::string& state_name(std::int32_t state) const { return states_[static_cast<std::size_t>(state)].name; }
   std::int32_t state_count() const { return static_cast<std::int32_t>(states_.size()); }
   std::int32_t fading_from() const { return fading_from_; }  // -1 unless a cross-fade runs
-  float fade_weight() const;                                  // weight of the current state, 1 when not fading
+  float fade_weight() const;                                 // weight of the current state, 1 when not fading
   double state_time() const { return state_time_; }
 
   std::int32_t joint_count() const override;

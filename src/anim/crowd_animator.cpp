@@ -15,8 +15,9 @@ namespace {
 std::size_t at(Index i) { return static_cast<std::size_t>(i); }
 
 void check_blend(const char* job, const motion::BlendSpaceView& v) {
-  if (v.joint_count < 1 || v.joint_count > kMaxLodJoints || v.clip_count < 1 || v.clips == nullptr || v.sync == nullptr ||
-      v.parents == nullptr || v.offsets == nullptr || v.joint_group == nullptr || v.mean_rotations == nullptr)
+  if (v.joint_count < 1 || v.joint_count > kMaxLodJoints || v.clip_count < 1 || v.clips == nullptr ||
+      v.sync == nullptr || v.parents == nullptr || v.offsets == nullptr || v.joint_group == nullptr ||
+      v.mean_rotations == nullptr)
     throw Error("is not set (BlendSpaceTables::view())", at_field(std::string(job) + ".blend"));
 }
 
@@ -30,7 +31,8 @@ Buffer<T> filled(Index n, T value) {
 
 void LocomoteJob::validate() const {
   check_blend("LocomoteJob", blend);
-  if (!(std::isfinite(step.dt) && step.dt >= 0.0f && step.dt <= 10.0f)) throw Error("must be in [0, 10] s", at_field("LocomoteJob.step.dt"));
+  if (!(std::isfinite(step.dt) && step.dt >= 0.0f && step.dt <= 10.0f))
+    throw Error("must be in [0, 10] s", at_field("LocomoteJob.step.dt"));
   const Index n = character_count();
   check_length("LocomoteJob", "speeds", speeds.size(), n);
   check_optional_length("LocomoteJob", "turn_rates", turn_rates.size(), n);
@@ -70,8 +72,10 @@ void PoseJob::validate() const {
   check_length("PoseJob", "blend_speeds", blend_speeds.size(), n);
   check_optional_length("PoseJob", "joint_masks", joint_masks.size(), n * mask_word_count(blend.joint_count));
   if (!cache.slots.empty()) {
-    if (cache.bucket_count < 1 || !(cache.bucket_width > 0.0f)) throw Error("must be positive", at_field("PoseJob.cache.bucket_count"));
-    check_length("PoseJob", "cache.slots", cache.slots.size(), static_cast<Index>(blend.segment_count()) * cache.bucket_count);
+    if (cache.bucket_count < 1 || !(cache.bucket_width > 0.0f))
+      throw Error("must be positive", at_field("PoseJob.cache.bucket_count"));
+    check_length("PoseJob", "cache.slots", cache.slots.size(),
+                 static_cast<Index>(blend.segment_count()) * cache.bucket_count);
     if (cache.frames < 1) throw Error("must be positive with a cache", at_field("PoseJob.cache.frames"));
     if (cache.cycles.size() % (static_cast<Index>(cache.frames) * J) != 0)
       throw Error("size must be a multiple of cache.frames * joints", at_field("PoseJob.cache.cycles"));
@@ -80,7 +84,9 @@ void PoseJob::validate() const {
     // Every slot a key names must exist (a bad table must not read past the arena).
     if (current_memory() == Memory::Host)
       for (Index k = 0; k < cache.slots.size(); ++k)
-        if (cache.slots[k] >= slots) throw Error("names slot " + std::to_string(cache.slots[k]) + " of " + std::to_string(slots), at_field("PoseJob.cache.slots"));
+        if (cache.slots[k] >= slots)
+          throw Error("names slot " + std::to_string(cache.slots[k]) + " of " + std::to_string(slots),
+                      at_field("PoseJob.cache.slots"));
   }
   check_length("PoseJob", "joint_positions", joint_positions.size(), n * J);
   check_length("PoseJob", "joint_rotations", joint_rotations.size(), n * J);
@@ -136,7 +142,8 @@ CycleCacheTable::CycleCacheTable(const motion::BlendSpace1D& space, MotionCacheC
   const std::int32_t J = space.joint_count();
   key_count_ = space.segment_count() * cache_.bucket_count();
   const std::size_t cycle_bytes = static_cast<std::size_t>(frames_) * static_cast<std::size_t>(J) * sizeof(glm::quat);
-  slot_count_ = static_cast<std::int32_t>(std::min<std::size_t>(static_cast<std::size_t>(key_count_), config.capacity_bytes / cycle_bytes));
+  slot_count_ = static_cast<std::int32_t>(
+      std::min<std::size_t>(static_cast<std::size_t>(key_count_), config.capacity_bytes / cycle_bytes));
   host_slots_.assign(at(key_count_), -1);
   for (std::int32_t s = slot_count_ - 1; s >= 0; --s) free_slots_.push_back(s);
   slots_ = Buffer<std::int32_t>(std::span<const std::int32_t>(host_slots_), current_memory());
@@ -156,7 +163,8 @@ std::int32_t default_cache_frames(const motion::BlendSpace1D& space) {
 }
 
 CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w, std::vector<float>* drops) const {
-  if (segment < 0 || segment >= space_->segment_count()) throw Error("no such segment", at_field("motion_cache.segment"));
+  if (segment < 0 || segment >= space_->segment_count())
+    throw Error("no such segment", at_field("motion_cache.segment"));
   const motion::BlendSpaceView view = space_->view();
   const std::int32_t J = view.joint_count;
   motion::BlendPoint point;
@@ -176,7 +184,8 @@ CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w, std::vect
     const float phase = static_cast<float>(k) / static_cast<float>(frames_);
     const motion::CharacterFrame f = motion::character_frame_at(view, point, phase, glm::vec3(0.0f), 0.0f, 1.0f);
     const motion::PlantedLegs legs = motion::plant_legs(view, f, nullptr);
-    for (std::int32_t j = 0; j < J; ++j) cycle.rotations[at(static_cast<Index>(k) * J + j)] = motion::synthesised_rotation(view, f, legs, j);
+    for (std::int32_t j = 0; j < J; ++j)
+      cycle.rotations[at(static_cast<Index>(k) * J + j)] = motion::synthesised_rotation(view, f, legs, j);
     if (drops != nullptr) (*drops)[at(k)] = legs.pelvis_drop;
   }
   return cycle;
@@ -184,7 +193,8 @@ CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w, std::vect
 
 std::int32_t CycleCacheTable::update(const std::vector<Index>& counts, std::int32_t max_new) {
   if (static_cast<std::int32_t>(counts.size()) != key_count_)
-    throw Error("has " + std::to_string(counts.size()) + " keys, expected " + std::to_string(key_count_), at_field("motion_cache.counts"));
+    throw Error("has " + std::to_string(counts.size()) + " keys, expected " + std::to_string(key_count_),
+                at_field("motion_cache.counts"));
   const std::int32_t B = cache_.bucket_count();
   const std::int32_t J = space_->joint_count();
   std::int32_t stored = 0;
@@ -197,7 +207,8 @@ std::int32_t CycleCacheTable::update(const std::vector<Index>& counts, std::int3
     if (cache_.find(w, static_cast<std::uint32_t>(segment), n) != nullptr) continue;
     if (stored >= max_new) continue;
     std::vector<float> drops;
-    const CachedCycle* held = cache_.insert(bucket, synthesise(segment, w, &drops), static_cast<std::uint32_t>(segment));
+    const CachedCycle* held =
+        cache_.insert(bucket, synthesise(segment, w, &drops), static_cast<std::uint32_t>(segment));
     ++stored;
     // FIFO evictions free their slots.
     for (std::int32_t k = 0; k < key_count_; ++k) {
@@ -235,7 +246,8 @@ QuantisationError CycleCacheTable::quantisation_error(std::int32_t w_samples, st
       const motion::PlantedLegs legs = motion::plant_legs(view, f, nullptr);
       for (std::int32_t j = 0; j < view.joint_count; ++j) out[j] = motion::synthesised_rotation(view, f, legs, j);
     };
-    const QuantisationError e = measure_quantisation_error(cache_.config(), synthesise_at, exact, w_samples, phase_samples);
+    const QuantisationError e =
+        measure_quantisation_error(cache_.config(), synthesise_at, exact, w_samples, phase_samples);
     if (e.max_deg > total.max_deg) {
       total.max_deg = e.max_deg;
       total.worst_w = static_cast<float>(segment) + e.worst_w;  // as a blend coordinate x
@@ -296,14 +308,15 @@ CrowdAnimator::CrowdAnimator(const motion::BlendSpace1D& space, Index count, Cro
   if (config_.cache) cache_.emplace(space, config_.cache_config, config_.cache_frames);
 }
 
-void CrowdAnimator::place(std::span<const glm::vec3> positions, std::span<const float> yaws, std::span<const float> scales,
-                          std::span<const float> phases) {
+void CrowdAnimator::place(std::span<const glm::vec3> positions, std::span<const float> yaws,
+                          std::span<const float> scales, std::span<const float> phases) {
   check_length("CrowdAnimator.place", "positions", static_cast<Index>(positions.size()), count_);
   check_length("CrowdAnimator.place", "yaws", static_cast<Index>(yaws.size()), count_);
   check_optional_length("CrowdAnimator.place", "scales", static_cast<Index>(scales.size()), count_);
   check_optional_length("CrowdAnimator.place", "phases", static_cast<Index>(phases.size()), count_);
   for (float s : scales)
-    if (!(std::isfinite(s) && s > 0.0f)) throw Error("scales must be positive and finite", at_field("CrowdAnimator.place.scales"));
+    if (!(std::isfinite(s) && s > 0.0f))
+      throw Error("scales must be positive and finite", at_field("CrowdAnimator.place.scales"));
   position_.copy_from(positions);
   yaw_.copy_from(yaws);
   if (!scales.empty()) scale_.copy_from(scales);
@@ -332,14 +345,16 @@ void CrowdAnimator::set_curvatures(std::span<const float> curvatures) {
   curvature_.copy_from(curvatures);
 }
 
-void CrowdAnimator::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> headings) {
+void CrowdAnimator::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities,
+                                   Span<const float> headings) {
   check_length("CrowdAnimator.drive_from_map", "positions", positions.size(), count_);
   const MapInputJob job{positions, velocities, headings, position_.span(), yaw_.span(), speed_.span()};
   job.run();
 }
 
 const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
-  if (!(std::isfinite(input.dt) && input.dt >= 0.0f && input.dt <= 10.0f)) throw Error("must be in [0, 10] s", at_field("frame.dt"));
+  if (!(std::isfinite(input.dt) && input.dt >= 0.0f && input.dt <= 10.0f))
+    throw Error("must be in [0, 10] s", at_field("frame.dt"));
   motion::BlendSpaceView view = tables_.view();
   if (cache_) {  // every character shows its bucket's blend: a cached cycle is exactly its pose
     view.quantum = cache_->bucket_width();
@@ -362,12 +377,15 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
   const bool lod = config_.lod && input.camera != nullptr;
   if (lod) {
     input.camera->validate();
-    make_lod_job(*input.camera, *lod_tables_, *parts_, {position_.span(), yaw_.span(), scale_.span()}, levels_.span(), masks_.span()).run();
+    make_lod_job(*input.camera, *lod_tables_, *parts_, {position_.span(), yaw_.span(), scale_.span()}, levels_.span(),
+                 masks_.span())
+        .run();
     stats_.lod = lod_histogram(levels_.span(), masks_.span(), lod_config_->level_count, lod_config_->joint_count);
   }
   if (cache_) {
     ScopedTimer timer("anim.cache_update");
-    const std::vector<Index> counts = cache_key_counts(view, blend_speed_.span(), cache_->bucket_width(), cache_->bucket_count());
+    const std::vector<Index> counts =
+        cache_key_counts(view, blend_speed_.span(), cache_->bucket_width(), cache_->bucket_count());
     stats_.cycles_stored = cache_->update(counts, config_.max_new_cycles_per_frame);
   }
 

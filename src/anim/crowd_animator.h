@@ -98,15 +98,15 @@ struct CharacterGait {
 struct PoseJob : CharacterGait {
   motion::BlendSpaceView blend;
   Span<const std::uint32_t> joint_masks;  // characters * mask_word_count(J); empty = every joint
-  CycleCacheView cache;  // empty slots = no cache
+  CycleCacheView cache;                   // empty slots = no cache
   // J = F * O (optional): per joint the fixed bone-aligned shape F (joint_shapes).
   Span<const glm::mat4x3> joint_shapes;
   // Outputs, character-major [c * J + j].
   Span<glm::vec3> joint_positions;
   Span<glm::quat> joint_rotations;
   Span<glm::mat4x3> draw_matrices;  // optional, with joint_shapes
-  Span<std::int32_t> evaluated;      // optional, per character: joints synthesised
-  Span<std::uint8_t> from_cache;     // optional, per character: 1 = read the cache
+  Span<std::int32_t> evaluated;     // optional, per character: joints synthesised
+  Span<std::uint8_t> from_cache;    // optional, per character: 1 = read the cache
 
   Index character_count() const { return positions.size(); }
   void validate() const;
@@ -127,24 +127,27 @@ struct PoseTotals {
 PoseTotals pose_totals(Span<const std::int32_t> evaluated, Span<const std::uint8_t> from_cache);
 
 // The cache key of a blend: segment * bucket_count + bucket of w.
-THRONG_HOST_DEVICE inline std::int32_t cache_key(const motion::BlendPoint& p, float bucket_width, std::int32_t bucket_count) {
+THRONG_HOST_DEVICE inline std::int32_t cache_key(const motion::BlendPoint& p, float bucket_width,
+                                                 std::int32_t bucket_count) {
   return p.segment * bucket_count + cache_bucket(p.w, bucket_width, bucket_count);
 }
 
 // Characters per cache key this frame (deterministic counts), from their
 // blend speeds: keys = segment_count * bucket_count entries.
-std::vector<Index> cache_key_counts(const motion::BlendSpaceView& blend, Span<const float> blend_speeds, float bucket_width,
-                                    std::int32_t bucket_count);
+std::vector<Index> cache_key_counts(const motion::BlendSpaceView& blend, Span<const float> blend_speeds,
+                                    float bucket_width, std::int32_t bucket_count);
 
 // Per joint the paper's F: a unit sphere squashed into an ellipsoid along the
 // bone to the joint's children (their mean offset, or its end site): centre
 // at mid-bone, half-length along the bone, radius `thickness` times the bone
 // length (at least min_radius). J = O * F with O the joint's world transform
 // (draw_matrix). A leaf without end site gets a sphere of min_radius.
-std::vector<glm::mat4x3> joint_shapes(const motion::Skeleton& skeleton, float thickness = 0.18f, float min_radius = 0.02f);
+std::vector<glm::mat4x3> joint_shapes(const motion::Skeleton& skeleton, float thickness = 0.18f,
+                                      float min_radius = 0.02f);
 
 // O * F for a joint at world position p, rotation q, uniform scale s.
-THRONG_HOST_DEVICE inline glm::mat4x3 draw_matrix(const glm::vec3& p, const glm::quat& q, float s, const glm::mat4x3& shape) {
+THRONG_HOST_DEVICE inline glm::mat4x3 draw_matrix(const glm::vec3& p, const glm::quat& q, float s,
+                                                  const glm::mat4x3& shape) {
   const glm::mat3 r = glm::mat3_cast(q) * s;
   glm::mat4x3 out;
   for (int c = 0; c < 3; ++c) out[c] = r * shape[c];
@@ -209,7 +212,7 @@ struct CrowdAnimatorConfig {
   std::vector<float> lod_thresholds = default_lod_thresholds();
   bool cache = true;
   MotionCacheConfig cache_config;
-  std::int32_t cache_frames = 0;             // per cached cycle; 0 = default_cache_frames
+  std::int32_t cache_frames = 0;  // per cached cycle; 0 = default_cache_frames
   std::int32_t max_new_cycles_per_frame = 16;
   bool draw_matrices = false;  // also write J = F * O (48 bytes per joint)
   void validate() const;

@@ -43,7 +43,8 @@ void LocomoteJob::run() const {
         glm::vec3 p = positions[c];
         float y = yaws[c], ph = phases[c], b = blend_speeds[c];
         motion::advance_locomotion(blend, step, speeds[c], turn_rates.empty() ? 0.0f : turn_rates[c],
-                                   curvatures.empty() ? 0.0f : curvatures[c], scales.empty() ? 1.0f : scales[c], p, y, ph, b);
+                                   curvatures.empty() ? 0.0f : curvatures[c], scales.empty() ? 1.0f : scales[c], p, y,
+                                   ph, b);
         positions[c] = p;
         yaws[c] = y;
         phases[c] = ph;
@@ -72,13 +73,14 @@ THRONG_HOST_DEVICE inline void pose_character(const PoseJob& job, Index c) {
   const motion::BlendSpaceView& view = job.blend;
   const CycleCacheView& cache = job.cache;
   const std::int32_t J = view.joint_count;
-  const motion::CharacterFrame f = motion::character_frame(view, job.blend_speeds[c], job.phases[c], job.positions[c], job.yaws[c],
-                                                           job.scales.empty() ? 1.0f : job.scales[c]);
+  const motion::CharacterFrame f = motion::character_frame(view, job.blend_speeds[c], job.phases[c], job.positions[c],
+                                                           job.yaws[c], job.scales.empty() ? 1.0f : job.scales[c]);
   const std::uint32_t* mask = job.joint_masks.empty() ? nullptr : job.joint_masks.data() + c * mask_word_count(J);
   const glm::quat* held = motion::held_rotations(view, f.point);
   glm::vec3* joints_p = job.joint_positions.data() + c * J;
   glm::quat* joints_r = job.joint_rotations.data() + c * J;
-  const std::int32_t slot = cache.slots.empty() ? -1 : cache.slots[cache_key(f.point, cache.bucket_width, cache.bucket_count)];
+  const std::int32_t slot =
+      cache.slots.empty() ? -1 : cache.slots[cache_key(f.point, cache.bucket_width, cache.bucket_count)];
   std::int32_t n = 0;
   if (slot >= 0) {
     const motion::CyclePoint cp = motion::cycle_point(cache.frames, f.phase);
@@ -86,47 +88,51 @@ THRONG_HOST_DEVICE inline void pose_character(const PoseJob& job, Index c) {
     const CachedJoint e{cycle + static_cast<Index>(cp.f0) * J, cycle + static_cast<Index>(cp.f1) * J, cp.t, f.frame};
     const float* drop = cache.drops.data() + static_cast<Index>(slot) * cache.frames;
     const float lowered = f.scale * (drop[cp.f0] + cp.t * (drop[cp.f1] - drop[cp.f0]));
-    n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, lowered, 0.0f), joints_p, joints_r,
-                    f.scale);
+    n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, lowered, 0.0f),
+                    joints_p, joints_r, f.scale);
   } else {
     const motion::PlantedLegs legs = motion::plant_legs(view, f, mask);
     const SynthesisedJoint e{&view, &f, &legs};
-    n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f),
-                    joints_p, joints_r, f.scale);
+    n = masked_pose(J, view.parents, view.offsets, mask, e, held,
+                    f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f), joints_p, joints_r, f.scale);
   }
   if (!job.evaluated.empty()) job.evaluated[c] = n;
   if (!job.from_cache.empty()) job.from_cache[c] = slot >= 0 ? 1 : 0;
   if (!job.draw_matrices.empty())
-    for (std::int32_t j = 0; j < J; ++j) job.draw_matrices[c * J + j] = draw_matrix(joints_p[j], joints_r[j], f.scale, job.joint_shapes[j]);
+    for (std::int32_t j = 0; j < J; ++j)
+      job.draw_matrices[c * J + j] = draw_matrix(joints_p[j], joints_r[j], f.scale, job.joint_shapes[j]);
 }
 
 }  // namespace
 
 void PoseJob::run() const {
   validate();
-  parallel_for("anim.pose", character_count(), THRONG_JOB_LAMBDA(Index c) { pose_character(*this, c); }, 32);
+  parallel_for(
+      "anim.pose", character_count(), THRONG_JOB_LAMBDA(Index c) { pose_character(*this, c); }, 32);
 }
 
 PoseTotals pose_totals(Span<const std::int32_t> evaluated, Span<const std::uint8_t> from_cache) {
   PoseTotals t;
   t.joints_synthesised = parallel_reduce(
-      "anim.pose_totals", evaluated.size(), Index{0}, THRONG_LAMBDA(Index c) { return static_cast<Index>(evaluated[c]); },
-      Plus{});
+      "anim.pose_totals", evaluated.size(), Index{0},
+      THRONG_LAMBDA(Index c) { return static_cast<Index>(evaluated[c]); }, Plus{});
   t.from_cache = parallel_reduce(
-      "anim.pose_totals", from_cache.size(), Index{0}, THRONG_LAMBDA(Index c) { return static_cast<Index>(from_cache[c]); },
-      Plus{});
+      "anim.pose_totals", from_cache.size(), Index{0},
+      THRONG_LAMBDA(Index c) { return static_cast<Index>(from_cache[c]); }, Plus{});
   return t;
 }
 
-std::vector<Index> cache_key_counts(const motion::BlendSpaceView& blend, Span<const float> blend_speeds, float bucket_width,
-                                    std::int32_t bucket_count) {
+std::vector<Index> cache_key_counts(const motion::BlendSpaceView& blend, Span<const float> blend_speeds,
+                                    float bucket_width, std::int32_t bucket_count) {
   if (blend.clip_count < 1 || bucket_count < 1) throw Error("needs clips and buckets", at_field("cache_key_counts"));
   const Index keys = static_cast<Index>(blend.segment_count()) * bucket_count;
   const motion::BlendSpaceView view = blend;
   const auto shown = blend_speeds;
-  return deterministic_histogram("anim.cache_keys", blend_speeds.size(), static_cast<std::int32_t>(keys), THRONG_LAMBDA(Index c) {
-    return cache_key(motion::blend_point(view, motion::blend_coordinate(view, shown[c])), bucket_width, bucket_count);
-  });
+  return deterministic_histogram(
+      "anim.cache_keys", blend_speeds.size(), static_cast<std::int32_t>(keys), THRONG_LAMBDA(Index c) {
+        return cache_key(motion::blend_point(view, motion::blend_coordinate(view, shown[c])), bucket_width,
+                         bucket_count);
+      });
 }
 
 }  // namespace throng::anim

@@ -14,7 +14,6 @@ namespace throng::anim {
 
 namespace {
 
-
 // The blend space as streamed agents show it: every blend at its bucket's centre.
 motion::BlendSpaceView quantised_view(motion::BlendSpaceView v, float width, std::int32_t buckets) {
   v.quantum = width;
@@ -26,19 +25,27 @@ motion::BlendSpaceView quantised_view(motion::BlendSpaceView v, float width, std
 
 void LocomotionStreamsConfig::validate() const {
   auto field = [](const char* f) { return at_field(std::string("locomotion_streams.") + f); };
-  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f)) throw Error("must be in [1, 1000] frames per second", field("frame_rate"));
+  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f))
+    throw Error("must be in [1, 1000] frames per second", field("frame_rate"));
   MotionCacheConfig{bucket_width, 0}.validate();
   if (!(blend_seconds >= 0.0f && blend_seconds <= 60.0f)) throw Error("must be in [0, 60] s", field("blend_seconds"));
-  if (!(exact_coverage > 0.0f && std::isfinite(exact_coverage))) throw Error("must be positive square pixels", field("exact_coverage"));
-  if (!(stop_after_seconds >= 0.0f && stop_after_seconds <= 1e6f)) throw Error("must be in [0, 1e6] s", field("stop_after_seconds"));
+  if (!(exact_coverage > 0.0f && std::isfinite(exact_coverage)))
+    throw Error("must be positive square pixels", field("exact_coverage"));
+  if (!(stop_after_seconds >= 0.0f && stop_after_seconds <= 1e6f))
+    throw Error("must be in [0, 1e6] s", field("stop_after_seconds"));
   if ((cluster_mask & 0xffu) == 0u) throw Error("must select at least one of the 8 clusters", field("cluster_mask"));
 }
 
-LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D> space, Index agents, LocomotionStreamsConfig config)
-    : space_(std::move(space)), config_(config), count_(agents), crowd_(StreamCrowdConfig{config.frame_rate, config.seed}) {
+LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D> space, Index agents,
+                                     LocomotionStreamsConfig config)
+    : space_(std::move(space)),
+      config_(config),
+      count_(agents),
+      crowd_(StreamCrowdConfig{config.frame_rate, config.seed}) {
   if (!space_) throw Error("needs a blend space", at_field("locomotion_streams.space"));
   config_.validate();
-  if (agents < 0 || agents > (Index{1} << 31)) throw Error("must be in [0, 2^31]", at_field("locomotion_streams.agents"));
+  if (agents < 0 || agents > (Index{1} << 31))
+    throw Error("must be in [0, 2^31]", at_field("locomotion_streams.agents"));
   const Memory m = current_memory();
   joints_ = space_->joint_count();
   tables_ = motion::BlendSpaceTables(*space_, m);
@@ -61,7 +68,9 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
     auto controller = std::make_unique<Blend1DController>(space_, options);
     const float rate = controller->cycles_per_second();
     const float frames = rate > 0.0f ? config_.frame_rate / rate : 1.0f;
-    if (!(frames <= 65000.0f)) throw Error("a cycle of " + std::to_string(frames) + " frames is too long for a stream's history", at_field("locomotion_streams.frame_rate"));
+    if (!(frames <= 65000.0f))
+      throw Error("a cycle of " + std::to_string(frames) + " frames is too long for a stream's history",
+                  at_field("locomotion_streams.frame_rate"));
     StreamSpec spec;
     spec.name = "locomotion_" + std::to_string(segment) + "_" + std::to_string(k % buckets_);
     spec.history = static_cast<std::int32_t>(std::ceil(frames)) + 1;  // one whole cycle: every phase has a slot
@@ -81,7 +90,9 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
   yaw_ = Buffer<float>::zeros(count_, m);
   speed_ = Buffer<float>::zeros(count_, m);
   std::vector<float> phases(static_cast<std::size_t>(count_));
-  for (Index a = 0; a < count_; ++a) phases[static_cast<std::size_t>(a)] = static_cast<float>(Rng(config_.seed, static_cast<std::uint64_t>(a)).uniform());
+  for (Index a = 0; a < count_; ++a)
+    phases[static_cast<std::size_t>(a)] =
+        static_cast<float>(Rng(config_.seed, static_cast<std::uint64_t>(a)).uniform());
   phase_ = Buffer<float>(std::span<const float>(phases), m);
   exact_ = Buffer<std::uint8_t>::zeros(count_, m);
   key_ = Buffer<std::int32_t>(count_, m);
@@ -99,12 +110,14 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
   }
 }
 
-void LocomotionStreams::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> headings) {
+void LocomotionStreams::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities,
+                                       Span<const float> headings) {
   check_length("locomotion_streams", "drive_from_map.positions", positions.size(), count_);
   MapInputJob{positions, velocities, headings, position_.span(), yaw_.span(), speed_.span()}.run();
 }
 
-void LocomotionStreams::set_agents(std::span<const glm::vec3> positions, std::span<const float> yaws, std::span<const float> speeds) {
+void LocomotionStreams::set_agents(std::span<const glm::vec3> positions, std::span<const float> yaws,
+                                   std::span<const float> speeds) {
   check_length("locomotion_streams", "positions", static_cast<Index>(positions.size()), count_);
   check_length("locomotion_streams", "yaws", static_cast<Index>(yaws.size()), count_);
   check_length("locomotion_streams", "speeds", static_cast<Index>(speeds.size()), count_);
@@ -133,7 +146,8 @@ const LocomotionStreamsStats& LocomotionStreams::animate(const Camera* camera) {
     manage_streams(counts);
     crowd_.step();
     std::vector<float> phases(static_cast<std::size_t>(keys_), 0.0f);
-    for (std::int32_t k = 0; k < keys_; ++k) phases[static_cast<std::size_t>(k)] = controllers_[static_cast<std::size_t>(k)]->phase();
+    for (std::int32_t k = 0; k < keys_; ++k)
+      phases[static_cast<std::size_t>(k)] = controllers_[static_cast<std::size_t>(k)]->phase();
     key_phase_.copy_from(std::span<const float>(phases));
   }
   select(1.0f / config_.frame_rate);
@@ -145,10 +159,12 @@ const LocomotionStreamsStats& LocomotionStreams::animate(const Camera* camera) {
   const StreamMemory memory = crowd_.memory();
   stats_.pose_bytes = memory.stream_poses;
   stats_.palette_bytes = memory.palettes;
-  stats_.agent_state_bytes = memory.agent_state + static_cast<std::size_t>(count_) * (sizeof(glm::vec3) + 3 * sizeof(float) + sizeof(std::uint8_t) +
-                                                                                    4 * sizeof(std::int32_t));
+  stats_.agent_state_bytes =
+      memory.agent_state + static_cast<std::size_t>(count_) * (sizeof(glm::vec3) + 3 * sizeof(float) +
+                                                               sizeof(std::uint8_t) + 4 * sizeof(std::int32_t));
   stats_.exact_bytes = static_cast<std::size_t>(stats_.exact) *
-                       (sizeof(Index) + sizeof(glm::vec3) + 3 * sizeof(float) + static_cast<std::size_t>(joints_) * (sizeof(glm::vec3) + sizeof(glm::quat)));
+                       (sizeof(Index) + sizeof(glm::vec3) + 3 * sizeof(float) +
+                        static_cast<std::size_t>(joints_) * (sizeof(glm::vec3) + sizeof(glm::quat)));
   for (std::int32_t k = 0; k < keys_; ++k) {
     if (crowd_.streams()[k].state() == StreamState::Running) ++stats_.streams_running;
     if (counts[static_cast<std::size_t>(k)] > 0) ++stats_.streams_in_use;
@@ -178,7 +194,8 @@ void LocomotionStreams::manage_streams(const std::vector<Index>& counts) {
 std::vector<Index> LocomotionStreams::classify(const Camera* camera) {
   const bool lod = config_.exact_near_camera && camera != nullptr && count_ > 0;
   if (lod) {
-    make_lod_job(*camera, *lod_tables_, *parts_, {position_.span(), yaw_.span(), {}}, levels_.span(), masks_.span()).run();
+    make_lod_job(*camera, *lod_tables_, *parts_, {position_.span(), yaw_.span(), {}}, levels_.span(), masks_.span())
+        .run();
   }
   StreamBucketJob buckets;
   buckets.blend = quantised_view(tables_.view(), config_.bucket_width, buckets_);
@@ -242,10 +259,14 @@ void LocomotionStreams::synthesise_exact() {
                               .out_phases = exact_phase_.span(),
                               .out_speeds = exact_speed_.span()};
   gather.run();
-  const PoseJob pose = make_pose_job(tables_.view(),
-                                     {exact_position_.span().subspan(0, n), exact_yaw_.span().subspan(0, n), {},
-                                      exact_phase_.span().subspan(0, n), exact_speed_.span().subspan(0, n)},
-                                     joint_position_.span().subspan(0, n * joints_), joint_rotation_.span().subspan(0, n * joints_));
+  const PoseJob pose =
+      make_pose_job(tables_.view(),
+                    {exact_position_.span().subspan(0, n),
+                     exact_yaw_.span().subspan(0, n),
+                     {},
+                     exact_phase_.span().subspan(0, n),
+                     exact_speed_.span().subspan(0, n)},
+                    joint_position_.span().subspan(0, n * joints_), joint_rotation_.span().subspan(0, n * joints_));
   pose.run();
   JointPaletteJob palettes;
   palettes.joint_count = joints_;
@@ -273,7 +294,8 @@ void LocomotionStreams::record_tracks() {
       // identity, so its linear part is the joint's world rotation.
       const Mat3x4& m = palette[j];
       f.positions[j] = transform_point(m, r.bind_positions[j]);
-      const glm::mat3 rotation(glm::vec3(m.r0.x, m.r1.x, m.r2.x), glm::vec3(m.r0.y, m.r1.y, m.r2.y), glm::vec3(m.r0.z, m.r1.z, m.r2.z));
+      const glm::mat3 rotation(glm::vec3(m.r0.x, m.r1.x, m.r2.x), glm::vec3(m.r0.y, m.r1.y, m.r2.y),
+                               glm::vec3(m.r0.z, m.r1.z, m.r2.z));
       f.rotations[j] = glm::normalize(glm::quat_cast(rotation));
     }
   }

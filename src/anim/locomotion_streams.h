@@ -60,10 +60,10 @@ struct JointPaletteJob {
   std::int32_t joint_count = 0;
   Span<const glm::vec3> joint_positions;  // characters * joint_count
   Span<const glm::quat> joint_rotations;
-  Span<const Mat3x4> inverse_bind;        // joint_count
-  Span<const float> scales;               // characters, or empty
-  Span<const Index> agents;               // characters, or empty
-  Span<const Index> palette_offsets;      // per agent, or empty
+  Span<const Mat3x4> inverse_bind;    // joint_count
+  Span<const float> scales;           // characters, or empty
+  Span<const Index> agents;           // characters, or empty
+  Span<const Index> palette_offsets;  // per agent, or empty
   Span<Mat3x4> palettes;
 
   Index character_count() const { return joint_count > 0 ? joint_positions.size() / joint_count : 0; }
@@ -77,11 +77,11 @@ struct StreamBucketJob {
   motion::BlendSpaceView blend;  // quantised to the buckets (BlendSpaceView::quantum)
   float bucket_width = 0.05f;
   std::int32_t bucket_count = 20;
-  Span<const float> speeds;           // per agent, m/s
-  Span<const std::uint8_t> levels;    // agents * kBodyPartCount (LodJob), or empty: nobody is exact
-  Span<std::uint8_t> exact;           // out: 1 = synthesised
-  Span<std::int32_t> exact_flags;     // out: the same as 0/1 integers (to scan)
-  Span<std::int32_t> keys;            // out: cache_key of the bucket, -1 for exact agents
+  Span<const float> speeds;         // per agent, m/s
+  Span<const std::uint8_t> levels;  // agents * kBodyPartCount (LodJob), or empty: nobody is exact
+  Span<std::uint8_t> exact;         // out: 1 = synthesised
+  Span<std::int32_t> exact_flags;   // out: the same as 0/1 integers (to scan)
+  Span<std::int32_t> keys;          // out: cache_key of the bucket, -1 for exact agents
 
   Index agent_count() const { return speeds.size(); }
   void validate() const;
@@ -102,15 +102,15 @@ struct StreamSelectJob {
   Span<const float> speeds;
   Span<const std::uint8_t> exact;
   Span<const std::int32_t> keys;
-  Span<const float> key_phases;   // per key: phase of its stream's newest slot
-  Span<const float> key_frames;   // per key: frames per cycle
+  Span<const float> key_phases;  // per key: phase of its stream's newest slot
+  Span<const float> key_frames;  // per key: frames per cycle
   Span<const SourceView> streams;
   Span<const ClusterRef> clusters;  // the crowd's: which stream each agent reads now
   std::int32_t cluster_stride = 1;
-  std::int32_t cluster = 0;         // the cluster whose source is compared
-  Span<float> phases;               // in/out
-  Span<std::int32_t> sources;       // out
-  Span<std::int32_t> offsets;       // out
+  std::int32_t cluster = 0;    // the cluster whose source is compared
+  Span<float> phases;          // in/out
+  Span<std::int32_t> sources;  // out
+  Span<std::int32_t> offsets;  // out
 
   Index agent_count() const { return speeds.size(); }
   void validate() const;
@@ -140,40 +140,41 @@ struct LocomotionStreamsConfig {
   // this much (LOD level 0 under the default thresholds, docs/lod.md) is
   // synthesised exactly.
   float exact_coverage = 1000.0f;
-  float stop_after_seconds = 2.0f;  // a stream no agent targets for this long stops
+  float stop_after_seconds = 2.0f;   // a stream no agent targets for this long stops
   std::uint32_t cluster_mask = ~0u;  // the clusters that follow locomotion (all by default)
   std::uint64_t seed = 1;            // initial gait phases
-  void validate() const;  // Error naming "locomotion_streams.<field>"
+  void validate() const;             // Error naming "locomotion_streams.<field>"
 };
 
 struct LocomotionStreamsStats {
   Index agents = 0;
-  Index streamed = 0;    // posed from a stream
-  Index exact = 0;       // synthesised per agent
-  Index retargeted = 0;  // agents that changed stream this frame (a transition started)
-  std::int32_t streams = 0;          // defined: one per speed bucket
+  Index streamed = 0;        // posed from a stream
+  Index exact = 0;           // synthesised per agent
+  Index retargeted = 0;      // agents that changed stream this frame (a transition started)
+  std::int32_t streams = 0;  // defined: one per speed bucket
   std::int32_t streams_running = 0;
-  std::int32_t streams_in_use = 0;   // targeted by at least one agent this frame
-  std::int32_t streams_started = 0;  // this frame (history filled at once)
-  std::size_t pose_bytes = 0;        // every stream's history (StreamMemory::stream_poses)
-  std::size_t exact_bytes = 0;       // the exact path's per-agent joint buffers this frame
-  std::size_t agent_state_bytes = 0; // cluster refs, rigs, events, palette offsets, phases, speeds, flags
+  std::int32_t streams_in_use = 0;    // targeted by at least one agent this frame
+  std::int32_t streams_started = 0;   // this frame (history filled at once)
+  std::size_t pose_bytes = 0;         // every stream's history (StreamMemory::stream_poses)
+  std::size_t exact_bytes = 0;        // the exact path's per-agent joint buffers this frame
+  std::size_t agent_state_bytes = 0;  // cluster refs, rigs, events, palette offsets, phases, speeds, flags
   std::size_t palette_bytes = 0;
 };
 
 // Joint position error of streamed agents against exact synthesis (the same
 // agents synthesised at their own speed, at the phase they show), in cm.
 struct SharingError {
-  Index agents = 0;             // streamed agents compared
-  double max_cm = 0.0;          // over agents and joints
-  double mean_cm = 0.0;         // of every agent's largest joint error
-  double p95_cm = 0.0;          // of every agent's largest joint error
+  Index agents = 0;                 // streamed agents compared
+  double max_cm = 0.0;              // over agents and joints
+  double mean_cm = 0.0;             // of every agent's largest joint error
+  double p95_cm = 0.0;              // of every agent's largest joint error
   std::vector<float> agent_max_cm;  // per compared agent (agent order)
 };
 
 class LocomotionStreams {
  public:
-  LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D> space, Index agents, LocomotionStreamsConfig config = {});
+  LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D> space, Index agents,
+                    LocomotionStreamsConfig config = {});
 
   Index agent_count() const { return count_; }
   std::int32_t joint_count() const { return joints_; }
@@ -201,7 +202,7 @@ class LocomotionStreams {
   // ---- outputs (current_memory())
   Span<const Mat3x4> palettes() const { return palettes_.span(); }
   Span<const Index> palette_offsets() const { return crowd_.palette_offsets(); }  // agent * joint_count()
-  Span<const std::uint8_t> exact() const { return exact_.span(); }                 // per agent: 1 = synthesised
+  Span<const std::uint8_t> exact() const { return exact_.span(); }                // per agent: 1 = synthesised
   Span<const float> phases() const { return phase_.span(); }                      // the gait phase each agent shows
   Span<const float> speeds() const { return speed_.span(); }
   Span<const glm::vec3> positions() const { return position_.span(); }
@@ -238,9 +239,9 @@ class LocomotionStreams {
   StreamCrowd crowd_;
   std::vector<Blend1DController*> controllers_;  // per key, owned by the streams
   std::vector<float> key_speed_;
-  std::vector<float> key_frames_;                // frames per cycle, per key
-  std::vector<std::int32_t> last_used_;          // per key: the last frame an agent targeted it
-  Buffer<float> key_phase_;                      // per key: phase of the head slot
+  std::vector<float> key_frames_;        // frames per cycle, per key
+  std::vector<std::int32_t> last_used_;  // per key: the last frame an agent targeted it
+  Buffer<float> key_phase_;              // per key: phase of the head slot
   Buffer<float> key_frames_device_;
   // Per agent.
   Buffer<glm::vec3> position_;

@@ -10,7 +10,6 @@
 
 namespace throng::anim {
 
-
 // ---- world joints -> palettes ------------------------------------------------------------------
 
 void JointPaletteJob::validate() const {
@@ -67,7 +66,9 @@ void StreamBucketJob::run() const {
           for (int p = 0; p < kBodyPartCount; ++p) near = near || levels[a * kBodyPartCount + p] == 0;
         exact[a] = near ? 1 : 0;
         exact_flags[a] = near ? 1 : 0;
-        keys[a] = near ? -1 : cache_key(motion::blend_point(blend, motion::blend_coordinate(blend, speeds[a])), bucket_width, bucket_count);
+        keys[a] = near ? -1
+                       : cache_key(motion::blend_point(blend, motion::blend_coordinate(blend, speeds[a])), bucket_width,
+                                   bucket_count);
       },
       1024);
 }
@@ -82,7 +83,8 @@ void StreamSelectJob::validate() const {
   check_length("StreamSelectJob", "phases", phases.size(), n);
   check_length("StreamSelectJob", "sources", sources.size(), n);
   check_length("StreamSelectJob", "offsets", offsets.size(), n);
-  if (cluster < 0 || cluster >= cluster_stride) throw Error("must be below the cluster stride", at_field("StreamSelectJob.cluster"));
+  if (cluster < 0 || cluster >= cluster_stride)
+    throw Error("must be below the cluster stride", at_field("StreamSelectJob.cluster"));
 }
 
 void StreamSelectJob::run() const {
@@ -108,7 +110,9 @@ void StreamSelectJob::run() const {
         } else {
           // Joining a stream: advance at the bucket's cadence, then take the
           // slot that shows this phase (the nearest; the phase snaps to it).
-          ph += motion::cycle_rate(quantised, motion::blend_point(quantised, motion::blend_coordinate(quantised, v)), v) * dt;
+          ph +=
+              motion::cycle_rate(quantised, motion::blend_point(quantised, motion::blend_coordinate(quantised, v)), v) *
+              dt;
           o = static_cast<std::int32_t>(glm::floor(motion::wrap_phase(key_phases[k] - ph) * F + 0.5f));
           const std::int32_t top = streams[k].history - 1;
           o = o < 0 ? 0 : (o > top ? top : o);
@@ -165,7 +169,9 @@ SharingError LocomotionStreams::sharing_error() const {
   const Memory m = current_memory();
   Buffer<glm::vec3> reference(count_ * joints_, m);
   Buffer<glm::quat> rotations(count_ * joints_, m);
-  make_pose_job(tables_.view(), {position_.span(), yaw_.span(), {}, phase_.span(), speed_.span()}, reference.span(), rotations.span()).run();
+  make_pose_job(tables_.view(), {position_.span(), yaw_.span(), {}, phase_.span(), speed_.span()}, reference.span(),
+                rotations.span())
+      .run();
   Buffer<float> errors(count_, m);
   const std::int32_t J = joints_;
   const auto exact = exact_.span();
@@ -181,7 +187,8 @@ SharingError LocomotionStreams::sharing_error() const {
           return;
         }
         float worst = 0.0f;
-        for (std::int32_t j = 0; j < J; ++j) worst = glm::max(worst, glm::length(transform_point(pal[a * J + j], bind[j]) - ref[a * J + j]));
+        for (std::int32_t j = 0; j < J; ++j)
+          worst = glm::max(worst, glm::length(transform_point(pal[a * J + j], bind[j]) - ref[a * J + j]));
         out[a] = 100.0f * worst;
       },
       256);

@@ -26,7 +26,8 @@ void check_part(BodyPart p) {
 
 float LodConfig::threshold(BodyPart p, int level) const {
   check_part(p);
-  if (level < 0 || level >= level_count - 1) throw Error("no threshold for this level", at_field(part_field(p, indexed("thresholds", level))));
+  if (level < 0 || level >= level_count - 1)
+    throw Error("no threshold for this level", at_field(part_field(p, indexed("thresholds", level))));
   return thresholds[at(static_cast<int>(p) * (level_count - 1) + level)];
 }
 
@@ -35,12 +36,14 @@ void LodConfig::set_thresholds(BodyPart p, const std::vector<float>& values) {
   if (static_cast<Index>(values.size()) != level_count - 1)
     throw Error("needs " + std::to_string(level_count - 1) + " values, got " + std::to_string(values.size()),
                 at_field(part_field(p, "thresholds")));
-  for (std::size_t l = 0; l < values.size(); ++l) thresholds[at(static_cast<int>(p) * (level_count - 1)) + l] = values[l];
+  for (std::size_t l = 0; l < values.size(); ++l)
+    thresholds[at(static_cast<int>(p) * (level_count - 1)) + l] = values[l];
 }
 
 const std::uint32_t* LodConfig::mask(BodyPart p, int level) const {
   check_part(p);
-  if (level < 0 || level >= level_count) throw Error("no such level", at_field(part_field(p, indexed("levels", level))));
+  if (level < 0 || level >= level_count)
+    throw Error("no such level", at_field(part_field(p, indexed("levels", level))));
   return masks.data() + at((static_cast<Index>(p) * level_count + level) * mask_words);
 }
 
@@ -72,15 +75,19 @@ void LodConfig::validate(const BodyParts& parts) const {
     throw Error("must be in [1, " + std::to_string(kMaxLodJoints) + "]", at_field("lod.joint_count"));
   if (level_count < 1 || level_count > kMaxLodLevels)
     throw Error("must be in [1, " + std::to_string(kMaxLodLevels) + "]", at_field("lod.level_count"));
-  if (mask_words != mask_word_count(joint_count)) throw Error("must be (joint_count + 31) / 32", at_field("lod.mask_words"));
-  check_length("lod", "thresholds", static_cast<Index>(thresholds.size()), static_cast<Index>(kBodyPartCount) * (level_count - 1));
-  check_length("lod", "masks", static_cast<Index>(masks.size()), static_cast<Index>(kBodyPartCount) * level_count * mask_words);
+  if (mask_words != mask_word_count(joint_count))
+    throw Error("must be (joint_count + 31) / 32", at_field("lod.mask_words"));
+  check_length("lod", "thresholds", static_cast<Index>(thresholds.size()),
+               static_cast<Index>(kBodyPartCount) * (level_count - 1));
+  check_length("lod", "masks", static_cast<Index>(masks.size()),
+               static_cast<Index>(kBodyPartCount) * level_count * mask_words);
   for (BodyPart p : kAllBodyParts) {
     float previous = INFINITY;
     for (int l = 0; l + 1 < level_count; ++l) {
       const float t = threshold(p, l);
       if (!(std::isfinite(t) && t > 0.0f && t < previous))
-        throw Error("must be positive, finite and below the previous level's threshold", at_field(part_field(p, indexed("thresholds", l))));
+        throw Error("must be positive, finite and below the previous level's threshold",
+                    at_field(part_field(p, indexed("thresholds", l))));
       previous = t;
     }
     for (int l = 0; l < level_count; ++l) {
@@ -88,17 +95,20 @@ void LodConfig::validate(const BodyParts& parts) const {
       const std::uint32_t* finer = l > 0 ? mask(p, l - 1) : nullptr;
       const std::string field = part_field(p, indexed("levels", l));
       for (std::int32_t w = 0; w < mask_words; ++w) {
-        const std::uint32_t valid = w == mask_words - 1 && joint_count % 32 != 0 ? (1u << (joint_count % 32)) - 1u : ~0u;
+        const std::uint32_t valid =
+            w == mask_words - 1 && joint_count % 32 != 0 ? (1u << (joint_count % 32)) - 1u : ~0u;
         if ((m[w] & ~valid) != 0u) throw Error("has bits beyond the last joint", at_field(field));
       }
       for (std::int32_t j = 0; j < joint_count; ++j) {
         if (!joint_synthesised(m, j)) continue;
         if (parts.part_of[at(j)] != static_cast<std::uint8_t>(p))
-          throw Error("joint " + std::to_string(j) + " belongs to " + to_string(static_cast<BodyPart>(parts.part_of[at(j)])),
-                      at_field(field));
+          throw Error(
+              "joint " + std::to_string(j) + " belongs to " + to_string(static_cast<BodyPart>(parts.part_of[at(j)])),
+              at_field(field));
         if (finer != nullptr && !joint_synthesised(finer, j))
-          throw Error("joint " + std::to_string(j) + " is synthesised here but not at the finer level " + std::to_string(l - 1),
-                      at_field(field));
+          throw Error(
+              "joint " + std::to_string(j) + " is synthesised here but not at the finer level " + std::to_string(l - 1),
+              at_field(field));
       }
       if (p == BodyPart::Torso && !joint_synthesised(m, 0))
         throw Error("the skeleton root must be synthesised at every level", at_field(field));
@@ -125,8 +135,9 @@ LodConfig make_lod_config(const BodyParts& parts, const std::vector<float>& thre
     std::int32_t max_depth = 0;
     for (std::int32_t j : parts.joints_of(p)) max_depth = std::max(max_depth, parts.depth[at(j)]);
     for (int l = 0; l < L; ++l) {
-      const std::int32_t keep = L == 1 ? max_depth + 1
-                                       : static_cast<std::int32_t>(std::lround(static_cast<double>(max_depth + 1) * (L - 1 - l) / (L - 1)));
+      const std::int32_t keep =
+          L == 1 ? max_depth + 1
+                 : static_cast<std::int32_t>(std::lround(static_cast<double>(max_depth + 1) * (L - 1 - l) / (L - 1)));
       std::vector<std::int32_t> joints;
       for (std::int32_t j : parts.joints_of(p))
         if (parts.depth[at(j)] < keep || j == 0) joints.push_back(j);
@@ -161,14 +172,16 @@ std::vector<Index> LodHistogram::per_joint(const LodConfig& config) const {
 
 void LodSpheresJob::validate() const {
   if (joint_count <= 0) throw Error("must be positive", at_field("LodSpheresJob.joint_count"));
-  if (spheres.size() % kBodyPartCount != 0) throw Error("size must be a multiple of 5", at_field("LodSpheresJob.spheres"));
+  if (spheres.size() % kBodyPartCount != 0)
+    throw Error("size must be a multiple of 5", at_field("LodSpheresJob.spheres"));
   const Index n = character_count();
   check_length("LodSpheresJob", "joint_positions", joint_positions.size(), n * joint_count);
   if (!scales.empty()) check_length("LodSpheresJob", "scales", scales.size(), n);
   for (int p = 0; p < kBodyPartCount; ++p) {
     const SphereAnchor& a = anchors[at(p)];
     if (a.joint_a < 0 || a.joint_a >= joint_count || a.joint_b < 0 || a.joint_b >= joint_count)
-      throw Error("joint out of range", at_field(std::string("LodSpheresJob.anchors.") + to_string(static_cast<BodyPart>(p))));
+      throw Error("joint out of range",
+                  at_field(std::string("LodSpheresJob.anchors.") + to_string(static_cast<BodyPart>(p))));
   }
 }
 
@@ -198,16 +211,19 @@ void LodJob::validate() const {
   if (level_count < 1 || level_count > kMaxLodLevels)
     throw Error("must be in [1, " + std::to_string(kMaxLodLevels) + "]", at_field("LodJob.level_count"));
   if (mask_words < 1 || mask_words > mask_word_count(kMaxLodJoints))
-    throw Error("must be in [1, " + std::to_string(mask_word_count(kMaxLodJoints)) + "]", at_field("LodJob.mask_words"));
+    throw Error("must be in [1, " + std::to_string(mask_word_count(kMaxLodJoints)) + "]",
+                at_field("LodJob.mask_words"));
   check_length("LodJob", "thresholds", thresholds.size(), static_cast<Index>(kBodyPartCount) * (level_count - 1));
-  check_length("LodJob", "part_masks", part_masks.size(), static_cast<Index>(kBodyPartCount) * level_count * mask_words);
+  check_length("LodJob", "part_masks", part_masks.size(),
+               static_cast<Index>(kBodyPartCount) * level_count * mask_words);
   if (levels.size() % kBodyPartCount != 0) throw Error("size must be a multiple of 5", at_field("LodJob.levels"));
   const Index n = character_count();
   check_length("LodJob", "joint_masks", joint_masks.size(), n * mask_words);
   if (!coverage.empty()) check_length("LodJob", "coverage", coverage.size(), n * kBodyPartCount);
   const bool from_roots = !roots.positions.empty() || !roots.headings.empty();
   if (from_roots == !spheres.empty())
-    throw Error("give either spheres or roots.positions and roots.headings, not both or neither", at_field("LodJob.spheres"));
+    throw Error("give either spheres or roots.positions and roots.headings, not both or neither",
+                at_field("LodJob.spheres"));
   if (from_roots) {
     check_length("LodJob", "roots.positions", roots.positions.size(), n);
     check_length("LodJob", "roots.headings", roots.headings.size(), n);
@@ -228,8 +244,8 @@ MaskedPose synthesise_with_mask(const motion::Skeleton& skeleton, Span<const std
   out.positions.resize(at(J));
   out.rotations.resize(at(J));
   out.evaluated = masked_pose(J, skeleton.parents.data(), skeleton.offsets.data(), mask.data(), local_rotation,
-                              held_rotations.empty() ? nullptr : held_rotations.data(), root_position, out.positions.data(),
-                              out.rotations.data());
+                              held_rotations.empty() ? nullptr : held_rotations.data(), root_position,
+                              out.positions.data(), out.rotations.data());
   return out;
 }
 

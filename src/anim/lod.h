@@ -105,9 +105,9 @@ struct LodTables {
 struct LodSpheresJob {
   std::int32_t joint_count = 0;
   std::array<SphereAnchor, kBodyPartCount> anchors{};  // BodyParts::anchors
-  Span<const glm::vec3> joint_positions;  // characters * joint_count, world space, character-major
-  Span<const float> scales;               // characters, or empty for scale 1
-  Span<glm::vec4> spheres;                // characters * 5: centre xyz, radius w
+  Span<const glm::vec3> joint_positions;               // characters * joint_count, world space, character-major
+  Span<const float> scales;                            // characters, or empty for scale 1
+  Span<glm::vec4> spheres;                             // characters * 5: centre xyz, radius w
 
   Index character_count() const { return spheres.size() / kBodyPartCount; }
   void validate() const;  // Error naming the span whose size is wrong
@@ -174,8 +174,8 @@ struct LodHistogram {
 };
 
 // Deterministic (integer counts over fixed blocks); spans in current_memory().
-LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint32_t> joint_masks, std::int32_t level_count,
-                           std::int32_t joint_count);
+LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint32_t> joint_masks,
+                           std::int32_t level_count, std::int32_t joint_count);
 
 // The pose stage's contract with LOD: forward kinematics where joint j's
 // local rotation is evaluate(j) when its mask bit is set (a null mask sets
@@ -184,10 +184,11 @@ LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint
 // null) carried by its rest offset times `scale`. The root's evaluate(0) is
 // its world rotation. Returns how many joints were evaluated.
 template <class Evaluate>
-THRONG_HOST_DEVICE inline std::int32_t masked_pose(std::int32_t joints, const std::int32_t* parents, const glm::vec3* offsets,
-                                                   const std::uint32_t* mask, const Evaluate& evaluate,
-                                                   const glm::quat* held_rotations, glm::vec3 root_position,
-                                                   glm::vec3* out_positions, glm::quat* out_rotations, float scale = 1.0f) {
+THRONG_HOST_DEVICE inline std::int32_t masked_pose(std::int32_t joints, const std::int32_t* parents,
+                                                   const glm::vec3* offsets, const std::uint32_t* mask,
+                                                   const Evaluate& evaluate, const glm::quat* held_rotations,
+                                                   glm::vec3 root_position, glm::vec3* out_positions,
+                                                   glm::quat* out_rotations, float scale = 1.0f) {
   std::int32_t evaluated = 0;
   for (std::int32_t j = 0; j < joints; ++j) {
     glm::quat local(1.0f, 0.0f, 0.0f, 0.0f);

@@ -30,7 +30,8 @@ void LodSpheresJob::run() const {
         const glm::vec3* joints = joint_positions.data() + c * joint_count;
         const float s = scales.empty() ? 1.0f : scales[c];
         for (int p = 0; p < kBodyPartCount; ++p)
-          spheres[c * kBodyPartCount + p] = glm::vec4(anchor_centre(anchor_table.a[p], joints), s * anchor_table.a[p].radius);
+          spheres[c * kBodyPartCount + p] =
+              glm::vec4(anchor_centre(anchor_table.a[p], joints), s * anchor_table.a[p].radius);
       },
       256);
 }
@@ -65,7 +66,8 @@ THRONG_HOST_DEVICE inline void classify_character(const LodJob& job, const Templ
   int level_of[kBodyPartCount];
   for (int p = 0; p < kBodyPartCount; ++p) {
     const glm::vec4 s = from_roots ? frame.place(tmpl.s[p]) : job.spheres[c * kBodyPartCount + p];
-    const float area = sphere_pixel_coverage(to_camera_space(job.camera, glm::vec3(s)), s.w, job.camera, job.cull_outside_view);
+    const float area =
+        sphere_pixel_coverage(to_camera_space(job.camera, glm::vec3(s)), s.w, job.camera, job.cull_outside_view);
     const float* part_thresholds = job.thresholds.data() + p * (L - 1);
     int level = 0;
     while (level < L - 1 && !(area >= part_thresholds[level])) ++level;
@@ -86,16 +88,18 @@ void LodJob::run() const {
   validate();
   Templates tmpl{};
   for (int p = 0; p < kBodyPartCount; ++p) tmpl.s[p] = template_spheres[static_cast<std::size_t>(p)];
-  parallel_for("anim.lod", character_count(), THRONG_JOB_LAMBDA(Index c) { classify_character(*this, tmpl, c); }, 256);
+  parallel_for(
+      "anim.lod", character_count(), THRONG_JOB_LAMBDA(Index c) { classify_character(*this, tmpl, c); }, 256);
 }
 
-LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint32_t> joint_masks, std::int32_t level_count,
-                           std::int32_t joint_count) {
+LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint32_t> joint_masks,
+                           std::int32_t level_count, std::int32_t joint_count) {
   if (level_count < 1 || level_count > kMaxLodLevels)
     throw Error("must be in [1, " + std::to_string(kMaxLodLevels) + "]", at_field("lod_histogram.level_count"));
   if (joint_count < 1 || joint_count > kMaxLodJoints)
     throw Error("must be in [1, " + std::to_string(kMaxLodJoints) + "]", at_field("lod_histogram.joint_count"));
-  if (levels.size() % kBodyPartCount != 0) throw Error("size must be a multiple of 5", at_field("lod_histogram.levels"));
+  if (levels.size() % kBodyPartCount != 0)
+    throw Error("size must be a multiple of 5", at_field("lod_histogram.levels"));
   const Index n = levels.size() / kBodyPartCount;
   const std::int32_t W = mask_word_count(joint_count);
   if (joint_masks.size() != n * W)
@@ -139,9 +143,11 @@ LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint
   for (Index b = 0; b < blocks; ++b) {
     const Index* counts = all.data() + b * row;
     for (int i = 0; i < kBodyPartCount * L; ++i) h.level_counts[static_cast<std::size_t>(i)] += counts[i];
-    for (std::int32_t k = 0; k <= J; ++k) h.joints_synthesised[static_cast<std::size_t>(k)] += counts[kBodyPartCount * L + k];
+    for (std::int32_t k = 0; k <= J; ++k)
+      h.joints_synthesised[static_cast<std::size_t>(k)] += counts[kBodyPartCount * L + k];
   }
-  for (std::int32_t k = 0; k <= J; ++k) h.total_joints_synthesised += k * h.joints_synthesised[static_cast<std::size_t>(k)];
+  for (std::int32_t k = 0; k <= J; ++k)
+    h.total_joints_synthesised += k * h.joints_synthesised[static_cast<std::size_t>(k)];
   return h;
 }
 

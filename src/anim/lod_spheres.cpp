@@ -36,8 +36,10 @@ std::vector<float> root_distances(const Skeleton& s) {
 std::int32_t common_ancestor(const Skeleton& s, std::int32_t a, std::int32_t b) {
   // Parents come before children, so the larger index is never the ancestor.
   while (a != b) {
-    if (a > b) a = s.parents[at(a)];
-    else b = s.parents[at(b)];
+    if (a > b)
+      a = s.parents[at(a)];
+    else
+      b = s.parents[at(b)];
   }
   return a;
 }
@@ -83,8 +85,9 @@ BodyParts make_body_parts(const Skeleton& s) {
   const std::array<std::int32_t, kBodyPartCount> centre_joint = {
       required_role(s, Role::LeftElbow), required_role(s, Role::RightElbow), hips, required_role(s, Role::LeftKnee),
       required_role(s, Role::RightKnee)};
-  out.part_root = {role_or_parent(s, Role::LeftShoulder, Role::LeftElbow), role_or_parent(s, Role::RightShoulder, Role::RightElbow),
-                   0, role_or_parent(s, Role::LeftThigh, Role::LeftKnee), role_or_parent(s, Role::RightThigh, Role::RightKnee)};
+  out.part_root = {
+      role_or_parent(s, Role::LeftShoulder, Role::LeftElbow), role_or_parent(s, Role::RightShoulder, Role::RightElbow),
+      0, role_or_parent(s, Role::LeftThigh, Role::LeftKnee), role_or_parent(s, Role::RightThigh, Role::RightKnee)};
 
   // Limb subtrees must be disjoint and must not contain the skeleton root.
   out.part_of.assign(at(J), static_cast<std::uint8_t>(BodyPart::Torso));
@@ -100,8 +103,8 @@ BodyParts make_body_parts(const Skeleton& s) {
     for (std::int32_t j = root; j < J; ++j) {
       if (!is_descendant(s, j, root)) continue;
       if (out.part_of[at(j)] != static_cast<std::uint8_t>(BodyPart::Torso))
-        throw Error("joint '" + s.names[at(j)] + "' is in two limbs (" + to_string(static_cast<BodyPart>(out.part_of[at(j)])) +
-                        " and " + to_string(p) + ")",
+        throw Error("joint '" + s.names[at(j)] + "' is in two limbs (" +
+                        to_string(static_cast<BodyPart>(out.part_of[at(j)])) + " and " + to_string(p) + ")",
                     at_field(field));
       out.part_of[at(j)] = static_cast<std::uint8_t>(p);
     }
@@ -120,7 +123,9 @@ BodyParts make_body_parts(const Skeleton& s) {
 
   // Radii: the worst tree-path bound over the part's joints and end sites.
   const std::vector<float> d = root_distances(s);
-  const auto path = [&](std::int32_t a, std::int32_t b) { return d[at(a)] + d[at(b)] - 2.0f * d[at(common_ancestor(s, a, b))]; };
+  const auto path = [&](std::int32_t a, std::int32_t b) {
+    return d[at(a)] + d[at(b)] - 2.0f * d[at(common_ancestor(s, a, b))];
+  };
   for (BodyPart p : kAllBodyParts) {
     SphereAnchor a;
     a.joint_a = centre_joint[part_index(p)];

@@ -23,8 +23,8 @@ namespace throng::anim {
 
 enum class BodyPart : std::uint8_t { LeftArm, RightArm, Torso, LeftLeg, RightLeg };
 inline constexpr int kBodyPartCount = 5;
-inline constexpr std::array<BodyPart, kBodyPartCount> kAllBodyParts = {BodyPart::LeftArm, BodyPart::RightArm, BodyPart::Torso,
-                                                                      BodyPart::LeftLeg, BodyPart::RightLeg};
+inline constexpr std::array<BodyPart, kBodyPartCount> kAllBodyParts = {
+    BodyPart::LeftArm, BodyPart::RightArm, BodyPart::Torso, BodyPart::LeftLeg, BodyPart::RightLeg};
 const char* to_string(BodyPart p);  // "left_arm", "torso", ...
 
 // A sphere centre in the current pose: mix(position[joint_a], position[joint_b], t).
@@ -44,10 +44,10 @@ THRONG_HOST_DEVICE inline glm::vec3 anchor_centre(const SphereAnchor& a, const g
 struct BodyParts {
   std::int32_t joint_count = 0;
   std::array<SphereAnchor, kBodyPartCount> anchors{};
-  std::array<std::int32_t, kBodyPartCount> part_root{};  // upper arm, skeleton root, thigh
-  std::vector<std::uint8_t> part_of;                      // per joint: its BodyPart
+  std::array<std::int32_t, kBodyPartCount> part_root{};          // upper arm, skeleton root, thigh
+  std::vector<std::uint8_t> part_of;                             // per joint: its BodyPart
   std::array<std::vector<std::int32_t>, kBodyPartCount> joints;  // per part, ascending
-  std::vector<std::int32_t> depth;  // per joint: bones between it and its part's root
+  std::vector<std::int32_t> depth;                               // per joint: bones between it and its part's root
   // Spheres in the rest pose in model space: origin on the ground under the
   // hips (the lowest rest joint or end site at y = 0), xyz centre, w radius.
   std::array<glm::vec4, kBodyPartCount> rest_spheres{};

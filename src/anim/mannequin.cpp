@@ -21,9 +21,9 @@ bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.
 struct Bone {
   glm::vec3 a, b;
   float radius = 0.0f;
-  std::int32_t driver = 0;      // rotates the bone
-  std::int32_t at_a = -1;       // driver of the bone that ends at a (blended near a)
-  std::int32_t at_b = -1;       // joint at b, whose rotation bends what follows (blended near b)
+  std::int32_t driver = 0;  // rotates the bone
+  std::int32_t at_a = -1;   // driver of the bone that ends at a (blended near a)
+  std::int32_t at_b = -1;   // joint at b, whose rotation bends what follows (blended near b)
 };
 
 float smooth01(float x) {
@@ -49,7 +49,8 @@ void add_capsule(SkinnedMesh& mesh, const Bone& bone, const MannequinOptions& o)
     const float phi = -0.5f * kPiF + 0.5f * kPiF * static_cast<float>(i) / static_cast<float>(o.cap_rings);
     rings.push_back({r * std::sin(phi), r * std::cos(phi), std::sin(phi)});
   }
-  for (int i = 1; i < o.body_rings - 1; ++i) rings.push_back({len * static_cast<float>(i) / static_cast<float>(o.body_rings - 1), r, 0.0f});
+  for (int i = 1; i < o.body_rings - 1; ++i)
+    rings.push_back({len * static_cast<float>(i) / static_cast<float>(o.body_rings - 1), r, 0.0f});
   for (int i = o.cap_rings; i >= 1; --i) {
     const float phi = 0.5f * kPiF - 0.5f * kPiF * static_cast<float>(i) / static_cast<float>(o.cap_rings);
     rings.push_back({len + r * std::sin(phi), r * std::cos(phi), std::sin(phi)});
@@ -62,7 +63,8 @@ void add_capsule(SkinnedMesh& mesh, const Bone& bone, const MannequinOptions& o)
     const float s = std::clamp(glm::dot(p - bone.a, u) / len, 0.0f, 1.0f);
     const float wb = bone.at_b >= 0 ? 0.5f * smooth01((s - (1.0f - o.blend)) / o.blend) : 0.0f;
     const float wa = bone.at_a >= 0 ? 0.5f * smooth01((o.blend - s) / o.blend) : 0.0f;
-    mesh.joints.emplace_back(static_cast<std::uint16_t>(bone.driver), static_cast<std::uint16_t>(bone.at_a >= 0 ? bone.at_a : 0),
+    mesh.joints.emplace_back(static_cast<std::uint16_t>(bone.driver),
+                             static_cast<std::uint16_t>(bone.at_a >= 0 ? bone.at_a : 0),
                              static_cast<std::uint16_t>(bone.at_b >= 0 ? bone.at_b : 0), 0);
     mesh.weights.emplace_back(1.0f - wa - wb, wa, wb, 0.0f);
   };
@@ -85,7 +87,9 @@ void add_capsule(SkinnedMesh& mesh, const Bone& bone, const MannequinOptions& o)
     if (glm::dot(n, out) < 0.0f) std::swap(i1, i2);
     mesh.indices.insert(mesh.indices.end(), {i0, i1, i2});
   };
-  auto ring_vertex = [&](std::size_t ring, int k) { return base + 1 + static_cast<std::uint32_t>(ring * S + static_cast<std::size_t>(k % S)); };
+  auto ring_vertex = [&](std::size_t ring, int k) {
+    return base + 1 + static_cast<std::uint32_t>(ring * S + static_cast<std::size_t>(k % S));
+  };
   for (int k = 0; k < S; ++k) tri(base, ring_vertex(0, k), ring_vertex(0, k + 1));
   for (std::size_t i = 0; i + 1 < rings.size(); ++i)
     for (int k = 0; k < S; ++k) {
@@ -104,11 +108,14 @@ float bone_radius(const motion::Skeleton& s, std::int32_t p, std::int32_t c, flo
       if (s.role(r) == j) return true;
     return false;
   };
-  auto in_spine = [&](std::int32_t j) { return std::find(s.spine_chain.begin(), s.spine_chain.end(), j) != s.spine_chain.end(); };
+  auto in_spine = [&](std::int32_t j) {
+    return std::find(s.spine_chain.begin(), s.spine_chain.end(), j) != s.spine_chain.end();
+  };
   auto is_clavicle = [&](std::int32_t j) {
     for (Role r : {Role::LeftShoulder, Role::RightShoulder}) {
       const std::int32_t sh = s.role(r);
-      if (sh > 0 && j >= 0 && s.parents[static_cast<std::size_t>(sh)] == j && !in_spine(j) && j != s.role(Role::Hips)) return true;
+      if (sh > 0 && j >= 0 && s.parents[static_cast<std::size_t>(sh)] == j && !in_spine(j) && j != s.role(Role::Hips))
+        return true;
     }
     return false;
   };
@@ -134,7 +141,9 @@ float bone_radius(const motion::Skeleton& s, std::int32_t p, std::int32_t c, flo
 }  // namespace
 
 void MannequinOptions::validate() const {
-  auto bad = [](const char* field, const std::string& what) { throw Error(what, at_field(std::string("mannequin.") + field)); };
+  auto bad = [](const char* field, const std::string& what) {
+    throw Error(what, at_field(std::string("mannequin.") + field));
+  };
   if (sides < 3 || sides > 64) bad("sides", "must be in [3, 64]");
   if (body_rings < 2 || body_rings > 64) bad("body_rings", "must be in [2, 64]");
   if (cap_rings < 1 || cap_rings > 32) bad("cap_rings", "must be in [1, 32]");
@@ -144,11 +153,16 @@ void MannequinOptions::validate() const {
 
 void SkinnedMesh::validate() const {
   const std::size_t n = positions.size();
-  auto bad = [](const char* field, const std::string& what) { throw Error(what, at_field(std::string("mesh.") + field)); };
+  auto bad = [](const char* field, const std::string& what) {
+    throw Error(what, at_field(std::string("mesh.") + field));
+  };
   if (joint_count <= 0) bad("joint_count", "must be positive");
-  if (normals.size() != n) bad("normals", "has " + std::to_string(normals.size()) + " entries, positions " + std::to_string(n));
-  if (joints.size() != n) bad("joints", "has " + std::to_string(joints.size()) + " entries, positions " + std::to_string(n));
-  if (weights.size() != n) bad("weights", "has " + std::to_string(weights.size()) + " entries, positions " + std::to_string(n));
+  if (normals.size() != n)
+    bad("normals", "has " + std::to_string(normals.size()) + " entries, positions " + std::to_string(n));
+  if (joints.size() != n)
+    bad("joints", "has " + std::to_string(joints.size()) + " entries, positions " + std::to_string(n));
+  if (weights.size() != n)
+    bad("weights", "has " + std::to_string(weights.size()) + " entries, positions " + std::to_string(n));
   if (indices.size() % 3 != 0) bad("indices", "length is not a multiple of 3");
   for (std::size_t i = 0; i < n; ++i) {
     const std::string at = fmt::format("[{}]", i);
@@ -157,13 +171,15 @@ void SkinnedMesh::validate() const {
     for (int k = 0; k < 4; ++k) {
       const float wk = weights[i][k];
       if (!(wk >= 0.0f && wk <= 1.0f)) bad("weights", at + " has a weight outside [0, 1]");
-      if (wk > 0.0f && joints[i][k] >= joint_count) bad("joints", at + " names joint " + std::to_string(joints[i][k]) + " of " + std::to_string(joint_count));
+      if (wk > 0.0f && joints[i][k] >= joint_count)
+        bad("joints", at + " names joint " + std::to_string(joints[i][k]) + " of " + std::to_string(joint_count));
       sum += wk;
     }
     if (std::abs(sum - 1.0f) > 1e-4f) bad("weights", at + " sums to " + std::to_string(sum) + ", not 1");
   }
   for (std::size_t i = 0; i < indices.size(); ++i)
-    if (indices[i] >= n) bad("indices", "[" + std::to_string(i) + "] = " + std::to_string(indices[i]) + " is not a vertex");
+    if (indices[i] >= n)
+      bad("indices", "[" + std::to_string(i) + "] = " + std::to_string(indices[i]) + " is not a vertex");
 }
 
 SkinnedMesh make_mannequin(const motion::Skeleton& skeleton, const MannequinOptions& options) {
@@ -173,7 +189,8 @@ SkinnedMesh make_mannequin(const motion::Skeleton& skeleton, const MannequinOpti
   std::vector<glm::quat> identity(static_cast<std::size_t>(J), glm::quat(1, 0, 0, 0));
   std::vector<glm::vec3> pos(static_cast<std::size_t>(J));
   std::vector<glm::quat> rot(static_cast<std::size_t>(J));
-  motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), identity.data(), nullptr, skeleton.offsets[0], pos.data(), rot.data());
+  motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), identity.data(), nullptr, skeleton.offsets[0],
+                  pos.data(), rot.data());
 
   float lo = pos[0].y, hi = pos[0].y;
   for (std::int32_t j = 0; j < J; ++j) {
@@ -204,9 +221,11 @@ SkinnedMesh make_mannequin(const motion::Skeleton& skeleton, const MannequinOpti
     bone.radius = bone_radius(skeleton, p, c, len, k);
     add_capsule(mesh, bone, options);
   };
-  for (std::int32_t j = 1; j < J; ++j) add_bone(skeleton.parents[static_cast<std::size_t>(j)], j, pos[static_cast<std::size_t>(j)]);
+  for (std::int32_t j = 1; j < J; ++j)
+    add_bone(skeleton.parents[static_cast<std::size_t>(j)], j, pos[static_cast<std::size_t>(j)]);
   for (std::int32_t j = 0; j < J; ++j)
-    if (skeleton.has_end_site[static_cast<std::size_t>(j)]) add_bone(j, -1, pos[static_cast<std::size_t>(j)] + skeleton.end_sites[static_cast<std::size_t>(j)]);
+    if (skeleton.has_end_site[static_cast<std::size_t>(j)])
+      add_bone(j, -1, pos[static_cast<std::size_t>(j)] + skeleton.end_sites[static_cast<std::size_t>(j)]);
   if (mesh.positions.empty()) throw Error("skeleton has no bone long enough for a mannequin", at_field("mannequin"));
   return mesh;
 }

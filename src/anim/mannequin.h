@@ -18,10 +18,10 @@ namespace throng::anim {
 struct SkinnedMesh {
   std::int32_t joint_count = 0;
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;           // unit
-  std::vector<glm::u16vec4> joints;         // influencing joints
-  std::vector<glm::vec4> weights;           // matching weights, >= 0, summing to 1
-  std::vector<std::uint32_t> indices;       // 3 per triangle
+  std::vector<glm::vec3> normals;      // unit
+  std::vector<glm::u16vec4> joints;    // influencing joints
+  std::vector<glm::vec4> weights;      // matching weights, >= 0, summing to 1
+  std::vector<std::uint32_t> indices;  // 3 per triangle
 
   std::int32_t vertex_count() const { return static_cast<std::int32_t>(positions.size()); }
   std::int32_t triangle_count() const { return static_cast<std::int32_t>(indices.size() / 3); }
@@ -32,12 +32,12 @@ struct SkinnedMesh {
 };
 
 struct MannequinOptions {
-  std::int32_t sides = 12;        // vertices around each capsule
-  std::int32_t body_rings = 5;    // rings along the straight part (>= 2)
-  std::int32_t cap_rings = 3;     // rings per hemispherical cap (>= 1)
-  float blend = 0.3f;             // fraction of a bone, at each end, blended with the neighbouring bone
-  float min_bone = 0.02f;         // bones shorter than this (x height / 1.75 m) get no capsule
-  void validate() const;          // Error naming "mannequin.<field>"
+  std::int32_t sides = 12;      // vertices around each capsule
+  std::int32_t body_rings = 5;  // rings along the straight part (>= 2)
+  std::int32_t cap_rings = 3;   // rings per hemispherical cap (>= 1)
+  float blend = 0.3f;           // fraction of a bone, at each end, blended with the neighbouring bone
+  float min_bone = 0.02f;       // bones shorter than this (x height / 1.75 m) get no capsule
+  void validate() const;        // Error naming "mannequin.<field>"
 };
 
 // One capsule per bone (parent joint to child joint, and joint to end site)

@@ -15,7 +15,8 @@ void CachedCycle::validate() const {
   if (rotations.size() != want)
     throw Error("has " + std::to_string(rotations.size()) + " rotations, expected " + std::to_string(want),
                 at_field("cycle.rotations"));
-  if (!(std::isfinite(duration) && duration > 0.0f)) throw Error("must be positive and finite", at_field("cycle.duration"));
+  if (!(std::isfinite(duration) && duration > 0.0f))
+    throw Error("must be positive and finite", at_field("cycle.duration"));
 }
 
 double rotation_angle_deg(const glm::quat& a, const glm::quat& b) {
@@ -38,7 +39,9 @@ MotionCache::MotionCache(MotionCacheConfig config) : config_(config) {
 
 std::int32_t MotionCache::bucket_of(float w) const { return cache_bucket(w, config_.bucket_width, bucket_count_); }
 
-float MotionCache::bucket_centre(std::int32_t bucket) const { return motion::weight_bucket_centre(bucket, config_.bucket_width); }
+float MotionCache::bucket_centre(std::int32_t bucket) const {
+  return motion::weight_bucket_centre(bucket, config_.bucket_width);
+}
 
 const CachedCycle* MotionCache::find(float w, std::uint32_t state, std::int64_t lookups) {
   const auto it = entries_.find(key(state, bucket_of(w)));
@@ -50,7 +53,9 @@ const CachedCycle* MotionCache::find(float w, std::uint32_t state, std::int64_t 
   return it->second.get();
 }
 
-bool MotionCache::contains(std::int32_t bucket, std::uint32_t state) const { return entries_.count(key(state, bucket)) != 0; }
+bool MotionCache::contains(std::int32_t bucket, std::uint32_t state) const {
+  return entries_.count(key(state, bucket)) != 0;
+}
 
 void MotionCache::erase(std::uint64_t k) {
   const auto it = entries_.find(k);
@@ -103,8 +108,9 @@ const CachedCycle& MotionCache::get(float w, const Synthesise& synthesise, std::
 void MotionCache::sample(float w, float phase, const Synthesise& synthesise, Span<glm::quat> out, std::uint32_t state) {
   const CachedCycle& cycle = get(w, synthesise, state);
   if (out.size() != cycle.joint_count)
-    throw Error("has " + std::to_string(out.size()) + " rotations, the cycle " + std::to_string(cycle.joint_count) + " joints",
-                at_field("motion_cache.sample.out"));
+    throw Error(
+        "has " + std::to_string(out.size()) + " rotations, the cycle " + std::to_string(cycle.joint_count) + " joints",
+        at_field("motion_cache.sample.out"));
   sample_cycle(cycle, phase, out.data());
 }
 
@@ -121,7 +127,8 @@ void MotionCache::clear() {
 
 std::vector<std::pair<std::uint32_t, std::int32_t>> MotionCache::fifo_order() const {
   std::vector<std::pair<std::uint32_t, std::int32_t>> out;
-  for (std::uint64_t k : order_) out.emplace_back(static_cast<std::uint32_t>(k >> 32), static_cast<std::int32_t>(k & 0xffffffffu));
+  for (std::uint64_t k : order_)
+    out.emplace_back(static_cast<std::uint32_t>(k >> 32), static_cast<std::int32_t>(k & 0xffffffffu));
   return out;
 }
 
@@ -144,8 +151,10 @@ QuantisationError measure_quantisation_error(const MotionCacheConfig& config, co
 }
 
 QuantisationError measure_quantisation_error(const MotionCacheConfig& config, const MotionCache::Synthesise& synthesise,
-                                             const ExactPose& exact, std::int32_t w_samples, std::int32_t phase_samples) {
-  if (w_samples < 1 || w_samples > 100000) throw Error("must be in [1, 100000]", at_field("quantisation_error.w_samples"));
+                                             const ExactPose& exact, std::int32_t w_samples,
+                                             std::int32_t phase_samples) {
+  if (w_samples < 1 || w_samples > 100000)
+    throw Error("must be in [1, 100000]", at_field("quantisation_error.w_samples"));
   if (phase_samples < 1 || phase_samples > 100000)
     throw Error("must be in [1, 100000]", at_field("quantisation_error.phase_samples"));
   const MotionCache buckets(config);  // for the bucket arithmetic only

@@ -60,7 +60,7 @@ THRONG_HOST_DEVICE inline std::int32_t cache_bucket(float w, float width, std::i
 double rotation_angle_deg(const glm::quat& a, const glm::quat& b);
 
 struct MotionCacheConfig {
-  float bucket_width = 0.05f;                      // of w; 1 / bucket_width buckets (the last may be narrower)
+  float bucket_width = 0.05f;                        // of w; 1 / bucket_width buckets (the last may be narrower)
   std::size_t capacity_bytes = 20u * 1024u * 1024u;  // rotations only; 0 disables storing
   // Throws Error naming "motion_cache.bucket_width" unless in [1e-4, 1].
   void validate() const;
@@ -74,7 +74,9 @@ struct MotionCacheStats {
   std::int64_t rejected = 0;  // cycles larger than the whole capacity, not stored
   std::size_t bytes = 0;      // held now
   std::size_t entries = 0;    // held now
-  double hit_rate() const { return hits + misses > 0 ? static_cast<double>(hits) / static_cast<double>(hits + misses) : 0.0; }
+  double hit_rate() const {
+    return hits + misses > 0 ? static_cast<double>(hits) / static_cast<double>(hits + misses) : 0.0;
+  }
 };
 
 class MotionCache {

@@ -19,8 +19,9 @@ namespace throng::anim {
 
 // One vertex, host or device. Normals take the blended linear part and are
 // renormalised (exact for rigid palettes away from joints).
-THRONG_HOST_DEVICE inline void skin_vertex(const Mat3x4* palette, const glm::vec3& p, const glm::vec3& n, const glm::u16vec4& joints,
-                                           const glm::vec4& weights, glm::vec3& out_p, glm::vec3& out_n) {
+THRONG_HOST_DEVICE inline void skin_vertex(const Mat3x4* palette, const glm::vec3& p, const glm::vec3& n,
+                                           const glm::u16vec4& joints, const glm::vec4& weights, glm::vec3& out_p,
+                                           glm::vec3& out_n) {
   glm::vec3 sp(0.0f), sn(0.0f);
   for (int k = 0; k < 4; ++k) {
     const float w = weights[k];
@@ -43,15 +44,15 @@ void skin_reference(const SkinnedMesh& mesh, std::span<const Mat3x4> palette, st
 // palettes[palette_offsets[c]]: out[c * V + v]. parallel_for "anim.skin"
 // over characters x vertices.
 struct SkinJob {
-  Span<const glm::vec3> positions;      // V, bind pose
-  Span<const glm::vec3> normals;        // V
-  Span<const glm::u16vec4> joints;      // V
-  Span<const glm::vec4> weights;        // V
-  std::int32_t joint_count = 0;         // the mesh's skeleton
-  Span<const Mat3x4> palettes;          // every character's palette
-  Span<const Index> palette_offsets;    // per character: its first matrix
-  Span<glm::vec3> out_positions;        // characters * V
-  Span<glm::vec3> out_normals;          // characters * V, or empty
+  Span<const glm::vec3> positions;    // V, bind pose
+  Span<const glm::vec3> normals;      // V
+  Span<const glm::u16vec4> joints;    // V
+  Span<const glm::vec4> weights;      // V
+  std::int32_t joint_count = 0;       // the mesh's skeleton
+  Span<const Mat3x4> palettes;        // every character's palette
+  Span<const Index> palette_offsets;  // per character: its first matrix
+  Span<glm::vec3> out_positions;      // characters * V
+  Span<glm::vec3> out_normals;        // characters * V, or empty
 
   Index character_count() const { return palette_offsets.size(); }
   void validate() const;  // Error naming the field

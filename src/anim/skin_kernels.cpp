@@ -11,10 +11,12 @@ void skin_reference(const SkinnedMesh& mesh, std::span<const Mat3x4> palette, st
                     std::span<glm::vec3> out_normals) {
   const auto V = static_cast<std::size_t>(mesh.vertex_count());
   if (palette.size() != static_cast<std::size_t>(mesh.joint_count))
-    throw Error("has " + std::to_string(palette.size()) + " matrices, the mesh has " + std::to_string(mesh.joint_count) + " joints",
+    throw Error("has " + std::to_string(palette.size()) + " matrices, the mesh has " +
+                    std::to_string(mesh.joint_count) + " joints",
                 at_field("skin.palette"));
   if (out_positions.size() != V) throw Error("must have one entry per vertex", at_field("skin.out_positions"));
-  if (!out_normals.empty() && out_normals.size() != V) throw Error("must be empty or have one entry per vertex", at_field("skin.out_normals"));
+  if (!out_normals.empty() && out_normals.size() != V)
+    throw Error("must be empty or have one entry per vertex", at_field("skin.out_normals"));
   for (std::size_t v = 0; v < V; ++v) {
     glm::vec3 p, n;
     skin_vertex(palette.data(), mesh.positions[v], mesh.normals[v], mesh.joints[v], mesh.weights[v], p, n);

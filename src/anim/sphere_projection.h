@@ -27,10 +27,10 @@
 namespace throng::anim {
 
 enum class SphereImage : std::uint8_t {
-  Behind,    // wholly behind the camera plane: nothing is seen
-  Ellipse,   // wholly in front of the camera plane: a bounded ellipse
-  Unbounded, // crosses the camera plane (camera outside): an unbounded conic region
-  Inside,    // the camera is inside the sphere: it fills every pixel
+  Behind,     // wholly behind the camera plane: nothing is seen
+  Ellipse,    // wholly in front of the camera plane: a bounded ellipse
+  Unbounded,  // crosses the camera plane (camera outside): an unbounded conic region
+  Inside,     // the camera is inside the sphere: it fills every pixel
 };
 
 const char* to_string(SphereImage kind);
@@ -49,14 +49,18 @@ struct ProjectedEllipse {
 // in square pixels (0 when not an Ellipse; see sphere_pixel_coverage for a
 // value usable as a screen-space measure in every case).
 template <class T>
-THRONG_HOST_DEVICE inline T sphere_ellipse_area(glm::vec<3, T> centre_cam, T radius, T focal_px, SphereImage* kind = nullptr) {
+THRONG_HOST_DEVICE inline T sphere_ellipse_area(glm::vec<3, T> centre_cam, T radius, T focal_px,
+                                                SphereImage* kind = nullptr) {
   const T d = -centre_cam.z;
   const T r2 = radius * radius;
   const T k = centre_cam.x * centre_cam.x + centre_cam.y * centre_cam.y + d * d - r2;
   SphereImage c = SphereImage::Ellipse;
-  if (k <= T(0)) c = SphereImage::Inside;
-  else if (d <= -radius) c = SphereImage::Behind;
-  else if (d <= radius) c = SphereImage::Unbounded;
+  if (k <= T(0))
+    c = SphereImage::Inside;
+  else if (d <= -radius)
+    c = SphereImage::Behind;
+  else if (d <= radius)
+    c = SphereImage::Unbounded;
   if (kind != nullptr) *kind = c;
   if (c != SphereImage::Ellipse) return T(0);
   const T e = d * d - r2;

@@ -46,14 +46,15 @@ struct StreamCrowd::RigTables {
   Buffer<glm::vec3> bind_positions;
 
   RigTablesView view() const {
-    return {rigs.span(),        parents.span(),        offsets.span(),           joint_cluster.span(),
-            inverse_bind.span(), hook_rotations.span(), hook_translations.span(), hook_joints.span(),
-            joint_segment.span(), segment_hooks.span(), bind_positions.span()};
+    return {rigs.span(),          parents.span(),        offsets.span(),           joint_cluster.span(),
+            inverse_bind.span(),  hook_rotations.span(), hook_translations.span(), hook_joints.span(),
+            joint_segment.span(), segment_hooks.span(),  bind_positions.span()};
   }
 };
 
 void StreamCrowdConfig::validate() const {
-  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f)) throw Error("must be in [1, 1000] frames per second", at_field("frame_rate"));
+  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f))
+    throw Error("must be in [1, 1000] frames per second", at_field("frame_rate"));
 }
 
 StreamCrowd::StreamCrowd(StreamCrowdConfig config, Memory memory) : config_(config), memory_(memory) {
@@ -120,7 +121,8 @@ void StreamCrowd::rebuild_rig_tables() {
         segment_hooks.emplace_back();
       } else {
         const auto pu = static_cast<std::size_t>(p);
-        segment_hooks.push_back(inverse_rigid(r.inverse_bind[pu]) * mat3x4_from(d.hook_rotation, d.hook_translation) * r.inverse_bind[pu]);
+        segment_hooks.push_back(inverse_rigid(r.inverse_bind[pu]) * mat3x4_from(d.hook_rotation, d.hook_translation) *
+                                r.inverse_bind[pu]);
       }
     }
     for (std::int32_t c = 0; c < r.clusters.count(); ++c) {
@@ -174,12 +176,15 @@ void StreamCrowd::check_agent_cluster(Index agent, std::int32_t cluster) const {
   const std::int32_t r = agent_rig(agent);
   const std::int32_t n = rigs_[static_cast<std::size_t>(r)].clusters.count();
   if (cluster < 0 || cluster >= n)
-    throw Error("rig '" + rigs_[static_cast<std::size_t>(r)].name + "' has " + std::to_string(n) + " clusters, not " + std::to_string(cluster + 1),
+    throw Error("rig '" + rigs_[static_cast<std::size_t>(r)].name + "' has " + std::to_string(n) + " clusters, not " +
+                    std::to_string(cluster + 1),
                 at_field("cluster"));
 }
 
-std::int32_t StreamCrowd::random_offset(Index agent, std::int32_t cluster, std::int32_t stream, std::uint64_t salt) const {
-  Rng rng(config_.seed ^ (salt * 0x9e3779b97f4a7c15ull), static_cast<std::uint64_t>(agent) * kMaxClusters + static_cast<std::uint64_t>(cluster));
+std::int32_t StreamCrowd::random_offset(Index agent, std::int32_t cluster, std::int32_t stream,
+                                        std::uint64_t salt) const {
+  Rng rng(config_.seed ^ (salt * 0x9e3779b97f4a7c15ull),
+          static_cast<std::uint64_t>(agent) * kMaxClusters + static_cast<std::uint64_t>(cluster));
   return static_cast<std::int32_t>(rng.below(static_cast<std::uint64_t>((*streams_)[stream].history())));
 }
 
@@ -206,28 +211,34 @@ void StreamCrowd::apply(std::vector<ClusterCommand> commands) {
 }
 
 void StreamCrowd::assign(Index first, Index count, std::int32_t cluster, std::int32_t stream, std::int32_t offset) {
-  if (first < 0 || count < 0 || first + count > agent_count_) throw Error("agent range out of bounds", at_field("assign"));
-  if (stream < 0 || stream >= streams_->size()) throw Error("no stream " + std::to_string(stream), at_field("assign.stream"));
+  if (first < 0 || count < 0 || first + count > agent_count_)
+    throw Error("agent range out of bounds", at_field("assign"));
+  if (stream < 0 || stream >= streams_->size())
+    throw Error("no stream " + std::to_string(stream), at_field("assign.stream"));
   const AnimStream& s = (*streams_)[stream];
-  if (offset < 0 || offset >= s.history()) throw Error("must be in [0, " + std::to_string(s.history()) + ")", at_field("assign.offset"));
+  if (offset < 0 || offset >= s.history())
+    throw Error("must be in [0, " + std::to_string(s.history()) + ")", at_field("assign.offset"));
   std::vector<ClusterCommand> cmds;
   cmds.reserve(static_cast<std::size_t>(count));
   for (Index a = first; a < first + count; ++a) {
     check_agent_cluster(a, cluster);
     if (host_agent_rig_[static_cast<std::size_t>(a)] != s.rig())
-      throw Error("stream '" + s.name() + "' is of another rig than agent " + std::to_string(a), at_field("assign.stream"));
+      throw Error("stream '" + s.name() + "' is of another rig than agent " + std::to_string(a),
+                  at_field("assign.stream"));
     cmds.push_back({a, cluster, stream, offset});
   }
   apply(std::move(cmds));
 }
 
 void StreamCrowd::assign_random(Index first, Index count, const VarietySpec& spec, std::uint64_t seed) {
-  if (first < 0 || count < 0 || first + count > agent_count_) throw Error("agent range out of bounds", at_field("variety"));
+  if (first < 0 || count < 0 || first + count > agent_count_)
+    throw Error("agent range out of bounds", at_field("variety"));
   for (std::size_t c = 0; c < spec.streams.size(); ++c)
     for (std::size_t k = 0; k < spec.streams[c].size(); ++k) {
       const std::int32_t s = spec.streams[c][k];
       if (s < 0 || s >= streams_->size())
-        throw Error("no stream " + std::to_string(s), at_field("variety.streams[" + std::to_string(c) + "][" + std::to_string(k) + "]"));
+        throw Error("no stream " + std::to_string(s),
+                    at_field("variety.streams[" + std::to_string(c) + "][" + std::to_string(k) + "]"));
     }
   std::vector<ClusterCommand> cmds;
   cmds.reserve(static_cast<std::size_t>(count * cluster_stride_));
@@ -310,13 +321,18 @@ void StreamCrowd::release_unique(std::int32_t instance) {
   uniques_->release(instance);
 }
 
-void StreamCrowd::transition_to_streamed(Index agent, std::int32_t cluster, std::int32_t stream, float blend_seconds, std::int32_t offset) {
+void StreamCrowd::transition_to_streamed(Index agent, std::int32_t cluster, std::int32_t stream, float blend_seconds,
+                                         std::int32_t offset) {
   check_agent_cluster(agent, cluster);
-  if (stream < 0 || stream >= streams_->size()) throw Error("no stream " + std::to_string(stream), at_field("transition.stream"));
+  if (stream < 0 || stream >= streams_->size())
+    throw Error("no stream " + std::to_string(stream), at_field("transition.stream"));
   const AnimStream& s = (*streams_)[stream];
-  if (s.rig() != agent_rig(agent)) throw Error("stream '" + s.name() + "' is of another rig than the agent", at_field("transition.stream"));
-  if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f)) throw Error("must be in [0, 1e4) seconds", at_field("transition.blend"));
-  if (offset >= s.history()) throw Error("must be below the stream's history " + std::to_string(s.history()), at_field("transition.offset"));
+  if (s.rig() != agent_rig(agent))
+    throw Error("stream '" + s.name() + "' is of another rig than the agent", at_field("transition.stream"));
+  if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f))
+    throw Error("must be in [0, 1e4) seconds", at_field("transition.blend"));
+  if (offset >= s.history())
+    throw Error("must be below the stream's history " + std::to_string(s.history()), at_field("transition.offset"));
   const float blend_frames = blend_seconds * config_.frame_rate;
   const Index key = agent * cluster_stride_ + cluster;
   const std::int32_t t0 = frame_ + 1;
@@ -338,11 +354,14 @@ void StreamCrowd::transition_to_unique(Index agent, std::int32_t cluster, std::i
   if (animation < 0 || animation >= uniques_->animation_count())
     throw Error("no unique animation " + std::to_string(animation), at_field("transition.animation"));
   if (uniques_->animation(animation).rig != agent_rig(agent))
-    throw Error("unique animation '" + uniques_->animation(animation).name + "' is of another rig than the agent", at_field("transition.animation"));
-  if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f)) throw Error("must be in [0, 1e4) seconds", at_field("transition.blend"));
+    throw Error("unique animation '" + uniques_->animation(animation).name + "' is of another rig than the agent",
+                at_field("transition.animation"));
+  if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f))
+    throw Error("must be in [0, 1e4) seconds", at_field("transition.blend"));
   if (then_stream >= streams_->size() || (then_stream >= 0 && (*streams_)[then_stream].rig() != agent_rig(agent)))
     throw Error("no stream of the agent's rig with this index", at_field("transition.then_stream"));
-  if (!(then_blend >= 0.0f && then_blend < 1e4f)) throw Error("must be in [0, 1e4) seconds", at_field("transition.then_blend"));
+  if (!(then_blend >= 0.0f && then_blend < 1e4f))
+    throw Error("must be in [0, 1e4) seconds", at_field("transition.then_blend"));
   const float blend_frames = blend_seconds * config_.frame_rate;
   const Index key = agent * cluster_stride_ + cluster;
   const std::int32_t t0 = frame_ + 1;
@@ -378,11 +397,15 @@ void StreamCrowd::set_override(Index agent, const BoneOverride& o) {
   const std::int32_t J = rigs_[static_cast<std::size_t>(r)].joint_count();
   if (o.joint < 0 || o.joint >= J) throw Error("must be a joint of the agent's rig", at_field("override.joint"));
   if (!(o.weight >= 0.0f && o.weight <= 1.0f)) throw Error("must be in [0, 1]", at_field("override.weight"));
-  if (!(o.max_angle >= 0.0f && o.max_angle <= 3.1416f)) throw Error("must be in [0, pi]", at_field("override.max_angle"));
+  if (!(o.max_angle >= 0.0f && o.max_angle <= 3.1416f))
+    throw Error("must be in [0, pi]", at_field("override.max_angle"));
   const glm::quat& q = o.rotation;
-  if (!(std::abs(glm::length(q) - 1.0f) < 1e-3f)) throw Error("must be a unit quaternion", at_field("override.rotation"));
-  if (!std::isfinite(o.target.x) || !std::isfinite(o.target.y) || !std::isfinite(o.target.z)) throw Error("must be finite", at_field("override.target"));
-  if (!(glm::length(o.aim_axis) > 1e-6f) || !std::isfinite(glm::length(o.aim_axis))) throw Error("must be a non-zero finite vector", at_field("override.aim_axis"));
+  if (!(std::abs(glm::length(q) - 1.0f) < 1e-3f))
+    throw Error("must be a unit quaternion", at_field("override.rotation"));
+  if (!std::isfinite(o.target.x) || !std::isfinite(o.target.y) || !std::isfinite(o.target.z))
+    throw Error("must be finite", at_field("override.target"));
+  if (!(glm::length(o.aim_axis) > 1e-6f) || !std::isfinite(glm::length(o.aim_axis)))
+    throw Error("must be a non-zero finite vector", at_field("override.aim_axis"));
   auto& list = overrides_[agent];
   auto it = std::find_if(list.begin(), list.end(), [&](const BoneOverride& x) { return x.joint == o.joint; });
   if (it != list.end()) {
@@ -398,7 +421,8 @@ void StreamCrowd::clear_override(Index agent, std::int32_t joint) {
   auto it = overrides_.find(agent);
   if (it == overrides_.end()) return;
   auto& list = it->second;
-  list.erase(std::remove_if(list.begin(), list.end(), [&](const BoneOverride& x) { return x.joint == joint; }), list.end());
+  list.erase(std::remove_if(list.begin(), list.end(), [&](const BoneOverride& x) { return x.joint == joint; }),
+             list.end());
   if (list.empty()) overrides_.erase(it);
   overrides_dirty_ = true;
 }
@@ -469,15 +493,19 @@ void StreamCrowd::step() {
     const Controller* c = uniques_->controller(ref.instance);
     if (c == nullptr) continue;
     const double left = c->duration() > 0.0 ? c->duration() - c->time() : 0.0;
-    if (c->finished() || (c->duration() > 0.0 && left <= ref.then_blend + 0.5 / config_.frame_rate)) returning.emplace_back(key, ref);
+    if (c->finished() || (c->duration() > 0.0 && left <= ref.then_blend + 0.5 / config_.frame_rate))
+      returning.emplace_back(key, ref);
   }
   std::sort(returning.begin(), returning.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [key, ref] : returning)
-    transition_to_streamed(key / cluster_stride_, static_cast<std::int32_t>(key % cluster_stride_), ref.then_stream, ref.then_blend);
+    transition_to_streamed(key / cluster_stride_, static_cast<std::int32_t>(key % cluster_stride_), ref.then_stream,
+                           ref.then_blend);
 }
 
-Index StreamCrowd::retarget(Span<const std::int32_t> sources, Span<const std::int32_t> offsets, float blend_seconds, std::uint32_t cluster_mask) {
-  if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f)) throw Error("must be in [0, 1e4) seconds", at_field("retarget.blend"));
+Index StreamCrowd::retarget(Span<const std::int32_t> sources, Span<const std::int32_t> offsets, float blend_seconds,
+                            std::uint32_t cluster_mask) {
+  if (!(blend_seconds >= 0.0f && blend_seconds < 1e4f))
+    throw Error("must be in [0, 1e4) seconds", at_field("retarget.blend"));
   if (retarget_changed_.size() != agent_count_) retarget_changed_ = Buffer<std::uint8_t>(agent_count_, memory_);
   const StreamRetargetJob job{.sources = sources,
                               .offsets = offsets,
@@ -494,10 +522,12 @@ Index StreamCrowd::retarget(Span<const std::int32_t> sources, Span<const std::in
   return count_nonzero(retarget_changed_.span());
 }
 
-void StreamCrowd::resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes, Span<std::int32_t> read_offsets,
-                          Span<const std::uint8_t> skip) const {
+void StreamCrowd::resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes,
+                          Span<std::int32_t> read_offsets, Span<const std::uint8_t> skip) const {
   if (palettes.size() != palette_size_)
-    throw Error("has " + std::to_string(palettes.size()) + " matrices, the crowd needs " + std::to_string(palette_size_), at_field("resolve.palettes"));
+    throw Error(
+        "has " + std::to_string(palettes.size()) + " matrices, the crowd needs " + std::to_string(palette_size_),
+        at_field("resolve.palettes"));
   rebuild_overrides();
   StreamResolveJob job;
   job.tables = tables_->view();
@@ -522,8 +552,8 @@ StreamMemory StreamCrowd::memory() const {
   StreamMemory m;
   m.stream_poses = streams_->pose_bytes();
   m.unique_poses = uniques_->pose_bytes();
-  m.agent_state = bytes_of(agent_rig_) + bytes_of(palette_offsets_) + bytes_of(clusters_) + bytes_of(agent_events_) + bytes_of(override_begin_) +
-                  bytes_of(override_list_);
+  m.agent_state = bytes_of(agent_rig_) + bytes_of(palette_offsets_) + bytes_of(clusters_) + bytes_of(agent_events_) +
+                  bytes_of(override_begin_) + bytes_of(override_list_);
   m.palettes = static_cast<std::size_t>(palette_size_) * sizeof(Mat3x4);
   return m;
 }

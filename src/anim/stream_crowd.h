@@ -49,10 +49,10 @@ struct StreamCrowdConfig {
 };
 
 struct StreamMemory {
-  std::size_t stream_poses = 0;   // StreamPool: sum over streams of M * (J * 16 + 12)
-  std::size_t unique_poses = 0;   // UniquePool slots
-  std::size_t agent_state = 0;    // cluster refs, rigs, palette offsets, events, overrides
-  std::size_t palettes = 0;       // 48 bytes per agent joint, when the caller allocates them
+  std::size_t stream_poses = 0;  // StreamPool: sum over streams of M * (J * 16 + 12)
+  std::size_t unique_poses = 0;  // UniquePool slots
+  std::size_t agent_state = 0;   // cluster refs, rigs, palette offsets, events, overrides
+  std::size_t palettes = 0;      // 48 bytes per agent joint, when the caller allocates them
   std::size_t total() const { return stream_poses + unique_poses + agent_state + palettes; }
 };
 
@@ -101,7 +101,8 @@ class StreamCrowd {
   // blend_seconds while the new target is blended in (SLERP per joint).
   // offset < 0: the offset of another cluster of the agent reading the same
   // stream, else a random one from the crowd's seed.
-  void transition_to_streamed(Index agent, std::int32_t cluster, std::int32_t stream, float blend_seconds, std::int32_t offset = -1);
+  void transition_to_streamed(Index agent, std::int32_t cluster, std::int32_t stream, float blend_seconds,
+                              std::int32_t offset = -1);
   // A fresh instance of a unique animation (shared by the agent's clusters
   // that go to the same animation). When the animation has a duration and
   // then_stream >= 0, the cluster goes back to then_stream so as to arrive
@@ -124,21 +125,22 @@ class StreamCrowd {
   // cluster actually read (-1 for none).
   // skip, if not empty (per agent): agents != 0 are posed by someone else
   // (exact synthesis) and their palettes are left as they are.
-  void resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes, Span<std::int32_t> read_offsets = {},
-               Span<const std::uint8_t> skip = {}) const;
+  void resolve(Span<const glm::vec3> positions, Span<const float> yaws, Span<Mat3x4> palettes,
+               Span<std::int32_t> read_offsets = {}, Span<const std::uint8_t> skip = {}) const;
   // A desired stream and offset per agent for the clusters in cluster_mask,
   // applied now in one kernel (StreamRetargetJob: a new stream is blended
   // in over blend_seconds, the same stream takes the new offset at once,
   // kNoSource sets the rest pose, clusters on unique instances are left
   // alone). Call after step() and before resolve(). Spans in the crowd's
   // memory. Returns how many agents changed the source of some cluster.
-  Index retarget(Span<const std::int32_t> sources, Span<const std::int32_t> offsets, float blend_seconds, std::uint32_t cluster_mask = ~0u);
+  Index retarget(Span<const std::int32_t> sources, Span<const std::int32_t> offsets, float blend_seconds,
+                 std::uint32_t cluster_mask = ~0u);
 
   // ---- data for the renderer and the simulation (in the crowd's memory)
-  Index palette_size() const { return palette_size_; }                  // matrices for all agents
+  Index palette_size() const { return palette_size_; }                           // matrices for all agents
   Span<const Index> palette_offsets() const { return palette_offsets_.span(); }  // per agent
   Span<const std::int32_t> agent_rigs() const { return agent_rig_.span(); }
-  Span<const ClusterRef> cluster_refs() const { return clusters_.span(); }  // agents * cluster_stride
+  Span<const ClusterRef> cluster_refs() const { return clusters_.span(); }     // agents * cluster_stride
   Span<const EventMask> agent_events() const { return agent_events_.span(); }  // per agent, the last step's events
   StreamMemory memory() const;
 
@@ -183,7 +185,7 @@ class StreamCrowd {
   std::uint64_t command_serial_ = 0;
   std::array<EventMask, kMaxClusters> event_filter_;
   // Unique instances: who targets them, references held, delayed releases.
-  std::unordered_map<Index, UniqueRef> unique_targets_;  // agent * stride + cluster
+  std::unordered_map<Index, UniqueRef> unique_targets_;                     // agent * stride + cluster
   std::map<std::pair<Index, std::int32_t>, std::int32_t> unique_by_agent_;  // (agent, animation) -> instance
   std::vector<std::int32_t> unique_refcount_;
   std::vector<std::pair<std::int32_t, std::int32_t>> delayed_releases_;  // (frame, instance)

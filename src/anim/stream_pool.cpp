@@ -26,7 +26,9 @@ void apply_root_motion(RootMotion mode, Pose& pose) {
 
 void check_pose(const Pose& pose, std::int32_t joints, const std::string& who) {
   if (pose.joint_count() != joints)
-    throw Error("controller wrote " + std::to_string(pose.joint_count()) + " joints, the rig has " + std::to_string(joints), at_field(who));
+    throw Error(
+        "controller wrote " + std::to_string(pose.joint_count()) + " joints, the rig has " + std::to_string(joints),
+        at_field(who));
 }
 
 }  // namespace
@@ -49,12 +51,17 @@ void StreamSpec::validate(std::int32_t rig_count, float frame_rate) const {
 
 // ---- AnimStream ------------------------------------------------------------------
 
-AnimStream::AnimStream(const Rig& rig, std::int32_t rig_index, StreamSpec spec, std::unique_ptr<Controller> controller, Memory memory)
-    : spec_(std::move(spec)), joints_(rig.joint_count()), controller_(std::move(controller)), kinematics_(rig.kinematics()) {
+AnimStream::AnimStream(const Rig& rig, std::int32_t rig_index, StreamSpec spec, std::unique_ptr<Controller> controller,
+                       Memory memory)
+    : spec_(std::move(spec)),
+      joints_(rig.joint_count()),
+      controller_(std::move(controller)),
+      kinematics_(rig.kinematics()) {
   spec_.rig = rig_index;
   if (!controller_) throw Error("a stream needs a controller", at_field("streams." + spec_.name + ".controller"));
   if (controller_->joint_count() != joints_)
-    throw Error("controller has " + std::to_string(controller_->joint_count()) + " joints, rig '" + rig.name + "' has " + std::to_string(joints_),
+    throw Error("controller has " + std::to_string(controller_->joint_count()) + " joints, rig '" + rig.name +
+                    "' has " + std::to_string(joints_),
                 at_field("streams." + spec_.name + ".controller"));
   const Index M = spec_.history;
   rotations_ = Buffer<glm::quat>(M * joints_, memory);
@@ -82,7 +89,8 @@ double AnimStream::dilation() const {
 std::int32_t AnimStream::max_offset() const { return static_cast<std::int32_t>(std::floor(dilation() + 1e-9)); }
 
 std::size_t AnimStream::pose_bytes() const {
-  return static_cast<std::size_t>(rotations_.size()) * sizeof(glm::quat) + static_cast<std::size_t>(skinning_.size()) * sizeof(Mat3x4) +
+  return static_cast<std::size_t>(rotations_.size()) * sizeof(glm::quat) +
+         static_cast<std::size_t>(skinning_.size()) * sizeof(Mat3x4) +
          static_cast<std::size_t>(roots_.size()) * sizeof(glm::vec3);
 }
 
@@ -126,7 +134,8 @@ void AnimStream::start(float frame_rate) {
   change_rate_ = static_cast<double>(spec_.history) / (static_cast<double>(spec_.time_to_dilate) * frame_rate);
 }
 
-void AnimStream::fill(float frame_rate, std::int32_t newest_frame, Pose& scratch, std::vector<Mat3x4>& palette_scratch) {
+void AnimStream::fill(float frame_rate, std::int32_t newest_frame, Pose& scratch,
+                      std::vector<Mat3x4>& palette_scratch) {
   start(frame_rate);
   const float dt = 1.0f / frame_rate;
   const std::int32_t M = spec_.history;
@@ -151,9 +160,11 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
   const double current_length = max_offset() + 1.0;
   const double growth = std::max(0.0, history - current_length);
   if (time_to_dilate == 0.0f) time_to_dilate = static_cast<float>(2.0 * growth / frame_rate);
-  if (!std::isfinite(time_to_dilate) || !(static_cast<double>(time_to_dilate) * frame_rate >= growth - 1e-6) || time_to_dilate < 0.0f)
-    throw Error("must be at least " + std::to_string(growth / frame_rate) + " s to grow the history from " + std::to_string(old_m) + " to " +
-                    std::to_string(history) + " slots at no more than one slot per frame",
+  if (!std::isfinite(time_to_dilate) || !(static_cast<double>(time_to_dilate) * frame_rate >= growth - 1e-6) ||
+      time_to_dilate < 0.0f)
+    throw Error("must be at least " + std::to_string(growth / frame_rate) + " s to grow the history from " +
+                    std::to_string(old_m) + " to " + std::to_string(history) +
+                    " slots at no more than one slot per frame",
                 at_field(at + ".time_to_dilate"));
   const Memory memory = rotations_.memory();
   Buffer<glm::quat> rotations(static_cast<Index>(history) * joints_, memory);
@@ -193,7 +204,8 @@ void AnimStream::resize_history(std::int32_t history, float time_to_dilate, floa
   change_rate_ = growth > 0.0 ? growth / (static_cast<double>(time_to_dilate) * frame_rate) : 0.0;
   spec_.history = history;
   // A later restart dilates over the new history: keep its time if it still suffices.
-  if (static_cast<double>(spec_.time_to_dilate) * frame_rate < history) spec_.time_to_dilate = 2.0f * static_cast<float>(history) / frame_rate;
+  if (static_cast<double>(spec_.time_to_dilate) * frame_rate < history)
+    spec_.time_to_dilate = 2.0f * static_cast<float>(history) / frame_rate;
 }
 
 void AnimStream::write(const Pose& pose, EventMask events, std::int32_t frame, std::vector<Mat3x4>& palette) {
@@ -214,10 +226,12 @@ void AnimStream::write(const Pose& pose, EventMask events, std::int32_t frame, s
 // ---- StreamPool --------------------------------------------------------------------
 
 StreamPool::StreamPool(float frame_rate, Memory memory) : frame_rate_(frame_rate), memory_(memory) {
-  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f)) throw Error("must be in [1, 1000] frames per second", at_field("frame_rate"));
+  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f))
+    throw Error("must be in [1, 1000] frames per second", at_field("frame_rate"));
 }
 
-std::int32_t StreamPool::add(const Rig& rig, std::int32_t rig_index, StreamSpec spec, std::unique_ptr<Controller> controller) {
+std::int32_t StreamPool::add(const Rig& rig, std::int32_t rig_index, StreamSpec spec,
+                             std::unique_ptr<Controller> controller) {
   spec.rig = rig_index;
   spec.validate(rig_index + 1, frame_rate_);
   if (spec.time_to_dilate == 0.0f) spec.time_to_dilate = 2.0f * static_cast<float>(spec.history) / frame_rate_;
@@ -291,7 +305,8 @@ void StreamPool::refresh_views() {
 // ---- UniquePool ----------------------------------------------------------------------
 
 UniquePool::UniquePool(float frame_rate, Memory memory) : frame_rate_(frame_rate), memory_(memory) {
-  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f)) throw Error("must be in [1, 1000] frames per second", at_field("frame_rate"));
+  if (!(frame_rate >= 1.0f && frame_rate <= 1000.0f))
+    throw Error("must be in [1, 1000] frames per second", at_field("frame_rate"));
 }
 
 void UniquePool::set_capacity(const Rig& rig, std::int32_t rig_index, std::int32_t capacity) {
@@ -341,7 +356,8 @@ std::int32_t UniquePool::add_animation(UniqueAnimation animation) {
     if (s.rig == animation.rig) slab = &s;
   if (slab == nullptr) throw Error("the unique pool has no capacity for this animation's rig", at_field(at + ".rig"));
   if (animation.controller->joint_count() != slab->joints)
-    throw Error("controller has " + std::to_string(animation.controller->joint_count()) + " joints, the rig " + std::to_string(slab->joints),
+    throw Error("controller has " + std::to_string(animation.controller->joint_count()) + " joints, the rig " +
+                    std::to_string(slab->joints),
                 at_field(at + ".controller"));
   animations_.push_back(std::move(animation));
   return animation_count() - 1;
@@ -354,7 +370,8 @@ std::int32_t UniquePool::find_animation(const std::string& name) const {
 }
 
 std::int32_t UniquePool::acquire(std::int32_t animation) {
-  if (animation < 0 || animation >= animation_count()) throw Error("no unique animation " + std::to_string(animation), at_field("animation"));
+  if (animation < 0 || animation >= animation_count())
+    throw Error("no unique animation " + std::to_string(animation), at_field("animation"));
   const UniqueAnimation& a = animations_[static_cast<std::size_t>(animation)];
   for (const Slab& s : slabs_) {
     if (s.rig != a.rig) continue;
@@ -368,8 +385,9 @@ std::int32_t UniquePool::acquire(std::int32_t animation) {
       inst.newest = -1;
       return s.first_instance + k;
     }
-    throw Error("the unique pool of rig " + std::to_string(a.rig) + " is full (" + std::to_string(s.capacity) + " instances)",
-                at_field("unique.capacity"));
+    throw Error(
+        "the unique pool of rig " + std::to_string(a.rig) + " is full (" + std::to_string(s.capacity) + " instances)",
+        at_field("unique.capacity"));
   }
   throw Error("no capacity for the animation's rig", at_field("unique.capacity"));
 }
@@ -386,7 +404,8 @@ bool UniquePool::active(std::int32_t instance) const {
 }
 
 std::int32_t UniquePool::active_count() const {
-  return static_cast<std::int32_t>(std::count_if(instances_.begin(), instances_.end(), [](const Instance& i) { return i.animation >= 0; }));
+  return static_cast<std::int32_t>(
+      std::count_if(instances_.begin(), instances_.end(), [](const Instance& i) { return i.animation >= 0; }));
 }
 
 const Controller* UniquePool::controller(std::int32_t instance) const {
@@ -394,7 +413,8 @@ const Controller* UniquePool::controller(std::int32_t instance) const {
 }
 
 ParameterSet& UniquePool::parameters(std::int32_t instance) {
-  if (!active(instance)) throw Error("unique instance " + std::to_string(instance) + " is not active", at_field("instance"));
+  if (!active(instance))
+    throw Error("unique instance " + std::to_string(instance) + " is not active", at_field("instance"));
   return instances_[static_cast<std::size_t>(instance)].parameters;
 }
 
@@ -407,7 +427,8 @@ void UniquePool::step(std::int32_t frame) {
     // A new instance shows its time-0 pose first, then advances.
     if (inst.newest >= 0) inst.controller->advance(dt, inst.parameters, events);
     inst.controller->evaluate(scratch_);
-    check_pose(scratch_, slab.joints, "unique.animations." + animations_[static_cast<std::size_t>(inst.animation)].name);
+    check_pose(scratch_, slab.joints,
+               "unique.animations." + animations_[static_cast<std::size_t>(inst.animation)].name);
     apply_root_motion(animations_[static_cast<std::size_t>(inst.animation)].root, scratch_);
     palette_scratch_.resize(static_cast<std::size_t>(slab.joints));
     slab.kinematics.palette(scratch_, palette_scratch_.data());
@@ -422,8 +443,7 @@ void UniquePool::step(std::int32_t frame) {
 
 std::size_t UniquePool::pose_bytes() const {
   std::size_t total = 0;
-  for (const Slab& s : slabs_)
-    total += static_cast<std::size_t>(s.capacity) * pose_slot_bytes(s.joints);
+  for (const Slab& s : slabs_) total += static_cast<std::size_t>(s.capacity) * pose_slot_bytes(s.joints);
   return total;
 }
 

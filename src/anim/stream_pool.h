@@ -76,18 +76,19 @@ const char* to_string(RootMotion r);
 struct StreamSpec {
   std::string name;
   std::int32_t rig = 0;
-  std::int32_t history = 64;      // M, slots
+  std::int32_t history = 64;  // M, slots
   RootMotion root = RootMotion::InPlace;
   // Seconds for offsets to spread after a start; 0 picks 2 * history /
   // frame_rate (agents play at half speed while their offsets spread).
   float time_to_dilate = 0.0f;
-  bool running = true;            // started when added
+  bool running = true;                                            // started when added
   void validate(std::int32_t rig_count, float frame_rate) const;  // Error naming "streams.<name>.<field>"
 };
 
 class AnimStream {
  public:
-  AnimStream(const Rig& rig, std::int32_t rig_index, StreamSpec spec, std::unique_ptr<Controller> controller, Memory memory);
+  AnimStream(const Rig& rig, std::int32_t rig_index, StreamSpec spec, std::unique_ptr<Controller> controller,
+             Memory memory);
 
   const std::string& name() const { return spec_.name; }
   const StreamSpec& spec() const { return spec_; }
@@ -102,9 +103,9 @@ class AnimStream {
 
   std::int32_t head() const { return head_; }
   std::int32_t newest_frame() const { return newest_; }
-  std::int32_t written() const { return written_; }  // slots written since the last start, <= M
-  double dilation() const;                            // D
-  double change_rate() const { return change_rate_; } // slots per frame while dilating
+  std::int32_t written() const { return written_; }    // slots written since the last start, <= M
+  double dilation() const;                             // D
+  double change_rate() const { return change_rate_; }  // slots per frame while dilating
   std::int32_t max_offset() const;
 
   // Bytes of pose history (local rotations, skinning palettes and roots):

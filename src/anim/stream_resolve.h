@@ -30,14 +30,14 @@ inline constexpr std::int32_t kNeverRead = -2147483647 - 1;
 
 // One agent's cluster (32 bytes): where its joints come from.
 struct ClusterRef {
-  std::int32_t source = kNoSource;  // target source
-  std::int32_t offset = 0;          // frames behind the source's newest pose (before dilation)
+  std::int32_t source = kNoSource;       // target source
+  std::int32_t offset = 0;               // frames behind the source's newest pose (before dilation)
   std::int32_t from_source = kNoSource;  // transition source, blended out
   std::int32_t from_offset = 0;
-  std::int32_t t0 = 0;              // frame the transition started
-  float blend_frames = 0.0f;        // <= 0: no transition
+  std::int32_t t0 = 0;                  // frame the transition started
+  float blend_frames = 0.0f;            // <= 0: no transition
   std::int32_t last_read = kNeverRead;  // frame number of the source last read (events)
-  std::uint32_t flags = 0;          // kClusterCulled
+  std::uint32_t flags = 0;              // kClusterCulled
 };
 
 // alpha = clamp((t - t0) / T, 0, 1), with times in animation frames.
@@ -57,10 +57,10 @@ struct BoneOverride {
   std::int32_t joint = -1;
   OverrideKind kind = OverrideKind::Rotation;
   float weight = 1.0f;
-  float max_angle = 1.2f;                  // radians, LookAt
+  float max_angle = 1.2f;                      // radians, LookAt
   glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // Rotation
-  glm::vec3 target{0.0f};                  // LookAt: world point (model space when resolve gets no agent transforms)
-  glm::vec3 aim_axis{0.0f, 0.0f, 1.0f};    // LookAt: in the joint's bind frame (+Z: where the rig faces)
+  glm::vec3 target{0.0f};                // LookAt: world point (model space when resolve gets no agent transforms)
+  glm::vec3 aim_axis{0.0f, 0.0f, 1.0f};  // LookAt: in the joint's bind frame (+Z: where the rig faces)
 };
 
 // Rigs concatenated without padding: rig r's joints are
@@ -78,16 +78,16 @@ struct RigView {
 
 struct RigTablesView {
   Span<const RigView> rigs;
-  Span<const std::int32_t> parents;       // rig-local parent index per joint
-  Span<const glm::vec3> offsets;          // rest offsets
-  Span<const std::uint8_t> joint_cluster; // cluster of each joint (rig-local)
+  Span<const std::int32_t> parents;        // rig-local parent index per joint
+  Span<const glm::vec3> offsets;           // rest offsets
+  Span<const std::uint8_t> joint_cluster;  // cluster of each joint (rig-local)
   Span<const Mat3x4> inverse_bind;
-  Span<const glm::quat> hook_rotations;   // per rig cluster
+  Span<const glm::quat> hook_rotations;  // per rig cluster
   Span<const glm::vec3> hook_translations;
-  Span<const std::int32_t> hook_joints;   // per rig cluster, rig-local, -1 for the root's cluster
-  Span<const std::uint8_t> joint_segment; // segment of each joint (rig-local, ClusterLayout::segment_of_joint)
-  Span<const Mat3x4> segment_hooks;       // per rig segment: B_p * hook * B_p^-1, p its root's parent, B = bind
-  Span<const glm::vec3> bind_positions;   // per joint, model space
+  Span<const std::int32_t> hook_joints;    // per rig cluster, rig-local, -1 for the root's cluster
+  Span<const std::uint8_t> joint_segment;  // segment of each joint (rig-local, ClusterLayout::segment_of_joint)
+  Span<const Mat3x4> segment_hooks;        // per rig segment: B_p * hook * B_p^-1, p its root's parent, B = bind
+  Span<const glm::vec3> bind_positions;    // per joint, model space
 };
 
 // One transition or assignment for one (agent, cluster).
@@ -95,10 +95,10 @@ struct ClusterCommand {
   Index agent = 0;
   std::int32_t cluster = 0;
   std::int32_t source = -1;
-  std::int32_t offset = 0;           // < 0: match another cluster of the agent on the same source, else fallback_offset
+  std::int32_t offset = 0;  // < 0: match another cluster of the agent on the same source, else fallback_offset
   std::int32_t fallback_offset = 0;
-  float blend_frames = 0.0f;         // <= 0: instant
-  std::int32_t transition = 0;       // 0: assign (drops any transition), 1: transition from the current target
+  float blend_frames = 0.0f;    // <= 0: instant
+  std::int32_t transition = 0;  // 0: assign (drops any transition), 1: transition from the current target
 };
 
 // Commands sorted by agent; groups[g] is the first command of the g-th
@@ -158,7 +158,7 @@ struct StreamEventsJob {
   std::int32_t cluster_stride = 1;
   std::array<EventMask, kMaxClusters> cluster_event_filter{};
   Span<EventMask> out_events;  // per agent
-  void validate() const;  // Error naming the field
+  void validate() const;       // Error naming the field
   void run() const;
 };
 
@@ -194,6 +194,5 @@ struct StreamResolveJob {
   void validate() const;  // Error naming the field
   void run() const;
 };
-
 
 }  // namespace throng::anim

@@ -14,7 +14,7 @@ struct SlotRead {
   const glm::quat* rotations;  // null: the rest pose (identity rotations)
   const Mat3x4* skinning;      // null: the rest pose (identity matrices)
   glm::vec3 root;
-  std::int32_t offset;         // effective offset read, -1 for none
+  std::int32_t offset;  // effective offset read, -1 for none
   // Spelled out: with default member initialisers, nvcc 13 stops with an
   // internal error ("Invalid bitcast") on the arrays of AgentPose below.
   THRONG_HOST_DEVICE SlotRead() : rotations(nullptr), skinning(nullptr), root(0.0f), offset(-1) {}
@@ -23,14 +23,15 @@ struct SlotRead {
 // The view of a source id, or null for none (or an id out of range).
 // Spans by reference: copying a non-const Span lvalue would pick Span's
 // host-only container constructor under nvcc.
-THRONG_HOST_DEVICE inline const SourceView* find_source(const Span<const SourceView>& streams, const Span<const SourceView>& uniques,
-                                                        std::int32_t source) {
+THRONG_HOST_DEVICE inline const SourceView* find_source(const Span<const SourceView>& streams,
+                                                        const Span<const SourceView>& uniques, std::int32_t source) {
   if (source >= 0 && source < streams.size()) return &streams[source];
   if (is_unique_source(source) && unique_instance(source) < uniques.size()) return &uniques[unique_instance(source)];
   return nullptr;
 }
 
-THRONG_HOST_DEVICE inline SlotRead read_source(const Span<const SourceView>& streams, const Span<const SourceView>& uniques, std::int32_t source,
+THRONG_HOST_DEVICE inline SlotRead read_source(const Span<const SourceView>& streams,
+                                               const Span<const SourceView>& uniques, std::int32_t source,
                                                std::int32_t offset, std::int32_t joints, glm::vec3 rest_root) {
   SlotRead r;
   r.root = rest_root;
@@ -53,8 +54,10 @@ struct EventFilter {
 // ---- commands -----------------------------------------------------------------
 
 void StreamCommandJob::validate() const {
-  if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamCommandJob.cluster_stride"));
-  if (groups.empty()) throw Error("needs at least one entry (the end of the last group)", at_field("StreamCommandJob.groups"));
+  if (cluster_stride < 1 || cluster_stride > kMaxClusters)
+    throw Error("must be in [1, 8]", at_field("StreamCommandJob.cluster_stride"));
+  if (groups.empty())
+    throw Error("needs at least one entry (the end of the last group)", at_field("StreamCommandJob.groups"));
 }
 
 void StreamCommandJob::run() const {
@@ -100,8 +103,8 @@ namespace {
 // Points agent a's clusters (those in the job's mask, of the first
 // `count`, never a unique source's) at (source, offset), starting a
 // transition where a cluster changes source; returns 1 if one changed.
-THRONG_HOST_DEVICE inline std::uint8_t retarget_clusters(const StreamRetargetJob& job, Index a, std::int32_t source, std::int32_t offset,
-                                                         std::int32_t count) {
+THRONG_HOST_DEVICE inline std::uint8_t retarget_clusters(const StreamRetargetJob& job, Index a, std::int32_t source,
+                                                         std::int32_t offset, std::int32_t count) {
   std::uint8_t changed = 0;
   const std::int32_t stride = job.cluster_stride;
   count = count < stride ? count : stride;
@@ -135,8 +138,10 @@ THRONG_HOST_DEVICE inline std::uint8_t retarget_clusters(const StreamRetargetJob
 
 void StreamRetargetJob::validate() const {
   const Index n = agent_count();
-  if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamRetargetJob.cluster_stride"));
-  if (!(blend_frames >= 0.0f && blend_frames < 1e7f)) throw Error("must be in [0, 1e7) frames", at_field("StreamRetargetJob.blend_frames"));
+  if (cluster_stride < 1 || cluster_stride > kMaxClusters)
+    throw Error("must be in [1, 8]", at_field("StreamRetargetJob.cluster_stride"));
+  if (!(blend_frames >= 0.0f && blend_frames < 1e7f))
+    throw Error("must be in [0, 1e7) frames", at_field("StreamRetargetJob.blend_frames"));
   check_length("StreamRetargetJob", "sources", sources.size(), n);
   check_length("StreamRetargetJob", "offsets", offsets.size(), n);
   check_length("StreamRetargetJob", "clusters", clusters.size(), n * cluster_stride);
@@ -171,7 +176,8 @@ void StreamRetargetJob::run() const {
 
 void StreamEventsJob::validate() const {
   const Index n = agent_rigs.size();
-  if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamEventsJob.cluster_stride"));
+  if (cluster_stride < 1 || cluster_stride > kMaxClusters)
+    throw Error("must be in [1, 8]", at_field("StreamEventsJob.cluster_stride"));
   check_length("StreamEventsJob", "clusters", clusters.size(), n * cluster_stride);
   check_length("StreamEventsJob", "out_events", out_events.size(), n);
 }
@@ -215,7 +221,8 @@ void StreamEventsJob::run() const {
 
 void StreamResolveJob::validate() const {
   const Index n = agent_count();
-  if (cluster_stride < 1 || cluster_stride > kMaxClusters) throw Error("must be in [1, 8]", at_field("StreamResolveJob.cluster_stride"));
+  if (cluster_stride < 1 || cluster_stride > kMaxClusters)
+    throw Error("must be in [1, 8]", at_field("StreamResolveJob.cluster_stride"));
   check_length("StreamResolveJob", "palette_offsets", palette_offsets.size(), n);
   check_length("StreamResolveJob", "clusters", clusters.size(), n * cluster_stride);
   if (!positions.empty()) check_length("StreamResolveJob", "positions", positions.size(), n);
@@ -264,11 +271,13 @@ THRONG_HOST_DEVICE inline void read_agent(const StreamResolveJob& job, Index a, 
     pose.to[c] = read_source(job.streams, job.uniques, ref.source, ref.offset, rig.joint_count, rig.rest_root);
     pose.alpha[c] = transition_alpha(ref, job.frame);
     if (pose.alpha[c] < 1.0f)
-      pose.from[c] = read_source(job.streams, job.uniques, ref.from_source, ref.from_offset, rig.joint_count, rig.rest_root);
+      pose.from[c] =
+          read_source(job.streams, job.uniques, ref.from_source, ref.from_offset, rig.joint_count, rig.rest_root);
     pose.culled[c] = (ref.flags & kClusterCulled) != 0u;
     if (!job.read_offsets.empty()) job.read_offsets[a * stride + c] = pose.to[c].offset;
   }
-  pose.world_q = job.yaws.empty() ? glm::quat(1.0f, 0.0f, 0.0f, 0.0f) : glm::angleAxis(job.yaws[a], glm::vec3(0.0f, 1.0f, 0.0f));
+  pose.world_q =
+      job.yaws.empty() ? glm::quat(1.0f, 0.0f, 0.0f, 0.0f) : glm::angleAxis(job.yaws[a], glm::vec3(0.0f, 1.0f, 0.0f));
   pose.world_t = job.positions.empty() ? glm::vec3(0.0f) : job.positions[a];
 }
 
@@ -314,10 +323,12 @@ THRONG_HOST_DEVICE inline void look_at(const BoneOverride& o, glm::quat& R, glm:
 
 // Joint j's local rotation: its cluster's slot, SLERPed from the
 // transition source by alpha, then a rotation override o (or null).
-THRONG_HOST_DEVICE inline glm::quat local_rotation(const AgentPose& pose, std::int32_t c, std::int32_t j, const BoneOverride* o) {
+THRONG_HOST_DEVICE inline glm::quat local_rotation(const AgentPose& pose, std::int32_t c, std::int32_t j,
+                                                   const BoneOverride* o) {
   glm::quat local = pose.to[c].rotations != nullptr ? pose.to[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   if (pose.alpha[c] < 1.0f) {
-    const glm::quat src = pose.from[c].rotations != nullptr ? pose.from[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    const glm::quat src =
+        pose.from[c].rotations != nullptr ? pose.from[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
     local = glm::slerp(src, local, pose.alpha[c]);
   }
   if (o != nullptr && o->kind == OverrideKind::Rotation) local = glm::slerp(local, o->rotation, o->weight);
@@ -328,7 +339,8 @@ THRONG_HOST_DEVICE inline glm::quat local_rotation(const AgentPose& pose, std::i
 // kinematics through the cluster hooks, look-at overrides, times the
 // agent's world transform and the inverse bind matrix. Overrides
 // [ov, ov_end) are sorted by joint.
-THRONG_HOST_DEVICE inline void pose_blended(const StreamResolveJob& job, const AgentPose& pose, Index ov, Index ov_end) {
+THRONG_HOST_DEVICE inline void pose_blended(const StreamResolveJob& job, const AgentPose& pose, Index ov,
+                                            Index ov_end) {
   const RigTablesView& T = job.tables;
   const RigView& rig = pose.rig;
   glm::quat R[kMaxRigJoints];
@@ -375,7 +387,8 @@ THRONG_HOST_DEVICE inline void collapse_culled(const StreamResolveJob& job, cons
     if (!pose.culled[c]) continue;
     std::int32_t hook = T.hook_joints[rig.cluster_base + c];
     hook = hook >= 0 ? hook : 0;
-    job.palettes[pose.base + j] = collapse_to(transform_point(job.palettes[pose.base + hook], T.bind_positions[rig.joint_base + hook]));
+    job.palettes[pose.base + j] =
+        collapse_to(transform_point(job.palettes[pose.base + hook], T.bind_positions[rig.joint_base + hook]));
   }
 }
 
@@ -387,7 +400,8 @@ THRONG_HOST_DEVICE inline void resolve_agent(const StreamResolveJob& job, Index 
   AgentPose pose;
   pose.rig = job.tables.rigs[r];
   pose.base = job.palette_offsets[a];
-  if (pose.rig.joint_count > kMaxRigJoints || pose.base < 0 || pose.base + pose.rig.joint_count > job.palettes.size()) return;
+  if (pose.rig.joint_count > kMaxRigJoints || pose.base < 0 || pose.base + pose.rig.joint_count > job.palettes.size())
+    return;
   read_agent(job, a, pose);
   Index ov = 0, ov_end = 0;
   if (!job.override_begin.empty()) {
@@ -408,7 +422,8 @@ THRONG_HOST_DEVICE inline void resolve_agent(const StreamResolveJob& job, Index 
 
 void StreamResolveJob::run() const {
   validate();
-  parallel_for("anim.stream_resolve", agent_count(), THRONG_JOB_LAMBDA(Index a) { resolve_agent(*this, a); }, 64);
+  parallel_for(
+      "anim.stream_resolve", agent_count(), THRONG_JOB_LAMBDA(Index a) { resolve_agent(*this, a); }, 64);
 }
 
 }  // namespace throng::anim

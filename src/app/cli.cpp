@@ -23,7 +23,8 @@ namespace {
 
 // 16777216 rather than 1.67772e+07; 0.01 rather than 0.010000.
 std::string number(double v) {
-  if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15) return fmt::format("{}", static_cast<long long>(v));
+  if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15)
+    return fmt::format("{}", static_cast<long long>(v));
   return fmt::format("{:g}", v);
 }
 
@@ -51,7 +52,8 @@ CLI::Validator greater_than(double min) {
 }
 
 CLI::Validator between(double lo, double hi) {
-  return number_check([lo, hi](double v) { return v >= lo && v <= hi; }, "must be between " + number(lo) + " and " + number(hi),
+  return number_check([lo, hi](double v) { return v >= lo && v <= hi; },
+                      "must be between " + number(lo) + " and " + number(hi),
                       "in [" + number(lo) + ", " + number(hi) + "]");
 }
 
@@ -62,10 +64,11 @@ void check_lod_thresholds(const std::vector<float>& thresholds, const std::strin
   for (std::size_t i = 0; i < thresholds.size(); ++i) {
     const float t = thresholds[i];
     if (!(t > 0.0f) || !std::isfinite(t))
-      throw Error(fmt::format("thresholds must be positive square pixels, got {}", number(static_cast<double>(t))), at_field(flag));
+      throw Error(fmt::format("thresholds must be positive square pixels, got {}", number(static_cast<double>(t))),
+                  at_field(flag));
     if (i > 0 && !(t < thresholds[i - 1]))
-      throw Error(fmt::format("thresholds must decrease (finest level first, e.g. 1000,30), got {} after {}", number(static_cast<double>(t)),
-                              number(static_cast<double>(thresholds[i - 1]))),
+      throw Error(fmt::format("thresholds must decrease (finest level first, e.g. 1000,30), got {} after {}",
+                              number(static_cast<double>(t)), number(static_cast<double>(thresholds[i - 1]))),
                   at_field(flag));
   }
 }

@@ -55,7 +55,8 @@ std::vector<Index> track_skating(anim::CrowdAnimator& crowd, const io::AnimateSp
 // The run: `frames` frames of dt seconds under the orbiting camera (its
 // radius, else the formation's extent + 15 m), each frame's locomotion
 // time (ms) and stats into `tally`; progress logged every 2 s.
-void animate_frames(FormationCrowd& formation_crowd, const io::AnimateSpec& spec, float dt, std::int64_t frames, LocomotionTally& tally) {
+void animate_frames(FormationCrowd& formation_crowd, const io::AnimateSpec& spec, float dt, std::int64_t frames,
+                    LocomotionTally& tally) {
   Camera lens;
   lens.width = spec.width;
   lens.height = spec.height;
@@ -75,7 +76,8 @@ void animate_frames(FormationCrowd& formation_crowd, const io::AnimateSpec& spec
     tally.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     const auto now = std::chrono::steady_clock::now();
     if (now - last_report > std::chrono::seconds(2)) {
-      spdlog::info("frame {}/{} ({:.0f}%)", f + 1, frames, 100.0 * static_cast<double>(f + 1) / static_cast<double>(frames));
+      spdlog::info("frame {}/{} ({:.0f}%)", f + 1, frames,
+                   100.0 * static_cast<double>(f + 1) / static_cast<double>(frames));
       last_report = now;
     }
   }
@@ -102,13 +104,15 @@ struct AnimateMeasures {
 
 // stats.json: the scenario, counts, frame times (ms), timings, joints
 // synthesised, joint LOD, cache, foot skating (cm) and the formation's drift.
-nlohmann::json animate_stats(const io::AnimateSpec& spec, const motion::BlendSpace1D& space, anim::CrowdAnimator& crowd, const LocomotionTally& tally,
-                             std::int64_t frames, float dt, const AnimateMeasures& m) {
+nlohmann::json animate_stats(const io::AnimateSpec& spec, const motion::BlendSpace1D& space, anim::CrowdAnimator& crowd,
+                             const LocomotionTally& tally, std::int64_t frames, float dt, const AnimateMeasures& m) {
   const Index n = spec.characters;
   const nlohmann::json frame_ms = tally.frame_ms_json();
   const double median = frame_ms["median"].get<double>();
   nlohmann::json stats;
-  stats["scenario"] = {{"name", spec.name}, {"source", spec.source}, {"shape", spec.shape == io::AnimateSpec::Shape::Circle ? "circle" : "grid"}};
+  stats["scenario"] = {{"name", spec.name},
+                       {"source", spec.source},
+                       {"shape", spec.shape == io::AnimateSpec::Shape::Circle ? "circle" : "grid"}};
   stats["characters"] = n;
   stats["joints"] = space.joint_count();
   stats["frames"] = frames;
@@ -118,7 +122,11 @@ nlohmann::json animate_stats(const io::AnimateSpec& spec, const motion::BlendSpa
   stats["threads"] = current_threads();
   nlohmann::json clips = nlohmann::json::array();
   for (const motion::LocomotionClip& c : space.clips())
-    clips.push_back({{"name", c.name}, {"speed_mps", c.speed}, {"stride_m", c.stride_m}, {"period_s", c.period_s}, {"frames", c.frame_count()}});
+    clips.push_back({{"name", c.name},
+                     {"speed_mps", c.speed},
+                     {"stride_m", c.stride_m},
+                     {"period_s", c.period_s},
+                     {"frames", c.frame_count()}});
   stats["blend_space"] = clips;
   stats["frame_ms"] = frame_ms;
   stats["characters_per_second"] = median > 0.0 ? static_cast<double>(n) / (median / 1000.0) : 0.0;
@@ -130,7 +138,10 @@ nlohmann::json animate_stats(const io::AnimateSpec& spec, const motion::BlendSpa
     cache["quantisation_error_deg"] = {{"max", q.max_deg}, {"mean", q.mean_deg}};
     stats["cache"] = cache;
   }
-  stats["foot_skating_cm"] = {{"mean", m.skate.mean_cm}, {"p95", m.skate.p95_cm}, {"max", m.skate.max_cm}, {"contacts", m.skate.contacts},
+  stats["foot_skating_cm"] = {{"mean", m.skate.mean_cm},
+                              {"p95", m.skate.p95_cm},
+                              {"max", m.skate.max_cm},
+                              {"contacts", m.skate.contacts},
                               {"characters", m.tracked}};
   if (spec.shape == io::AnimateSpec::Shape::Circle) stats["formation"] = {{"max_drift_from_ring_m", m.drift}};
   return stats;
@@ -140,33 +151,41 @@ nlohmann::json animate_stats(const io::AnimateSpec& spec, const motion::BlendSpa
 fs::path write_stats(const std::string& out_dir, const nlohmann::json& stats) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
-  if (ec || !fs::is_directory(out_dir)) throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(out_dir, 0));
+  if (ec || !fs::is_directory(out_dir))
+    throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(out_dir, 0));
   const fs::path json_path = fs::path(out_dir) / "stats.json";
   io::write_json_file(json_path.string(), stats);
   return json_path;
 }
 
 // The summary on stdout, from stats.json's content and the measures.
-void print_animate_summary(const io::AnimateSpec& spec, const motion::BlendSpace1D& space, const LocomotionTally& tally, std::int64_t frames,
-                           const nlohmann::json& stats, const AnimateMeasures& m, const fs::path& json_path) {
+void print_animate_summary(const io::AnimateSpec& spec, const motion::BlendSpace1D& space, const LocomotionTally& tally,
+                           std::int64_t frames, const nlohmann::json& stats, const AnimateMeasures& m,
+                           const fs::path& json_path) {
   const Index n = spec.characters;
   const double median = stats["frame_ms"]["median"].get<double>();
   const double mean = stats["frame_ms"]["mean"].get<double>();
   std::printf("%s: %lld characters, %d joints, %lld frames at %g fps (%s mode, %s, %d threads)\n", spec.name.c_str(),
-              static_cast<long long>(n), space.joint_count(), static_cast<long long>(frames), static_cast<double>(spec.fps),
-              spec.paper_mode ? "paper" : "continuous", to_string(current_backend()), current_threads());
+              static_cast<long long>(n), space.joint_count(), static_cast<long long>(frames),
+              static_cast<double>(spec.fps), spec.paper_mode ? "paper" : "continuous", to_string(current_backend()),
+              current_threads());
   std::printf("  locomotion frame: median %.3f ms, mean %.3f ms (%.3g characters/s)\n", median, mean,
               static_cast<double>(stats["characters_per_second"]));
-  std::printf("  joints synthesised: %.1f of %d per character%s\n", static_cast<double>(tally.joints_synthesised) / tally.character_frames(),
-              space.joint_count(), spec.lod ? " (joint LOD)" : "");
+  std::printf("  joints synthesised: %.1f of %d per character%s\n",
+              static_cast<double>(tally.joints_synthesised) / tally.character_frames(), space.joint_count(),
+              spec.lod ? " (joint LOD)" : "");
   if (stats.contains("cache"))
-    std::printf("  cache: %.1f%% hits, %lld cycles held (%.2f MB), %lld evictions, quantisation error max %.2f deg, mean %.3f deg\n",
-                100.0 * static_cast<double>(stats["cache"]["hit_rate"]), static_cast<long long>(stats["cache"]["entries"]),
-                static_cast<double>(stats["cache"]["bytes"]) / (1024.0 * 1024.0), static_cast<long long>(stats["cache"]["evictions"]),
-                static_cast<double>(stats["cache"]["quantisation_error_deg"]["max"]),
-                static_cast<double>(stats["cache"]["quantisation_error_deg"]["mean"]));
+    std::printf(
+        "  cache: %.1f%% hits, %lld cycles held (%.2f MB), %lld evictions, quantisation error max %.2f deg, mean %.3f "
+        "deg\n",
+        100.0 * static_cast<double>(stats["cache"]["hit_rate"]), static_cast<long long>(stats["cache"]["entries"]),
+        static_cast<double>(stats["cache"]["bytes"]) / (1024.0 * 1024.0),
+        static_cast<long long>(stats["cache"]["evictions"]),
+        static_cast<double>(stats["cache"]["quantisation_error_deg"]["max"]),
+        static_cast<double>(stats["cache"]["quantisation_error_deg"]["mean"]));
   std::printf("  foot skating: %s of %zu characters\n", motion::describe(m.skate).c_str(), m.tracked);
-  if (spec.shape == io::AnimateSpec::Shape::Circle) std::printf("  formation: largest drift from a ring %.2g m\n", m.drift);
+  if (spec.shape == io::AnimateSpec::Shape::Circle)
+    std::printf("  formation: largest drift from a ring %.2g m\n", m.drift);
   std::printf("  wrote %s\n", json_path.string().c_str());
 }
 
@@ -175,7 +194,8 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
   if (duration_override > 0.0f) spec.duration_s = duration_override;
   if (characters_override > 0) spec.characters = characters_override;
   const std::string out_dir = out_override.empty() ? spec.output : out_override;
-  check_memory_budget(static_cast<double>(spec.characters) * kLocomotionBytesPerAgent, fmt::format("{} characters", spec.characters),
+  check_memory_budget(static_cast<double>(spec.characters) * kLocomotionBytesPerAgent,
+                      fmt::format("{} characters", spec.characters),
                       characters_override > 0 ? "--characters" : "characters");
 
   FormationCrowd formation_crowd(spec, folder);  // blend space, formation, speeds drawn from the seed
@@ -186,8 +206,8 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
 
   const float dt = 1.0f / spec.fps;
   const auto frames = std::max<std::int64_t>(1, std::llround(static_cast<double>(spec.duration_s) * spec.fps));
-  spdlog::info("animating {} characters ({} joints, {} clips, {} mode) for {} frames at {} fps", n, space.joint_count(), space.clip_count(),
-               spec.paper_mode ? "paper" : "continuous", frames, spec.fps);
+  spdlog::info("animating {} characters ({} joints, {} clips, {} mode) for {} frames at {} fps", n, space.joint_count(),
+               space.clip_count(), spec.paper_mode ? "paper" : "continuous", frames, spec.fps);
   LocomotionTally tally;
   animate_frames(formation_crowd, spec, dt, frames, tally);
 
@@ -203,7 +223,8 @@ void animate(io::AnimateSpec spec, const fs::path& folder, const std::string& ou
 }  // namespace
 
 void add_animate_command(CLI::App& app, const GlobalOptions& g) {
-  auto* cmd = app.add_subcommand("animate", "Animate characters in a formation with the locomotion stage alone (no crowd simulation)");
+  auto* cmd = app.add_subcommand(
+      "animate", "Animate characters in a formation with the locomotion stage alone (no crowd simulation)");
   static std::string scenario = "formation";
   static std::string out_dir;
   static float duration = 0.0f;

@@ -14,7 +14,9 @@ void add_bench_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_flag("--quick", options.quick, "Short runs on small sizes (a smoke test, not for quoting)");
   cmd->add_option("--json", json_path, "Write the results as JSON to this file");
   cmd->add_option("--filter", options.filter, "Regular expression on benchmark names, e.g. 'core/.*'");
-  cmd->add_option("--thread-counts", options.threads, "CPU thread counts to run, e.g. 1,2 (default: 1 and all cores)")->delimiter(',')->check(at_least(1));
+  cmd->add_option("--thread-counts", options.threads, "CPU thread counts to run, e.g. 1,2 (default: 1 and all cores)")
+      ->delimiter(',')
+      ->check(at_least(1));
   cmd->callback([&g] {
     apply_global_options(g);
     std::ofstream out;

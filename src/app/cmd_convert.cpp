@@ -40,7 +40,8 @@ const std::vector<MotionWriter>& motion_writers() {
 // The writer for `path`, or an Error listing the extensions there are writers for.
 const MotionWriter& writer_for(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   std::vector<std::string> extensions;
   for (const MotionWriter& w : motion_writers()) {
     if (ext == w.extension) return w;
@@ -78,9 +79,9 @@ void add_convert_command(CLI::App& app, const GlobalOptions& g) {
     const io::BvhFile bvh = io::read_bvh(input, r);
     w.frame_time = bvh.frame_time;
     writer.write(output, bvh, w);
-    spdlog::info("{}: {} joints, {} frames, read as {} ({}), written as {} with order {}", output, bvh.skeleton.joint_count(),
-                 bvh.clip.frame_count, motion::to_string(bvh.unit), bvh.unit_detected ? "detected" : "given",
-                 motion::to_string(w.unit), motion::to_string(w.order));
+    spdlog::info("{}: {} joints, {} frames, read as {} ({}), written as {} with order {}", output,
+                 bvh.skeleton.joint_count(), bvh.clip.frame_count, motion::to_string(bvh.unit),
+                 bvh.unit_detected ? "detected" : "given", motion::to_string(w.unit), motion::to_string(w.order));
   });
 }
 

@@ -43,7 +43,8 @@ nlohmann::json describe(const motion::DefaultMotion& m, const motion::Skeleton& 
   const motion::CycleReport r = motion::analyze_cycle(skeleton, m.clip, options);
   // Skating over three strides sampled by the generator itself (exact).
   const motion::LocomotionGenerator generator(skeleton, m.spec);
-  const motion::FootSkatingReport skate = motion::measure_foot_skating(skeleton, generator.sample(3 * m.clip.frame_count));
+  const motion::FootSkatingReport skate =
+      motion::measure_foot_skating(skeleton, generator.sample(3 * m.clip.frame_count));
   nlohmann::json j = {{"name", m.spec.name},
                       {"file", file},
                       {"description", m.description},
@@ -70,7 +71,8 @@ nlohmann::json describe(const motion::DefaultMotion& m, const motion::Skeleton& 
 }  // namespace
 
 void add_export_command(CLI::App& app, const GlobalOptions& g) {
-  auto* cmd = app.add_subcommand("export-default", "Write the default skeleton's locomotion cycles as BVH plus motions.json");
+  auto* cmd =
+      app.add_subcommand("export-default", "Write the default skeleton's locomotion cycles as BVH plus motions.json");
   static std::string dir;
   static std::string order = "ZXY";
   static std::string units = "cm";
@@ -83,14 +85,16 @@ void add_export_command(CLI::App& app, const GlobalOptions& g) {
     namespace fs = std::filesystem;
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (ec || !fs::is_directory(dir)) throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(dir, 0));
+    if (ec || !fs::is_directory(dir))
+      throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(dir, 0));
 
     const motion::Skeleton skeleton = motion::default_skeleton();
     const auto motions = motion::make_default_motions(skeleton);
-    nlohmann::json summary = {{"skeleton", {{"joints", skeleton.joint_count()}, {"height_m", 1.75}, {"names", skeleton.names}}},
-                              {"units", motion::to_string(w.unit)},
-                              {"rotation_order", motion::to_string(w.order)},
-                              {"motions", nlohmann::json::array()}};
+    nlohmann::json summary = {
+        {"skeleton", {{"joints", skeleton.joint_count()}, {"height_m", 1.75}, {"names", skeleton.names}}},
+        {"units", motion::to_string(w.unit)},
+        {"rotation_order", motion::to_string(w.order)},
+        {"motions", nlohmann::json::array()}};
     for (const auto& m : motions) {
       const std::string file = m.spec.name + ".bvh";
       w.frame_time = 1.0 / m.spec.fps;

@@ -37,9 +37,11 @@ struct ExportOptions {
 void export_crowd(const ExportOptions& o) {
   std::error_code ec;
   if (std::filesystem::is_directory(o.scenario, ec))
-    throw Error("is a folder: export-crowd runs a scenario (a YAML file or a built-in name); give it the scenario the run used, with "
-                "its --agents and --seed",
-                at_field("scenario", o.scenario));
+    throw Error(
+        "is a folder: export-crowd runs a scenario (a YAML file or a built-in name); give it the scenario the run "
+        "used, with "
+        "its --agents and --seed",
+        at_field("scenario", o.scenario));
   io::LoadedScenario loaded = io::load_scenario(o.scenario);
   sim::ScenarioSpec& spec = loaded.spec;
   if (o.agents > 0) sim::scale_agent_counts(spec, o.agents);
@@ -47,21 +49,25 @@ void export_crowd(const ExportOptions& o) {
   const auto steps = static_cast<std::int64_t>(std::ceil(o.seconds / static_cast<double>(spec.dt) - 1e-9));
   const auto frames = static_cast<std::int64_t>(std::floor(o.seconds * o.fps + 1e-9)) + 1;
   const std::string out = !o.out.empty() ? o.out : "out/" + spec.name + "/crowd.glb";
-  if (std::filesystem::path(out).extension() != ".glb") throw Error("must name a .glb file (glTF 2.0 binary)", at_field("--out", out));
+  if (std::filesystem::path(out).extension() != ".glb")
+    throw Error("must name a .glb file (glTF 2.0 binary)", at_field("--out", out));
 
   // Size and memory, before any work: the keys dominate both.
   const anim::Rig probe = anim::make_rig("mannequin", motion::make_default_blend_space().skeleton());
   const double bytes = io::CrowdTake::estimate_bytes(probe, spec.total_agents(), frames);
   if (bytes > o.max_megabytes * 1e6)
-    throw Error(fmt::format("{} agents x {} frames would write about {:.0f} MB, over --max-size {:g} MB: lower --fps, --seconds or --agents, "
+    throw Error(fmt::format("{} agents x {} frames would write about {:.0f} MB, over --max-size {:g} MB: lower --fps, "
+                            "--seconds or --agents, "
                             "or raise --max-size",
                             spec.total_agents(), frames, bytes / 1e6, o.max_megabytes),
                 at_field("--max-size"));
-  check_memory_budget(2.0 * bytes + static_cast<double>(spec.total_agents()) * (kSimBytesPerAgent + kLocomotionBytesPerAgent),
-                      fmt::format("{} agents, {} frames", spec.total_agents(), frames), "--agents");
+  check_memory_budget(
+      2.0 * bytes + static_cast<double>(spec.total_agents()) * (kSimBytesPerAgent + kLocomotionBytesPerAgent),
+      fmt::format("{} agents, {} frames", spec.total_agents(), frames), "--agents");
 
-  std::fprintf(stderr, "throng export-crowd: %s: %lld agents, %.3g s at %g fps (%lld frames), about %.1f MB\n", spec.name.c_str(),
-               static_cast<long long>(spec.total_agents()), o.seconds, o.fps, static_cast<long long>(frames), bytes / 1e6);
+  std::fprintf(stderr, "throng export-crowd: %s: %lld agents, %.3g s at %g fps (%lld frames), about %.1f MB\n",
+               spec.name.c_str(), static_cast<long long>(spec.total_agents()), o.seconds, o.fps,
+               static_cast<long long>(frames), bytes / 1e6);
   std::unique_ptr<sim::Simulation> sim = io::build_simulation(loaded);
   sim::FrameLoop loop(*sim);
   std::optional<io::CrowdTake> take;
@@ -93,23 +99,26 @@ void export_crowd(const ExportOptions& o) {
   }
   io::write_crowd_glb(out, *take);
   const auto size = std::filesystem::file_size(out, ec);
-  std::printf("wrote %s: %lld agents x %d joints, %d frames at %g fps (%.3g s simulated in %.1f s), %.1f MB\n", out.c_str(),
-              static_cast<long long>(take->agents()), take->joints(), take->frames(), o.fps, result.simulated_seconds, result.wall_seconds,
-              static_cast<double>(size) / 1e6);
+  std::printf("wrote %s: %lld agents x %d joints, %d frames at %g fps (%.3g s simulated in %.1f s), %.1f MB\n",
+              out.c_str(), static_cast<long long>(take->agents()), take->joints(), take->frames(), o.fps,
+              result.simulated_seconds, result.wall_seconds, static_cast<double>(size) / 1e6);
 }
 
 }  // namespace
 
 void add_export_crowd_command(CLI::App& app, const GlobalOptions& g) {
-  auto* cmd = app.add_subcommand("export-crowd",
-                                 "Run a scenario and write its animated crowd as glTF 2.0 (.glb): the skinned mannequin and every agent's "
-                                 "joints keyed at --fps, for Blender, Maya, Houdini or Unreal");
+  auto* cmd = app.add_subcommand(
+      "export-crowd",
+      "Run a scenario and write its animated crowd as glTF 2.0 (.glb): the skinned mannequin and every agent's "
+      "joints keyed at --fps, for Blender, Maya, Houdini or Unreal");
   static ExportOptions o;
   cmd->add_option("scenario", o.scenario, "Scenario file, or a built-in name")->capture_default_str();
   cmd->add_option("--out", o.out, "The .glb to write (default: out/<scenario>/crowd.glb)");
   cmd->add_option("--format", o.format, "Export format")->check(CLI::IsMember({"gltf"}))->capture_default_str();
   cmd->add_option("--agents", o.agents, "Total agents (groups keep their proportions)")->check(at_least(1));
-  cmd->add_option("--seconds", o.seconds, "Simulated seconds to export")->check(between(0.01, 3600))->capture_default_str();
+  cmd->add_option("--seconds", o.seconds, "Simulated seconds to export")
+      ->check(between(0.01, 3600))
+      ->capture_default_str();
   cmd->add_option("--fps", o.fps, "Keys per simulated second")->check(between(1, 120))->capture_default_str();
   cmd->add_option("--seed", o.seed, "Random seed (spawn positions, speeds, random goals)");
   cmd->add_option("--max-size", o.max_megabytes, "Refuse an export estimated above this many MB")

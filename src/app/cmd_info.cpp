@@ -35,8 +35,9 @@ std::vector<motion::RoleOverride> role_options(const std::vector<std::string>& i
     const auto eq = item.find('=');
     const auto role = motion::parse_role(item.substr(0, eq));
     if (eq == std::string::npos || !role || eq + 1 == item.size())
-      throw Error("expected ROLE=JOINT with ROLE one of hips, neck, head, left_shoulder, ..., right_toe; got '" + item + "'",
-                  at_field("--role"));
+      throw Error(
+          "expected ROLE=JOINT with ROLE one of hips, neck, head, left_shoulder, ..., right_toe; got '" + item + "'",
+          at_field("--role"));
     out.push_back({*role, item.substr(eq + 1)});
   }
   return out;
@@ -58,10 +59,18 @@ nlohmann::json cycle_info(const io::BvhFile& bvh) {
     for (const auto& i : foot.intervals) intervals.push_back({i.begin, i.end});
     contacts.push_back(intervals);
   }
-  return {{"start_frame", c.start_frame},   {"end_frame", c.end_frame},        {"period_frames", c.period_frames},
-          {"period_s", c.period_s},         {"steps", c.steps},                {"cadence_steps_per_min", c.cadence},
-          {"stride_length_m", c.stride_length}, {"mean_speed_m_s", c.mean_speed}, {"turn_rate_rad_s", c.turn_rate},
-          {"pose_rms_m", c.pose_rms_m},     {"input_is_loop", c.input_is_loop}, {"contacts_left_right", contacts}};
+  return {{"start_frame", c.start_frame},
+          {"end_frame", c.end_frame},
+          {"period_frames", c.period_frames},
+          {"period_s", c.period_s},
+          {"steps", c.steps},
+          {"cadence_steps_per_min", c.cadence},
+          {"stride_length_m", c.stride_length},
+          {"mean_speed_m_s", c.mean_speed},
+          {"turn_rate_rad_s", c.turn_rate},
+          {"pose_rms_m", c.pose_rms_m},
+          {"input_is_loop", c.input_is_loop},
+          {"contacts_left_right", contacts}};
 }
 
 bool has_bvh_extension(const std::string& path) {
@@ -75,13 +84,15 @@ void print_text(const nlohmann::json& j) {
   std::printf("%-12s %s\n", "file", j["file"].get<std::string>().c_str());
   std::printf("%-12s %d (%d end sites), %d channels\n", "joints", j["joints"].get<int>(), j["end_sites"].get<int>(),
               j["channels"].get<int>());
-  std::printf("%-12s %d at %.9g s (%.4g fps), %.3f s\n", "frames", j["frames"].get<int>(), j["frame_time"].get<double>(),
-              j["frame_rate"].get<double>(), j["duration"].get<double>());
+  std::printf("%-12s %d at %.9g s (%.4g fps), %.3f s\n", "frames", j["frames"].get<int>(),
+              j["frame_time"].get<double>(), j["frame_rate"].get<double>(), j["duration"].get<double>());
   const auto& u = j["units"];
-  std::printf("%-12s %s (%s), %.9g m per unit; rest pose %.3f m across\n", "units", u["unit"].get<std::string>().c_str(),
-              u["detected"].get<bool>() ? "detected" : "given", u["metres_per_unit"].get<double>(), j["rest_extent_m"].get<double>());
+  std::printf("%-12s %s (%s), %.9g m per unit; rest pose %.3f m across\n", "units",
+              u["unit"].get<std::string>().c_str(), u["detected"].get<bool>() ? "detected" : "given",
+              u["metres_per_unit"].get<double>(), j["rest_extent_m"].get<double>());
   std::string orders;
-  for (auto& [order, count] : j["rotation_orders"].items()) orders += fmt::format("{}{} x{}", orders.empty() ? "" : ", ", order, count.get<int>());
+  for (auto& [order, count] : j["rotation_orders"].items())
+    orders += fmt::format("{}{} x{}", orders.empty() ? "" : ", ", order, count.get<int>());
   std::printf("%-12s %s\n", "rotations", orders.c_str());
   std::string found, missing;
   for (std::size_t r = 0; r < motion::kRoleCount; ++r) {  // in Role order, not the JSON's sorted keys
@@ -104,10 +115,12 @@ void print_text(const nlohmann::json& j) {
   } else if (c.contains("error")) {
     std::printf("%-12s not analysed: %s\n", "cycle", c["error"].get<std::string>().c_str());
   } else {
-    std::printf("%-12s frames %d..%d (%.3f s), %d steps, cadence %.1f steps/min, stride %.2f m, mean speed %.2f m/s, turn %.1f deg/s\n",
-                "cycle", c["start_frame"].get<int>(), c["end_frame"].get<int>(), c["period_s"].get<double>(), c["steps"].get<int>(),
-                c["cadence_steps_per_min"].get<double>(), c["stride_length_m"].get<double>(), c["mean_speed_m_s"].get<double>(),
-                c["turn_rate_rad_s"].get<double>() * 57.29577951308232);
+    std::printf(
+        "%-12s frames %d..%d (%.3f s), %d steps, cadence %.1f steps/min, stride %.2f m, mean speed %.2f m/s, turn %.1f "
+        "deg/s\n",
+        "cycle", c["start_frame"].get<int>(), c["end_frame"].get<int>(), c["period_s"].get<double>(),
+        c["steps"].get<int>(), c["cadence_steps_per_min"].get<double>(), c["stride_length_m"].get<double>(),
+        c["mean_speed_m_s"].get<double>(), c["turn_rate_rad_s"].get<double>() * 57.29577951308232);
   }
 }
 
@@ -126,7 +139,8 @@ void add_info_command(CLI::App& app, const GlobalOptions& g) {
   cmd->callback([&g] {
     apply_global_options(g);
     if (!file.empty()) {
-      if (!has_bvh_extension(file)) throw Error("cannot describe this file type (expected a .bvh file)", at_line(file, 0));
+      if (!has_bvh_extension(file))
+        throw Error("cannot describe this file type (expected a .bvh file)", at_line(file, 0));
       io::BvhReadOptions options;
       options.unit = units_option(units, "--units");
       options.role_overrides = role_options(roles);
@@ -152,7 +166,8 @@ void add_info_command(CLI::App& app, const GlobalOptions& g) {
       std::printf("%s\n", j.dump(2).c_str());
       return;
     }
-    for (auto& [k, v] : j.items()) std::printf("%-17s %s\n", k.c_str(), v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
+    for (auto& [k, v] : j.items())
+      std::printf("%-17s %s\n", k.c_str(), v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
   });
 }
 

@@ -62,8 +62,8 @@ void check_match_args(const MatchArgs& a) {
 // Roadmap: the planner of --random's obstacle world (from --seed) or of the
 // paths file's world, for agents of po.radius (m), its counts in
 // report["roadmap"] and its build time (ms) in roadmap_ms; with neither, an empty planner.
-path::Planner build_planner(const MatchArgs& a, const io::PathsFile& file, const path::PlanOptions& po, nlohmann::json& report,
-                            double& roadmap_ms) {
+path::Planner build_planner(const MatchArgs& a, const io::PathsFile& file, const path::PlanOptions& po,
+                            nlohmann::json& report, double& roadmap_ms) {
   path::Planner planner;
   if (!(a.random > 0 || file.has_world)) return planner;
   const auto t0 = std::chrono::steady_clock::now();
@@ -72,11 +72,14 @@ path::Planner build_planner(const MatchArgs& a, const io::PathsFile& file, const
     wo.seed = a.seed;
     planner = path::Planner::build(path::random_obstacle_world(wo), po);
   } else {
-    planner = path::Planner::build(path::FreeSpace::build(file.has_walkable ? &file.walkable : nullptr, file.polygons, file.circles, po.free_space), po);
+    planner = path::Planner::build(path::FreeSpace::build(file.has_walkable ? &file.walkable : nullptr, file.polygons,
+                                                          file.circles, po.free_space),
+                                   po);
   }
   roadmap_ms = ms_since(t0);
-  spdlog::info("roadmap: {} nodes, {} edges (of {} Voronoi edges, {} inside free space) for radius {} m", planner.roadmap().node_count(),
-               planner.roadmap().edge_count(), planner.roadmap().voronoi_edges, planner.roadmap().inside_edges, po.radius);
+  spdlog::info("roadmap: {} nodes, {} edges (of {} Voronoi edges, {} inside free space) for radius {} m",
+               planner.roadmap().node_count(), planner.roadmap().edge_count(), planner.roadmap().voronoi_edges,
+               planner.roadmap().inside_edges, po.radius);
   report["roadmap"] = {{"nodes", planner.roadmap().node_count()},
                        {"edges", planner.roadmap().edge_count()},
                        {"voronoi_edges", planner.roadmap().voronoi_edges},
@@ -99,8 +102,8 @@ std::vector<path::PathQuery> path_queries(const MatchArgs& a, const io::PathsFil
 // Paths to match: the file's given paths and its planned ones that were found
 // (planned[q] for the q-th planned entry), or --random's found paths with
 // speeds drawn in [1, 3) m/s from --seed; the paths not found counted in `unplanned`.
-std::vector<path::PathInput> collect_inputs(const MatchArgs& a, const io::PathsFile& file, const std::vector<path::PlannedPath>& planned,
-                                            std::int64_t& unplanned) {
+std::vector<path::PathInput> collect_inputs(const MatchArgs& a, const io::PathsFile& file,
+                                            const std::vector<path::PlannedPath>& planned, std::int64_t& unplanned) {
   std::vector<path::PathInput> inputs;
   Rng speed_rng(a.seed, 0x5eed);
   if (a.random > 0) {
@@ -120,7 +123,8 @@ std::vector<path::PathInput> collect_inputs(const MatchArgs& a, const io::PathsF
     if (e.planned) {
       const path::PlannedPath& p = planned[q++];
       if (!p.found()) {
-        spdlog::warn("{}: no path from ({}, {}) to ({}, {}): {}", e.name, e.from.x, e.from.y, e.to.x, e.to.y, path::to_string(p.status));
+        spdlog::warn("{}: no path from ({}, {}) to ({}, {}): {}", e.name, e.from.x, e.from.y, e.to.x, e.to.y,
+                     path::to_string(p.status));
         ++unplanned;
         continue;
       }
@@ -160,20 +164,29 @@ MatchInputs gather_paths(const MatchArgs& a, const io::PathsFile& file, nlohmann
 
 // The summary on stdout: paths, grid, the three sequencings' errors, the
 // playback's deviation (m) and the stages' times (ms).
-void print_match_summary(const path::MatchRun& run, const path::MotionGraph& machine, const MatchInputs& in, double machine_ms) {
+void print_match_summary(const path::MatchRun& run, const path::MotionGraph& machine, const MatchInputs& in,
+                         double machine_ms) {
   double length = 0;
   for (const auto& p : run.paths) length += p.length;
-  std::printf("paths            %zu (%lld not planned), %.1f m in all\n", run.paths.size(), static_cast<long long>(in.unplanned), length);
-  std::printf("grid             %lld curves x %lld motions = %lld pairs, k = %d, d = %.2f m\n", static_cast<long long>(run.curves),
-              static_cast<long long>(run.motions), static_cast<long long>(run.curves * run.motions), machine.k(), machine.segment_length());
-  std::printf("greedy           path error %.4f m/point, %lld illegal transitions in %lld paths\n", run.greedy.path_error,
-              static_cast<long long>(run.greedy.illegal), static_cast<long long>(run.greedy.paths_with_illegal));
-  std::printf("greedy repaired  path error %.4f m/point, %lld illegal transitions\n", run.repaired.path_error, static_cast<long long>(run.repaired.illegal));
-  std::printf("dynamic program  path error %.4f m/point, %lld illegal transitions\n", run.dp.path_error, static_cast<long long>(run.dp.illegal));
-  std::printf("playback (DP)    deviation of the root from the path: mean %.3f m, max %.3f m\n", run.deviation_mean, run.deviation_max);
-  std::printf("time (ms)        machine %.1f, roadmap %.1f, plan %.1f, resample %.1f, grid %.1f, sequences %.1f, playback %.1f (%d threads, %s)\n",
-              machine_ms, in.roadmap_ms, in.plan_ms, run.resample_ms, run.grid_ms, run.sequences_ms, run.playback_ms, current_threads(),
-              to_string(current_backend()));
+  std::printf("paths            %zu (%lld not planned), %.1f m in all\n", run.paths.size(),
+              static_cast<long long>(in.unplanned), length);
+  std::printf("grid             %lld curves x %lld motions = %lld pairs, k = %d, d = %.2f m\n",
+              static_cast<long long>(run.curves), static_cast<long long>(run.motions),
+              static_cast<long long>(run.curves * run.motions), machine.k(), machine.segment_length());
+  std::printf("greedy           path error %.4f m/point, %lld illegal transitions in %lld paths\n",
+              run.greedy.path_error, static_cast<long long>(run.greedy.illegal),
+              static_cast<long long>(run.greedy.paths_with_illegal));
+  std::printf("greedy repaired  path error %.4f m/point, %lld illegal transitions\n", run.repaired.path_error,
+              static_cast<long long>(run.repaired.illegal));
+  std::printf("dynamic program  path error %.4f m/point, %lld illegal transitions\n", run.dp.path_error,
+              static_cast<long long>(run.dp.illegal));
+  std::printf("playback (DP)    deviation of the root from the path: mean %.3f m, max %.3f m\n", run.deviation_mean,
+              run.deviation_max);
+  std::printf(
+      "time (ms)        machine %.1f, roadmap %.1f, plan %.1f, resample %.1f, grid %.1f, sequences %.1f, playback %.1f "
+      "(%d threads, %s)\n",
+      machine_ms, in.roadmap_ms, in.plan_ms, run.resample_ms, run.grid_ms, run.sequences_ms, run.playback_ms,
+      current_threads(), to_string(current_backend()));
 }
 
 // match.json's "paths": per path its length (m), curves, errors (m/point),
@@ -196,9 +209,11 @@ nlohmann::json paths_json(const path::MatchRun& run) {
 
 // match.json beside report["roadmap"]: the input, the machine, the grid, the
 // sequencings, the playback, the timings (ms) and the paths.
-void fill_match_report(nlohmann::json& report, const MatchArgs& a, const path::StateMachineSpec& spec, const path::MotionGraph& machine,
-                       const path::MatchRun& run, const MatchInputs& in, double machine_ms) {
-  report["input"] = a.random > 0 ? nlohmann::json{{"random", a.random}, {"seed", a.seed}} : nlohmann::json{{"file", a.file}};
+void fill_match_report(nlohmann::json& report, const MatchArgs& a, const path::StateMachineSpec& spec,
+                       const path::MotionGraph& machine, const path::MatchRun& run, const MatchInputs& in,
+                       double machine_ms) {
+  report["input"] =
+      a.random > 0 ? nlohmann::json{{"random", a.random}, {"seed", a.seed}} : nlohmann::json{{"file", a.file}};
   report["machine"] = {{"name", spec.name},
                        {"states", machine.states().size()},
                        {"segments", machine.segment_count()},
@@ -211,9 +226,11 @@ void fill_match_report(nlohmann::json& report, const MatchArgs& a, const path::S
   report["greedy"] = stats_json(run.greedy);
   report["greedy_repaired"] = stats_json(run.repaired);
   report["dp"] = stats_json(run.dp);
-  report["playback"] = {{"deviation_mean_m", run.deviation_mean}, {"deviation_max_m", run.deviation_max}, {"ms", run.playback_ms}};
-  report["timings_ms"] = {{"machine", machine_ms}, {"roadmap", in.roadmap_ms}, {"plan", in.plan_ms}, {"resample", run.resample_ms},
-                          {"grid", run.grid_ms}, {"sequences", run.sequences_ms}, {"playback", run.playback_ms}};
+  report["playback"] = {
+      {"deviation_mean_m", run.deviation_mean}, {"deviation_max_m", run.deviation_max}, {"ms", run.playback_ms}};
+  report["timings_ms"] = {{"machine", machine_ms},       {"roadmap", in.roadmap_ms}, {"plan", in.plan_ms},
+                          {"resample", run.resample_ms}, {"grid", run.grid_ms},      {"sequences", run.sequences_ms},
+                          {"playback", run.playback_ms}};
   report["threads"] = current_threads();
   report["backend"] = to_string(current_backend());
   report["unplanned"] = in.unplanned;
@@ -221,11 +238,13 @@ void fill_match_report(nlohmann::json& report, const MatchArgs& a, const path::S
 }
 
 // Writes --out/match.json and a BVH clip per kept playback (path name.bvh).
-void write_match_outputs(const MatchArgs& a, const nlohmann::json& report, const path::MatchRun& run, const path::MotionGraph& machine) {
+void write_match_outputs(const MatchArgs& a, const nlohmann::json& report, const path::MatchRun& run,
+                         const path::MotionGraph& machine) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(a.out, ec);
-  if (ec || !fs::is_directory(a.out)) throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(a.out, 0));
+  if (ec || !fs::is_directory(a.out))
+    throw Error("cannot create folder: " + (ec ? ec.message() : std::string("not a folder")), at_line(a.out, 0));
   const fs::path json_path = fs::path(a.out) / "match.json";
   io::write_json_file(json_path.string(), report);
   for (std::size_t i = 0; i < run.clips.size(); ++i) {
@@ -245,12 +264,13 @@ void run_match(const MatchArgs& a) {
   io::PathsFile file;
   if (!a.file.empty()) file = io::read_paths(a.file);
   const std::string machine_file = !a.machine.empty() ? a.machine : file.machine;
-  const path::StateMachineSpec spec = machine_file.empty() ? io::default_state_machine_spec() : io::read_state_machine(machine_file);
+  const path::StateMachineSpec spec =
+      machine_file.empty() ? io::default_state_machine_spec() : io::read_state_machine(machine_file);
   const path::MotionGraph machine = path::MotionGraph::build(spec, motion::default_skeleton());
   const double machine_ms = ms_since(t0);
   spdlog::info("state machine '{}': {} states, {} motion segments ({} locomotion), d = {} x {} m = {:.2f} m", spec.name,
-               machine.states().size(), machine.segment_count(), machine.locomotion_segments().size(), machine.k(), machine.spacing(),
-               machine.segment_length());
+               machine.states().size(), machine.segment_count(), machine.locomotion_segments().size(), machine.k(),
+               machine.spacing(), machine.segment_length());
 
   const MatchInputs in = gather_paths(a, file, report);
   path::MatchRunOptions mo;
@@ -270,7 +290,8 @@ void add_match_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("paths", a.file, "Paths file (YAML, see docs/path.md)");
   cmd->add_option("--random", a.random, "Instead: N random paths planned through a random obstacle field");
   cmd->add_option("--seed", a.seed, "Seed of the random field and paths (default 1)");
-  cmd->add_option("--machine", a.machine, "State machine file (default: the built-in data/motion/default_machine.yaml)");
+  cmd->add_option("--machine", a.machine,
+                  "State machine file (default: the built-in data/motion/default_machine.yaml)");
   cmd->add_option("--radius", a.radius, "Agent radius for --random planning, m (default 0.3)");
   cmd->add_option("--out", a.out, "Output folder for match.json (default out/match)");
   cmd->add_option("--bvh", a.bvh, "Also write the playback clips of the first N paths as BVH");

@@ -60,7 +60,8 @@ class InterruptGuard {
   }
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {
+  }, old_term_{};
 };
 
 struct RunOptions {
@@ -72,7 +73,7 @@ struct RunOptions {
   std::string scheduler;
   std::string out;
   std::int64_t every = 0;
-  std::string trajectory_format;  // empty = the scenario's, else csv
+  std::string trajectory_format;               // empty = the scenario's, else csv
   std::optional<io::TrajectoryFormat> format;  // trajectory_format, checked
   bool no_trajectories = false;
   std::int64_t check_every = 0;  // soak checks every K steps; 0 = none
@@ -108,7 +109,12 @@ constexpr double kDemoRenderSpeed = 50.0;
 class Progress {
  public:
   Progress(std::int64_t max_steps, Index agents, bool quiet)
-      : max_steps_(max_steps), agents_(agents), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), start_(Clock::now()), last_(start_) {}
+      : max_steps_(max_steps),
+        agents_(agents),
+        quiet_(quiet),
+        tty_(isatty(STDERR_FILENO) != 0),
+        start_(Clock::now()),
+        last_(start_) {}
 
   void update(const sim::Simulation& sim, const sim::FrameInfo& f) {
     if (quiet_ || f.frame == 0) return;
@@ -122,8 +128,9 @@ class Progress {
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double rate = elapsed > 0 ? static_cast<double>(f.frame) / elapsed : 0.0;
     const double fraction = max_steps_ > 0 ? static_cast<double>(f.frame) / static_cast<double>(max_steps_) : 1.0;
-    const std::string text = fmt::format("step {}/{}  t={:.1f}s  arrived {}/{}  {:.0f} steps/s  {:.3g} agent-steps/s", f.frame, max_steps_,
-                                         f.time, sim.arrived_count(), agents_, rate, rate * static_cast<double>(agents_));
+    const std::string text =
+        fmt::format("step {}/{}  t={:.1f}s  arrived {}/{}  {:.0f} steps/s  {:.3g} agent-steps/s", f.frame, max_steps_,
+                    f.time, sim.arrived_count(), agents_, rate, rate * static_cast<double>(agents_));
     if (tty_) {
       constexpr int kWidth = 30;
       const int filled = static_cast<int>(fraction * kWidth);
@@ -150,52 +157,64 @@ double stage_ms(const nlohmann::json& stats, const char* stage) {
   return stages.contains(stage) ? stages[stage]["ms_per_step"].get<double>() : 0.0;
 }
 
-void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nlohmann::json& stats, const std::string& written) {
+void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nlohmann::json& stats,
+                   const std::string& written) {
   const auto& crowd = stats["crowd"];
   const double agent_steps = static_cast<double>(r.steps) * static_cast<double>(sim.agent_count());
   std::printf("%s: %lld agents, %lld steps (%.1f s simulated) in %.2f s: %.3g agent-steps/s, %s model, %s, %s x%d%s\n",
-              sim.spec().name.c_str(), static_cast<long long>(sim.agent_count()), static_cast<long long>(r.steps), r.simulated_seconds,
-              r.wall_seconds, r.wall_seconds > 0 ? agent_steps / r.wall_seconds : 0.0, to_string(sim.spec().model.kind),
-              to_string(sim.scheduler()), to_string(current_backend()), current_threads(), r.interrupted ? " (interrupted)" : "");
+              sim.spec().name.c_str(), static_cast<long long>(sim.agent_count()), static_cast<long long>(r.steps),
+              r.simulated_seconds, r.wall_seconds, r.wall_seconds > 0 ? agent_steps / r.wall_seconds : 0.0,
+              to_string(sim.spec().model.kind), to_string(sim.scheduler()), to_string(current_backend()),
+              current_threads(), r.interrupted ? " (interrupted)" : "");
   const auto& at = crowd["arrival_time_s"];
   std::printf("  arrived %lld/%lld", crowd["arrived"].get<long long>(), static_cast<long long>(sim.agent_count()));
-  if (crowd["arrived"].get<long long>() > 0) std::printf(" (mean %.1f s, last %.1f s)", at["mean"].get<double>(), at["max"].get<double>());
+  if (crowd["arrived"].get<long long>() > 0)
+    std::printf(" (mean %.1f s, last %.1f s)", at["mean"].get<double>(), at["max"].get<double>());
   std::printf("; mean speed %.2f m/s\n", crowd["mean_speed_mps"]["over_samples"].get<double>());
   const auto& ov = crowd["overlaps"];
-  std::printf("  overlaps deeper than %.0f cm: %lld pairs at most (deepest %.1f cm); minimum separation %s; obstacle penetrations %lld\n",
-              100.0 * ov["tolerance_m"].get<double>(), ov["max_pairs"].get<long long>(), 100.0 * ov["max_depth_m"].get<double>(),
-              crowd["min_separation_m"].is_null() ? "n/a" : fmt::format("{:.3f} m", crowd["min_separation_m"].get<double>()).c_str(),
-              crowd["obstacle_penetrations"]["max"].get<long long>());
+  std::printf(
+      "  overlaps deeper than %.0f cm: %lld pairs at most (deepest %.1f cm); minimum separation %s; obstacle "
+      "penetrations %lld\n",
+      100.0 * ov["tolerance_m"].get<double>(), ov["max_pairs"].get<long long>(),
+      100.0 * ov["max_depth_m"].get<double>(),
+      crowd["min_separation_m"].is_null() ? "n/a"
+                                          : fmt::format("{:.3f} m", crowd["min_separation_m"].get<double>()).c_str(),
+      crowd["obstacle_penetrations"]["max"].get<long long>());
   const auto& stuck = stats["stuck_agents"];
   std::printf("  stuck agents (at rest over %.0f s with the way ahead free): %lld", stuck["threshold_s"].get<double>(),
               stuck["agents"].get<long long>());
   if (stuck["agents"].get<long long>() > 0)
-    std::printf(" (at most %lld at once, first at %.1f s)", stuck["max_at_once"].get<long long>(), stuck["first_time_s"].get<double>());
+    std::printf(" (at most %lld at once, first at %.1f s)", stuck["max_at_once"].get<long long>(),
+                stuck["first_time_s"].get<double>());
   std::printf("\n");
   const bool colour = sim.scheduler() == sim::SchedulerKind::FourColour;
-  std::printf("  ms per step: %.3f (bin %.3f, %s %.3f, move %.3f)\n", stats["timings"]["step_ms"].get<double>(), stage_ms(stats, "sim.bin"),
-              colour ? "sense+steer" : "sense", colour ? stage_ms(stats, "sim.sense_steer") : stage_ms(stats, "sim.sense"),
-              stage_ms(stats, "sim.move"));
+  std::printf("  ms per step: %.3f (bin %.3f, %s %.3f, move %.3f)\n", stats["timings"]["step_ms"].get<double>(),
+              stage_ms(stats, "sim.bin"), colour ? "sense+steer" : "sense",
+              colour ? stage_ms(stats, "sim.sense_steer") : stage_ms(stats, "sim.sense"), stage_ms(stats, "sim.move"));
   if (stats.contains("locomotion")) {
     const auto& l = stats["locomotion"];
-    std::printf("  locomotion: %lld frames, median %.3f ms per frame; joints synthesised %.1f of %d per agent", l["frames"].get<long long>(),
-                l["frame_ms"]["median"].get<double>(), l["joints_synthesised_per_character"].get<double>(), l["joints"].get<int>());
+    std::printf("  locomotion: %lld frames, median %.3f ms per frame; joints synthesised %.1f of %d per agent",
+                l["frames"].get<long long>(), l["frame_ms"]["median"].get<double>(),
+                l["joints_synthesised_per_character"].get<double>(), l["joints"].get<int>());
     if (l.contains("cache")) std::printf("; cache hits %.1f%%", 100.0 * l["cache"]["hit_rate"].get<double>());
     const auto& skate = l["foot_skating_cm"];
     if (skate["contacts"].get<int>() > 0)
-      std::printf("\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts\n", skate["mean"].get<double>(), skate["p95"].get<double>(),
-                  skate["contacts"].get<int>());
+      std::printf("\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts\n", skate["mean"].get<double>(),
+                  skate["p95"].get<double>(), skate["contacts"].get<int>());
     else
       std::printf("\n  foot skating: no contacts measured\n");
   }
   if (stats.contains("soak")) {
     const auto& s = stats["soak"];
     const auto& rss = s["rss_mib"];
-    std::printf("  soak checks: %lld, every %lld steps; deepest overlap %.1f cm (bound %.0f cm); resident memory %.1f -> %.1f MiB",
-                s["checks"].get<long long>(), s["check_every_steps"].get<long long>(), 100.0 * s["max_overlap_m"].get<double>(),
-                100.0 * s["overlap_bound_m"].get<double>(), rss["first"].get<double>(), rss["end"].get<double>());
+    std::printf(
+        "  soak checks: %lld, every %lld steps; deepest overlap %.1f cm (bound %.0f cm); resident memory %.1f -> %.1f "
+        "MiB",
+        s["checks"].get<long long>(), s["check_every_steps"].get<long long>(), 100.0 * s["max_overlap_m"].get<double>(),
+        100.0 * s["overlap_bound_m"].get<double>(), rss["first"].get<double>(), rss["end"].get<double>());
     if (!rss["after_warmup"].is_null())
-      std::printf(" (%+.1f%% after step %lld)", 100.0 * rss["growth"].get<double>(), rss["warmup_step"].get<long long>());
+      std::printf(" (%+.1f%% after step %lld)", 100.0 * rss["growth"].get<double>(),
+                  rss["warmup_step"].get<long long>());
     std::printf("\n");
   }
   if (!written.empty()) std::printf("  wrote %s\n", written.c_str());
@@ -204,7 +223,10 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
 // stats.json's "scenario": name, description, source and groups.
 nlohmann::json scenario_section(const io::LoadedScenario& loaded) {
   const sim::ScenarioSpec& spec = loaded.spec;
-  nlohmann::json section = {{"name", spec.name}, {"description", spec.description}, {"source", loaded.source.file}, {"groups", nlohmann::json::array()}};
+  nlohmann::json section = {{"name", spec.name},
+                            {"description", spec.description},
+                            {"source", loaded.source.file},
+                            {"groups", nlohmann::json::array()}};
   for (const sim::GroupSpec& g : spec.groups) section["groups"].push_back({{"name", g.name}, {"count", g.count}});
   return section;
 }
@@ -249,10 +271,10 @@ std::int64_t apply_run_options(sim::ScenarioSpec& spec, const RunOptions& o) {
 // scenario's outputs.dir, else out/NAME) and returns it.
 std::string make_output_dir(const io::LoadedScenario& loaded, const RunOptions& o, std::int64_t max_steps) {
   const sim::ScenarioSpec& spec = loaded.spec;
-  std::fprintf(stderr, "throng run: %s (%s): %lld agents, up to %lld steps of %.3g s, %s model, %s, %s x%d\n", spec.name.c_str(),
-               loaded.source.file.c_str(), static_cast<long long>(spec.total_agents()), static_cast<long long>(max_steps),
-               static_cast<double>(spec.dt), to_string(spec.model.kind), to_string(spec.scheduler), to_string(current_backend()),
-               current_threads());
+  std::fprintf(stderr, "throng run: %s (%s): %lld agents, up to %lld steps of %.3g s, %s model, %s, %s x%d\n",
+               spec.name.c_str(), loaded.source.file.c_str(), static_cast<long long>(spec.total_agents()),
+               static_cast<long long>(max_steps), static_cast<double>(spec.dt), to_string(spec.model.kind),
+               to_string(spec.scheduler), to_string(current_backend()), current_threads());
   const std::string dir = !o.out.empty() ? o.out : (!spec.outputs.dir.empty() ? spec.outputs.dir : "out/" + spec.name);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -265,8 +287,9 @@ std::string make_output_dir(const io::LoadedScenario& loaded, const RunOptions& 
 void check_run_budget(const sim::ScenarioSpec& spec, const RunOptions& o) {
   const std::int64_t total = spec.total_agents();
   const bool animate_planned = !o.no_animate && (o.animate || !o.render.empty() || total <= kAnimateUpTo);
-  check_memory_budget(static_cast<double>(total) * (kSimBytesPerAgent + (animate_planned ? kLocomotionBytesPerAgent : 0.0)),
-                      fmt::format("{} agents{}", total, animate_planned ? ", animated" : ""), o.agents > 0 ? "--agents" : "groups");
+  check_memory_budget(
+      static_cast<double>(total) * (kSimBytesPerAgent + (animate_planned ? kLocomotionBytesPerAgent : 0.0)),
+      fmt::format("{} agents{}", total, animate_planned ? ", animated" : ""), o.agents > 0 ? "--agents" : "groups");
 }
 
 // Set-up: the world and the crowd, kernel timings reset. Interrupted, it
@@ -281,8 +304,8 @@ std::unique_ptr<sim::Simulation> build_or_exit(const io::LoadedScenario& loaded,
   } catch (const Interrupted& e) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
     if (spec.outputs.stats) io::write_json_file(dir + "/stats.json", interrupted_setup_stats(loaded, e, seconds));
-    std::fprintf(stderr, "throng run: interrupted while %s, %.2f s into set-up; nothing was simulated%s\n", e.during().c_str(), seconds,
-                 spec.outputs.stats ? (" (wrote " + dir + "/stats.json)").c_str() : "");
+    std::fprintf(stderr, "throng run: interrupted while %s, %.2f s into set-up; nothing was simulated%s\n",
+                 e.during().c_str(), seconds, spec.outputs.stats ? (" (wrote " + dir + "/stats.json)").c_str() : "");
     std::exit(130);
   }
   std::fprintf(stderr, "throng run: world and crowd ready in %.2f s\n",
@@ -301,8 +324,8 @@ struct RunOutputs {
 // Output stages: crowd metrics sampled once a simulated second, soak checks
 // every --check-every steps (DIR/soak.jsonl), trajectories every K-th frame
 // beside the walkable area (DIR/geometry.wkt, .geojson, written now).
-RunOutputs add_output_stages(sim::FrameLoop& loop, const sim::Simulation& sim, const io::LoadedScenario& loaded, const RunOptions& o,
-                             const std::string& dir, std::int64_t max_steps) {
+RunOutputs add_output_stages(sim::FrameLoop& loop, const sim::Simulation& sim, const io::LoadedScenario& loaded,
+                             const RunOptions& o, const std::string& dir, std::int64_t max_steps) {
   const sim::ScenarioSpec& spec = loaded.spec;
   RunOutputs out;
   sim::MetricsOptions metrics;
@@ -345,15 +368,17 @@ struct RenderHooks {
 // The rendering camera, from `start` (the scenario's, at the video's size):
 // --camera, else the scenario's camera.motion, else one that follows the
 // crowd; lo.camera returns it at each simulated time (s).
-void set_render_camera(LocomotionStageOptions& lo, const Camera& start, const RunOptions& o, const sim::ScenarioSpec& spec,
-                       const sim::Simulation* simulation) {
-  const std::string motion = !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : "follow");
+void set_render_camera(LocomotionStageOptions& lo, const Camera& start, const RunOptions& o,
+                       const sim::ScenarioSpec& spec, const sim::Simulation* simulation) {
+  const std::string motion =
+      !o.camera.empty() ? o.camera : (!spec.camera_motion.empty() ? spec.camera_motion : "follow");
   const double speed = o.render_speed;
   if (motion == "follow") {
     const auto follow = std::make_shared<FollowCamera>(start, 0.5 * speed);  // eases over half a video second
     lo.camera = [follow, simulation](double t) { return follow->at(*simulation, t); };
   } else {
-    const double period = o.camera_period > 0.0 ? o.camera_period : (spec.camera_period_s > 0.0f ? spec.camera_period_s : 40.0);
+    const double period =
+        o.camera_period > 0.0 ? o.camera_period : (spec.camera_period_s > 0.0f ? spec.camera_period_s : 40.0);
     const auto path = std::make_shared<render::CameraPath>(
         render::animate_camera(start, render::parse_camera_kind(motion, "--camera"), static_cast<float>(period)));
     lo.camera = [path, speed](double t) { return path->at(t / speed); };
@@ -363,8 +388,9 @@ void set_render_camera(LocomotionStageOptions& lo, const Camera& start, const Ru
 // --render: a recorder of o.width x o.height pixels at o.fps writing into
 // `dir`, fed by lo.on_frame, its camera set by set_render_camera; hooks
 // receive its finish call and the characters' size per frame.
-void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const RunOptions& o, const sim::ScenarioSpec& spec,
-                     const sim::Simulation& sim, const std::string& dir, RenderHooks& hooks) {
+void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const RunOptions& o,
+                     const sim::ScenarioSpec& spec, const sim::Simulation& sim, const std::string& dir,
+                     RenderHooks& hooks) {
   render::RecordSpec record;
   record.output = render::parse_record_output(o.render, "--render");
   record.folder = dir;
@@ -394,7 +420,8 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
     ScopedTimer timer("render.frame");
     character_px->push_back(median_character_px(*camera, *simulation));
     if (!*recorder) {
-      *recorder = std::make_unique<render::Recorder>(record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
+      *recorder = std::make_unique<render::Recorder>(
+          record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
       (*recorder)->set_world(simulation->world());
     }
     (*recorder)->add_frame(*camera, render::poses_of(moved.animator(), simulation->crowd()));
@@ -405,21 +432,24 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
     const std::string wrote = (*recorder)->finish();
     return fmt::format("{} ({} frames, {}x{} at {:g} fps)", wrote, frames, record.width, record.height, record.fps);
   };
-  std::fprintf(stderr, "throng run: rendering %s (%s, %dx%d, %g fps, %gx speed) into %s\n", o.render.c_str(), o.render_mode.c_str(), o.width,
-               o.height, o.fps, speed, dir.c_str());
+  std::fprintf(stderr, "throng run: rendering %s (%s, %dx%d, %g fps, %gx speed) into %s\n", o.render.c_str(),
+               o.render_mode.c_str(), o.width, o.height, o.fps, speed, dir.c_str());
 }
 #endif
 
 // The locomotion stage, on by default up to kAnimateUpTo agents: joint LOD
 // under the scenario's camera and, with --render, the recorder.
-RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec, const RunOptions& o,
-                                 const std::string& dir) {
+RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec,
+                                 const RunOptions& o, const std::string& dir) {
   RenderHooks hooks;
   const Index n = sim.agent_count();
-  if (o.no_animate && !o.render.empty()) throw Error("--render draws the animated agents: drop --no-animate", at_field("--render"));
+  if (o.no_animate && !o.render.empty())
+    throw Error("--render draws the animated agents: drop --no-animate", at_field("--render"));
   const bool animate = !o.no_animate && (o.animate || !o.render.empty() || n <= kAnimateUpTo);
   if (!animate && !o.no_animate)
-    std::fprintf(stderr, "throng run: %lld agents: locomotion off above %lld agents (--animate turns it on; see docs/render.md for its cost)\n",
+    std::fprintf(stderr,
+                 "throng run: %lld agents: locomotion off above %lld agents (--animate turns it on; see docs/render.md "
+                 "for its cost)\n",
                  static_cast<long long>(n), static_cast<long long>(kAnimateUpTo));
   if (!animate) return hooks;
   LocomotionStageOptions lo;
@@ -440,7 +470,8 @@ RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& si
 
 // The run: up to max_steps steps (fewer when everyone arrived and the
 // scenario stops then, or after Ctrl-C), progress on stderr unless quiet.
-sim::RunResult run_steps(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec, std::int64_t max_steps, bool quiet) {
+sim::RunResult run_steps(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec,
+                         std::int64_t max_steps, bool quiet) {
   Progress progress(max_steps, sim.agent_count(), quiet);
   sim::RunControl control;
   control.max_steps = max_steps;
@@ -453,12 +484,14 @@ sim::RunResult run_steps(sim::FrameLoop& loop, const sim::Simulation& sim, const
 // stats.json's content: the stages' sections, the geometry files, the
 // rendered characters' median size (px) and the scenario; the video's
 // description joins outputs.written.
-nlohmann::json run_stats(sim::FrameLoop& loop, const io::LoadedScenario& loaded, RunOutputs& outputs, const RenderHooks& hooks) {
+nlohmann::json run_stats(sim::FrameLoop& loop, const io::LoadedScenario& loaded, RunOutputs& outputs,
+                         const RenderHooks& hooks) {
   std::string& written = outputs.written;
   nlohmann::json stats;
   loop.finish(stats);
   if (outputs.geometry_files)
-    stats["trajectories"]["geometry"] = {{"wkt", outputs.geometry_files->wkt}, {"geojson", outputs.geometry_files->geojson}};
+    stats["trajectories"]["geometry"] = {{"wkt", outputs.geometry_files->wkt},
+                                         {"geojson", outputs.geometry_files->geojson}};
   if (hooks.finish_render) {
     const std::string rendered = hooks.finish_render();
     if (!rendered.empty()) written += (written.empty() ? "" : ", ") + rendered;
@@ -470,7 +503,8 @@ nlohmann::json run_stats(sim::FrameLoop& loop, const io::LoadedScenario& loaded,
     std::vector<float> px = character_px;
     std::nth_element(px.begin(), px.begin() + static_cast<std::ptrdiff_t>(px.size() / 2), px.end());
     stats["render"] = {{"frames", character_px.size()}, {"median_character_px", px[px.size() / 2]}};
-    std::fprintf(stderr, "throng run: characters in the picture: a median %.0f px tall\n", static_cast<double>(px[px.size() / 2]));
+    std::fprintf(stderr, "throng run: characters in the picture: a median %.0f px tall\n",
+                 static_cast<double>(px[px.size() / 2]));
   }
   stats["scenario"] = scenario_section(loaded);
   return stats;
@@ -478,8 +512,8 @@ nlohmann::json run_stats(sim::FrameLoop& loop, const io::LoadedScenario& loaded,
 
 // Writes DIR/stats.json (when the scenario writes stats) and prints the
 // summary; exits 1 on a failed soak check, 130 after Ctrl-C.
-void write_and_report(const sim::Simulation& sim, const sim::RunResult& result, const nlohmann::json& stats, const sim::ScenarioSpec& spec,
-                      const std::string& dir, RunOutputs& outputs) {
+void write_and_report(const sim::Simulation& sim, const sim::RunResult& result, const nlohmann::json& stats,
+                      const sim::ScenarioSpec& spec, const std::string& dir, RunOutputs& outputs) {
   std::string& written = outputs.written;
   if (spec.outputs.stats) {
     io::write_json_file(dir + "/stats.json", stats);
@@ -520,36 +554,48 @@ void run_scenario(const RunOptions& o) {
 }  // namespace
 
 void add_run_command(CLI::App& app, const GlobalOptions& g) {
-  auto* cmd = app.add_subcommand("run", "Run a scenario (a YAML file or a built-in name); write trajectories and statistics");
+  auto* cmd =
+      app.add_subcommand("run", "Run a scenario (a YAML file or a built-in name); write trajectories and statistics");
   static RunOptions o;
   std::string names;
   for (const std::string& n : io::builtin_scenario_names()) names += (names.empty() ? "" : ", ") + n;
   cmd->add_option("scenario", o.scenario, "Scenario file, or a built-in: " + names)->capture_default_str();
   cmd->add_option("--agents", o.agents, "Total agents (groups keep their proportions)")->check(at_least(1));
-  auto* steps = cmd->add_option("--steps", o.steps, "Steps to run (default: the scenario's duration)")->check(at_least(1));
+  auto* steps =
+      cmd->add_option("--steps", o.steps, "Steps to run (default: the scenario's duration)")->check(at_least(1));
   cmd->add_option("--seconds", o.seconds, "Simulated seconds to run")->check(greater_than(0))->excludes(steps);
   cmd->add_option("--seed", o.seed, "Random seed (spawn positions, speeds, random goals)");
   cmd->add_option("--scheduler", o.scheduler, "double_buffer or four_colour (default: the scenario's)")
       ->check(CLI::IsMember({"double_buffer", "four_colour", "four_color"}));
   cmd->add_option("--out", o.out, "Output folder (default: the scenario's, else out/<name>)");
-  cmd->add_option("--every", o.every, "Write trajectories every K-th frame (default: the scenario's, else once a simulated second)")
+  cmd->add_option("--every", o.every,
+                  "Write trajectories every K-th frame (default: the scenario's, else once a simulated second)")
       ->check(at_least(1));
   cmd->add_option("--trajectory-format", o.trajectory_format,
-                  "Trajectory file format: csv (trajectories.csv), pedpy (trajectories.txt) or sqlite (trajectories.sqlite, JuPedSim's "
+                  "Trajectory file format: csv (trajectories.csv), pedpy (trajectories.txt) or sqlite "
+                  "(trajectories.sqlite, JuPedSim's "
                   "schema); default: the scenario's outputs.trajectories.format, else csv");
-  cmd->add_flag("--no-trajectories", o.no_trajectories, "Write no trajectories (nor geometry.wkt and geometry.geojson)");
+  cmd->add_flag("--no-trajectories", o.no_trajectories,
+                "Write no trajectories (nor geometry.wkt and geometry.geojson)");
   cmd->add_flag("--quiet", o.quiet, "No progress display");
-  cmd->add_option("--check-every", o.check_every,
-                  "Soak checks every K steps: fail on a non-finite agent, one outside free space, an overlap beyond 8 cm, or resident "
-                  "memory growing over 5% after the first tenth of the run; DIR/soak.jsonl and stats.json's soak section")
+  cmd->add_option(
+         "--check-every", o.check_every,
+         "Soak checks every K steps: fail on a non-finite agent, one outside free space, an overlap beyond 8 cm, or "
+         "resident "
+         "memory growing over 5% after the first tenth of the run; DIR/soak.jsonl and stats.json's soak section")
       ->check(at_least(1));
   auto* no_animate = cmd->add_flag("--no-animate", o.no_animate, "Skip the locomotion stage (agents are not animated)");
-  cmd->add_flag("--animate", o.animate, fmt::format("Animate even above {} agents", kAnimateUpTo))->excludes(no_animate);
-  cmd->add_option("--render", o.render, "Write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames) under the scenario's camera")
+  cmd->add_flag("--animate", o.animate, fmt::format("Animate even above {} agents", kAnimateUpTo))
+      ->excludes(no_animate);
+  cmd->add_option("--render", o.render,
+                  "Write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames) under the scenario's camera")
       ->check(CLI::IsMember({"video", "frames"}));
   cmd->add_flag("--no-lod", o.no_lod, "Synthesise every joint of every agent (no joint LOD)");
-  cmd->add_flag("--lod-colours", o.lod_colours, "Render characters in joint-LOD level colours instead of their clothes (a debug view)");
-  cmd->add_option("--lod-thresholds", o.lod_thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
+  cmd->add_flag("--lod-colours", o.lod_colours,
+                "Render characters in joint-LOD level colours instead of their clothes (a debug view)");
+  cmd->add_option("--lod-thresholds", o.lod_thresholds,
+                  "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")
+      ->delimiter(',');
   cmd->add_flag("--no-render", o.no_render, "The demo: do not write its video");
   cmd->add_option("--render-mode", o.render_mode, "skinned (the mannequin) or joints (a sphere per bone)")
       ->check(CLI::IsMember({"skinned", "joints"}))
@@ -557,16 +603,20 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--width", o.width, "Video width, pixels")->check(between(16, 7680))->capture_default_str();
   cmd->add_option("--height", o.height, "Video height, pixels")->check(between(16, 4320))->capture_default_str();
   cmd->add_option("--fps", o.fps, "Video frames per second")->check(between(1, 240))->capture_default_str();
-  auto* speed = cmd->add_option("--render-speed", o.render_speed, "Simulated seconds per video second (time-lapse above 1)")
-                    ->check(between(0.01, 1000))
-                    ->capture_default_str();
-  cmd->add_option("--render-seconds", o.render_seconds, "Render the first S simulated seconds only (default: the whole run)")
+  auto* speed =
+      cmd->add_option("--render-speed", o.render_speed, "Simulated seconds per video second (time-lapse above 1)")
+          ->check(between(0.01, 1000))
+          ->capture_default_str();
+  cmd->add_option("--render-seconds", o.render_seconds,
+                  "Render the first S simulated seconds only (default: the whole run)")
       ->check(greater_than(0));
   cmd->add_option("--camera", o.camera,
-                  "The scenario's camera kept fixed, orbiting its target, flying over it, or following the crowd from its direction "
+                  "The scenario's camera kept fixed, orbiting its target, flying over it, or following the crowd from "
+                  "its direction "
                   "(default: the scenario's camera.motion, else orbit; the demo follows)")
       ->check(CLI::IsMember({"fixed", "orbit", "flyover", "follow"}));
-  cmd->add_option("--camera-period", o.camera_period, "Video seconds per orbit or fly-over (default: the scenario's, else 40)")
+  cmd->add_option("--camera-period", o.camera_period,
+                  "Video seconds per orbit or fly-over (default: the scenario's, else 40)")
       ->check(greater_than(0));
   cmd->callback([&g, cmd, speed] {
     // The built-in demo (no scenario named) writes a short time-lapse video.
@@ -581,13 +631,14 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
     // Options that only shape the video or frames are refused without them
     // rather than ignored (the demo renders unless --no-render).
     refuse_unless(*cmd, !o.render.empty(),
-                  {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera", "--camera-period",
-                   "--lod-colours"},
+                  {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera",
+                   "--camera-period", "--lod-colours"},
                   "--render video|frames");
     refuse_unless(*cmd, !o.no_lod, {"--lod-thresholds"}, "joint LOD (it has no effect with --no-lod)");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");
     // Checked here, like the other flags, before the (possibly long) set-up.
-    if (!o.trajectory_format.empty()) o.format = io::parse_trajectory_format(o.trajectory_format, "--trajectory-format");
+    if (!o.trajectory_format.empty())
+      o.format = io::parse_trajectory_format(o.trajectory_format, "--trajectory-format");
     apply_global_options(g);
     run_scenario(o);
   });

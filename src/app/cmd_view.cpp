@@ -42,7 +42,9 @@ class FormationScene final : public render::ViewerScene {
   FormationScene(io::AnimateSpec spec, const std::filesystem::path& folder) : crowd_(std::move(spec), folder) {}
   std::string title() const override { return "throng: " + crowd_.spec().name; }
   anim::CrowdAnimator& animator() override { return crowd_.animator(); }
-  void advance(double dt, const Camera& camera) override { crowd_.advance(static_cast<float>(dt), crowd_.spec().lod ? &camera : nullptr); }
+  void advance(double dt, const Camera& camera) override {
+    crowd_.advance(static_cast<float>(dt), crowd_.spec().lod ? &camera : nullptr);
+  }
   glm::vec3 centre() const override { return glm::vec3(0.0f); }
   float extent() const override { return crowd_.formation().extent; }
   std::string status() const override { return fmt::format("formation, {:.1f} s", crowd_.time()); }
@@ -78,7 +80,9 @@ class FormationScene final : public render::ViewerScene {
 class SimulationScene final : public render::ViewerScene {
  public:
   SimulationScene(const io::LoadedScenario& loaded, const std::vector<float>& lod_thresholds)
-      : sim_(io::build_simulation(loaded)), locomotion_(*sim_, locomotion_options(lod_thresholds)), camera_(scenario_camera(*sim_)) {
+      : sim_(io::build_simulation(loaded)),
+        locomotion_(*sim_, locomotion_options(lod_thresholds)),
+        camera_(scenario_camera(*sim_)) {
     max_steps_ = sim_->spec().step_count();
     sim::Aabb box = sim_->world().bounds();
     for (const glm::vec2& p : sim_->positions()) box.add(p);
@@ -93,8 +97,8 @@ class SimulationScene final : public render::ViewerScene {
   glm::vec3 centre() const override { return centre_; }
   float extent() const override { return extent_; }
   std::string status() const override {
-    return fmt::format("{}: step {}, {:.1f} s simulated, arrived {}/{}{}", sim_->spec().name, sim_->steps_done(), sim_->time(),
-                       sim_->arrived_count(), sim_->agent_count(), finished_ ? " (ended)" : "");
+    return fmt::format("{}: step {}, {:.1f} s simulated, arrived {}/{}{}", sim_->spec().name, sim_->steps_done(),
+                       sim_->time(), sim_->arrived_count(), sim_->agent_count(), finished_ ? " (ended)" : "");
   }
   render::CharacterPoses poses() override { return render::poses_of(locomotion_.animator(), sim_->crowd()); }
   void decorate(render::Renderer& renderer) const override { render::show_world(renderer, sim_->world()); }
@@ -162,12 +166,15 @@ void add_view_options(CLI::App* cmd, ViewArgs& a) {
   render::ViewerOptions& o = a.o;
   std::string names;
   for (const std::string& n : io::builtin_scenario_names()) names += n + ", ";
-  cmd->add_option("scenario", a.scenario, "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
+  cmd->add_option("scenario", a.scenario,
+                  "Scenario file or built-in (" + names + "formation: the locomotion formation of throng animate)")
       ->capture_default_str();
-  cmd->add_option("--agents", a.agents, "How many agents (groups keep their proportions)")->check(between(1, static_cast<double>(Index{1} << 24)));
+  cmd->add_option("--agents", a.agents, "How many agents (groups keep their proportions)")
+      ->check(between(1, static_cast<double>(Index{1} << 24)));
   cmd->add_option("--layout", a.layout, "For formation: ring (walking round rings) or grid")
       ->check(CLI::IsMember({"ring", "grid"}));
-  cmd->add_option("--mode", a.mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")->check(CLI::IsMember({"skinned", "joints"}));
+  cmd->add_option("--mode", a.mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")
+      ->check(CLI::IsMember({"skinned", "joints"}));
   cmd->add_flag("--lod-colours", o.lod_colours, "Joint-LOD level colours instead of clothes, a debug view (L toggles)");
   cmd->add_option("--width", o.width, "Window width, pixels")->check(between(16, 7680));
   cmd->add_option("--height", o.height, "Window height, pixels")->check(between(16, 4320));
@@ -177,15 +184,23 @@ void add_view_options(CLI::App* cmd, ViewArgs& a) {
   cmd->add_flag("--paused", o.paused, "Start paused (space toggles, period steps)");
   cmd->add_flag("!--no-panel", o.panel, "Hide the ImGui panel");
   cmd->add_flag("--bins", o.bins, "Show agents per cell (the simulation's bins; 4 m for the formation) as a heat map");
-  cmd->add_flag("--headless", a.headless, "No window: render --frames frames offscreen (EGL), for videos and screenshots");
-  cmd->add_option("--render", a.render_output, "With --headless: write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames)")
+  cmd->add_flag("--headless", a.headless,
+                "No window: render --frames frames offscreen (EGL), for videos and screenshots");
+  cmd->add_option("--render", a.render_output,
+                  "With --headless: write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames)")
       ->check(CLI::IsMember({"video", "frames"}));
   cmd->add_option("--out", a.out_dir, "Folder for --render (default out/view)");
   cmd->add_option("--fps", a.fps, "With --headless: frames per second of the video")->check(between(1, 240));
-  cmd->add_option("--camera", a.camera_kind, "With --headless: the scenario's camera kept fixed, orbiting or flying over (default: the scenario's camera.motion, else orbit)")
+  cmd->add_option("--camera", a.camera_kind,
+                  "With --headless: the scenario's camera kept fixed, orbiting or flying over (default: the scenario's "
+                  "camera.motion, else orbit)")
       ->check(CLI::IsMember({"fixed", "orbit", "flyover"}));
-  cmd->add_option("--camera-period", a.camera_period, "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")->check(greater_than(0));
-  cmd->add_option("--lod-thresholds", a.thresholds, "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")->delimiter(',');
+  cmd->add_option("--camera-period", a.camera_period,
+                  "With --headless: seconds per orbit or fly-over (default: the scenario's, else 60)")
+      ->check(greater_than(0));
+  cmd->add_option("--lod-thresholds", a.thresholds,
+                  "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")
+      ->delimiter(',');
 }
 
 // Refuses combinations that would do nothing (recording options in a
@@ -193,9 +208,11 @@ void add_view_options(CLI::App* cmd, ViewArgs& a) {
 void check_view_args(const CLI::App& cmd, ViewArgs& a) {
   render::ViewerOptions& o = a.o;
   // Options of the offscreen recording are refused in a window, not ignored.
-  refuse_unless(cmd, a.headless, {"--fps", "--camera", "--camera-period"}, "--headless (with --render video|frames or --screenshot)");
+  refuse_unless(cmd, a.headless, {"--fps", "--camera", "--camera-period"},
+                "--headless (with --render video|frames or --screenshot)");
   refuse_unless(cmd, !a.render_output.empty(), {"--out"}, "--render video|frames");
-  if (!o.screenshot.empty() && o.frames == 0) throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
+  if (!o.screenshot.empty() && o.frames == 0)
+    throw Error("--screenshot needs --frames N (the frame to save)", at_field("--screenshot"));
   if (a.headless && o.frames == 0) throw Error("--headless needs --frames N", at_field("--frames"));
   check_lod_thresholds(a.thresholds, "--lod-thresholds");
   if (!a.render_output.empty() && !a.headless) throw Error("--render needs --headless", at_field("--render"));
@@ -213,7 +230,8 @@ std::unique_ptr<render::ViewerScene> make_scene(ViewArgs& a, const GlobalOptions
     std::filesystem::path folder;
     io::AnimateSpec spec = load_animate_spec(a.scenario, folder);
     if (a.agents > 0) spec.characters = a.agents;
-    if (!a.layout.empty()) spec.shape = a.layout == "grid" ? io::AnimateSpec::Shape::Grid : io::AnimateSpec::Shape::Circle;
+    if (!a.layout.empty())
+      spec.shape = a.layout == "grid" ? io::AnimateSpec::Shape::Grid : io::AnimateSpec::Shape::Circle;
     if (!a.thresholds.empty()) spec.lod_thresholds = a.thresholds;
     apply_global_options(g);
     return std::make_unique<FormationScene>(std::move(spec), folder);
@@ -233,7 +251,8 @@ std::unique_ptr<render::ViewerScene> make_scene(ViewArgs& a, const GlobalOptions
 void record_headless(render::ViewerScene& scene, const ViewArgs& a) {
   const render::ViewerOptions& o = a.o;
   render::HeadlessViewOptions h;
-  h.record.output = a.render_output.empty() ? render::RecordOutput::None : render::parse_record_output(a.render_output, "--render");
+  h.record.output =
+      a.render_output.empty() ? render::RecordOutput::None : render::parse_record_output(a.render_output, "--render");
   h.record.folder = a.out_dir;
   h.record.width = o.width;
   h.record.height = o.height;

@@ -16,7 +16,7 @@ struct GlobalOptions {
   std::string backend = "auto";  // auto | cpu | cuda
   int threads = 0;               // 0 = all cores
   std::string log_level = "info";
-  std::string max_memory;        // "" = 80 % of physical memory (core/memory_budget.h)
+  std::string max_memory;  // "" = 80 % of physical memory (core/memory_budget.h)
 };
 
 // Applies --backend/--threads/--log-level/--max-memory; throws Error on bad values.
@@ -53,7 +53,6 @@ void refuse_unless(const CLI::App& cmd, bool given, const std::vector<std::strin
 // the write options with that rotation order and unit (frame time unset);
 // throws Error naming the flag on an unknown name.
 io::BvhWriteOptions bvh_write_options(const std::string& order, const std::string& units);
-
 
 void add_run_command(CLI::App& app, const GlobalOptions& g);
 void add_animate_command(CLI::App& app, const GlobalOptions& g);

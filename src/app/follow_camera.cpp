@@ -11,12 +11,14 @@ namespace throng::app {
 
 FollowCamera::FollowCamera(const Camera& view, double ease_seconds, float min_character_px)
     : view_(view), ease_seconds_(ease_seconds), min_character_px_(min_character_px) {
-  if (!(ease_seconds > 0.0) || !std::isfinite(ease_seconds)) throw Error("must be positive seconds", at_field("camera.ease"));
+  if (!(ease_seconds > 0.0) || !std::isfinite(ease_seconds))
+    throw Error("must be positive seconds", at_field("camera.ease"));
   if (!(min_character_px >= 0.0f) || !std::isfinite(min_character_px))
     throw Error("must be a finite number of pixels >= 0", at_field("camera.min_character_px"));
   const glm::vec3 d = view.position - view.target;
   const float length = glm::length(d);
-  if (!(length > 0.0f) || !std::isfinite(length)) throw Error("the camera's position equals its target", at_field("camera"));
+  if (!(length > 0.0f) || !std::isfinite(length))
+    throw Error("the camera's position equals its target", at_field("camera"));
   direction_ = d / length;
 }
 
@@ -29,7 +31,8 @@ float median_character_px(const Camera& camera, const sim::Simulation& sim) {
     if ((flags[i] & sim::kAgentActive) == 0) continue;
     const glm::vec3 foot = world_to_pixel(v, world_from_ground(positions[i], 0.0f));
     const glm::vec3 head = world_to_pixel(v, world_from_ground(positions[i], kCharacterHeight));
-    if (foot.z <= 0.0f || head.z <= 0.0f || foot.x < 0.0f || foot.x >= v.width || foot.y < 0.0f || foot.y >= v.height) continue;
+    if (foot.z <= 0.0f || head.z <= 0.0f || foot.x < 0.0f || foot.x >= v.width || foot.y < 0.0f || foot.y >= v.height)
+      continue;
     heights.push_back(std::fabs(foot.y - head.y));
   }
   if (heights.empty()) return 0.0f;
@@ -38,7 +41,8 @@ float median_character_px(const Camera& camera, const sim::Simulation& sim) {
   return *mid;
 }
 
-Index FollowCamera::focus_agent(const std::vector<glm::vec2>& positions, const std::vector<std::uint8_t>& flags, glm::vec2 middle) {
+Index FollowCamera::focus_agent(const std::vector<glm::vec2>& positions, const std::vector<std::uint8_t>& flags,
+                                glm::vec2 middle) {
   // The agent nearest the middle, kept while it stays active and no other is
   // markedly nearer: on a ring every agent is about as near, and a focus
   // that hopped between them would swing the camera across the empty centre.
@@ -83,12 +87,14 @@ Camera FollowCamera::at(const sim::Simulation& sim, double t) {
     // A sphere holding the agents (and a character's height) fits the
     // narrower field of view; never closer than 8 m, so a lone agent is framed whole.
     const float reach = std::max(0.5f * glm::length(box.size()) + 1.0f, 4.0f);
-    const float half_fov = 0.5f * std::min(view_.fov_y, 2.0f * std::atan(std::tan(0.5f * view_.fov_y) * aspect_ratio(view_)));
+    const float half_fov =
+        0.5f * std::min(view_.fov_y, 2.0f * std::atan(std::tan(0.5f * view_.fov_y) * aspect_ratio(view_)));
     float distance = std::max(reach / std::sin(half_fov), 8.0f);
     glm::vec2 middle = 0.5f * (box.min + box.max);
     // Farther than this, a character is under min_character_px tall: stay
     // there and aim at an agent near the middle (a ring's middle is empty).
-    const float farthest = std::max(focal_length_pixels(view_) * kCharacterHeight / std::max(min_character_px_, 1e-3f), 8.0f);
+    const float farthest =
+        std::max(focal_length_pixels(view_) * kCharacterHeight / std::max(min_character_px_, 1e-3f), 8.0f);
     if (distance > farthest) {
       distance = farthest;
       middle = positions[static_cast<std::size_t>(focus_agent(positions, flags, middle))];

@@ -23,7 +23,8 @@ io::AnimateSpec load_animate_spec(const std::string& what, fs::path& folder) {
   }
   const std::vector<std::string> names = io::builtin_animate_specs();
   if (std::find(names.begin(), names.end(), what) != names.end()) return io::builtin_animate_spec(what);
-  throw Error(fmt::format("no such file or built-in scenario '{}' (built-in: {})", what, fmt::join(names, ", ")), at_field("scenario"));
+  throw Error(fmt::format("no such file or built-in scenario '{}' (built-in: {})", what, fmt::join(names, ", ")),
+              at_field("scenario"));
 }
 
 motion::BlendSpace1D load_blend_space(const io::AnimateSpec& spec, const fs::path& folder) {
@@ -34,16 +35,17 @@ motion::BlendSpace1D load_blend_space(const io::AnimateSpec& spec, const fs::pat
     const io::AnimateClipSource& src = spec.clips[i];
     const fs::path path = fs::path(src.file).is_absolute() ? fs::path(src.file) : folder / src.file;
     const io::BvhFile file = io::read_bvh(path.string());
-    if (i == 0) skeleton = file.skeleton;
+    if (i == 0)
+      skeleton = file.skeleton;
     else if (file.skeleton.joint_count() != skeleton.joint_count())
-      throw Error("has " + std::to_string(file.skeleton.joint_count()) + " joints, the first clip " + std::to_string(skeleton.joint_count()) +
-                      ": clips of a blend space share one skeleton",
+      throw Error("has " + std::to_string(file.skeleton.joint_count()) + " joints, the first clip " +
+                      std::to_string(skeleton.joint_count()) + ": clips of a blend space share one skeleton",
                   at_field("motion[" + std::to_string(i) + "]", spec.source));
     motion::LocomotionOptions options;
     options.cycle.skip_frames = src.skip_frames;
     clips.push_back(motion::prepare_locomotion_clip(skeleton, file.clip, src.name, options));
-    spdlog::info("{}: cycle of {} frames, {:.2f} m/s, stride {:.2f} m", src.name, clips.back().frame_count(), clips.back().speed,
-                 clips.back().stride_m);
+    spdlog::info("{}: cycle of {} frames, {:.2f} m/s, stride {:.2f} m", src.name, clips.back().frame_count(),
+                 clips.back().speed, clips.back().stride_m);
   }
   return motion::BlendSpace1D(std::move(skeleton), std::move(clips));
 }
@@ -60,7 +62,8 @@ Formation make_formation(const io::AnimateSpec& s) {
       const auto capacity = std::max<std::size_t>(1, static_cast<std::size_t>(2.0f * kPiF * r / s.spacing));
       const std::size_t here = std::min(capacity, n - placed);
       for (std::size_t k = 0; k < here; ++k) {
-        const float a = 2.0f * kPiF * (static_cast<float>(k) + 0.5f * static_cast<float>(ring % 2)) / static_cast<float>(here);
+        const float a =
+            2.0f * kPiF * (static_cast<float>(k) + 0.5f * static_cast<float>(ring % 2)) / static_cast<float>(here);
         // Counter-clockwise seen from above: angle a at (cos a, -sin a) in XZ,
         // walking along (-sin a, -cos a), a left turn of curvature 1 / r.
         f.positions.emplace_back(r * std::cos(a), 0.0f, -r * std::sin(a));
@@ -75,7 +78,8 @@ Formation make_formation(const io::AnimateSpec& s) {
     const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
     const float half = 0.5f * s.spacing * static_cast<float>(side - 1);
     for (std::size_t i = 0; i < n; ++i) {
-      f.positions.emplace_back(s.spacing * static_cast<float>(i % side) - half, 0.0f, s.spacing * static_cast<float>(i / side) - half);
+      f.positions.emplace_back(s.spacing * static_cast<float>(i % side) - half, 0.0f,
+                               s.spacing * static_cast<float>(i / side) - half);
       f.yaws.push_back(0.0f);
       f.curvatures.push_back(0.0f);
       f.rings.push_back(0.0f);
@@ -94,14 +98,18 @@ anim::CrowdAnimatorConfig animator_config(const io::AnimateSpec& spec) {
   config.lod_thresholds = spec.lod_thresholds;
   config.cache = spec.cache;
   config.cache_config.bucket_width = spec.bucket_width;
-  config.cache_config.capacity_bytes = static_cast<std::size_t>(static_cast<double>(spec.cache_capacity_mb) * 1024.0 * 1024.0);
+  config.cache_config.capacity_bytes =
+      static_cast<std::size_t>(static_cast<double>(spec.cache_capacity_mb) * 1024.0 * 1024.0);
   return config;
 }
 
 }  // namespace
 
 FormationCrowd::FormationCrowd(io::AnimateSpec spec, const fs::path& folder)
-    : spec_(std::move(spec)), space_(load_blend_space(spec_, folder)), formation_(make_formation(spec_)), rng_(spec_.seed) {
+    : spec_(std::move(spec)),
+      space_(load_blend_space(spec_, folder)),
+      formation_(make_formation(spec_)),
+      rng_(spec_.seed) {
   const Index n = spec_.characters;
   crowd_ = std::make_unique<anim::CrowdAnimator>(space_, n, animator_config(spec_));
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);

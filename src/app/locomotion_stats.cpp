@@ -28,7 +28,10 @@ void LocomotionTally::add(const anim::FrameStats& frame, double ms) {
 
 nlohmann::json LocomotionTally::frame_ms_json() const {
   const std::vector<double> kept = frame_ms.values();
-  return {{"median", percentile(kept, 0.5)}, {"mean", frame_ms.mean()}, {"p95", percentile(kept, 0.95)}, {"max", frame_ms.max()}};
+  return {{"median", percentile(kept, 0.5)},
+          {"mean", frame_ms.mean()},
+          {"p95", percentile(kept, 0.95)},
+          {"max", frame_ms.max()}};
 }
 
 nlohmann::json LocomotionTally::lod_json(const anim::CrowdAnimator& crowd, const std::vector<float>& thresholds) const {
@@ -37,7 +40,8 @@ nlohmann::json LocomotionTally::lod_json(const anim::CrowdAnimator& crowd, const
   nlohmann::json parts;
   for (anim::BodyPart p : anim::kAllBodyParts) {
     std::vector<Index> levels;
-    for (int l = 0; l < lod->level_count; ++l) levels.push_back(level_counts[static_cast<std::size_t>(static_cast<int>(p) * lod->level_count + l)]);
+    for (int l = 0; l < lod->level_count; ++l)
+      levels.push_back(level_counts[static_cast<std::size_t>(static_cast<int>(p) * lod->level_count + l)]);
     parts[anim::to_string(p)] = levels;
   }
   return {{"thresholds_px2", thresholds},
@@ -50,16 +54,17 @@ nlohmann::json LocomotionTally::cache_json(const anim::CrowdAnimator& crowd) con
   const anim::CycleCacheTable* cache = crowd.cache();
   if (cache == nullptr) return nullptr;
   const anim::MotionCacheStats& c = cache->cache().stats();
-  return {{"bucket_width", cache->bucket_width()},
-          {"capacity_bytes", cache->cache().config().capacity_bytes},
-          {"hits", c.hits},
-          {"misses", c.misses},
-          {"insertions", c.insertions},
-          {"evictions", c.evictions},
-          {"bytes", c.bytes},
-          {"entries", c.entries},
-          {"hit_rate", c.hit_rate()},
-          {"from_cache_fraction", character_frames() > 0.0 ? static_cast<double>(from_cache) / character_frames() : 0.0}};
+  return {
+      {"bucket_width", cache->bucket_width()},
+      {"capacity_bytes", cache->cache().config().capacity_bytes},
+      {"hits", c.hits},
+      {"misses", c.misses},
+      {"insertions", c.insertions},
+      {"evictions", c.evictions},
+      {"bytes", c.bytes},
+      {"entries", c.entries},
+      {"hit_rate", c.hit_rate()},
+      {"from_cache_fraction", character_frames() > 0.0 ? static_cast<double>(from_cache) / character_frames() : 0.0}};
 }
 
 }  // namespace throng::app

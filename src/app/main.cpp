@@ -22,7 +22,8 @@ namespace throng::app {
 void apply_global_options(const GlobalOptions& g) {
   const auto level = spdlog::level::from_str(g.log_level);
   if (level == spdlog::level::off && g.log_level != "off")
-    throw Error("unknown log level '" + g.log_level + "' (trace, debug, info, warn, error, off)", at_field("--log-level"));
+    throw Error("unknown log level '" + g.log_level + "' (trace, debug, info, warn, error, off)",
+                at_field("--log-level"));
   spdlog::set_level(level);
   if (g.threads < 0) throw Error("thread count must be >= 0 (0 = all cores)", at_field("--threads"));
   configure_execution(resolve_backend(parse_backend_choice(g.backend)), g.threads);
@@ -31,10 +32,14 @@ void apply_global_options(const GlobalOptions& g) {
 
 void add_global_options(CLI::App& app, GlobalOptions& g) {
   const char* group = "Global options (before or after the command)";
-  app.add_option("--backend", g.backend, "Where kernels run: auto, cpu or cuda")->check(CLI::IsMember({"auto", "cpu", "cuda"}))->group(group);
+  app.add_option("--backend", g.backend, "Where kernels run: auto, cpu or cuda")
+      ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
+      ->group(group);
   app.add_option("--threads", g.threads, "CPU threads (0 = all cores)")->check(at_least(0))->group(group);
   app.add_option("--log-level", g.log_level, "trace, debug, info, warn, error or off")->group(group);
-  app.add_option("--max-memory", g.max_memory, "Memory a command may plan to use, e.g. 8G (default: 80 % of physical memory)")->group(group);
+  app.add_option("--max-memory", g.max_memory,
+                 "Memory a command may plan to use, e.g. 8G (default: 80 % of physical memory)")
+      ->group(group);
 }
 
 }  // namespace throng::app
@@ -45,7 +50,8 @@ namespace {
 // word was not expected); say which word is not a command instead.
 class UnknownCommand : public CLI::ParseError {
  public:
-  explicit UnknownCommand(std::string message) : CLI::ParseError("UnknownCommand", std::move(message), CLI::ExitCodes::ExtrasError) {}
+  explicit UnknownCommand(std::string message)
+      : CLI::ParseError("UnknownCommand", std::move(message), CLI::ExitCodes::ExtrasError) {}
 };
 
 // The first word on the command line that is neither an option of the top
@@ -70,7 +76,8 @@ void check_command_word(const CLI::App& app, int argc, char** argv) {
   const std::optional<std::string> word = command_word(app, argc, argv);
   if (!word) return;
   std::vector<std::string> names;
-  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    names.push_back(sub->get_name());
   for (const std::string& name : names)
     if (name == *word) return;
   std::string message = "unknown command '" + *word + "'";

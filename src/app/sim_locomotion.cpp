@@ -76,7 +76,8 @@ void SimulationLocomotion::remember(const sim::Simulation& sim) {
   copy_span(sim.crowd().heading.span(), previous_headings_.span().subspan(0, n));
 }
 
-const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera, bool moving) {
+const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim, float alpha, float dt,
+                                                      const Camera* camera, bool moving) {
   const auto t0 = std::chrono::steady_clock::now();
   const sim::CrowdState& c = sim.crowd();
   // Agents between the steps, moving at their displacement over the step.
@@ -119,11 +120,14 @@ nlohmann::json SimulationLocomotion::stats() const {
   nlohmann::json kernels = nlohmann::json::object();
   for (const KernelStat& k : KernelTimings::global().stats())
     if (k.name.rfind("anim.", 0) == 0)
-      kernels[k.name] = {{"count", k.count}, {"total_ms", k.total_ms}, {"median_ms", k.median_ms},
+      kernels[k.name] = {{"count", k.count},
+                         {"total_ms", k.total_ms},
+                         {"median_ms", k.median_ms},
                          {"ms_per_frame", frames > 0 ? k.total_ms / static_cast<double>(frames) : 0.0}};
   out["kernels"] = kernels;
   out["joints_synthesised_per_character"] =
-      tally_.character_frames() > 0.0 ? static_cast<double>(tally_.joints_synthesised) / tally_.character_frames() : 0.0;
+      tally_.character_frames() > 0.0 ? static_cast<double>(tally_.joints_synthesised) / tally_.character_frames()
+                                      : 0.0;
   if (nlohmann::json lod = tally_.lod_json(crowd, thresholds_); !lod.is_null()) out["lod"] = lod;
   if (nlohmann::json cache = tally_.cache_json(crowd); !cache.is_null()) out["cache"] = cache;
   ThinnedSample slides = slides_cm_;

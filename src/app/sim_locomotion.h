@@ -60,7 +60,8 @@ class SimulationLocomotion {
   // over that step (what the root moves, so strides match it), dt seconds
   // after the previous frame, joint LOD for `camera` (null: every joint).
   // moving = false shows everyone standing (a finished simulation).
-  const anim::FrameStats& animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera, bool moving = true);
+  const anim::FrameStats& animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera,
+                                  bool moving = true);
 
   std::int64_t frames() const { return tally_.frames; }
   // stats.json's "locomotion" section: frame timings, kernels (anim.*),
@@ -74,8 +75,8 @@ class SimulationLocomotion {
   Index tracked_ = 0;
   Buffer<glm::vec2> previous_positions_, shown_positions_, moved_, still_;
   Buffer<float> previous_headings_, shown_headings_;
-  LocomotionTally tally_;  // over the frames
-  std::int32_t skating_frames_ = 0;  // frames in the current foot-tracking window
+  LocomotionTally tally_;                       // over the frames
+  std::int32_t skating_frames_ = 0;             // frames in the current foot-tracking window
   ThinnedSample slides_cm_{kMaxSkatingSlides};  // contacts of the windows closed so far
 };
 
@@ -85,7 +86,7 @@ class SimulationLocomotion {
 // called (rendering); the camera at a time drives the LOD.
 struct LocomotionStageOptions {
   SimulationLocomotionOptions locomotion;
-  double fps = 0.0;  // 0: a frame per step
+  double fps = 0.0;                           // 0: a frame per step
   std::function<Camera(double time)> camera;  // the camera of each frame (rendering and LOD)
   bool lod = true;                            // false or no camera: every joint synthesised
   std::function<void(double time, const Camera* camera, SimulationLocomotion& animated)> on_frame;

@@ -8,7 +8,8 @@ namespace throng {
 
 void saxpy(float a, Span<const float> x, Span<float> y) {
   if (x.size() != y.size()) throw Error("saxpy: x and y differ in length");
-  parallel_for("core.saxpy", x.size(), THRONG_LAMBDA(Index i) { y[i] = a * x[i] + y[i]; });
+  parallel_for(
+      "core.saxpy", x.size(), THRONG_LAMBDA(Index i) { y[i] = a * x[i] + y[i]; });
 }
 
 float sum(Span<const float> x) { return deterministic_sum("core.sum_f32", x); }
@@ -26,8 +27,8 @@ float exclusive_scan(Span<const float> in, Span<float> out) { return scan_checke
 
 Index count_nonzero(Span<const std::uint8_t> flags) {
   return parallel_reduce(
-      "core.count_nonzero", flags.size(), Index{0}, THRONG_LAMBDA(Index i) { return static_cast<Index>(flags[i] != 0 ? 1 : 0); },
-      detail::Plus{});
+      "core.count_nonzero", flags.size(), Index{0},
+      THRONG_LAMBDA(Index i) { return static_cast<Index>(flags[i] != 0 ? 1 : 0); }, detail::Plus{});
 }
 
 namespace {

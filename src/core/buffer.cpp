@@ -37,8 +37,9 @@ void copy_bytes(void* dst, Memory dst_m, const void* src, Memory src_m, std::siz
     std::memcpy(dst, src, bytes);
     return;
   }
-  const cuda::Copy kind = dst_m == Memory::Device ? (src_m == Memory::Device ? cuda::Copy::DeviceToDevice : cuda::Copy::HostToDevice)
-                                                  : cuda::Copy::DeviceToHost;
+  const cuda::Copy kind = dst_m == Memory::Device
+                              ? (src_m == Memory::Device ? cuda::Copy::DeviceToDevice : cuda::Copy::HostToDevice)
+                              : cuda::Copy::DeviceToHost;
   cuda::copy(dst, src, bytes, kind);
 }
 

@@ -76,8 +76,12 @@ class Buffer {
     if (n > 0) detail::copy_bytes(data_, memory_, values.data(), Memory::Host, bytes(n));
   }
   // Elements [first, first + out.size()) into host memory, and back from it.
-  void read(Index first, std::span<T> out) const { copy_range(out.data(), Memory::Host, data_ + first, memory_, out.size()); }
-  void write(Index first, std::span<const T> values) { copy_range(data_ + first, memory_, values.data(), Memory::Host, values.size()); }
+  void read(Index first, std::span<T> out) const {
+    copy_range(out.data(), Memory::Host, data_ + first, memory_, out.size());
+  }
+  void write(Index first, std::span<const T> values) {
+    copy_range(data_ + first, memory_, values.data(), Memory::Host, values.size());
+  }
   std::vector<T> to_vector() const {
     std::vector<T> out(static_cast<std::size_t>(size_));
     if (size_ > 0) detail::copy_bytes(out.data(), Memory::Host, data_, memory_, bytes(size_));
@@ -126,7 +130,9 @@ void copy_to_host(Span<From> from, std::span<To> to) {
 template <class From, class To>
 void copy_span(Span<From> from, Span<To> to) {
   static_assert(std::is_same_v<std::remove_const_t<From>, To>, "copy_span: element types differ");
-  if (!to.empty()) detail::copy_bytes(to.data(), current_memory(), from.data(), current_memory(), static_cast<std::size_t>(to.size()) * sizeof(To));
+  if (!to.empty())
+    detail::copy_bytes(to.data(), current_memory(), from.data(), current_memory(),
+                       static_cast<std::size_t>(to.size()) * sizeof(To));
 }
 
 }  // namespace throng

@@ -25,7 +25,8 @@ void Camera::validate() const {
   if (!(std::isfinite(fov_y) && fov_y > 0.0f && fov_y < 3.14159f))
     fail("fov_y", "must be in (0, pi) radians, got " + std::to_string(fov_y));
   if (width <= 0 || width > kMaxViewport) fail("width", "must be in [1, 32768] pixels, got " + std::to_string(width));
-  if (height <= 0 || height > kMaxViewport) fail("height", "must be in [1, 32768] pixels, got " + std::to_string(height));
+  if (height <= 0 || height > kMaxViewport)
+    fail("height", "must be in [1, 32768] pixels, got " + std::to_string(height));
   if (!(std::isfinite(near_plane) && near_plane > 0.0f)) fail("near_plane", "must be positive");
   if (!(std::isfinite(far_plane) && far_plane > near_plane)) fail("far_plane", "must be greater than near_plane");
   const glm::vec3 forward = target - position;

@@ -23,7 +23,7 @@ struct Camera {
   glm::vec3 position{0.0f, 1.7f, 10.0f};
   glm::vec3 target{0.0f, 1.0f, 0.0f};
   glm::vec3 up{0.0f, 1.0f, 0.0f};
-  float fov_y = 0.9272952f;  // vertical field of view, radians (2 atan(1/2), about 53 degrees)
+  float fov_y = 0.9272952f;   // vertical field of view, radians (2 atan(1/2), about 53 degrees)
   std::int32_t width = 1920;  // viewport, pixels
   std::int32_t height = 1080;
   float near_plane = 0.1f;  // metres
@@ -50,7 +50,7 @@ THRONG_HOST_DEVICE inline glm::mat4 projection_matrix(const Camera& c) {
 
 // What per-agent kernels need, computed once per frame from a Camera.
 struct CameraView {
-  glm::mat4 view{1.0f};  // world -> camera space
+  glm::mat4 view{1.0f};   // world -> camera space
   float focal_px = 1.0f;  // focal length, pixels
   float width = 1.0f;     // viewport, pixels
   float height = 1.0f;
@@ -98,11 +98,11 @@ THRONG_HOST_DEVICE inline glm::vec3 pixel_ray(const CameraView& v, glm::vec2 pix
 // and the renderer's default camera.
 struct CameraOrbit {
   glm::vec3 centre{0.0f};
-  float radius = 30.0f;          // metres from the centre, in the ground plane
-  float height = 8.0f;           // eye height above the centre
-  float target_height = 1.0f;    // looks at centre + (0, target_height, 0)
-  float angular_speed = 0.2f;    // radians per second, counter-clockwise seen from +Y
-  float start_angle = 0.0f;      // radians; 0 puts the camera on +X of the centre
+  float radius = 30.0f;        // metres from the centre, in the ground plane
+  float height = 8.0f;         // eye height above the centre
+  float target_height = 1.0f;  // looks at centre + (0, target_height, 0)
+  float angular_speed = 0.2f;  // radians per second, counter-clockwise seen from +Y
+  float start_angle = 0.0f;    // radians; 0 puts the camera on +X of the centre
 };
 
 // The orbit's camera at `seconds`; fov, viewport and clip planes come from `lens`.

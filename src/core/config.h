@@ -17,7 +17,7 @@
 // nothing: spans and parameters), so the body reads its members by name
 // with no local copies first.
 //   void SaxpyJob::run() const { parallel_for("saxpy", x.size(), THRONG_JOB_LAMBDA(Index i) { y[i] += a * x[i]; }); }
-#define THRONG_JOB_LAMBDA(...) [=, *this] THRONG_HOST_DEVICE(__VA_ARGS__)
+#define THRONG_JOB_LAMBDA(...) [ =, *this ] THRONG_HOST_DEVICE(__VA_ARGS__)
 
 #include <cstdint>
 

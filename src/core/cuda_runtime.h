@@ -7,8 +7,8 @@
 
 namespace throng::cuda {
 
-bool compiled();         // the build has the CUDA backend
-int device_count();      // 0 when not compiled or no device/driver
+bool compiled();     // the build has the CUDA backend
+int device_count();  // 0 when not compiled or no device/driver
 std::string device_name(int device);
 std::string runtime_error_text();  // why device_count() is 0, if it is
 

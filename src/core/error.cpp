@@ -39,7 +39,8 @@ Location at_field(std::string field, std::string file) {
 
 void check_length(const char* owner, const char* field, std::int64_t got, std::int64_t want) {
   if (got != want)
-    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want), at_field(std::string(owner) + "." + field));
+    throw Error("has " + std::to_string(got) + " elements, expected " + std::to_string(want),
+                at_field(std::string(owner) + "." + field));
 }
 
 void check_optional_length(const char* owner, const char* field, std::int64_t got, std::int64_t want) {

@@ -40,13 +40,11 @@ std::string cuda_status() {
 
 Backend resolve_backend(BackendChoice choice) {
   switch (choice) {
-    case BackendChoice::Cpu:
-      return Backend::Cpu;
+    case BackendChoice::Cpu: return Backend::Cpu;
     case BackendChoice::Cuda:
       if (!cuda_usable()) throw Error("backend 'cuda' requested but " + cuda_status(), at_field("backend"));
       return Backend::Cuda;
-    case BackendChoice::Auto:
-      break;
+    case BackendChoice::Auto: break;
   }
   if (cuda_usable()) return Backend::Cuda;
   std::call_once(g_cpu_notice, [] { spdlog::info("no usable GPU ({}); using the CPU backend", cuda_status()); });
@@ -70,8 +68,7 @@ int current_threads() {
   return t <= 0 ? hardware_threads() : t;
 }
 
-ScopedExecution::ScopedExecution(Backend backend, int threads)
-    : saved_backend_(g_backend), saved_threads_(g_threads) {
+ScopedExecution::ScopedExecution(Backend backend, int threads) : saved_backend_(g_backend), saved_threads_(g_threads) {
   configure_execution(backend, threads);
 }
 

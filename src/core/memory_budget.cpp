@@ -51,14 +51,19 @@ std::uint64_t parse_memory_size(const std::string& text, const std::string& fiel
   if (ec != std::errc() || !std::isfinite(value)) throw bad();
   std::string unit(rest, end);
   for (char& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  if (unit.size() > 1 && unit.back() == 'B') unit.pop_back();                     // "GB", "GIB" -> "G", "GI"
-  if (unit.size() == 2 && unit.back() == 'I') unit.pop_back();                    // "GI" -> "G"
+  if (unit.size() > 1 && unit.back() == 'B') unit.pop_back();   // "GB", "GIB" -> "G", "GI"
+  if (unit.size() == 2 && unit.back() == 'I') unit.pop_back();  // "GI" -> "G"
   double scale = 1;
-  if (unit == "K") scale = 1024.0;
-  else if (unit == "M") scale = 1024.0 * 1024.0;
-  else if (unit == "G") scale = 1024.0 * 1024.0 * 1024.0;
-  else if (unit == "T") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
-  else if (!unit.empty() && unit != "B") throw bad();
+  if (unit == "K")
+    scale = 1024.0;
+  else if (unit == "M")
+    scale = 1024.0 * 1024.0;
+  else if (unit == "G")
+    scale = 1024.0 * 1024.0 * 1024.0;
+  else if (unit == "T")
+    scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  else if (!unit.empty() && unit != "B")
+    throw bad();
   const double bytes = value * scale;
   if (!(bytes >= 1.0)) throw Error(fmt::format("the memory budget must be positive, got '{}'", text), at_field(field));
   if (bytes > 1.8e19) throw bad();
@@ -79,10 +84,13 @@ void check_memory_budget(double bytes, const std::string& what, const std::strin
   const std::uint64_t budget = memory_budget();
   if (bytes <= static_cast<double>(budget)) return;
   const bool set = g_budget.load() > 0;
-  throw Error(fmt::format("about {} for {} exceeds the memory budget of {} ({}); ask for less, or raise it with --max-memory",
-                          format_bytes(bytes), what, format_bytes(static_cast<double>(budget)),
-                          set ? "--max-memory" : fmt::format("80 % of this machine's {}", format_bytes(static_cast<double>(physical_memory_bytes())))),
-              at_field(field));
+  throw Error(
+      fmt::format(
+          "about {} for {} exceeds the memory budget of {} ({}); ask for less, or raise it with --max-memory",
+          format_bytes(bytes), what, format_bytes(static_cast<double>(budget)),
+          set ? "--max-memory"
+              : fmt::format("80 % of this machine's {}", format_bytes(static_cast<double>(physical_memory_bytes())))),
+      at_field(field));
 }
 
 }  // namespace throng

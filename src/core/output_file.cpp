@@ -16,7 +16,10 @@ OutputFile::OutputFile(std::string path, OnFailure on_failure)
 OutputFile::~OutputFile() { abandon(); }
 
 OutputFile::OutputFile(OutputFile&& other) noexcept
-    : path_(std::move(other.path_)), writing_path_(std::move(other.writing_path_)), on_failure_(other.on_failure_), committed_(other.committed_) {
+    : path_(std::move(other.path_)),
+      writing_path_(std::move(other.writing_path_)),
+      on_failure_(other.on_failure_),
+      committed_(other.committed_) {
   other.committed_ = true;  // the moved-from object owns no file
 }
 

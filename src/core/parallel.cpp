@@ -39,8 +39,9 @@ void cpu_parallel_for(Index n, Index grain, RangeFn fn, const void* body) {
 }
 
 void kernel_not_compiled_for_cuda(const char* description) {
-  throw Error(std::string("kernel '") + description +
-              "' runs on the CPU only: its source is not listed in throng_kernel_sources, so no CUDA version was compiled");
+  throw Error(
+      std::string("kernel '") + description +
+      "' runs on the CPU only: its source is not listed in throng_kernel_sources, so no CUDA version was compiled");
 }
 
 }  // namespace throng::detail

@@ -30,7 +30,9 @@ class Rng {
   THRONG_HOST_DEVICE double uniform() { return static_cast<double>(next() >> 11) * (1.0 / 9007199254740992.0); }
   THRONG_HOST_DEVICE double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
   // Uniform integer in [0, n), n > 0.
-  THRONG_HOST_DEVICE std::uint64_t below(std::uint64_t n) { return static_cast<std::uint64_t>(uniform() * static_cast<double>(n)) % n; }
+  THRONG_HOST_DEVICE std::uint64_t below(std::uint64_t n) {
+    return static_cast<std::uint64_t>(uniform() * static_cast<double>(n)) % n;
+  }
   // Standard normal (Box-Muller, one value per call).
   THRONG_HOST_DEVICE double normal() {
     const double u1 = 1.0 - uniform();  // (0, 1]

@@ -121,7 +121,8 @@ std::vector<Index> deterministic_histogram(const char* description, Index n, std
   parallel_for(description, blocks, detail::CountBlocks<KeyOf>{partial.span(), n, per_block, bins, key_of}, 1);
   const std::vector<std::int32_t> all = partial.to_vector();
   for (Index b = 0; b < blocks; ++b)
-    for (std::int32_t k = 0; k < bins; ++k) counts[static_cast<std::size_t>(k)] += all[static_cast<std::size_t>(b * bins + k)];
+    for (std::int32_t k = 0; k < bins; ++k)
+      counts[static_cast<std::size_t>(k)] += all[static_cast<std::size_t>(b * bins + k)];
   return counts;
 }
 
@@ -133,7 +134,8 @@ T exclusive_scan(const char* description, Span<const T> in, Span<T> out) {
   if (n == 0) return T{};
   const Index blocks = detail::block_count(n);
   Buffer<T> sums(blocks, current_memory());
-  parallel_for(description, blocks, detail::FoldBlocks<T, detail::Load<T>, detail::Plus>{sums.span(), n, T{}, {in}, {}}, 1);
+  parallel_for(description, blocks, detail::FoldBlocks<T, detail::Load<T>, detail::Plus>{sums.span(), n, T{}, {in}, {}},
+               1);
   std::vector<T> offsets = sums.to_vector();
   T total{};
   for (T& o : offsets) {

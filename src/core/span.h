@@ -28,7 +28,8 @@ struct Span {
   THRONG_HOST_DEVICE constexpr Span(T* p, Index n) : ptr(p), count(n) {}
   // Host containers (std::vector, std::array, std::span) convert implicitly.
   // (Not a Span: copying one must stay the host+device copy constructor.)
-  template <class C, class = decltype(std::data(std::declval<C&>())), class = std::enable_if_t<!is_span<std::remove_cv_t<C>>::value>>
+  template <class C, class = decltype(std::data(std::declval<C&>())),
+            class = std::enable_if_t<!is_span<std::remove_cv_t<C>>::value>>
   Span(C& c) : ptr(std::data(c)), count(static_cast<Index>(std::size(c))) {}
   // Span<T> -> Span<const T>
   template <class U, class = std::enable_if_t<std::is_same_v<const U, T> && !std::is_same_v<U, T>>>

@@ -54,7 +54,8 @@ std::vector<KernelStat> KernelTimings::stats() const {
     std::lock_guard lock(g_mutex);
     for (const auto& [name, s] : g_series) out.push_back({name, s.count, s.total, median(s.recent), s.min, s.max});
   }
-  std::stable_sort(out.begin(), out.end(), [](const KernelStat& a, const KernelStat& b) { return a.total_ms > b.total_ms; });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const KernelStat& a, const KernelStat& b) { return a.total_ms > b.total_ms; });
   return out;
 }
 
@@ -62,11 +63,11 @@ std::string KernelTimings::table() const {
   const auto rows = stats();
   std::size_t width = 6;
   for (const auto& r : rows) width = std::max(width, r.name.size());
-  std::string s = fmt::format("{:<{}}  {:>9}  {:>12}  {:>11}  {:>11}  {:>11}\n", "kernel", width, "count", "total ms", "median ms",
-                              "min ms", "max ms");
+  std::string s = fmt::format("{:<{}}  {:>9}  {:>12}  {:>11}  {:>11}  {:>11}\n", "kernel", width, "count", "total ms",
+                              "median ms", "min ms", "max ms");
   for (const auto& r : rows)
-    s += fmt::format("{:<{}}  {:>9}  {:>12.3f}  {:>11.4f}  {:>11.4f}  {:>11.4f}\n", r.name, width, r.count, r.total_ms, r.median_ms,
-                     r.min_ms, r.max_ms);
+    s += fmt::format("{:<{}}  {:>9}  {:>12.3f}  {:>11.4f}  {:>11.4f}  {:>11.4f}\n", r.name, width, r.count, r.total_ms,
+                     r.median_ms, r.min_ms, r.max_ms);
   return s;
 }
 

@@ -25,8 +25,9 @@ class Reader : public YamlReader {
   AnimateSpec read(const YAML::Node& root) {
     AnimateSpec s;
     if (root.IsNull()) return s;
-    expect_map(root, "", {"name", "characters", "formation", "speed", "scale", "motion", "mode", "duration", "fps", "seed", "camera", "lod",
-                          "cache", "foot_skating", "output"});
+    expect_map(root, "",
+               {"name", "characters", "formation", "speed", "scale", "motion", "mode", "duration", "fps", "seed",
+                "camera", "lod", "cache", "foot_skating", "output"});
     if (const auto n = root["name"]) s.name = text(n, "name");
     if (const auto n = root["characters"]) s.characters = integer(n, "characters", 1, 10'000'000);
     if (const auto f = root["formation"]) formation(f, "formation", s);
@@ -47,7 +48,8 @@ class Reader : public YamlReader {
     }
     if (const auto f = root["foot_skating"]) {
       expect_map(f, "foot_skating", {"characters"});
-      if (const auto n = f["characters"]) s.skating_characters = static_cast<std::int32_t>(integer(n, "foot_skating.characters", 0, 10000));
+      if (const auto n = f["characters"])
+        s.skating_characters = static_cast<std::int32_t>(integer(n, "foot_skating.characters", 0, 10000));
     }
     if (const auto n = root["output"]) s.output = text(n, "output");
     return s;
@@ -57,7 +59,8 @@ class Reader : public YamlReader {
   void formation(const YAML::Node& f, const std::string& path, AnimateSpec& s) {
     expect_map(f, path, {"shape", "radius", "ring_spacing", "spacing", "direction"});
     if (const auto n = f["shape"])
-      s.shape = word(n, child(path, "shape"), {"circle", "grid"}) == "circle" ? AnimateSpec::Shape::Circle : AnimateSpec::Shape::Grid;
+      s.shape = word(n, child(path, "shape"), {"circle", "grid"}) == "circle" ? AnimateSpec::Shape::Circle
+                                                                              : AnimateSpec::Shape::Grid;
     if (const auto n = f["radius"]) s.radius = real_in(n, child(path, "radius"), 0.5, 1e5);
     if (const auto n = f["ring_spacing"]) s.ring_spacing = real_in(n, child(path, "ring_spacing"), 0.3, 100.0);
     if (const auto n = f["spacing"]) s.spacing = real_in(n, child(path, "spacing"), 0.3, 100.0);
@@ -95,7 +98,8 @@ class Reader : public YamlReader {
         if (!c["file"]) fail(c, child(field, "file"), "each clip needs a file");
         src.file = text(c["file"], child(field, "file"));
         if (const auto n = c["name"]) src.name = text(n, child(field, "name"));
-        if (const auto n = c["skip_frames"]) src.skip_frames = static_cast<std::int32_t>(integer(n, child(field, "skip_frames"), 0, 100000));
+        if (const auto n = c["skip_frames"])
+          src.skip_frames = static_cast<std::int32_t>(integer(n, child(field, "skip_frames"), 0, 100000));
       }
       if (src.file.empty()) fail(c, field, "empty file name");
       if (src.name.empty()) src.name = std::filesystem::path(src.file).stem().string();
@@ -107,7 +111,8 @@ class Reader : public YamlReader {
     expect_map(c, path, {"orbit_radius", "elevation", "angular_speed", "fov_deg", "resolution"});
     if (const auto n = c["orbit_radius"]) s.camera_radius = real_in(n, child(path, "orbit_radius"), 0.0, 1e6);
     if (const auto n = c["elevation"]) s.camera_elevation = real_in(n, child(path, "elevation"), -1e5, 1e5);
-    if (const auto n = c["angular_speed"]) s.camera_angular_speed = real_in(n, child(path, "angular_speed"), -100.0, 100.0);
+    if (const auto n = c["angular_speed"])
+      s.camera_angular_speed = real_in(n, child(path, "angular_speed"), -100.0, 100.0);
     if (const auto n = c["fov_deg"]) s.camera_fov_deg = real_in(n, child(path, "fov_deg"), 1.0, 179.0);
     if (const auto n = c["resolution"]) {
       const std::string rp = child(path, "resolution");
@@ -161,7 +166,8 @@ std::vector<std::string> builtin_animate_specs() { return kBuiltinAnimateScenari
 AnimateSpec builtin_animate_spec(std::string_view name) {
   const auto text = kBuiltinAnimateScenarios.find(name);
   if (!text) {
-    throw Error(fmt::format("no built-in animate scenario '{}' (built-in: {})", name, fmt::join(kBuiltinAnimateScenarios.names(), ", ")),
+    throw Error(fmt::format("no built-in animate scenario '{}' (built-in: {})", name,
+                            fmt::join(kBuiltinAnimateScenarios.names(), ", ")),
                 at_field("scenario"));
   }
   AnimateSpec s = parse_animate_spec(std::string(*text), "built-in:" + std::string(name));

@@ -12,8 +12,8 @@
 namespace throng::io {
 
 struct AnimateClipSource {
-  std::string file;             // BVH, relative to the scenario file's folder
-  std::string name;             // defaults to the file's stem
+  std::string file;              // BVH, relative to the scenario file's folder
+  std::string name;              // defaults to the file's stem
   std::int32_t skip_frames = 0;  // leading frames the cycle search ignores (a T-pose)
   bool operator==(const AnimateClipSource&) const = default;
 };
@@ -25,15 +25,15 @@ struct AnimateSpec {
 
   enum class Shape : std::uint8_t { Circle, Grid };
   Shape shape = Shape::Circle;
-  float radius = 12.0f;        // m: the innermost ring (circle)
-  float ring_spacing = 1.6f;   // m between rings (circle)
-  float spacing = 1.3f;        // m between neighbours on a ring, or on the grid
-  bool clockwise = false;      // circle: walking direction seen from above
+  float radius = 12.0f;       // m: the innermost ring (circle)
+  float ring_spacing = 1.6f;  // m between rings (circle)
+  float spacing = 1.3f;       // m between neighbours on a ring, or on the grid
+  bool clockwise = false;     // circle: walking direction seen from above
 
-  float speed_min = 0.8f;      // m/s, each character draws its own
+  float speed_min = 0.8f;  // m/s, each character draws its own
   float speed_max = 2.4f;
-  float change_every_s = 5.0f; // redraw speeds this often (0: never)
-  float scale_min = 1.0f;      // uniform scale per character
+  float change_every_s = 5.0f;  // redraw speeds this often (0: never)
+  float scale_min = 1.0f;       // uniform scale per character
   float scale_max = 1.0f;
 
   std::vector<AnimateClipSource> clips;  // empty: the default motion set

@@ -43,7 +43,8 @@ nlohmann::json bvh_info(const BvhFile& b) {
   json roles = json::object();
   for (std::size_t r = 0; r < motion::kRoleCount; ++r) {
     const std::int32_t j = s.roles[r];
-    roles[motion::to_string(static_cast<motion::Role>(r))] = j >= 0 ? json(s.names[static_cast<std::size_t>(j)]) : json(nullptr);
+    roles[motion::to_string(static_cast<motion::Role>(r))] =
+        j >= 0 ? json(s.names[static_cast<std::size_t>(j)]) : json(nullptr);
   }
   json spine = json::array();
   for (std::int32_t j : s.spine_chain) spine.push_back(s.names[static_cast<std::size_t>(j)]);
@@ -56,7 +57,10 @@ nlohmann::json bvh_info(const BvhFile& b) {
           {"frame_time", b.frame_time},
           {"frame_rate", 1.0 / b.frame_time},
           {"duration", static_cast<double>(b.clip.frame_count) * b.frame_time},
-          {"units", {{"unit", motion::to_string(b.unit)}, {"detected", b.unit_detected}, {"metres_per_unit", motion::metres_per_unit(b.unit)}}},
+          {"units",
+           {{"unit", motion::to_string(b.unit)},
+            {"detected", b.unit_detected},
+            {"metres_per_unit", motion::metres_per_unit(b.unit)}}},
           {"rest_extent_m", rest_extent(s)},
           {"rotation_orders", orders},
           {"roles", roles},

@@ -61,7 +61,9 @@ bool iequals(std::string_view a, std::string_view b) {
     if (upper(a[i]) != upper(b[i])) return false;
   return true;
 }
-bool istarts_with(std::string_view s, std::string_view prefix) { return s.size() >= prefix.size() && iequals(s.substr(0, prefix.size()), prefix); }
+bool istarts_with(std::string_view s, std::string_view prefix) {
+  return s.size() >= prefix.size() && iequals(s.substr(0, prefix.size()), prefix);
+}
 
 // A token as shown in an error: quoted, shortened, control bytes escaped.
 std::string shown(std::string_view t) {
@@ -98,7 +100,9 @@ class Scanner {
     if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = line_start_ = 3;  // a UTF-8 byte order mark
   }
 
-  [[noreturn]] void fail(int line, int col, const std::string& message) const { throw Error(message, at_line(name_, line, col)); }
+  [[noreturn]] void fail(int line, int col, const std::string& message) const {
+    throw Error(message, at_line(name_, line, col));
+  }
   [[noreturn]] void fail(const Token& t, const std::string& message) const { fail(t.line, t.col, message); }
   [[noreturn]] void expected(const std::string& what, const Token& found) const {
     fail(found, "expected " + what + ", found " + shown(found.text));
@@ -165,7 +169,8 @@ class Scanner {
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     // Far beyond any length or angle in motion data, and keeps every value
     // finite once converted to float and scaled to metres.
-    if (ec == std::errc() && end == s.data() + s.size() && std::abs(v) <= kMaxMagnitude) return v;  // also false for NaN
+    if (ec == std::errc() && end == s.data() + s.size() && std::abs(v) <= kMaxMagnitude)
+      return v;  // also false for NaN
     if (ec == std::errc::result_out_of_range) fail(t, what() + " is out of range: " + shown(t.text));
     if (ec != std::errc() || end != s.data() + s.size()) expected("a number (" + what() + ")", t);
     if (!std::isfinite(v)) fail(t, what() + " is not a finite number: " + shown(t.text));
@@ -242,7 +247,8 @@ class Parser {
   glm::dvec3 offset_values() {
     s_.expect("OFFSET");
     glm::dvec3 v;
-    for (int i = 0; i < 3; ++i) v[i] = s_.number(s_.next(), [i] { return std::string("OFFSET ") + static_cast<char>('x' + i); });
+    for (int i = 0; i < 3; ++i)
+      v[i] = s_.number(s_.next(), [i] { return std::string("OFFSET ") + static_cast<char>('x' + i); });
     return v;
   }
 
@@ -260,7 +266,8 @@ class Parser {
       s_.next();
       const Token count_token = s_.next();
       const std::int64_t count = s_.integer(count_token, "channel count");
-      if (count < 0 || count > 6) s_.fail(count_token, "channel count must be 0 to 6, found " + shown(count_token.text));
+      if (count < 0 || count > 6)
+        s_.fail(count_token, "channel count must be 0 to 6, found " + shown(count_token.text));
       for (std::int64_t i = 0; i < count; ++i) {
         const Token c = s_.next();
         static constexpr BvhChannel kAll[] = {BvhChannel::Xposition, BvhChannel::Yposition, BvhChannel::Zposition,
@@ -351,8 +358,8 @@ class Parser {
     const Token& at = frames_token_;
     if (frames_ > 0 && channel_total_ == 0) s_.fail(at, "the hierarchy has no channels, so there can be no frames");
     if (values > options_.limits.max_values)
-      s_.fail(at, std::to_string(frames_) + " frames x " + std::to_string(channel_total_) + " channels exceeds the limit of " +
-                      std::to_string(options_.limits.max_values) + " values");
+      s_.fail(at, std::to_string(frames_) + " frames x " + std::to_string(channel_total_) +
+                      " channels exceeds the limit of " + std::to_string(options_.limits.max_values) + " values");
     if (frames_ * J > options_.limits.max_poses)
       s_.fail(at, std::to_string(frames_) + " frames x " + std::to_string(J) + " joints exceeds the limit of " +
                       std::to_string(options_.limits.max_poses) + " joint poses");
@@ -374,26 +381,30 @@ class Parser {
     for (std::int64_t f = 0; f < frames_; ++f) {
       s_.skip_space();
       if (s_.at_end())
-        s_.fail(s_.line(), 0, "file ends after " + std::to_string(f) + " frame rows; 'Frames:' says " + std::to_string(frames_));
+        s_.fail(s_.line(), 0,
+                "file ends after " + std::to_string(f) + " frame rows; 'Frames:' says " + std::to_string(frames_));
       const int row_line = s_.line();
       std::int64_t k = 0;
       for (;;) {
         s_.skip_blanks();
         if (s_.at_line_end()) break;
         const Token t = s_.word();
-        const double v = s_.number(t, [f, k] { return "frame row " + std::to_string(f + 1) + " value " + std::to_string(k + 1); });
+        const double v =
+            s_.number(t, [f, k] { return "frame row " + std::to_string(f + 1) + " value " + std::to_string(k + 1); });
         if (k < channel_total_) row[static_cast<std::size_t>(k)] = v;
         ++k;
       }
       if (k != channel_total_)
-        s_.fail(row_line, 0, "frame row " + std::to_string(f + 1) + " has " + std::to_string(k) + " values, expected " +
-                                 std::to_string(channel_total_) + " (one per channel)");
+        s_.fail(row_line, 0,
+                "frame row " + std::to_string(f + 1) + " has " + std::to_string(k) + " values, expected " +
+                    std::to_string(channel_total_) + " (one per channel)");
       store_pose(clip, static_cast<std::int32_t>(f), row);
     }
     s_.skip_space();
     if (!s_.at_end()) {
       const Token extra = s_.word();
-      s_.fail(extra, "more frame rows than 'Frames: " + std::to_string(frames_) + "' (found " + shown(extra.text) + ")");
+      s_.fail(extra,
+              "more frame rows than 'Frames: " + std::to_string(frames_) + "' (found " + shown(extra.text) + ")");
     }
   }
 
@@ -469,7 +480,8 @@ class Parser {
 BvhFile parse_bvh(std::string_view text, const std::string& name, const BvhReadOptions& options) {
   const std::uint64_t limit = std::min<std::uint64_t>(options.limits.max_file_bytes, INT_MAX);
   if (text.size() > limit)
-    throw Error(std::to_string(text.size()) + " bytes exceeds the limit of " + std::to_string(limit) + " bytes", at_line(name, 0));
+    throw Error(std::to_string(text.size()) + " bytes exceeds the limit of " + std::to_string(limit) + " bytes",
+                at_line(name, 0));
   Parser parser(text, name, options);
   BvhFile out = parser.parse();
   out.bytes = text.size();
@@ -481,7 +493,9 @@ BvhFile read_bvh(const std::string& path, const BvhReadOptions& options) {
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) throw Error("cannot read: " + ec.message(), at_line(path, 0));
   const std::uint64_t limit = std::min<std::uint64_t>(options.limits.max_file_bytes, INT_MAX);
-  if (size > limit) throw Error(std::to_string(size) + " bytes exceeds the limit of " + std::to_string(limit) + " bytes", at_line(path, 0));
+  if (size > limit)
+    throw Error(std::to_string(size) + " bytes exceeds the limit of " + std::to_string(limit) + " bytes",
+                at_line(path, 0));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open for reading", at_line(path, 0));
   std::string text(static_cast<std::size_t>(size), '\0');

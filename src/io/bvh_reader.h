@@ -38,11 +38,11 @@ inline int axis_of(BvhChannel c) { return static_cast<int>(c) % 3; }
 
 // Hostile-input guards, checked before anything of that size is allocated.
 struct BvhLimits {
-  std::int32_t max_joints = 1024;            // ROOT + JOINT blocks
+  std::int32_t max_joints = 1024;  // ROOT + JOINT blocks
   std::int64_t max_frames = 1'000'000;
   std::uint64_t max_file_bytes = 512ull << 20;
-  std::int64_t max_values = 1ll << 28;       // frames * channels
-  std::int64_t max_poses = 1ll << 26;        // frames * joints (32 bytes each in the clip)
+  std::int64_t max_values = 1ll << 28;  // frames * channels
+  std::int64_t max_poses = 1ll << 26;   // frames * joints (32 bytes each in the clip)
   std::size_t max_name_length = 256;
 };
 
@@ -57,7 +57,7 @@ struct BvhFile {
   motion::Clip clip;          // metres; clip.frame_time = (float)frame_time
   // Per joint, its channels in the order the file lists them.
   std::vector<std::vector<BvhChannel>> channels;
-  double frame_time = 0.0;  // seconds, exactly as written
+  double frame_time = 0.0;                              // seconds, exactly as written
   motion::LengthUnit unit = motion::LengthUnit::Metre;  // the file's unit
   bool unit_detected = false;                           // guessed (true) or given
   std::int32_t end_site_count = 0;

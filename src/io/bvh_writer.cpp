@@ -41,7 +41,8 @@ std::string clean_name(const std::string& name, std::size_t index) {
 
 void check_finite(double v, const char* what, std::int32_t frame, const std::string& joint) {
   if (!std::isfinite(v))
-    throw Error(std::string("non-finite ") + what + " in frame " + std::to_string(frame) + ", joint '" + joint + "'", at_field("clip"));
+    throw Error(std::string("non-finite ") + what + " in frame " + std::to_string(frame) + ", joint '" + joint + "'",
+                at_field("clip"));
 }
 
 // Frame time written (s): options.frame_time when > 0, else the clip's.
@@ -51,13 +52,14 @@ double check_clip(const motion::Skeleton& sk, const motion::Clip& clip, const Bv
   sk.validate();
   const std::size_t J = static_cast<std::size_t>(sk.joint_count());
   const auto frames = static_cast<std::size_t>(std::max(clip.frame_count, 0));
-  if (clip.joint_count != sk.joint_count() || clip.rotations.size() != frames * J || clip.root_positions.size() != frames ||
-      (!clip.translations.empty() && clip.translations.size() != frames * J))
+  if (clip.joint_count != sk.joint_count() || clip.rotations.size() != frames * J ||
+      clip.root_positions.size() != frames || (!clip.translations.empty() && clip.translations.size() != frames * J))
     throw Error("clip (" + std::to_string(clip.joint_count) + " joints, " + std::to_string(clip.frame_count) +
                     " frames) does not match the skeleton (" + std::to_string(J) + " joints) or its own arrays",
                 at_field("clip"));
   const double frame_time = options.frame_time > 0.0 ? options.frame_time : static_cast<double>(clip.frame_time);
-  if (!std::isfinite(frame_time) || !(frame_time > 0.0)) throw Error("must be positive and finite", at_field("clip.frame_time"));
+  if (!std::isfinite(frame_time) || !(frame_time > 0.0))
+    throw Error("must be positive and finite", at_field("clip.frame_time"));
   return frame_time;
 }
 
@@ -74,7 +76,8 @@ JointLayout joint_layout(const motion::Skeleton& sk, const motion::Clip& clip, s
   const std::size_t J = static_cast<std::size_t>(sk.joint_count());
   JointLayout l;
   l.children.resize(J);
-  for (std::size_t j = 1; j < J; ++j) l.children[static_cast<std::size_t>(sk.parents[j])].push_back(static_cast<std::int32_t>(j));
+  for (std::size_t j = 1; j < J; ++j)
+    l.children[static_cast<std::size_t>(sk.parents[j])].push_back(static_cast<std::int32_t>(j));
   l.animated.assign(J, 0);
   if (!clip.translations.empty())
     for (std::size_t f = 0; f < frames; ++f)
@@ -98,8 +101,8 @@ void append_offset(std::string& out, std::size_t depth, const glm::vec3& v, doub
 
 // The opening of joint j's block at `depth`: name, offset, channels; j
 // joins l.order.
-void open_joint(std::string& out, const motion::Skeleton& sk, JointLayout& l, std::int32_t j, std::size_t depth, const std::string& rotation_channels,
-                double per_metre) {
+void open_joint(std::string& out, const motion::Skeleton& sk, JointLayout& l, std::int32_t j, std::size_t depth,
+                const std::string& rotation_channels, double per_metre) {
   const auto u = static_cast<std::size_t>(j);
   l.order.push_back(j);
   indent(out, depth);
@@ -109,12 +112,16 @@ void open_joint(std::string& out, const motion::Skeleton& sk, JointLayout& l, st
   append_offset(out, depth + 1, sk.offsets[u], per_metre);
   indent(out, depth + 1);
   const bool positions = j == 0 || l.animated[u];
-  out.append("CHANNELS ").append(positions ? "6 Xposition Yposition Zposition" : "3").append(rotation_channels).append("\n");
+  out.append("CHANNELS ")
+      .append(positions ? "6 Xposition Yposition Zposition" : "3")
+      .append(rotation_channels)
+      .append("\n");
 }
 
 // The HIERARCHY section: joints depth first from the root, children in
 // index order, end sites where the skeleton has them; fills l.order.
-void write_hierarchy(std::string& out, const motion::Skeleton& sk, JointLayout& l, const std::string& rotation_channels, double per_metre) {
+void write_hierarchy(std::string& out, const motion::Skeleton& sk, JointLayout& l, const std::string& rotation_channels,
+                     double per_metre) {
   out.append("HIERARCHY\n");
   l.order.reserve(l.names.size());
   std::vector<std::pair<std::int32_t, std::size_t>> stack = {{0, 0}};
@@ -147,8 +154,8 @@ void write_hierarchy(std::string& out, const motion::Skeleton& sk, JointLayout& 
 // One MOTION line: frame f's channels for the joints in l.order, positions
 // (m times per_metre) then rotations (degrees, Euler angles in options.order
 // written in the order of `axes`).
-void write_frame(std::string& out, const motion::Clip& clip, const JointLayout& l, std::size_t f, const BvhWriteOptions& options,
-                 const std::array<int, 3>& axes, double per_metre) {
+void write_frame(std::string& out, const motion::Clip& clip, const JointLayout& l, std::size_t f,
+                 const BvhWriteOptions& options, const std::array<int, 3>& axes, double per_metre) {
   const std::size_t J = l.names.size();
   bool first = true;
   auto value = [&](float v) {
@@ -168,7 +175,8 @@ void write_frame(std::string& out, const motion::Clip& clip, const JointLayout& 
     }
     const glm::quat& q = clip.rotations[k];
     check_finite(static_cast<double>(glm::dot(q, q)), "rotation", static_cast<std::int32_t>(f), l.names[u]);
-    if (!(glm::dot(q, q) > 0.0f)) check_finite(NAN, "rotation (zero quaternion)", static_cast<std::int32_t>(f), l.names[u]);
+    if (!(glm::dot(q, q) > 0.0f))
+      check_finite(NAN, "rotation (zero quaternion)", static_cast<std::int32_t>(f), l.names[u]);
     const glm::dvec3 e = motion::quat_to_euler(options.order, glm::dquat(q));
     for (int a : axes) value(static_cast<float>(e[a] * kDegreesPerRadian));
   }
@@ -204,7 +212,8 @@ std::string write_bvh_string(const motion::Skeleton& sk, const motion::Clip& cli
   return out;
 }
 
-void write_bvh(const std::string& path, const motion::Skeleton& skeleton, const motion::Clip& clip, const BvhWriteOptions& options) {
+void write_bvh(const std::string& path, const motion::Skeleton& skeleton, const motion::Clip& clip,
+               const BvhWriteOptions& options) {
   const std::string text = write_bvh_string(skeleton, clip, options);
   OutputFile file(path);
   {

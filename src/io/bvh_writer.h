@@ -26,7 +26,8 @@ struct BvhWriteOptions {
 };
 
 // Throws Error when skeleton and clip disagree or hold non-finite values.
-std::string write_bvh_string(const motion::Skeleton& skeleton, const motion::Clip& clip, const BvhWriteOptions& options = {});
+std::string write_bvh_string(const motion::Skeleton& skeleton, const motion::Clip& clip,
+                             const BvhWriteOptions& options = {});
 void write_bvh(const std::string& path, const motion::Skeleton& skeleton, const motion::Clip& clip,
                const BvhWriteOptions& options = {});
 

@@ -74,16 +74,20 @@ int add_mesh(tinygltf::Model& m, GlbBuilder& b, const anim::SkinnedMesh& mesh) {
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
   prim.attributes["POSITION"] =
-      b.accessor(b.view(mesh.positions.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER), 0, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                 TINYGLTF_TYPE_VEC3, n, to_doubles(lo), to_doubles(hi));
-  prim.attributes["NORMAL"] = b.accessor(b.view(mesh.normals.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
-                                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
-  prim.attributes["JOINTS_0"] = b.accessor(b.view(mesh.joints.data(), n * sizeof(glm::u16vec4), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
-                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, n);
-  prim.attributes["WEIGHTS_0"] = b.accessor(b.view(mesh.weights.data(), n * sizeof(glm::vec4), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
-                                            TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, n);
-  prim.indices = b.accessor(b.view(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER), 0,
-                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, mesh.indices.size());
+      b.accessor(b.view(mesh.positions.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
+                 TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, to_doubles(lo), to_doubles(hi));
+  prim.attributes["NORMAL"] =
+      b.accessor(b.view(mesh.normals.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
+                 TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
+  prim.attributes["JOINTS_0"] =
+      b.accessor(b.view(mesh.joints.data(), n * sizeof(glm::u16vec4), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
+                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, n);
+  prim.attributes["WEIGHTS_0"] =
+      b.accessor(b.view(mesh.weights.data(), n * sizeof(glm::vec4), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
+                 TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, n);
+  prim.indices = b.accessor(
+      b.view(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER), 0,
+      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, mesh.indices.size());
   tinygltf::Material material;
   material.name = "mannequin";
   material.pbrMetallicRoughness.baseColorFactor = {0.55, 0.6, 0.7, 1.0};
@@ -106,8 +110,8 @@ int add_inverse_bind(GlbBuilder& b, const anim::Rig& rig) {
                             x.r0.z, x.r1.z, x.r2.z, 0.0f, x.r0.w, x.r1.w, x.r2.w, 1.0f};
     mats.insert(mats.end(), cols, cols + 16);
   }
-  return b.accessor(b.view(mats.data(), mats.size() * sizeof(float)), 0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4,
-                    rig.inverse_bind.size());
+  return b.accessor(b.view(mats.data(), mats.size() * sizeof(float)), 0, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                    TINYGLTF_TYPE_MAT4, rig.inverse_bind.size());
 }
 
 // Agent a's joint nodes, mesh node and skin; its keys go into `anim`.
@@ -159,7 +163,8 @@ void add_agent(tinygltf::Model& m, GlbBuilder& b, const CrowdTake& take, Index a
     } else {
       n.translation = to_doubles(sk.offsets[static_cast<std::size_t>(j)]);
     }
-    channel(first + j, "rotation", (3 + 4 * static_cast<std::size_t>(j)) * static_cast<std::size_t>(F) * sizeof(float), TINYGLTF_TYPE_VEC4);
+    channel(first + j, "rotation", (3 + 4 * static_cast<std::size_t>(j)) * static_cast<std::size_t>(F) * sizeof(float),
+            TINYGLTF_TYPE_VEC4);
     for (std::int32_t c = j + 1; c < J; ++c)
       if (sk.parents[static_cast<std::size_t>(c)] == j) n.children.push_back(first + c);
     m.nodes.push_back(n);
@@ -178,7 +183,8 @@ void add_agent(tinygltf::Model& m, GlbBuilder& b, const CrowdTake& take, Index a
 
 }  // namespace
 
-CrowdTake::CrowdTake(anim::Rig rig, std::vector<float> scales, double fps) : rig_(std::move(rig)), scales_(std::move(scales)), fps_(fps) {
+CrowdTake::CrowdTake(anim::Rig rig, std::vector<float> scales, double fps)
+    : rig_(std::move(rig)), scales_(std::move(scales)), fps_(fps) {
   if (!(fps > 0.0) || !std::isfinite(fps)) throw Error("must be a positive frame rate", at_field("fps"));
 }
 
@@ -205,18 +211,21 @@ void CrowdTake::add_frame(Span<const glm::vec3> joint_positions, Span<const glm:
 }
 
 const glm::vec3& CrowdTake::root_position(std::int32_t frame, Index a) const {
-  return root_positions_[static_cast<std::size_t>(frame) * static_cast<std::size_t>(agents()) + static_cast<std::size_t>(a)];
+  return root_positions_[static_cast<std::size_t>(frame) * static_cast<std::size_t>(agents()) +
+                         static_cast<std::size_t>(a)];
 }
 
 const glm::quat& CrowdTake::rotation(std::int32_t frame, Index a, std::int32_t joint) const {
-  const std::size_t row = static_cast<std::size_t>(frame) * static_cast<std::size_t>(agents()) + static_cast<std::size_t>(a);
+  const std::size_t row =
+      static_cast<std::size_t>(frame) * static_cast<std::size_t>(agents()) + static_cast<std::size_t>(a);
   return rotations_[row * static_cast<std::size_t>(joints()) + static_cast<std::size_t>(joint)];
 }
 
 double CrowdTake::estimate_bytes(const anim::Rig& rig, Index agents, std::int64_t frames) {
   const double J = rig.joint_count(), n = static_cast<double>(agents), f = static_cast<double>(frames);
   const double keys = n * f * (3.0 + 4.0 * J) * 4.0 + f * 4.0;
-  const double mesh = static_cast<double>(rig.mesh.vertex_count()) * (12 + 12 + 8 + 16) + static_cast<double>(rig.mesh.indices.size()) * 4;
+  const double mesh = static_cast<double>(rig.mesh.vertex_count()) * (12 + 12 + 8 + 16) +
+                      static_cast<double>(rig.mesh.indices.size()) * 4;
   const double json = n * (J + 1.0) * 420.0;  // nodes, accessors, samplers and channels per joint
   return keys + mesh + J * 64.0 + json;
 }
@@ -234,9 +243,9 @@ void write_crowd_glb(const std::string& path, const CrowdTake& take) {
   const int inverse_bind = add_inverse_bind(b, take.rig());
   std::vector<float> times(static_cast<std::size_t>(take.frames()));
   for (std::size_t f = 0; f < times.size(); ++f) times[f] = static_cast<float>(static_cast<double>(f) / take.fps());
-  const int time_accessor =
-      b.accessor(b.view(times.data(), times.size() * sizeof(float)), 0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, times.size(),
-                 {times.empty() ? 0.0 : times.front()}, {times.empty() ? 0.0 : times.back()});
+  const int time_accessor = b.accessor(b.view(times.data(), times.size() * sizeof(float)), 0,
+                                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, times.size(),
+                                       {times.empty() ? 0.0 : times.front()}, {times.empty() ? 0.0 : times.back()});
   tinygltf::Animation anim;
   anim.name = "crowd";
   for (Index a = 0; a < take.agents(); ++a) add_agent(m, b, take, a, inverse_bind, time_accessor, anim);
@@ -259,17 +268,22 @@ namespace {
 // Accessor `index` of `m` as `T` per element (its component type and type
 // checked, every element inside its buffer view and buffer), tightly packed.
 template <class T>
-std::vector<T> read_accessor(const tinygltf::Model& m, int index, int component, int type, const std::string& path, const std::string& what) {
-  if (index < 0 || index >= static_cast<int>(m.accessors.size())) throw Error(what + ": no such accessor", in_file(path, what));
+std::vector<T> read_accessor(const tinygltf::Model& m, int index, int component, int type, const std::string& path,
+                             const std::string& what) {
+  if (index < 0 || index >= static_cast<int>(m.accessors.size()))
+    throw Error(what + ": no such accessor", in_file(path, what));
   const tinygltf::Accessor& a = m.accessors[static_cast<std::size_t>(index)];
-  if (a.componentType != component || a.type != type || a.bufferView < 0 || a.bufferView >= static_cast<int>(m.bufferViews.size()))
+  if (a.componentType != component || a.type != type || a.bufferView < 0 ||
+      a.bufferView >= static_cast<int>(m.bufferViews.size()))
     throw Error(what + ": unexpected component type or type", in_file(path, what));
   const tinygltf::BufferView& v = m.bufferViews[static_cast<std::size_t>(a.bufferView)];
-  if (v.buffer < 0 || v.buffer >= static_cast<int>(m.buffers.size())) throw Error(what + ": no such buffer", in_file(path, what));
+  if (v.buffer < 0 || v.buffer >= static_cast<int>(m.buffers.size()))
+    throw Error(what + ": no such buffer", in_file(path, what));
   const std::vector<unsigned char>& data = m.buffers[static_cast<std::size_t>(v.buffer)].data;
   const std::size_t stride = v.byteStride != 0 ? v.byteStride : sizeof(T);
   const std::size_t start = v.byteOffset + a.byteOffset;
-  if (a.count > 0 && (start + (a.count - 1) * stride + sizeof(T) > v.byteOffset + v.byteLength || v.byteOffset + v.byteLength > data.size()))
+  if (a.count > 0 && (start + (a.count - 1) * stride + sizeof(T) > v.byteOffset + v.byteLength ||
+                      v.byteOffset + v.byteLength > data.size()))
     throw Error(what + ": data beyond its buffer", in_file(path, what));
   std::vector<T> out(a.count);
   for (std::size_t i = 0; i < a.count; ++i) std::memcpy(&out[i], &data[start + i * stride], sizeof(T));
@@ -277,11 +291,14 @@ std::vector<T> read_accessor(const tinygltf::Model& m, int index, int component,
 }
 
 glm::vec3 vec3_of(const std::vector<double>& v, glm::vec3 otherwise) {
-  return v.size() == 3 ? glm::vec3(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])) : otherwise;
+  return v.size() == 3 ? glm::vec3(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]))
+                       : otherwise;
 }
 
 // Images are not part of a crowd: skip them rather than decode them.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) { return true; }
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
 
 // The glTF model in `bytes` (a .glb under 4 GiB), images skipped; throws
 // Error naming `path` when it does not parse.
@@ -316,8 +333,8 @@ std::vector<int> parent_nodes(const tinygltf::Model& m, const std::string& path)
 // one per joint.
 std::vector<anim::Mat3x4> read_inverse_bind(const tinygltf::Model& m, std::int32_t joints, const std::string& path) {
   std::vector<anim::Mat3x4> inverse_bind;
-  for (const glm::mat4& ibm : read_accessor<glm::mat4>(m, m.skins[0].inverseBindMatrices, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4,
-                                                        path, "inverseBindMatrices")) {
+  for (const glm::mat4& ibm : read_accessor<glm::mat4>(m, m.skins[0].inverseBindMatrices, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                                       TINYGLTF_TYPE_MAT4, path, "inverseBindMatrices")) {
     const float* c = &ibm[0][0];  // column-major
     anim::Mat3x4 x;
     x.r0 = glm::vec4(c[0], c[4], c[8], c[12]);
@@ -325,7 +342,8 @@ std::vector<anim::Mat3x4> read_inverse_bind(const tinygltf::Model& m, std::int32
     x.r2 = glm::vec4(c[2], c[6], c[10], c[14]);
     inverse_bind.push_back(x);
   }
-  if (static_cast<std::int32_t>(inverse_bind.size()) != joints) throw Error("one inverse bind matrix per joint expected", in_file(path, "skins[0]"));
+  if (static_cast<std::int32_t>(inverse_bind.size()) != joints)
+    throw Error("one inverse bind matrix per joint expected", in_file(path, "skins[0]"));
   return inverse_bind;
 }
 
@@ -344,8 +362,10 @@ anim::SkinnedMesh read_mesh(const tinygltf::Model& m, std::int32_t joints, const
   mesh.positions = read_accessor<glm::vec3>(m, attribute("POSITION"), kFloat, TINYGLTF_TYPE_VEC3, path, "POSITION");
   mesh.normals = read_accessor<glm::vec3>(m, attribute("NORMAL"), kFloat, TINYGLTF_TYPE_VEC3, path, "NORMAL");
   mesh.weights = read_accessor<glm::vec4>(m, attribute("WEIGHTS_0"), kFloat, TINYGLTF_TYPE_VEC4, path, "WEIGHTS_0");
-  mesh.joints = read_accessor<glm::u16vec4>(m, attribute("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, path, "JOINTS_0");
-  mesh.indices = read_accessor<std::uint32_t>(m, prim.indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, path, "indices");
+  mesh.joints = read_accessor<glm::u16vec4>(m, attribute("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                            TINYGLTF_TYPE_VEC4, path, "JOINTS_0");
+  mesh.indices = read_accessor<std::uint32_t>(m, prim.indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                              TINYGLTF_TYPE_SCALAR, path, "indices");
   try {
     mesh.validate();
   } catch (const Error& e) {
@@ -357,14 +377,15 @@ anim::SkinnedMesh read_mesh(const tinygltf::Model& m, std::int32_t joints, const
 // The joint a channel of animation `anim` keys, as its index a * joints + j,
 // after checking the channel's sampler, target node (not a mesh node) and
 // path (translation or rotation).
-std::size_t keyed_joint(const tinygltf::Model& m, const tinygltf::Animation& anim, const tinygltf::AnimationChannel& c, std::int32_t joints,
-                        const std::string& path) {
+std::size_t keyed_joint(const tinygltf::Model& m, const tinygltf::Animation& anim, const tinygltf::AnimationChannel& c,
+                        std::int32_t joints, const std::string& path) {
   if (c.sampler < 0 || c.sampler >= static_cast<int>(anim.samplers.size()) || c.target_node < 0 ||
       c.target_node >= static_cast<int>(m.nodes.size()))
     throw Error("channel out of range", in_file(path, "animations[0].channels"));
   const int node = c.target_node;
   if (node % (joints + 1) == joints) throw Error("a mesh node is animated", in_file(path, "animations[0].channels"));
-  if (c.target_path != "rotation" && c.target_path != "translation") throw Error("only translation and rotation are keyed", in_file(path, c.target_path));
+  if (c.target_path != "rotation" && c.target_path != "translation")
+    throw Error("only translation and rotation are keyed", in_file(path, c.target_path));
   return static_cast<std::size_t>((node / (joints + 1)) * joints + node % (joints + 1));
 }
 }  // namespace
@@ -376,7 +397,8 @@ CrowdGlb::CrowdGlb(const std::string& path) {
   if (ec || size >= (std::uintmax_t{1} << 32)) throw Error("unreadable, or 4 GiB or larger", in_file(path));
   std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
   std::ifstream in(path, std::ios::binary);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()))) throw Error("cannot read", in_file(path));
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size())))
+    throw Error("cannot read", in_file(path));
   load(bytes, path);
 }
 
@@ -390,7 +412,8 @@ CrowdGlb CrowdGlb::parse(std::span<const unsigned char> bytes, const std::string
 // bind matrices, mesh, then the keyed channels of animation 0.
 void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& path) {
   const tinygltf::Model m = parse_glb(bytes, path);
-  if (m.skins.empty() || m.meshes.size() != 1) throw Error("expected one mesh and a skin per agent (throng export-crowd's layout)", in_file(path));
+  if (m.skins.empty() || m.meshes.size() != 1)
+    throw Error("expected one mesh and a skin per agent (throng export-crowd's layout)", in_file(path));
   agents_ = static_cast<Index>(m.skins.size());
   joints_ = static_cast<std::int32_t>(m.skins[0].joints.size());
   if (joints_ == 0 || m.nodes.size() != static_cast<std::size_t>(agents_) * static_cast<std::size_t>(joints_ + 1))
@@ -402,9 +425,11 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
   for (Index a = 0; a < agents_; ++a) {
     const tinygltf::Skin& skin = m.skins[static_cast<std::size_t>(a)];
     const int first = static_cast<int>(a) * (joints_ + 1);
-    if (static_cast<std::int32_t>(skin.joints.size()) != joints_) throw Error("skins differ in joint count", in_file(path, "skins"));
+    if (static_cast<std::int32_t>(skin.joints.size()) != joints_)
+      throw Error("skins differ in joint count", in_file(path, "skins"));
     for (std::int32_t j = 0; j < joints_; ++j) {
-      if (skin.joints[static_cast<std::size_t>(j)] != first + j) throw Error("skin joints out of layout", in_file(path, "skins"));
+      if (skin.joints[static_cast<std::size_t>(j)] != first + j)
+        throw Error("skin joints out of layout", in_file(path, "skins"));
       const tinygltf::Node& gn = m.nodes[static_cast<std::size_t>(first + j)];
       Node& n = nodes_[static_cast<std::size_t>(a * joints_ + j)];
       const int p = parent_node[static_cast<std::size_t>(first + j)];
@@ -412,8 +437,8 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
       if (n.parent >= j) throw Error("a joint's parent comes after it", in_file(path, "nodes"));
       n.translation = vec3_of(gn.translation, glm::vec3(0.0f));
       if (gn.rotation.size() == 4)
-        n.rotation = glm::quat(static_cast<float>(gn.rotation[3]), static_cast<float>(gn.rotation[0]), static_cast<float>(gn.rotation[1]),
-                               static_cast<float>(gn.rotation[2]));
+        n.rotation = glm::quat(static_cast<float>(gn.rotation[3]), static_cast<float>(gn.rotation[0]),
+                               static_cast<float>(gn.rotation[1]), static_cast<float>(gn.rotation[2]));
       n.scale = gn.scale.size() == 3 ? static_cast<float>(gn.scale[0]) : 1.0f;
     }
   }
@@ -428,23 +453,27 @@ void CrowdGlb::load(std::span<const unsigned char> bytes, const std::string& pat
     const tinygltf::AnimationSampler& s = anim.samplers[static_cast<std::size_t>(c.sampler)];
     std::size_t frames = 0;
     if (c.target_path == "rotation") {
-      rotation_keys_.push_back(read_accessor<glm::vec4>(m, s.output, kFloat, TINYGLTF_TYPE_VEC4, path, "sampler output"));
+      rotation_keys_.push_back(
+          read_accessor<glm::vec4>(m, s.output, kFloat, TINYGLTF_TYPE_VEC4, path, "sampler output"));
       frames = rotation_keys_.back().size();
       n.rotation_keys = static_cast<std::int32_t>(rotation_keys_.size()) - 1;
     } else {
-      translation_keys_.push_back(read_accessor<glm::vec3>(m, s.output, kFloat, TINYGLTF_TYPE_VEC3, path, "sampler output"));
+      translation_keys_.push_back(
+          read_accessor<glm::vec3>(m, s.output, kFloat, TINYGLTF_TYPE_VEC3, path, "sampler output"));
       frames = translation_keys_.back().size();
       n.translation_keys = static_cast<std::int32_t>(translation_keys_.size()) - 1;
     }
     if (frames == 0) throw Error("a channel without keys", in_file(path, "animations[0]"));
-    if (frames_ != 0 && static_cast<std::int32_t>(frames) != frames_) throw Error("channels differ in key count", in_file(path, "animations[0]"));
+    if (frames_ != 0 && static_cast<std::int32_t>(frames) != frames_)
+      throw Error("channels differ in key count", in_file(path, "animations[0]"));
     frames_ = static_cast<std::int32_t>(frames);
   }
 }
 
-void CrowdGlb::joint_frames(Index a, std::int32_t frame, std::vector<glm::vec3>& positions, std::vector<glm::quat>& rotations,
-                            std::vector<float>& scales) const {
-  if (a < 0 || a >= agents_ || frame < 0 || (frames_ > 0 && frame >= frames_)) throw Error("agent or frame out of range", at_field("frame"));
+void CrowdGlb::joint_frames(Index a, std::int32_t frame, std::vector<glm::vec3>& positions,
+                            std::vector<glm::quat>& rotations, std::vector<float>& scales) const {
+  if (a < 0 || a >= agents_ || frame < 0 || (frames_ > 0 && frame >= frames_))
+    throw Error("agent or frame out of range", at_field("frame"));
   positions.resize(static_cast<std::size_t>(joints_));
   rotations.resize(static_cast<std::size_t>(joints_));
   scales.resize(static_cast<std::size_t>(joints_));

@@ -102,7 +102,7 @@ class CrowdGlb {
   Index agents_ = 0;
   std::int32_t joints_ = 0, frames_ = 0;
   double fps_ = 0.0;
-  std::vector<Node> nodes_;  // [a * J + j]
+  std::vector<Node> nodes_;                               // [a * J + j]
   std::vector<std::vector<glm::vec3>> translation_keys_;  // per keyed channel, per frame
   std::vector<std::vector<glm::vec4>> rotation_keys_;     // per keyed channel, per frame: x, y, z, w
   std::vector<anim::Mat3x4> inverse_bind_;

@@ -35,11 +35,13 @@ class Reader : public YamlReader {
   glm::vec2 point(const YAML::Node& n, const std::string& path) {
     visit(n, path);
     if (!n.IsSequence() || n.size() != 2) fail(n, path, "expected a point [x, y], got " + kind(n));
-    return {real_in(n[0], item(path, 0), -kMaxCoordinate, kMaxCoordinate), real_in(n[1], item(path, 1), -kMaxCoordinate, kMaxCoordinate)};
+    return {real_in(n[0], item(path, 0), -kMaxCoordinate, kMaxCoordinate),
+            real_in(n[1], item(path, 1), -kMaxCoordinate, kMaxCoordinate)};
   }
   std::vector<glm::vec2> points(const YAML::Node& n, const std::string& path, std::size_t at_least) {
     std::vector<glm::vec2> out;
-    each_item(n, path, at_least, kMaxPoints, "points [x, y]", [&](const YAML::Node& p, const std::string& pp) { out.push_back(point(p, pp)); });
+    each_item(n, path, at_least, kMaxPoints, "points [x, y]",
+              [&](const YAML::Node& p, const std::string& pp) { out.push_back(point(p, pp)); });
     return out;
   }
 
@@ -49,24 +51,29 @@ class Reader : public YamlReader {
     if (w["bounds"]) {
       const std::string bp = child(path, "bounds");
       const std::vector<glm::vec2> b = points(w["bounds"], bp, 2);
-      if (b.size() != 2 || !(b[1].x > b[0].x && b[1].y > b[0].y)) fail(w["bounds"], bp, "bounds are [[xmin, ymin], [xmax, ymax]] with max > min");
+      if (b.size() != 2 || !(b[1].x > b[0].x && b[1].y > b[0].y))
+        fail(w["bounds"], bp, "bounds are [[xmin, ymin], [xmax, ymax]] with max > min");
       out.has_walkable = true;
       out.walkable.outer = sim::rect_ring(b[0], b[1]);
     }
     if (const YAML::Node cs = w["circles"]) {
-      each_item(cs, child(path, "circles"), 0, kAnyCount, "circles {center, radius}", [&](const YAML::Node& c, const std::string& cp) {
-        expect_map(c, cp, {"center", "radius"});
-        const glm::vec2 center = point(required(c, cp, "center"), child(cp, "center"));
-        out.circles.push_back({center, real_in(required(c, cp, "radius"), child(cp, "radius"), 1e-3, kMaxCoordinate)});
-      });
+      each_item(cs, child(path, "circles"), 0, kAnyCount, "circles {center, radius}",
+                [&](const YAML::Node& c, const std::string& cp) {
+                  expect_map(c, cp, {"center", "radius"});
+                  const glm::vec2 center = point(required(c, cp, "center"), child(cp, "center"));
+                  out.circles.push_back(
+                      {center, real_in(required(c, cp, "radius"), child(cp, "radius"), 1e-3, kMaxCoordinate)});
+                });
     }
     if (const YAML::Node ps = w["polygons"]) {
-      each_item(ps, child(path, "polygons"), 0, kAnyCount, "polygons (lists of points)", [&](const YAML::Node& p, const std::string& pp) {
-        sim::Polygon poly;
-        poly.outer = points(p, pp, 3);
-        if (sim::find_self_intersection(poly.outer)) fail(p, pp, "polygon is self-intersecting or has a zero-length edge");
-        out.polygons.push_back(std::move(poly));
-      });
+      each_item(ps, child(path, "polygons"), 0, kAnyCount, "polygons (lists of points)",
+                [&](const YAML::Node& p, const std::string& pp) {
+                  sim::Polygon poly;
+                  poly.outer = points(p, pp, 3);
+                  if (sim::find_self_intersection(poly.outer))
+                    fail(p, pp, "polygon is self-intersecting or has a zero-length edge");
+                  out.polygons.push_back(std::move(poly));
+                });
     }
   }
 
@@ -87,9 +94,8 @@ class Reader : public YamlReader {
     }
     if (p["speed"]) e.speed = real_in(p["speed"], child(path, "speed"), 0, 10);
     if (const YAML::Node ms = p["marks"])
-      each_item(ms, child(path, "marks"), 0, kAnyCount, "marks {from, to, state}", [&](const YAML::Node& m, const std::string& mp) {
-        e.marks.push_back(mark(m, mp));
-      });
+      each_item(ms, child(path, "marks"), 0, kAnyCount, "marks {from, to, state}",
+                [&](const YAML::Node& m, const std::string& mp) { e.marks.push_back(mark(m, mp)); });
     return e;
   }
 

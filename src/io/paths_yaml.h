@@ -19,14 +19,14 @@ struct PathEntry {
   std::vector<glm::vec2> points;  // explicit polyline; empty when planned
   bool planned = false;
   glm::vec2 from{0.0f}, to{0.0f};
-  float speed = 0.0f;             // desired, m/s (0 = any)
+  float speed = 0.0f;  // desired, m/s (0 = any)
   std::vector<path::PathMark> marks;
   Location where;
 };
 
 struct PathsFile {
-  std::string machine;       // state machine file (resolved against the paths file's folder); empty = default
-  float radius = 0.25f;      // agent radius for planning
+  std::string machine;   // state machine file (resolved against the paths file's folder); empty = default
+  float radius = 0.25f;  // agent radius for planning
   bool has_world = false;
   bool has_walkable = false;
   sim::Polygon walkable;

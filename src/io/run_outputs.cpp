@@ -59,7 +59,8 @@ class TextSink : public TrajectorySink {
  public:
   explicit TextSink(std::string path) : path_(std::move(path)) {
     file_ = std::fopen(path_.c_str(), "wb");
-    if (file_ == nullptr) throw Error(std::string("cannot open for writing: ") + std::strerror(errno), Location{path_, 0, 0, {}});
+    if (file_ == nullptr)
+      throw Error(std::string("cannot open for writing: ") + std::strerror(errno), Location{path_, 0, 0, {}});
   }
   ~TextSink() override {
     if (file_ != nullptr) std::fclose(file_);
@@ -93,7 +94,8 @@ class CsvSink final : public TextSink {
     buffer_.clear();
     auto out = std::back_inserter(buffer_);
     for (const TrajectoryRow& r : f.rows)
-      fmt::format_to(out, "{},{:.3f},{},{:.4f},{:.4f},{:.4f},{:.4f}\n", f.step, f.time, r.agent, r.x, r.y, r.heading, r.speed);
+      fmt::format_to(out, "{},{:.3f},{},{:.4f},{:.4f},{:.4f},{:.4f}\n", f.step, f.time, r.agent, r.x, r.y, r.heading,
+                     r.speed);
     put(buffer_);
   }
   bool uniform_frames() const override { return false; }
@@ -109,20 +111,21 @@ class CsvSink final : public TextSink {
 class PedpySink final : public TextSink {
  public:
   PedpySink(std::string path, double fps) : TextSink(std::move(path)), fps_(fps) {
-    put(fmt::format(
-        "#description: trajectories written by throng run\n"
-        "#framerate: {}\n"
-        "#geometry: geometry.wkt\n"
-        "#ID: the agent ID, from 1 (agent index + 1)\n"
-        "#FR: the frame, from 0 (step / every; time = FR / fps)\n"
-        "#X,Y,Z: the agent coordinates in metres (Z = 0)\n"
-        "#id\tframe\tx/m\ty/m\tz/m\n",
-        fps_));
+    put(
+        fmt::format("#description: trajectories written by throng run\n"
+                    "#framerate: {}\n"
+                    "#geometry: geometry.wkt\n"
+                    "#ID: the agent ID, from 1 (agent index + 1)\n"
+                    "#FR: the frame, from 0 (step / every; time = FR / fps)\n"
+                    "#X,Y,Z: the agent coordinates in metres (Z = 0)\n"
+                    "#id\tframe\tx/m\ty/m\tz/m\n",
+                    fps_));
   }
   void write(const TrajectoryFrame& f) override {
     buffer_.clear();
     auto out = std::back_inserter(buffer_);
-    for (const TrajectoryRow& r : f.rows) fmt::format_to(out, "{}\t{}\t{:.4f}\t{:.4f}\t0\n", r.agent + 1, f.index, r.x, r.y);
+    for (const TrajectoryRow& r : f.rows)
+      fmt::format_to(out, "{}\t{}\t{:.4f}\t{:.4f}\t0\n", r.agent + 1, f.index, r.x, r.y);
     put(buffer_);
   }
   bool uniform_frames() const override { return true; }
@@ -183,8 +186,12 @@ void TrajectoryWriter::finish(const sim::Simulation&, nlohmann::json& stats) {
   if (sink_ == nullptr) return;
   sink_->close();
   file_.commit();
-  nlohmann::json section = {{"format", to_string(output_.format)}, {"path", output_.path}, {"every_frames", output_.every},
-                            {"frames", frames_}, {"rows", rows_}, {"columns", sink_->columns()}};
+  nlohmann::json section = {{"format", to_string(output_.format)},
+                            {"path", output_.path},
+                            {"every_frames", output_.every},
+                            {"frames", frames_},
+                            {"rows", rows_},
+                            {"columns", sink_->columns()}};
   sink_->describe(section);
   stats["trajectories"] = std::move(section);
 }

@@ -49,9 +49,9 @@ class TrajectorySink {
 
 struct TrajectoryOutput {
   TrajectoryFormat format = TrajectoryFormat::Csv;
-  std::string path;        // the file to write
-  std::int64_t every = 1;  // write every `every`-th step
-  double dt = 0.1;         // s per step: the frame rate is 1 / (dt * every)
+  std::string path;          // the file to write
+  std::int64_t every = 1;    // write every `every`-th step
+  double dt = 0.1;           // s per step: the frame rate is 1 / (dt * every)
   std::string geometry_wkt;  // the walkable area (sqlite stores it)
 };
 

@@ -34,7 +34,9 @@ constexpr double kDegrees = 0.017453292519943295;
 class Reader : public YamlReader {
  public:
   Reader(const std::string& file, const ScenarioReadLimits& limits, ScenarioSource& source)
-      : YamlReader(file, YamlReadRules{limits.max_nodes, kMaxText, false}, &source.marks), limits_(limits), source_(source) {}
+      : YamlReader(file, YamlReadRules{limits.max_nodes, kMaxText, false}, &source.marks),
+        limits_(limits),
+        source_(source) {}
 
   glm::vec2 point(const YAML::Node& n, const std::string& path) {
     visit(n, path);
@@ -51,7 +53,8 @@ class Reader : public YamlReader {
     double xy[2];
     for (int k = 0; k < 2; ++k) {
       const YAML::Node c = n[k];
-      if (const std::string problem = number_problem(c, &xy[k]); !problem.empty()) fail(c, item(path(), static_cast<std::size_t>(k)), problem);
+      if (const std::string problem = number_problem(c, &xy[k]); !problem.empty())
+        fail(c, item(path(), static_cast<std::size_t>(k)), problem);
     }
     const double max_extent = limits_.scenario.max_extent;
     if (std::fabs(xy[0]) > max_extent || std::fabs(xy[1]) > max_extent)
@@ -117,7 +120,8 @@ class Reader : public YamlReader {
   // {polygon: [...], holes: [...]} or {rect: {min, max}}.
   sim::Polygon area(const YAML::Node& n, const std::string& path) {
     const std::string k = one_of(n, path, {"polygon", "rect"}, {"holes"});
-    sim::Polygon p = k == "rect" ? rect_polygon(n["rect"], child(path, "rect")) : sim::Polygon{ring(n["polygon"], child(path, "polygon")), {}};
+    sim::Polygon p = k == "rect" ? rect_polygon(n["rect"], child(path, "rect"))
+                                 : sim::Polygon{ring(n["polygon"], child(path, "polygon")), {}};
     if (n["holes"]) p.holes = holes(n["holes"], child(path, "holes"));
     return p;
   }
@@ -149,7 +153,8 @@ class Reader : public YamlReader {
       r.kind = Region::Kind::ring;
       expect_map(v, sub, {"center", "radius", "spacing"});
       r.center = v["center"] ? point(v["center"], child(sub, "center")) : glm::vec2(0.0f);
-      if (v["radius"].IsDefined() == v["spacing"].IsDefined()) fail(v, sub, "a ring needs one of 'radius' or 'spacing'");
+      if (v["radius"].IsDefined() == v["spacing"].IsDefined())
+        fail(v, sub, "a ring needs one of 'radius' or 'spacing'");
       if (v["radius"]) r.radius = real(v["radius"], child(sub, "radius"));
       if (v["spacing"]) r.spacing = real(v["spacing"], child(sub, "spacing"));
     } else if (k == "points") {
@@ -200,24 +205,26 @@ class Reader : public YamlReader {
   // those every model shares. A parameter of another model is an error that
   // says which type it belongs to.
   sim::ModelParams model(const YAML::Node& n, const std::string& path) {
-    static const std::vector<std::string_view> shared = {"type", "max_speed", "contact_iterations", "contact_extra_iterations",
-                                                         "contact_tolerance"};
-    static const std::vector<std::string_view> priority = {"pred_time", "max_force", "personal_space", "lane_half_width", "relaxation_time",
-                                                           "probe_margin"};
-    static const std::vector<std::string_view> cfs = {"time_gap",       "neighbour_strength", "neighbour_range", "wall_strength",
-                                                      "wall_range",     "avoid_strength",     "avoid_time",      "side_margin",
-                                                      "turn_time",      "anticipation_time"};
-    static const std::vector<std::string_view> ttc = {"ttc_strength", "ttc_time_horizon", "ttc_relaxation_time", "ttc_sensing_radius",
+    static const std::vector<std::string_view> shared = {"type", "max_speed", "contact_iterations",
+                                                         "contact_extra_iterations", "contact_tolerance"};
+    static const std::vector<std::string_view> priority = {"pred_time",       "max_force",       "personal_space",
+                                                           "lane_half_width", "relaxation_time", "probe_margin"};
+    static const std::vector<std::string_view> cfs = {
+        "time_gap",       "neighbour_strength", "neighbour_range", "wall_strength", "wall_range",
+        "avoid_strength", "avoid_time",         "side_margin",     "turn_time",     "anticipation_time"};
+    static const std::vector<std::string_view> ttc = {"ttc_strength",         "ttc_time_horizon",
+                                                      "ttc_relaxation_time",  "ttc_sensing_radius",
                                                       "ttc_max_acceleration", "ttc_side_bias"};
-    static const std::vector<std::string_view> sf = {"sf_mass",       "sf_relaxation_time", "sf_strength",       "sf_range",
-                                                     "sf_body_stiffness", "sf_friction",    "sf_anisotropy",     "sf_sensing_radius",
-                                                     "sf_max_substep", "sf_side_bias"};
+    static const std::vector<std::string_view> sf = {
+        "sf_mass",     "sf_relaxation_time", "sf_strength",       "sf_range",       "sf_body_stiffness",
+        "sf_friction", "sf_anisotropy",      "sf_sensing_radius", "sf_max_substep", "sf_side_bias"};
     visit(n, path);
     if (!n.IsMap()) fail(n, path, "expected a map (model.type and its parameters), got " + kind(n));
     sim::ModelParams m;
     if (n["type"])
-      m.kind = sim::parse_model_kind(word(n["type"], child(path, "type"), {"collision_free_speed", "priority", "ttc", "social_force"}),
-                                    child(path, "type"));
+      m.kind = sim::parse_model_kind(
+          word(n["type"], child(path, "type"), {"collision_free_speed", "priority", "ttc", "social_force"}),
+          child(path, "type"));
     auto keys_of_model = [&](sim::ModelKind k) -> const std::vector<std::string_view>& {
       if (k == sim::ModelKind::SocialForce) return sf;
       return k == sim::ModelKind::Priority ? priority : (k == sim::ModelKind::Ttc ? ttc : cfs);
@@ -228,13 +235,13 @@ class Reader : public YamlReader {
     for (auto it = n.begin(); it != n.end(); ++it) {
       const YAML::Node key = it->first;
       if (!key.IsScalar()) continue;
-      for (const sim::ModelKind owner : {sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Priority, sim::ModelKind::Ttc,
-                                      sim::ModelKind::SocialForce}) {
+      for (const sim::ModelKind owner : {sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Priority,
+                                         sim::ModelKind::Ttc, sim::ModelKind::SocialForce}) {
         const std::vector<std::string_view>& keys = keys_of_model(owner);
         if (owner == m.kind || std::find(keys.begin(), keys.end(), key.Scalar()) == keys.end()) continue;
         fail_at(key.Mark(), child(path, key.Scalar()),
-                fmt::format("'{}' is a parameter of the {} model, and this scenario's model.type is {}", key.Scalar(), to_string(owner),
-                            to_string(m.kind)));
+                fmt::format("'{}' is a parameter of the {} model, and this scenario's model.type is {}", key.Scalar(),
+                            to_string(owner), to_string(m.kind)));
       }
     }
     keys_of(n, path, allowed);
@@ -274,10 +281,12 @@ class Reader : public YamlReader {
     opt("sf_sensing_radius", m.sf.sensing_radius);
     opt("sf_max_substep", m.sf.max_substep);
     opt("sf_side_bias", m.sf.side_bias);
-    if (n["contact_iterations"]) m.contact_iterations = static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
+    if (n["contact_iterations"])
+      m.contact_iterations =
+          static_cast<std::int32_t>(integer(n["contact_iterations"], child(path, "contact_iterations"), 0, 64));
     if (n["contact_extra_iterations"])
-      m.contact_extra_iterations =
-          static_cast<std::int32_t>(integer(n["contact_extra_iterations"], child(path, "contact_extra_iterations"), 0, 64));
+      m.contact_extra_iterations = static_cast<std::int32_t>(
+          integer(n["contact_extra_iterations"], child(path, "contact_extra_iterations"), 0, 64));
     opt("contact_tolerance", m.contact_tolerance);
     return m;
   }
@@ -324,12 +333,14 @@ class Reader : public YamlReader {
         if (const YAML::Node size = s["size"]) {
           const std::string sp = child(ip, "size");
           visit(size, sp);
-          if (!size.IsSequence() || size.size() != 2) fail(size, sp, "expected [min, max] in metres, got " + kind(size));
+          if (!size.IsSequence() || size.size() != 2)
+            fail(size, sp, "expected [min, max] in metres, got " + kind(size));
           spec.min_size = real(size[0], item(sp, 0));
           spec.max_size = real(size[1], item(sp, 1));
         }
         if (s["clearance"]) spec.clearance = real(s["clearance"], child(ip, "clearance"));
-        if (s["seed"]) spec.seed = static_cast<std::uint64_t>(integer(s["seed"], child(ip, "seed"), 0, std::int64_t{1} << 53));
+        if (s["seed"])
+          spec.seed = static_cast<std::uint64_t>(integer(s["seed"], child(ip, "seed"), 0, std::int64_t{1} << 53));
         w.scatters.push_back(spec);
         w.scatter_fields.push_back(ip);
       }
@@ -337,13 +348,15 @@ class Reader : public YamlReader {
   }
 
   sim::GroupSpec group(const YAML::Node& n, const std::string& path, const sim::ModelParams& model) {
-    expect_map(n, path, {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius"});
+    expect_map(n, path,
+               {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius"});
     sim::GroupSpec g;
     if (n["name"]) g.name = text(n["name"], child(path, "name"));
     // count may be left out when the group spawns at points: one agent per point.
     const YAML::Node spawn = required(n, path, "spawn");
     const bool at_points = spawn.IsMap() && spawn["points"];
-    if (n["count"] || !at_points) g.count = integer(required(n, path, "count"), child(path, "count"), 0, limits_.scenario.max_agents);
+    if (n["count"] || !at_points)
+      g.count = integer(required(n, path, "count"), child(path, "count"), 0, limits_.scenario.max_agents);
     if (n["radius"]) g.radius = real(n["radius"], child(path, "radius"));
     // Unless given, speeds stay within the model's maximum.
     g.speed.max = std::min(g.speed.max, model.max_speed);
@@ -366,7 +379,8 @@ class Reader : public YamlReader {
     g.goal = goal(required(n, path, "goal"), child(path, "goal"));
     if (n["on_arrival"]) {
       const std::string a = word(n["on_arrival"], child(path, "on_arrival"), {"stop", "despawn", "loop"});
-      g.arrival = a == "stop" ? sim::ArrivalBehaviour::Stop : (a == "despawn" ? sim::ArrivalBehaviour::Despawn : sim::ArrivalBehaviour::Loop);
+      g.arrival = a == "stop" ? sim::ArrivalBehaviour::Stop
+                              : (a == "despawn" ? sim::ArrivalBehaviour::Despawn : sim::ArrivalBehaviour::Loop);
     }
     if (n["arrival_radius"]) g.arrival_radius = real(n["arrival_radius"], child(path, "arrival_radius"));
     return g;
@@ -382,7 +396,8 @@ class Reader : public YamlReader {
     // Looking straight down: put the map's north (+y) at the top of the image.
     const glm::vec3 d = target - eye;
     if (std::fabs(d.x) + std::fabs(d.y) <= 1e-4f * std::fabs(d.z)) c.up = world_from_map(glm::vec3(0.0f, 1.0f, 0.0f));
-    if (n["fov_degrees"]) c.fov_y = static_cast<float>(real_in(n["fov_degrees"], child(path, "fov_degrees"), 1.0, 179.0) * kDegrees);
+    if (n["fov_degrees"])
+      c.fov_y = static_cast<float>(real_in(n["fov_degrees"], child(path, "fov_degrees"), 1.0, 179.0) * kDegrees);
     if (n["width"]) c.width = static_cast<std::int32_t>(integer(n["width"], child(path, "width"), 1, 1 << 15));
     if (n["height"]) c.height = static_cast<std::int32_t>(integer(n["height"], child(path, "height"), 1, 1 << 15));
     if (n["near"]) c.near_plane = real(n["near"], child(path, "near"));
@@ -392,10 +407,11 @@ class Reader : public YamlReader {
     } catch (const Error& e) {
       // Camera names its own fields; say it in the file's words.
       std::string field = e.location().field;
-      for (const auto& [from, to] : {std::pair<std::string_view, std::string_view>{"camera.fov_y", "camera.fov_degrees"},
-                                     {"camera.near_plane", "camera.near"},
-                                     {"camera.far_plane", "camera.far"},
-                                     {"camera.up", "camera.target"}})
+      for (const auto& [from, to] :
+           {std::pair<std::string_view, std::string_view>{"camera.fov_y", "camera.fov_degrees"},
+            {"camera.near_plane", "camera.near"},
+            {"camera.far_plane", "camera.far"},
+            {"camera.up", "camera.target"}})
         if (field == from) field = to;
       const std::string key = field.substr(field.find('.') + 1);
       fail(n[key] ? n[key] : n, field, e.message());
@@ -410,7 +426,8 @@ class Reader : public YamlReader {
     sim::MeasurementSpec m;
     if (!(n.IsMap() && (n["areas"] || n["lines"] || n["voronoi_cutoff"]))) {
       // A misspelt key is told apart from both forms' keys.
-      if (n.IsMap() && !n["rect"] && !n["disc"] && !n["ring"] && !n["polygon"]) expect_map(n, path, {"rect", "areas", "lines", "voronoi_cutoff"});
+      if (n.IsMap() && !n["rect"] && !n["disc"] && !n["ring"] && !n["polygon"])
+        expect_map(n, path, {"rect", "areas", "lines", "voronoi_cutoff"});
       const Region r = region(n, path);
       if (r.kind != Region::Kind::rect) fail(n, path, "the measurement area is a rect");
       sim::Aabb box;
@@ -419,10 +436,12 @@ class Reader : public YamlReader {
       m.areas.push_back({"area", box});
       return m;
     }
-    if (n["rect"]) fail(n["rect"], child(path, "rect"), "give either 'rect' (one area) or 'areas' and 'lines', not both");
+    if (n["rect"])
+      fail(n["rect"], child(path, "rect"), "give either 'rect' (one area) or 'areas' and 'lines', not both");
     expect_map(n, path, {"areas", "lines", "voronoi_cutoff"});
     // Names label the results in stats.json: each names one thing.
-    auto name_of = [&](const YAML::Node& item_node, const std::string& ip, std::vector<std::string>& taken, const std::string& fallback) {
+    auto name_of = [&](const YAML::Node& item_node, const std::string& ip, std::vector<std::string>& taken,
+                       const std::string& fallback) {
       const YAML::Node given = item_node["name"];
       const std::string np = child(ip, "name");
       const std::string name = given ? text(given, np) : fallback;
@@ -456,7 +475,8 @@ class Reader : public YamlReader {
         sim::MeasurementLine l;
         l.from = point(required(list[i], ip, "from"), child(ip, "from"));
         l.to = point(required(list[i], ip, "to"), child(ip, "to"));
-        if (!(sim::length_of(l.to - l.from) > 0.0f)) fail(list[i]["to"], child(ip, "to"), "the line has no length: 'to' equals 'from'");
+        if (!(sim::length_of(l.to - l.from) > 0.0f))
+          fail(list[i]["to"], child(ip, "to"), "the line has no length: 'to' equals 'from'");
         l.name = name_of(list[i], ip, names, fmt::format("line{}", i));
         m.lines.push_back(l);
       }
@@ -478,7 +498,9 @@ class Reader : public YamlReader {
       expect_map(t, tp, {"format", "every"});
       if (t["format"]) format = parse_trajectory_format(text(t["format"], child(tp, "format")), child(tp, "format"));
       if (t["every"]) {
-        if (n["every"]) fail(t["every"], child(tp, "every"), fmt::format("give the stride once: {} or {}", child(path, "every"), child(tp, "every")));
+        if (n["every"])
+          fail(t["every"], child(tp, "every"),
+               fmt::format("give the stride once: {} or {}", child(path, "every"), child(tp, "every")));
         o.every = integer(t["every"], child(tp, "every"), 1, limits_.scenario.max_steps);
       }
     } else if (t) {
@@ -490,20 +512,24 @@ class Reader : public YamlReader {
 
   sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name, TrajectoryFormat& format) {
     expect_map(root, "",
-               {"name", "description", "seed", "scheduler", "planning", "dt", "duration", "steps", "stop_when_arrived", "model", "world", "groups",
-                "camera", "measurement", "outputs"});
+               {"name", "description", "seed", "scheduler", "planning", "dt", "duration", "steps", "stop_when_arrived",
+                "model", "world", "groups", "camera", "measurement", "outputs"});
     sim::ScenarioSpec s;
     s.name = root["name"] ? text(root["name"], "name") : default_name;
     if (root["description"]) s.description = text(root["description"], "description");
     if (root["seed"]) s.seed = static_cast<std::uint64_t>(integer(root["seed"], "seed", 0, std::int64_t{1} << 53));
-    if (root["scheduler"]) s.scheduler = sim::parse_scheduler(word(root["scheduler"], "scheduler", {"double_buffer", "four_colour", "four_color"}), "scheduler");
+    if (root["scheduler"])
+      s.scheduler = sim::parse_scheduler(
+          word(root["scheduler"], "scheduler", {"double_buffer", "four_colour", "four_color"}), "scheduler");
     if (root["planning"])
-      s.planning = word(root["planning"], "planning", {"roadmap", "none"}) == "none" ? sim::PlanningKind::None : sim::PlanningKind::Roadmap;
+      s.planning = word(root["planning"], "planning", {"roadmap", "none"}) == "none" ? sim::PlanningKind::None
+                                                                                     : sim::PlanningKind::Roadmap;
     if (root["dt"]) s.dt = real_in(root["dt"], "dt", 1e-4, 10.0);
     if (root["duration"]) s.duration = real_in(root["duration"], "duration", 1e-3, 1e9);
     if (root["steps"]) s.steps = integer(root["steps"], "steps", 1, limits_.scenario.max_steps);
     if (s.step_count() > limits_.scenario.max_steps)
-      fail(root["duration"] ? root["duration"] : root, "duration", fmt::format("duration / dt exceeds {} steps", limits_.scenario.max_steps));
+      fail(root["duration"] ? root["duration"] : root, "duration",
+           fmt::format("duration / dt exceeds {} steps", limits_.scenario.max_steps));
     if (root["stop_when_arrived"]) s.stop_when_arrived = boolean(root["stop_when_arrived"], "stop_when_arrived");
     if (root["model"]) s.model = model(root["model"], "model");
     if (root["world"]) world(root["world"], "world", s.world);
@@ -514,7 +540,8 @@ class Reader : public YamlReader {
       s.groups.push_back(group(groups[i], item("groups", i), s.model));
       agents += s.groups.back().count;
       if (agents > limits_.scenario.max_agents)
-        fail(groups[i], item("groups", i), fmt::format("the scenario has more than {} agents", limits_.scenario.max_agents));
+        fail(groups[i], item("groups", i),
+             fmt::format("the scenario has more than {} agents", limits_.scenario.max_agents));
     }
     if (root["camera"]) {
       s.camera = camera(root["camera"], "camera");
@@ -546,10 +573,12 @@ Location ScenarioSource::locate(const std::string& field) const {
   std::string key = field;
   // Drop trailing parts ("[3]", ".radius", " (shape 5)") until a recorded key remains.
   while (!key.empty()) {
-    if (const auto it = marks.find(key); it != marks.end()) return Location{file, it->second.first, it->second.second, field};
+    if (const auto it = marks.find(key); it != marks.end())
+      return Location{file, it->second.first, it->second.second, field};
     if (key.back() == ']') {
       const std::size_t open = key.rfind('[');
-      if (const auto it = item_marks.find(std::string_view(key).substr(0, open)); open != std::string::npos && it != item_marks.end()) {
+      if (const auto it = item_marks.find(std::string_view(key).substr(0, open));
+          open != std::string::npos && it != item_marks.end()) {
         std::size_t i = 0;
         const auto [end, ec] = std::from_chars(key.data() + open + 1, key.data() + key.size() - 1, i);
         if (ec == std::errc() && end == key.data() + key.size() - 1 && i < it->second.size() && it->second[i].first > 0)
@@ -575,7 +604,8 @@ LoadedScenario parse_scenario(std::string_view text, const std::string& name, co
   LoadedScenario out;
   out.source.file = name;
   const YAML::Node root = load_yaml(std::string(text), name);
-  if (!root || root.IsNull()) throw Error("the file is empty; a scenario needs at least 'groups'", Location{name, 1, 1, {}});
+  if (!root || root.IsNull())
+    throw Error("the file is empty; a scenario needs at least 'groups'", Location{name, 1, 1, {}});
   try {
     Reader reader(name, limits, out.source);
     out.spec = reader.scenario(root, stem_of(name), out.trajectory_format);
@@ -591,7 +621,8 @@ LoadedScenario read_scenario_file(const std::string& path, const ScenarioReadLim
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) throw Error("cannot read the scenario file: " + ec.message(), Location{path, 0, 0, {}});
-  if (size > limits.max_file_bytes) throw Error(fmt::format("the file is larger than {} bytes", limits.max_file_bytes), Location{path, 0, 0, {}});
+  if (size > limits.max_file_bytes)
+    throw Error(fmt::format("the file is larger than {} bytes", limits.max_file_bytes), Location{path, 0, 0, {}});
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open the scenario file", Location{path, 0, 0, {}});
   std::ostringstream ss;
@@ -606,7 +637,9 @@ std::optional<std::string_view> builtin_scenario_text(std::string_view name) { r
 LoadedScenario load_builtin_scenario(std::string_view name, const ScenarioReadLimits& limits) {
   const auto text = builtin_scenario_text(name);
   if (!text) {
-    throw Error(fmt::format("no built-in scenario '{}' (built-ins: {})", name, fmt::join(builtin_scenario_names(), ", ")), at_field("scenario"));
+    throw Error(
+        fmt::format("no built-in scenario '{}' (built-ins: {})", name, fmt::join(builtin_scenario_names(), ", ")),
+        at_field("scenario"));
   }
   LoadedScenario s = parse_scenario(*text, "builtin:" + std::string(name), limits);
   return s;
@@ -618,12 +651,14 @@ LoadedScenario load_scenario(const std::string& name_or_path, const ScenarioRead
   if (std::filesystem::is_regular_file(name_or_path, ec)) return read_scenario_file(name_or_path, limits);
   if (std::filesystem::is_directory(name_or_path, ec))
     throw Error("is a folder, not a scenario file (give the .yaml file inside it)", Location{name_or_path, 0, 0, {}});
-  const bool looks_like_path = name_or_path.find('/') != std::string::npos || name_or_path.find('.') != std::string::npos;
+  const bool looks_like_path =
+      name_or_path.find('/') != std::string::npos || name_or_path.find('.') != std::string::npos;
   if (looks_like_path) throw Error("no such scenario file", Location{name_or_path, 0, 0, {}});
   return load_builtin_scenario(name_or_path, limits);  // throws, listing the built-ins
 }
 
-std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario, const sim::SimulationOptions& options) {
+std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario,
+                                                  const sim::SimulationOptions& options) {
   try {
     // `planning: roadmap` (the default): routes over the Voronoi roadmap for
     // groups with a goal and no waypoints (or the caller's planner);
@@ -639,9 +674,11 @@ std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario
     planned.planner = &planner;
     auto simulation = std::make_unique<sim::Simulation>(scenario.spec, planned);
     if (const path::RoutePlannerStats st = planner.stats(); st.queries > 0)
-      spdlog::info("planning: {} of {} agents routed over the roadmap, {} straight, {} without a route ({} roadmap(s) in {:.2f} s, "
-                   "queries {:.2f} s)",
-                   st.planned, st.queries, st.straight, st.fallback, st.roadmaps, st.build_seconds, st.plan_seconds);
+      spdlog::info(
+          "planning: {} of {} agents routed over the roadmap, {} straight, {} without a route ({} roadmap(s) in {:.2f} "
+          "s, "
+          "queries {:.2f} s)",
+          st.planned, st.queries, st.straight, st.fallback, st.roadmaps, st.build_seconds, st.plan_seconds);
     return simulation;
   } catch (const Error& e) {
     throw scenario.source.located(e);

@@ -34,12 +34,12 @@ struct ScenarioReadLimits {
   std::uint64_t max_file_bytes = 64ull << 20;
   std::int64_t max_nodes = 4'000'000;  // YAML nodes visited (aliases count each time they are used)
   std::int64_t max_groups = 10'000;
-  sim::ScenarioLimits scenario;        // agents, vertices, obstacles, waypoints, extent
+  sim::ScenarioLimits scenario;  // agents, vertices, obstacles, waypoints, extent
 };
 
 // Where every key of a scenario came from.
 struct ScenarioSource {
-  std::string file;  // the path, or "builtin:<name>"
+  std::string file;                                               // the path, or "builtin:<name>"
   std::map<std::string, std::pair<int, int>, std::less<>> marks;  // key path -> 1-based (line, column)
   // Long lists kept compact: list path -> (line, column) of item i, for
   // "path[i]" (spawn points).
@@ -73,6 +73,7 @@ LoadedScenario load_scenario(const std::string& name_or_path, const ScenarioRead
 
 // Builds the world and spawns the crowd; errors carry the file position of
 // the offending key.
-std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario, const sim::SimulationOptions& options = {});
+std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario,
+                                                  const sim::SimulationOptions& options = {});
 
 }  // namespace throng::io

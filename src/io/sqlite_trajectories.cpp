@@ -53,7 +53,8 @@ SqliteTrajectorySink::SqliteTrajectorySink(std::string path, double fps, const s
   std::error_code ec;
   std::filesystem::remove(path_, ec);  // a fresh database, as JuPedSim drops its tables
   std::filesystem::remove(path_ + "-journal", ec);
-  if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) fail("cannot open");
+  if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK)
+    fail("cannot open");
   // A rollback journal keeps every committed frame readable after a crash
   // of the process; not waiting for the disk (synchronous off) only risks
   // frames on a crash of the machine.
@@ -76,13 +77,15 @@ void SqliteTrajectorySink::create_schema(const std::string& geometry_wkt) {
   exec("CREATE TABLE geometry(hash INTEGER NOT NULL, wkt TEXT NOT NULL)");
   exec("CREATE UNIQUE INDEX geometry_hash ON geometry(hash)");
   exec("CREATE TABLE frame_data(frame INTEGER NOT NULL, geometry_hash INTEGER NOT NULL)");
-  exec("CREATE TABLE trajectory_data(frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT NULL, pos_y REAL NOT NULL, "
-       "ori_x REAL NOT NULL, ori_y REAL NOT NULL)");
+  exec(
+      "CREATE TABLE trajectory_data(frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT NULL, pos_y REAL NOT "
+      "NULL, "
+      "ori_x REAL NOT NULL, ori_y REAL NOT NULL)");
   exec("CREATE INDEX frame_id_idx ON trajectory_data(frame, id)");
   const Bounds b = wkt_bounds(geometry_wkt);
   sqlite3_stmt* meta = prepare("INSERT INTO metadata VALUES(?, ?)");
   const std::pair<const char*, std::string> entries[] = {
-      {"version", std::to_string(kVersion)}, {"fps", fmt::format("{}", fps_)}, {"xmin", fmt::format("{}", b.xmin)},
+      {"version", std::to_string(kVersion)}, {"fps", fmt::format("{}", fps_)},    {"xmin", fmt::format("{}", b.xmin)},
       {"xmax", fmt::format("{}", b.xmax)},   {"ymin", fmt::format("{}", b.ymin)}, {"ymax", fmt::format("{}", b.ymax)}};
   for (const auto& [key, value] : entries) {
     sqlite3_bind_text(meta, 1, key, -1, SQLITE_STATIC);
@@ -156,7 +159,8 @@ sqlite3_stmt* SqliteTrajectorySink::prepare(const char* sql) {
 }
 
 void SqliteTrajectorySink::fail(const std::string& what) const {
-  throw Error(fmt::format("SQLite: {}: {}", what, db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory"), Location{path_, 0, 0, {}});
+  throw Error(fmt::format("SQLite: {}: {}", what, db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory"),
+              Location{path_, 0, 0, {}});
 }
 
 }  // namespace throng::io

@@ -23,30 +23,36 @@ class Reader : public YamlReader {
   using YamlReader::YamlReader;
 
   path::StateMachineSpec machine(const YAML::Node& root) {
-    expect_map(root, "", {"name", "fps", "spacing", "points_per_segment", "transition_frames", "pose_weight", "start_state", "end_state",
-                          "clips", "groups", "states", "edges"});
+    expect_map(root, "",
+               {"name", "fps", "spacing", "points_per_segment", "transition_frames", "pose_weight", "start_state",
+                "end_state", "clips", "groups", "states", "edges"});
     path::StateMachineSpec m;
     if (root["name"]) m.name = text(root["name"], "name");
     if (root["fps"]) m.fps = number_in(root["fps"], "fps", 1, 1000);
     if (root["spacing"]) m.spacing = real_in(root["spacing"], "spacing", 1e-3, 1);
     if (root["points_per_segment"])
-      m.points_per_segment = static_cast<std::int32_t>(integer(root["points_per_segment"], "points_per_segment", 2, 4096));
-    if (root["transition_frames"]) m.transition_frames = static_cast<std::int32_t>(integer(root["transition_frames"], "transition_frames", 0, 240));
+      m.points_per_segment =
+          static_cast<std::int32_t>(integer(root["points_per_segment"], "points_per_segment", 2, 4096));
+    if (root["transition_frames"])
+      m.transition_frames = static_cast<std::int32_t>(integer(root["transition_frames"], "transition_frames", 0, 240));
     if (root["pose_weight"]) m.pose_weight = real_in(root["pose_weight"], "pose_weight", 0, 1e6);
     if (root["start_state"]) m.start_state = text(root["start_state"], "start_state");
     if (root["end_state"]) m.end_state = text(root["end_state"], "end_state");
-    by_name(required(root, "", "clips"), "clips", [&](const std::string& name, const YAML::Node& n, const std::string& path) {
-      m.clips.push_back(clip(name, n, path));
-    });
+    by_name(required(root, "", "clips"), "clips",
+            [&](const std::string& name, const YAML::Node& n, const std::string& path) {
+              m.clips.push_back(clip(name, n, path));
+            });
     if (const YAML::Node groups = root["groups"])
       by_name(groups, "groups", [&](const std::string& name, const YAML::Node& n, const std::string& path) {
         m.groups.push_back(group(name, n, path));
       });
-    by_name(required(root, "", "states"), "states", [&](const std::string& name, const YAML::Node& n, const std::string& path) {
-      m.states.push_back(state(name, n, path));
-    });
+    by_name(required(root, "", "states"), "states",
+            [&](const std::string& name, const YAML::Node& n, const std::string& path) {
+              m.states.push_back(state(name, n, path));
+            });
     if (const YAML::Node edges = root["edges"])
-      each_item(edges, "edges", 0, kAnyCount, "edges", [&](const YAML::Node& e, const std::string& ep) { m.edges.push_back(edge(e, ep)); });
+      each_item(edges, "edges", 0, kAnyCount, "edges",
+                [&](const YAML::Node& e, const std::string& ep) { m.edges.push_back(edge(e, ep)); });
     return m;
   }
 
@@ -87,11 +93,14 @@ class Reader : public YamlReader {
     }
     if (n["gait"]) {
       const std::string g = word(n["gait"], child(path, "gait"), {"stand", "walk", "run"});
-      c.spec.gait = g == "stand" ? motion::biomech::Gait::Stand : (g == "walk" ? motion::biomech::Gait::Walk : motion::biomech::Gait::Run);
+      c.spec.gait = g == "stand" ? motion::biomech::Gait::Stand
+                                 : (g == "walk" ? motion::biomech::Gait::Walk : motion::biomech::Gait::Run);
       if (c.spec.gait == motion::biomech::Gait::Stand) c.spec.speed = 0;
     }
     if (n["speed"]) c.spec.speed = number_in(n["speed"], child(path, "speed"), 0, 7);
-    if (n["turn_rate_dps"]) c.spec.turn_rate = number_in(n["turn_rate_dps"], child(path, "turn_rate_dps"), -86, 86) * std::numbers::pi / 180.0;
+    if (n["turn_rate_dps"])
+      c.spec.turn_rate =
+          number_in(n["turn_rate_dps"], child(path, "turn_rate_dps"), -86, 86) * std::numbers::pi / 180.0;
     if (n["idle_period_s"]) c.spec.idle_period_s = number_in(n["idle_period_s"], child(path, "idle_period_s"), 0.5, 60);
     at(n, path, [&] { c.spec.validate(); });
     return c;
@@ -115,8 +124,9 @@ class Reader : public YamlReader {
     s.where = where(n, path);
     if (n["group"]) s.group = text(n["group"], child(path, "group"));
     if (n["locomotion"]) s.locomotion = loose_boolean(n["locomotion"], child(path, "locomotion"));
-    each_item(required(n, path, "segments"), child(path, "segments"), 1, kAnyCount, "segments",
-              [&](const YAML::Node& seg, const std::string& sp) { s.segments.push_back(segment(seg, sp, s.locomotion)); });
+    each_item(
+        required(n, path, "segments"), child(path, "segments"), 1, kAnyCount, "segments",
+        [&](const YAML::Node& seg, const std::string& sp) { s.segments.push_back(segment(seg, sp, s.locomotion)); });
     return s;
   }
 
@@ -128,8 +138,9 @@ class Reader : public YamlReader {
     if (seg["start"]) sp.start_frame = number_in(seg["start"], child(path, "start"), 0, 36000);
     if (seg["frames"]) {
       if (locomotion)
-        fail(seg["frames"], child(path, "frames"),
-             "a locomotion segment's length is the machine's segment length (points_per_segment x spacing), not frames");
+        fail(
+            seg["frames"], child(path, "frames"),
+            "a locomotion segment's length is the machine's segment length (points_per_segment x spacing), not frames");
       sp.frames = number_in(seg["frames"], child(path, "frames"), 1, 36000);
     }
     return sp;

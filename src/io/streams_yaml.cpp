@@ -32,7 +32,8 @@ class Reader : public YamlReader {
   Reader(std::string name, const StreamsYamlOptions& options) : YamlReader(std::move(name)), options_(options) {}
 
   std::unique_ptr<anim::StreamCrowd> read(const YAML::Node& root) {
-    if (!root.IsMap()) fail(root, "", "expected a mapping with 'rigs', 'clips', 'streams' (see docs/streams.md), got " + kind(root));
+    if (!root.IsMap())
+      fail(root, "", "expected a mapping with 'rigs', 'clips', 'streams' (see docs/streams.md), got " + kind(root));
     keys_of(root, "", {"frame_rate", "seed", "events", "rigs", "clips", "streams", "unique"});
     anim::StreamCrowdConfig config;
     if (root["frame_rate"]) config.frame_rate = real_in(root["frame_rate"], "frame_rate", 1.0, 1000.0);
@@ -86,12 +87,15 @@ class Reader : public YamlReader {
   void count_pose_bytes(const YAML::Node& n, const std::string& path, std::size_t bytes) {
     pose_bytes_ += bytes;
     if (pose_bytes_ > options_.limits.max_pose_bytes)
-      fail(n, path, "pose memory would exceed " + std::to_string(options_.limits.max_pose_bytes) + " bytes (" + std::to_string(pose_bytes_) + ")");
+      fail(n, path,
+           "pose memory would exceed " + std::to_string(options_.limits.max_pose_bytes) + " bytes (" +
+               std::to_string(pose_bytes_) + ")");
   }
 
   // ---- rigs
   void read_rig(const YAML::Node& r, const std::string& path) {
-    if (!r.IsMap()) fail(r, path, "expected a rig: {name, skeleton: default | bvh: FILE, clusters, unique_capacity}, got " + kind(r));
+    if (!r.IsMap())
+      fail(r, path, "expected a rig: {name, skeleton: default | bvh: FILE, clusters, unique_capacity}, got " + kind(r));
     keys_of(r, path, {"name", "skeleton", "bvh", "unit", "clusters", "unique_capacity"});
     const std::string name = name_of(required(r, path, "name"), child(path, "name"));
     if (crowd_->find_rig(name) >= 0) fail(r["name"], child(path, "name"), "rig '" + name + "' defined twice");
@@ -107,8 +111,10 @@ class Reader : public YamlReader {
       fail(r, path, "a rig needs 'skeleton: default' or 'bvh: FILE'");
     }
     std::vector<anim::ClusterDef> clusters;
-    each(r["clusters"], child(path, "clusters"), [&](const YAML::Node& c, const std::string& cp) { clusters.push_back(read_cluster(c, cp)); });
-    const std::int32_t index = at(r, path, [&] { return crowd_->add_rig(anim::make_rig(name, std::move(skeleton), std::move(clusters))); });
+    each(r["clusters"], child(path, "clusters"),
+         [&](const YAML::Node& c, const std::string& cp) { clusters.push_back(read_cluster(c, cp)); });
+    const std::int32_t index =
+        at(r, path, [&] { return crowd_->add_rig(anim::make_rig(name, std::move(skeleton), std::move(clusters))); });
     if (const YAML::Node capacity = r["unique_capacity"]) {
       const std::string cp = child(path, "unique_capacity");
       const auto cap = static_cast<std::int32_t>(integer(capacity, cp, 0, 1 << 24));
@@ -120,22 +126,28 @@ class Reader : public YamlReader {
 
   anim::ClusterDef read_cluster(const YAML::Node& c, const std::string& path) {
     if (!c.IsMap())
-      fail(c, path, "expected a cluster: {name, roots: [joint...], hook_rotation_deg: [x, y, z], hook_translation: [x, y, z]}, got " + kind(c));
+      fail(c, path,
+           "expected a cluster: {name, roots: [joint...], hook_rotation_deg: [x, y, z], hook_translation: [x, y, z]}, "
+           "got " +
+               kind(c));
     keys_of(c, path, {"name", "roots", "hook_rotation_deg", "hook_translation"});
     anim::ClusterDef d;
     d.name = name_of(required(c, path, "name"), child(path, "name"));
     d.roots = names_of(required(c, path, "roots"), child(path, "roots"));
     if (c["hook_rotation_deg"]) {
-      const glm::dvec3 e = vec3(c["hook_rotation_deg"], child(path, "hook_rotation_deg"), -360.0, 360.0) * (3.14159265358979323846 / 180.0);
+      const glm::dvec3 e = vec3(c["hook_rotation_deg"], child(path, "hook_rotation_deg"), -360.0, 360.0) *
+                           (3.14159265358979323846 / 180.0);
       d.hook_rotation = glm::quat(glm::dquat(glm::dvec3(e)));
     }
-    if (c["hook_translation"]) d.hook_translation = glm::vec3(vec3(c["hook_translation"], child(path, "hook_translation"), -100.0, 100.0));
+    if (c["hook_translation"])
+      d.hook_translation = glm::vec3(vec3(c["hook_translation"], child(path, "hook_translation"), -100.0, 100.0));
     return d;
   }
 
   glm::dvec3 vec3(const YAML::Node& n, const std::string& path, double lo, double hi) {
     if (!n.IsSequence() || n.size() != 3) fail(n, path, "expected [x, y, z], got " + kind(n));
-    return {number_in(n[0], item(path, 0), lo, hi), number_in(n[1], item(path, 1), lo, hi), number_in(n[2], item(path, 2), lo, hi)};
+    return {number_in(n[0], item(path, 0), lo, hi), number_in(n[1], item(path, 1), lo, hi),
+            number_in(n[2], item(path, 2), lo, hi)};
   }
 
   // The BVH file of map n's `bvh`, in n's `unit` when given.
@@ -158,7 +170,9 @@ class Reader : public YamlReader {
 
   // ---- clips
   void read_clip(const YAML::Node& c, const std::string& path) {
-    if (!c.IsMap()) fail(c, path, "expected a clip: {name, rig, default: NAME | bvh: FILE, frames, loop, footsteps, events}, got " + kind(c));
+    if (!c.IsMap())
+      fail(c, path,
+           "expected a clip: {name, rig, default: NAME | bvh: FILE, frames, loop, footsteps, events}, got " + kind(c));
     keys_of(c, path, {"name", "rig", "default", "bvh", "unit", "frames", "loop", "footsteps", "events"});
     const std::string name = name_of(required(c, path, "name"), child(path, "name"));
     if (clips_.count(name)) fail(c["name"], child(path, "name"), "clip '" + name + "' defined twice");
@@ -172,18 +186,20 @@ class Reader : public YamlReader {
     out.clip.clip = std::make_shared<motion::Clip>(std::move(clip));
     out.clip.loop = c["loop"] ? loose_boolean(c["loop"], child(path, "loop")) : true;
     if (c["footsteps"] && loose_boolean(c["footsteps"], child(path, "footsteps")))
-      out.clip.events =
-          at(c["footsteps"], child(path, "footsteps"), [&] { return anim::footstep_events(rig.skeleton, out.clip, crowd_->event_names()); });
+      out.clip.events = at(c["footsteps"], child(path, "footsteps"),
+                           [&] { return anim::footstep_events(rig.skeleton, out.clip, crowd_->event_names()); });
     if (c["events"]) {
       each(c["events"], child(path, "events"), [&](const YAML::Node& e, const std::string& ep) {
         if (!e.IsMap()) fail(e, ep, "expected an event: {name, time}, got " + kind(e));
         keys_of(e, ep, {"name", "time"});
         anim::ClipEvent ev;
-        ev.id = at(e, ep, [&] { return crowd_->event_names().intern(name_of(required(e, ep, "name"), child(ep, "name"))); });
+        ev.id = at(e, ep,
+                   [&] { return crowd_->event_names().intern(name_of(required(e, ep, "name"), child(ep, "name"))); });
         ev.time = real_in(required(e, ep, "time"), child(ep, "time"), 0.0, out.clip.duration());
         out.clip.events.push_back(ev);
       });
-      std::stable_sort(out.clip.events.begin(), out.clip.events.end(), [](const auto& a, const auto& b) { return a.time < b.time; });
+      std::stable_sort(out.clip.events.begin(), out.clip.events.end(),
+                       [](const auto& a, const auto& b) { return a.time < b.time; });
     }
     at(c, path, [&] { out.clip.validate(); });
     clips_[name] = std::move(out);
@@ -197,7 +213,8 @@ class Reader : public YamlReader {
       const std::string motion_name = text(d, dp);
       std::vector<std::string> known;
       for (const auto& s : motion::default_motion_specs()) {
-        if (s.name == motion_name) return at(d, dp, [&] { return motion::LocomotionGenerator(rig.skeleton, s).make_clip(); });
+        if (s.name == motion_name)
+          return at(d, dp, [&] { return motion::LocomotionGenerator(rig.skeleton, s).make_clip(); });
         known.push_back(s.name);
       }
       fail(d, dp, "no default motion '" + motion_name + "' (known: " + join(known) + ")");
@@ -213,7 +230,8 @@ class Reader : public YamlReader {
 
   // Frames [first, end) of clip.
   motion::Clip frames_of(const YAML::Node& fr, const std::string& path, const motion::Clip& clip) {
-    if (!fr.IsSequence() || fr.size() != 2) fail(fr, path, "expected [first, end): frames first..end-1, got " + kind(fr));
+    if (!fr.IsSequence() || fr.size() != 2)
+      fail(fr, path, "expected [first, end): frames first..end-1, got " + kind(fr));
     const auto first = static_cast<std::int32_t>(integer(fr[0], item(path, 0), 0, clip.frame_count - 1));
     const auto end = static_cast<std::int32_t>(integer(fr[1], item(path, 1), first + 1, clip.frame_count));
     motion::Clip cut;
@@ -231,10 +249,14 @@ class Reader : public YamlReader {
     auto it = clips_.find(name);
     if (it == clips_.end()) fail(n, path, "no clip named '" + name + "'");
     if (it->second.rig != rig)
-      fail(n, path, "clip '" + name + "' is of rig '" + crowd_->rig(it->second.rig).name + "', not '" + crowd_->rig(rig).name + "'");
+      fail(n, path,
+           "clip '" + name + "' is of rig '" + crowd_->rig(it->second.rig).name + "', not '" + crowd_->rig(rig).name +
+               "'");
     return it->second;
   }
-  const AnimClip& clip_of(const YAML::Node& n, const std::string& path, std::int32_t rig) { return named_clip(n, path, rig).clip; }
+  const AnimClip& clip_of(const YAML::Node& n, const std::string& path, std::int32_t rig) {
+    return named_clip(n, path, rig).clip;
+  }
 
   // ---- blend spaces (shared by every controller that names the same clips)
   motion::LocomotionClip prepared(const YAML::Node& n, const std::string& path, std::int32_t rig) {
@@ -248,16 +270,21 @@ class Reader : public YamlReader {
     });
   }
 
-  bool is_default_skeleton(std::int32_t rig) const { return crowd_->rig(rig).skeleton.names == motion::default_skeleton().names; }
+  bool is_default_skeleton(std::int32_t rig) const {
+    return crowd_->rig(rig).skeleton.names == motion::default_skeleton().names;
+  }
 
   // `space: default` or `clips: [NAME...]` (straight locomotion clips of the rig, by speed).
-  std::shared_ptr<const motion::BlendSpace1D> speed_space(const YAML::Node& n, const std::string& path, std::int32_t rig, bool plant_feet) {
+  std::shared_ptr<const motion::BlendSpace1D> speed_space(const YAML::Node& n, const std::string& path,
+                                                          std::int32_t rig, bool plant_feet) {
     if (n["space"] && n["clips"]) fail(n, path, "give either 'space: default' or 'clips: [...]', not both");
     if (const YAML::Node space = n["space"]) {
       const std::string sp = child(path, "space");
       if (text(space, sp) != "default") fail(space, sp, "the only built-in blend space is 'default'");
       if (!is_default_skeleton(rig)) fail(space, sp, "the default blend space needs a rig with 'skeleton: default'");
-      if (!plant_feet) fail(n["plant_feet"], child(path, "plant_feet"), "the default blend space plants feet; give 'clips' to turn it off");
+      if (!plant_feet)
+        fail(n["plant_feet"], child(path, "plant_feet"),
+             "the default blend space plants feet; give 'clips' to turn it off");
       return anim::default_blend_spaces().speeds;
     }
     const std::string cp = child(path, "clips");
@@ -267,22 +294,26 @@ class Reader : public YamlReader {
     auto found = spaces_.find(key);
     if (found != spaces_.end()) return found->second;
     std::vector<motion::LocomotionClip> prepared_clips;
-    each(clips, cp, [&](const YAML::Node& c, const std::string& ip) { prepared_clips.push_back(prepared(c, ip, rig)); });
+    each(clips, cp,
+         [&](const YAML::Node& c, const std::string& ip) { prepared_clips.push_back(prepared(c, ip, rig)); });
     motion::BlendSpaceOptions options;
     options.plant_feet = plant_feet;
     auto space = at(clips, cp, [&] {
-      return std::make_shared<const motion::BlendSpace1D>(crowd_->rig(rig).skeleton, std::move(prepared_clips), options);
+      return std::make_shared<const motion::BlendSpace1D>(crowd_->rig(rig).skeleton, std::move(prepared_clips),
+                                                          options);
     });
     spaces_[key] = space;
     return space;
   }
 
-  std::shared_ptr<const motion::BlendSpace1D> turn_space(const YAML::Node& n, const std::string& path, std::int32_t rig) {
+  std::shared_ptr<const motion::BlendSpace1D> turn_space(const YAML::Node& n, const std::string& path,
+                                                         std::int32_t rig) {
     const std::string key = std::to_string(rig) + "|turn|" + text(n, path);
     auto found = spaces_.find(key);
     if (found != spaces_.end()) return found->second;
     const NamedClip& c = named_clip(n, path, rig);
-    auto space = at(n, path, [&] { return anim::make_turn_space(crowd_->rig(rig).skeleton, *c.clip.clip, c.clip.name, c.cycle); });
+    auto space = at(
+        n, path, [&] { return anim::make_turn_space(crowd_->rig(rig).skeleton, *c.clip.clip, c.clip.name, c.cycle); });
     spaces_[key] = space;
     return space;
   }
@@ -294,7 +325,10 @@ class Reader : public YamlReader {
   }
 
   std::unique_ptr<Controller> blend1d(const YAML::Node& n, const std::string& path, std::int32_t rig) {
-    if (!n.IsMap()) fail(n, path, "expected {clips: [NAME...] | space: default, parameter, speed, phase, footsteps, plant_feet}, got " + kind(n));
+    if (!n.IsMap())
+      fail(n, path,
+           "expected {clips: [NAME...] | space: default, parameter, speed, phase, footsteps, plant_feet}, got " +
+               kind(n));
     keys_of(n, path, {"clips", "space", "parameter", "speed", "phase", "footsteps", "plant_feet"});
     anim::Blend1DOptions o;
     if (n["parameter"]) o.parameter = name_of(n["parameter"], child(path, "parameter"));
@@ -308,10 +342,14 @@ class Reader : public YamlReader {
 
   std::unique_ptr<Controller> blend2d(const YAML::Node& n, const std::string& path, std::int32_t rig) {
     if (!n.IsMap())
-      fail(n, path, "expected {clips: [NAME...] | space: default, turn_left: CLIP, turn_right: CLIP, speed_parameter, turn_parameter, speed, "
-                    "turn, phase, footsteps, plant_feet}, got " + kind(n));
-    keys_of(n, path, {"clips", "space", "turn_left", "turn_right", "speed_parameter", "turn_parameter", "speed", "turn", "phase", "footsteps",
-                      "plant_feet"});
+      fail(n, path,
+           "expected {clips: [NAME...] | space: default, turn_left: CLIP, turn_right: CLIP, speed_parameter, "
+           "turn_parameter, speed, "
+           "turn, phase, footsteps, plant_feet}, got " +
+               kind(n));
+    keys_of(n, path,
+            {"clips", "space", "turn_left", "turn_right", "speed_parameter", "turn_parameter", "speed", "turn", "phase",
+             "footsteps", "plant_feet"});
     anim::Blend2DOptions o;
     if (n["speed_parameter"]) o.speed_parameter = name_of(n["speed_parameter"], child(path, "speed_parameter"));
     if (n["turn_parameter"]) o.turn_parameter = name_of(n["turn_parameter"], child(path, "turn_parameter"));
@@ -329,7 +367,9 @@ class Reader : public YamlReader {
       left = turn_space(required(n, path, "turn_left"), child(path, "turn_left"), rig);
       right = turn_space(required(n, path, "turn_right"), child(path, "turn_right"), rig);
     }
-    return at(n, path, [&] { return std::make_unique<anim::Blend2DController>(std::move(speeds), std::move(left), std::move(right), o); });
+    return at(n, path, [&] {
+      return std::make_unique<anim::Blend2DController>(std::move(speeds), std::move(left), std::move(right), o);
+    });
   }
 
   // ---- controllers
@@ -338,7 +378,9 @@ class Reader : public YamlReader {
       fail(n, path, "controllers nested deeper than " + std::to_string(options_.limits.max_controller_depth));
     if (!n.IsMap())
       fail(n, path,
-           "expected a controller: {clip: NAME, rate}, {blend1d: ...}, {blend2d: ...}, {layered: ...} or {state_machine: ...}, got " + kind(n));
+           "expected a controller: {clip: NAME, rate}, {blend1d: ...}, {blend2d: ...}, {layered: ...} or "
+           "{state_machine: ...}, got " +
+               kind(n));
     if (n["clip"]) {
       keys_of(n, path, {"clip", "rate", "start"});
       const float rate = n["rate"] ? real_in(n["rate"], child(path, "rate"), -100.0, 100.0) : 1.0f;
@@ -362,7 +404,8 @@ class Reader : public YamlReader {
   std::unique_ptr<Controller> layered(const YAML::Node& n, const std::string& path, std::int32_t rig, int depth) {
     if (!n.IsMap()) fail(n, path, "expected {base: CONTROLLER, layers: [...]}, got " + kind(n));
     keys_of(n, path, {"base", "layers"});
-    auto out = std::make_unique<anim::LayeredController>(controller(required(n, path, "base"), child(path, "base"), rig, depth + 1));
+    auto out = std::make_unique<anim::LayeredController>(
+        controller(required(n, path, "base"), child(path, "base"), rig, depth + 1));
     each(n["layers"], child(path, "layers"), [&](const YAML::Node& l, const std::string& lp) {
       anim::Layer layer = read_layer(l, lp, rig, depth);
       at(l, lp, [&] { out->add_layer(std::move(layer)); });
@@ -371,19 +414,25 @@ class Reader : public YamlReader {
   }
 
   anim::Layer read_layer(const YAML::Node& l, const std::string& path, std::int32_t rig, int depth) {
-    if (!l.IsMap()) fail(l, path, "expected a layer: {controller, mode, weight, weight_parameter, mask, mask_weight, reference}, got " + kind(l));
+    if (!l.IsMap())
+      fail(l, path,
+           "expected a layer: {controller, mode, weight, weight_parameter, mask, mask_weight, reference}, got " +
+               kind(l));
     keys_of(l, path, {"controller", "mode", "weight", "weight_parameter", "mask", "mask_weight", "reference"});
     const motion::Skeleton& skeleton = crowd_->rig(rig).skeleton;
     anim::Layer layer;
     layer.controller = controller(required(l, path, "controller"), child(path, "controller"), rig, depth + 1);
     if (l["mode"])
-      layer.mode = word(l["mode"], child(path, "mode"), {"override", "additive"}) == "override" ? anim::LayerMode::Override : anim::LayerMode::Additive;
+      layer.mode = word(l["mode"], child(path, "mode"), {"override", "additive"}) == "override"
+                       ? anim::LayerMode::Override
+                       : anim::LayerMode::Additive;
     if (l["weight"]) layer.weight = real_in(l["weight"], child(path, "weight"), 0.0, 1.0);
     if (l["weight_parameter"]) layer.weight_parameter = name_of(l["weight_parameter"], child(path, "weight_parameter"));
     const float mask_weight = l["mask_weight"] ? real_in(l["mask_weight"], child(path, "mask_weight"), 0.0, 1.0) : 1.0f;
     if (l["mask"]) {
       const std::vector<std::string> roots = names_of(l["mask"], child(path, "mask"));
-      layer.mask = at(l["mask"], child(path, "mask"), [&] { return anim::BoneMask::subtrees(skeleton, roots, mask_weight); });
+      layer.mask =
+          at(l["mask"], child(path, "mask"), [&] { return anim::BoneMask::subtrees(skeleton, roots, mask_weight); });
     } else {
       layer.mask = anim::BoneMask::all(skeleton.joint_count(), mask_weight);
     }
@@ -417,7 +466,8 @@ class Reader : public YamlReader {
     while (i < s.size() && (std::isalnum(static_cast<unsigned char>(s[i])) || s[i] == '_')) ++i;
     anim::Condition c;
     c.parameter = s.substr(start, i - start);
-    if (c.parameter.empty()) fail(n, path, "expected 'parameter OP value' (OP one of < <= > >= == !=) or '[!]parameter', found '" + s + "'");
+    if (c.parameter.empty())
+      fail(n, path, "expected 'parameter OP value' (OP one of < <= > >= == !=) or '[!]parameter', found '" + s + "'");
     skip();
     if (i == s.size()) {
       c.op = negated ? anim::Compare::Equal : anim::Compare::NotEqual;
@@ -425,9 +475,9 @@ class Reader : public YamlReader {
       return c;
     }
     if (negated) fail(n, path, "'!' only goes before a lone parameter: '" + s + "'");
-    static const std::pair<const char*, anim::Compare> ops[] = {{"<=", anim::Compare::LessEqual}, {">=", anim::Compare::GreaterEqual},
-                                                                {"==", anim::Compare::Equal},     {"!=", anim::Compare::NotEqual},
-                                                                {"<", anim::Compare::Less},       {">", anim::Compare::Greater}};
+    static const std::pair<const char*, anim::Compare> ops[] = {
+        {"<=", anim::Compare::LessEqual}, {">=", anim::Compare::GreaterEqual}, {"==", anim::Compare::Equal},
+        {"!=", anim::Compare::NotEqual},  {"<", anim::Compare::Less},          {">", anim::Compare::Greater}};
     bool found = false;
     for (const auto& [text_op, op] : ops)
       if (s.compare(i, std::char_traits<char>::length(text_op), text_op) == 0) {
@@ -447,7 +497,8 @@ class Reader : public YamlReader {
       fail(n, path, "expected a number after the comparison in '" + s + "'");
     }
     while (used < rest.size() && std::isspace(static_cast<unsigned char>(rest[used]))) ++used;
-    if (used != rest.size() || !std::isfinite(v)) fail(n, path, "expected a finite number after the comparison in '" + s + "'");
+    if (used != rest.size() || !std::isfinite(v))
+      fail(n, path, "expected a finite number after the comparison in '" + s + "'");
     c.value = static_cast<float>(v);
     return c;
   }
@@ -486,7 +537,8 @@ class Reader : public YamlReader {
         if (w.IsScalar())
           when.push_back(condition(w, child(tp, "when")));
         else
-          each(w, child(tp, "when"), [&](const YAML::Node& c, const std::string& cp) { when.push_back(condition(c, cp)); });
+          each(w, child(tp, "when"),
+               [&](const YAML::Node& c, const std::string& cp) { when.push_back(condition(c, cp)); });
       }
       const float fade = t["fade"] ? real_in(t["fade"], child(tp, "fade"), 0.0, 1e3) : 0.2f;
       at(t, tp, [&] { sm->add_transition(from, to, std::move(when), fade); });
@@ -505,15 +557,20 @@ class Reader : public YamlReader {
 
   // ---- streams and unique animations
   void read_stream(const YAML::Node& s, const std::string& path) {
-    if (!s.IsMap()) fail(s, path, "expected a stream: {name, rig, history, root, time_to_dilate, running, parameters, controller}, got " + kind(s));
+    if (!s.IsMap())
+      fail(s, path,
+           "expected a stream: {name, rig, history, root, time_to_dilate, running, parameters, controller}, got " +
+               kind(s));
     keys_of(s, path, {"name", "rig", "history", "root", "time_to_dilate", "running", "parameters", "controller"});
     anim::StreamSpec spec;
     spec.name = name_of(required(s, path, "name"), child(path, "name"));
-    if (crowd_->streams().find(spec.name) >= 0) fail(s["name"], child(path, "name"), "stream '" + spec.name + "' defined twice");
+    if (crowd_->streams().find(spec.name) >= 0)
+      fail(s["name"], child(path, "name"), "stream '" + spec.name + "' defined twice");
     spec.rig = rig_of(required(s, path, "rig"), child(path, "rig"));
     if (s["history"]) spec.history = static_cast<std::int32_t>(integer(s["history"], child(path, "history"), 1, 65536));
     if (s["root"]) spec.root = root_motion(s["root"], child(path, "root"));
-    if (s["time_to_dilate"]) spec.time_to_dilate = real_in(s["time_to_dilate"], child(path, "time_to_dilate"), 0.0, 1e6);
+    if (s["time_to_dilate"])
+      spec.time_to_dilate = real_in(s["time_to_dilate"], child(path, "time_to_dilate"), 0.0, 1e6);
     if (s["running"]) spec.running = loose_boolean(s["running"], child(path, "running"));
     const anim::Rig& rig = crowd_->rig(spec.rig);
     count_pose_bytes(s, path, static_cast<std::size_t>(spec.history) * anim::pose_slot_bytes(rig.joint_count()));
@@ -534,10 +591,12 @@ class Reader : public YamlReader {
     keys_of(u, path, {"name", "rig", "root", "controller"});
     anim::UniqueAnimation a;
     a.name = name_of(required(u, path, "name"), child(path, "name"));
-    if (crowd_->uniques().find_animation(a.name) >= 0) fail(u["name"], child(path, "name"), "unique animation '" + a.name + "' defined twice");
+    if (crowd_->uniques().find_animation(a.name) >= 0)
+      fail(u["name"], child(path, "name"), "unique animation '" + a.name + "' defined twice");
     a.rig = rig_of(required(u, path, "rig"), child(path, "rig"));
     a.root = u["root"] ? root_motion(u["root"], child(path, "root")) : anim::RootMotion::InPlace;
-    if (crowd_->uniques().capacity(a.rig) == 0) fail(u["rig"], child(path, "rig"), "rig '" + crowd_->rig(a.rig).name + "' has no unique_capacity");
+    if (crowd_->uniques().capacity(a.rig) == 0)
+      fail(u["rig"], child(path, "rig"), "rig '" + crowd_->rig(a.rig).name + "' has no unique_capacity");
     a.controller = controller(required(u, path, "controller"), child(path, "controller"), a.rig, 0);
     at(u, path, [&] { crowd_->uniques().add_animation(std::move(a)); });
   }
@@ -551,7 +610,8 @@ class Reader : public YamlReader {
 
 }  // namespace
 
-std::unique_ptr<anim::StreamCrowd> parse_stream_crowd(std::string_view text, const std::string& name, const StreamsYamlOptions& options) {
+std::unique_ptr<anim::StreamCrowd> parse_stream_crowd(std::string_view text, const std::string& name,
+                                                      const StreamsYamlOptions& options) {
   if (text.size() > options.limits.max_file_bytes)
     throw Error("file is larger than " + std::to_string(options.limits.max_file_bytes) + " bytes", at_line(name, 0, 0));
   const YAML::Node root = load_yaml(std::string(text), name);
@@ -566,7 +626,8 @@ std::unique_ptr<anim::StreamCrowd> load_stream_crowd(const std::string& path, St
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) throw Error("cannot read: " + ec.message(), at_line(path, 0, 0));
-  if (size > limits.max_file_bytes) throw Error("file is larger than " + std::to_string(limits.max_file_bytes) + " bytes", at_line(path, 0, 0));
+  if (size > limits.max_file_bytes)
+    throw Error("file is larger than " + std::to_string(limits.max_file_bytes) + " bytes", at_line(path, 0, 0));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open", at_line(path, 0, 0));
   std::ostringstream text;

@@ -21,9 +21,9 @@ namespace throng::io {
 // Bounds on what a file may ask for, checked before allocating.
 struct StreamsYamlLimits {
   std::size_t max_file_bytes = 4u << 20;
-  std::size_t max_pose_bytes = 1u << 30;  // stream histories plus unique slots
-  std::int32_t max_controller_depth = 16; // nested layers and state machines
-  std::int32_t max_items = 4096;          // rigs, clips, streams, states... each
+  std::size_t max_pose_bytes = 1u << 30;   // stream histories plus unique slots
+  std::int32_t max_controller_depth = 16;  // nested layers and state machines
+  std::int32_t max_items = 4096;           // rigs, clips, streams, states... each
 };
 
 struct StreamsYamlOptions {

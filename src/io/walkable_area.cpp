@@ -26,7 +26,8 @@ void drop_straight_vertices(sim::Ring& ring) {
   for (std::size_t i = 0; ring.size() > 3 && i < ring.size();) {
     const glm::dvec2 a(ring[(i + ring.size() - 1) % ring.size()]), b(ring[i]), c(ring[(i + 1) % ring.size()]);
     const glm::dvec2 u = b - a, v = c - b;
-    const bool straight = std::fabs(u.x * v.y - u.y * v.x) <= 1e-9 * glm::length(u) * glm::length(v) && glm::dot(u, v) > 0;
+    const bool straight =
+        std::fabs(u.x * v.y - u.y * v.x) <= 1e-9 * glm::length(u) * glm::length(v) && glm::dot(u, v) > 0;
     if (straight)
       ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(i));
     else
@@ -45,7 +46,8 @@ sim::Ring oriented(const sim::Ring& r, bool counter_clockwise) {
   while (out.size() > 1 && out.back() == out.front()) out.pop_back();
   drop_straight_vertices(out);
   // Start at the lowest-leftmost vertex, so equal areas print equal.
-  const auto first = std::min_element(out.begin(), out.end(), [](glm::vec2 a, glm::vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  const auto first = std::min_element(out.begin(), out.end(),
+                                      [](glm::vec2 a, glm::vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   std::rotate(out.begin(), first, out.end());
   if ((sim::signed_area2(out) > 0) != counter_clockwise) std::reverse(out.begin(), out.end());
   return out;

@@ -31,22 +31,30 @@ YAML::Node load_yaml(const std::string& text, const std::string& file) {
 }
 
 Error yaml_error(const YAML::Exception& e, const std::string& file) {
-  return Error("YAML: " + e.msg, Location{file, e.mark.is_null() ? 1 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1, {}});
+  return Error("YAML: " + e.msg,
+               Location{file, e.mark.is_null() ? 1 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1, {}});
 }
 
 std::string shown(std::string_view s) {
   constexpr std::size_t kShown = 40;
   std::string out;
-  for (char c : s.substr(0, kShown)) out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) ? '?' : c;
+  for (char c : s.substr(0, kShown))
+    out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) ? '?' : c;
   return "'" + out + (s.size() > kShown ? "...'" : "'");
 }
 
-std::string child(const std::string& path, std::string_view key) { return path.empty() ? std::string(key) : path + "." + std::string(key); }
+std::string child(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
 std::string item(const std::string& path, std::size_t i) { return fmt::format("{}[{}]", path, i); }
 
-Location YamlReader::where(const YAML::Node& n, const std::string& path) const { return location(file_, n.Mark(), path); }
+Location YamlReader::where(const YAML::Node& n, const std::string& path) const {
+  return location(file_, n.Mark(), path);
+}
 
-void YamlReader::fail(const YAML::Node& n, const std::string& path, const std::string& message) const { throw Error(message, where(n, path)); }
+void YamlReader::fail(const YAML::Node& n, const std::string& path, const std::string& message) const {
+  throw Error(message, where(n, path));
+}
 
 void YamlReader::fail_at(const YAML::Mark& m, const std::string& path, const std::string& message) const {
   throw Error(message, location(file_, m, path));
@@ -69,7 +77,8 @@ std::string YamlReader::kind(const YAML::Node& n) {
   return "the value " + shown(n.Scalar());
 }
 
-std::vector<std::string> YamlReader::keys_of(const YAML::Node& n, const std::string& path, const std::vector<std::string_view>& allowed) const {
+std::vector<std::string> YamlReader::keys_of(const YAML::Node& n, const std::string& path,
+                                             const std::vector<std::string_view>& allowed) const {
   std::vector<std::string> keys;
   for (auto it = n.begin(); it != n.end(); ++it) {
     const YAML::Node key = it->first;
@@ -81,19 +90,22 @@ std::vector<std::string> YamlReader::keys_of(const YAML::Node& n, const std::str
       const std::string hint = close.empty() ? "" : fmt::format(" (did you mean '{}'?)", close);
       fail_at(key.Mark(), where, fmt::format("unknown key {}{}; expected one of {}", shown(k), hint, join(allowed)));
     }
-    if (std::find(keys.begin(), keys.end(), k) != keys.end()) fail_at(key.Mark(), where, fmt::format("duplicate key {}", shown(k)));
+    if (std::find(keys.begin(), keys.end(), k) != keys.end())
+      fail_at(key.Mark(), where, fmt::format("duplicate key {}", shown(k)));
     keys.push_back(k);
   }
   return keys;
 }
 
-void YamlReader::expect_map(const YAML::Node& n, const std::string& path, const std::vector<std::string_view>& allowed) {
+void YamlReader::expect_map(const YAML::Node& n, const std::string& path,
+                            const std::vector<std::string_view>& allowed) {
   visit(n, path);
   if (!n.IsMap()) fail(n, path, "expected a map with keys " + join(allowed) + ", got " + kind(n));
   keys_of(n, path, allowed);
 }
 
-std::string YamlReader::one_of(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> kinds,
+std::string YamlReader::one_of(const YAML::Node& n, const std::string& path,
+                               std::initializer_list<std::string_view> kinds,
                                std::initializer_list<std::string_view> extra) {
   visit(n, path);
   if (!n.IsMap()) fail(n, path, "expected a map with one of the keys " + join(kinds) + ", got " + kind(n));
@@ -102,19 +114,22 @@ std::string YamlReader::one_of(const YAML::Node& n, const std::string& path, std
   std::string found;
   for (const std::string& k : keys_of(n, path, allowed)) {
     if (std::find(kinds.begin(), kinds.end(), k) == kinds.end()) continue;
-    if (!found.empty()) fail(n, child(path, k), fmt::format("give only one of {} (found '{}' and '{}')", join(kinds), found, k));
+    if (!found.empty())
+      fail(n, child(path, k), fmt::format("give only one of {} (found '{}' and '{}')", join(kinds), found, k));
     found = k;
   }
   if (found.empty()) fail(n, path, "needs one of the keys " + join(kinds));
   return found;
 }
 
-void YamlReader::expect_list(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size, const char* what) {
+void YamlReader::expect_list(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size,
+                             const char* what) {
   visit(n, path);
   if (!n.IsSequence()) fail(n, path, fmt::format("expected a list of {}, got {}", what, kind(n)));
   if (n.size() < min_size)
-    fail(n, path, min_size == 1 ? fmt::format("must not be empty: give at least one of the {}", what)
-                                : fmt::format("needs at least {} {}, got {}", min_size, what, n.size()));
+    fail(n, path,
+         min_size == 1 ? fmt::format("must not be empty: give at least one of the {}", what)
+                       : fmt::format("needs at least {} {}, got {}", min_size, what, n.size()));
   if (n.size() > max_size) fail(n, path, fmt::format("has more than {} {}", max_size, what));
 }
 
@@ -135,7 +150,8 @@ std::string YamlReader::number_problem(const YAML::Node& n, double* out) const {
   if (!text.empty() && text[0] == '+') text.remove_prefix(1);
   double v = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return "expected a number, got " + shown(n.Scalar());
+  if (ec != std::errc() || end != text.data() + text.size() || text.empty())
+    return "expected a number, got " + shown(n.Scalar());
   if (!std::isfinite(v)) return "the number must be finite, got " + shown(n.Scalar());  // inf, nan
   if (std::fabs(v) > 3.0e38)
     return "the number " + shown(n.Scalar()) + " is too large: values are single precision (up to 3.4e38)";
@@ -184,11 +200,13 @@ bool YamlReader::loose_boolean(const YAML::Node& n, const std::string& path) {
 std::string YamlReader::text(const YAML::Node& n, const std::string& path) {
   visit(n, path);
   if (!n.IsScalar()) fail(n, path, "expected a string, got " + kind(n));
-  if (n.Scalar().size() > rules_.max_text) fail(n, path, fmt::format("the string is longer than {} characters", rules_.max_text));
+  if (n.Scalar().size() > rules_.max_text)
+    fail(n, path, fmt::format("the string is longer than {} characters", rules_.max_text));
   return n.Scalar();
 }
 
-std::string YamlReader::word(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> choices) {
+std::string YamlReader::word(const YAML::Node& n, const std::string& path,
+                             std::initializer_list<std::string_view> choices) {
   const std::string s = text(n, path);
   if (std::find(choices.begin(), choices.end(), s) == choices.end())
     fail(n, path, fmt::format("expected one of {}, got {}", join(choices), shown(s)));

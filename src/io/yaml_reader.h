@@ -47,8 +47,9 @@ std::string join(const Words& words) {
 // What one read accepts: hostile-input guards, and whether a quoted number
 // ('3') counts as a number.
 struct YamlReadRules {
-  std::int64_t max_nodes = std::numeric_limits<std::int64_t>::max();  // values visited (an alias counts each time it is used)
-  std::size_t max_text = std::numeric_limits<std::size_t>::max();      // characters of one string
+  std::int64_t max_nodes =
+      std::numeric_limits<std::int64_t>::max();  // values visited (an alias counts each time it is used)
+  std::size_t max_text = std::numeric_limits<std::size_t>::max();  // characters of one string
   bool quoted_numbers = true;
 };
 
@@ -95,17 +96,20 @@ class YamlReader {
   static std::string kind(const YAML::Node& n);
   // The keys of map n, each in `allowed` and none twice; an unknown key is
   // an error at the key, with the nearest allowed key as a hint.
-  std::vector<std::string> keys_of(const YAML::Node& n, const std::string& path, const std::vector<std::string_view>& allowed) const;
+  std::vector<std::string> keys_of(const YAML::Node& n, const std::string& path,
+                                   const std::vector<std::string_view>& allowed) const;
   // A map whose keys are all in `allowed`.
   void expect_map(const YAML::Node& n, const std::string& path, const std::vector<std::string_view>& allowed);
   // A map with exactly one of the keys `kinds` (and optionally some of `extra`); returns that key.
   std::string one_of(const YAML::Node& n, const std::string& path, std::initializer_list<std::string_view> kinds,
                      std::initializer_list<std::string_view> extra = {});
   // A list of min_size to max_size `what`.
-  void expect_list(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size, const char* what);
+  void expect_list(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size,
+                   const char* what);
   // expect_list, then f(item, its key path) for each item.
   template <class F>
-  void each_item(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size, const char* what, const F& f) {
+  void each_item(const YAML::Node& n, const std::string& path, std::size_t min_size, std::size_t max_size,
+                 const char* what, const F& f) {
     expect_list(n, path, min_size, max_size, what);
     for (std::size_t i = 0; i < n.size(); ++i) f(n[i], item(path, i));
   }
@@ -120,7 +124,9 @@ class YamlReader {
   double number(const YAML::Node& n, const std::string& path);
   double number_in(const YAML::Node& n, const std::string& path, double lo, double hi);
   float real(const YAML::Node& n, const std::string& path) { return static_cast<float>(number(n, path)); }
-  float real_in(const YAML::Node& n, const std::string& path, double lo, double hi) { return static_cast<float>(number_in(n, path, lo, hi)); }
+  float real_in(const YAML::Node& n, const std::string& path, double lo, double hi) {
+    return static_cast<float>(number_in(n, path, lo, hi));
+  }
   // A whole number in [lo, hi] (1e6 is one; 2.5 is not).
   std::int64_t integer(const YAML::Node& n, const std::string& path, std::int64_t lo, std::int64_t hi);
   // true or false (True, TRUE, False, FALSE), nothing else.

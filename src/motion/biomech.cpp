@@ -36,7 +36,9 @@ double step_length(double speed, double cadence_steps_per_min) {
   return cadence_steps_per_min > 0.0 ? 60.0 * speed / cadence_steps_per_min : 0.0;
 }
 
-double stride_length(double speed, double cadence_steps_per_min) { return 2.0 * step_length(speed, cadence_steps_per_min); }
+double stride_length(double speed, double cadence_steps_per_min) {
+  return 2.0 * step_length(speed, cadence_steps_per_min);
+}
 
 // Linear through ~0.63 at 1.0 m/s and ~0.59 at 1.8 m/s.
 double walking_duty_factor(double speed) { return std::clamp(0.677 - 0.05 * speed, 0.55, 0.70); }
@@ -47,7 +49,8 @@ double duty_factor(Gait gait, double speed, double stride_time_s) {
   switch (gait) {
     case Gait::Stand: return 1.0;
     case Gait::Walk: return walking_duty_factor(speed);
-    case Gait::Run: return stride_time_s > 0.0 ? std::clamp(running_contact_time(speed) / stride_time_s, 0.2, 0.49) : 0.4;
+    case Gait::Run:
+      return stride_time_s > 0.0 ? std::clamp(running_contact_time(speed) / stride_time_s, 0.2, 0.49) : 0.4;
   }
   return 1.0;
 }

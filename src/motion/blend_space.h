@@ -71,12 +71,12 @@ glm::vec3 knee_hinge(const glm::vec3& knee_offset, const glm::vec3& ankle_offset
                      std::int32_t knee);
 
 struct ClipInfo {
-  std::int32_t first_row = 0;  // of the clip's frames in the stacked texture
-  std::int32_t rows = 0;       // frames per cycle
-  float speed = 0.0f;          // m/s at scale 1
-  float stride = 0.0f;         // m per cycle
-  float turn = 0.0f;           // rad per cycle
-  float period = 1.0f;         // s per cycle
+  std::int32_t first_row = 0;            // of the clip's frames in the stacked texture
+  std::int32_t rows = 0;                 // frames per cycle
+  float speed = 0.0f;                    // m/s at scale 1
+  float stride = 0.0f;                   // m per cycle
+  float turn = 0.0f;                     // rad per cycle
+  float period = 1.0f;                   // s per cycle
   float ankle_ground[2] = {0.0f, 0.0f};  // lowest ankle heights (m)
 };
 

@@ -23,10 +23,12 @@ struct Clip {
 
   float duration() const { return static_cast<float>(frame_count) * frame_time; }
   const glm::quat& rotation(std::int32_t frame, std::int32_t joint) const {
-    return rotations[static_cast<std::size_t>(frame) * static_cast<std::size_t>(joint_count) + static_cast<std::size_t>(joint)];
+    return rotations[static_cast<std::size_t>(frame) * static_cast<std::size_t>(joint_count) +
+                     static_cast<std::size_t>(joint)];
   }
   glm::quat& rotation(std::int32_t frame, std::int32_t joint) {
-    return rotations[static_cast<std::size_t>(frame) * static_cast<std::size_t>(joint_count) + static_cast<std::size_t>(joint)];
+    return rotations[static_cast<std::size_t>(frame) * static_cast<std::size_t>(joint_count) +
+                     static_cast<std::size_t>(joint)];
   }
   // Allocates every array for frames x joints (identity rotations, zero root).
   void resize(std::int32_t frames, std::int32_t joints);

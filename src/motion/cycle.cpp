@@ -16,8 +16,8 @@ std::vector<glm::dvec3> rest_positions(const Skeleton& s) {
   std::vector<glm::dvec3> p(static_cast<std::size_t>(s.joint_count()));
   for (std::int32_t j = 0; j < s.joint_count(); ++j) {
     const auto parent = s.parents[static_cast<std::size_t>(j)];
-    p[static_cast<std::size_t>(j)] =
-        (parent < 0 ? glm::dvec3(0.0) : p[static_cast<std::size_t>(parent)]) + glm::dvec3(s.offsets[static_cast<std::size_t>(j)]);
+    p[static_cast<std::size_t>(j)] = (parent < 0 ? glm::dvec3(0.0) : p[static_cast<std::size_t>(parent)]) +
+                                     glm::dvec3(s.offsets[static_cast<std::size_t>(j)]);
   }
   return p;
 }
@@ -35,11 +35,11 @@ double horizontal_distance(const glm::vec3& a, const glm::vec3& b) {
 // root velocity in the heading frame (plus yaw rate scaled to m/s).
 struct Features {
   std::int32_t frames = 0;
-  std::int32_t points = 0;              // joints + 1 (root height)
-  std::vector<glm::dvec3> pose;         // frames x points
+  std::int32_t points = 0;       // joints + 1 (root height)
+  std::vector<glm::dvec3> pose;  // frames x points
   std::vector<glm::dvec3> pose_velocity;
   std::vector<glm::dvec4> root_velocity;  // x, y, z, yaw rate * leg length
-  std::vector<double> heading;           // unwrapped, radians
+  std::vector<double> heading;            // unwrapped, radians
 };
 
 Features compute_features(const ModelSpaceClip& m, double dt, double leg) {
@@ -60,7 +60,8 @@ Features compute_features(const ModelSpaceClip& m, double dt, double leg) {
   for (std::int32_t i = 0; i < F; ++i) {
     const glm::dquat inv = yaw_rotation(-f.heading[static_cast<std::size_t>(i)]);
     const glm::dvec3 root(m.positions[at(i, J, 0)]);
-    for (std::int32_t j = 0; j < J; ++j) f.pose[at(i, f.points, j)] = inv * (glm::dvec3(m.positions[at(i, J, j)]) - root);
+    for (std::int32_t j = 0; j < J; ++j)
+      f.pose[at(i, f.points, j)] = inv * (glm::dvec3(m.positions[at(i, J, j)]) - root);
     f.pose[at(i, f.points, J)] = glm::dvec3(0.0, root.y, 0.0);
   }
   for (std::int32_t i = 0; i < F; ++i) {
@@ -98,7 +99,8 @@ PairCost pair_cost(const Features& f, std::int32_t a, std::int32_t b, const Cycl
   const glm::dvec4 r = f.root_velocity[static_cast<std::size_t>(a)] - f.root_velocity[static_cast<std::size_t>(b)];
   PairCost c;
   c.pose = pose;
-  c.total = pose + o.joint_velocity_time * o.joint_velocity_time * vel + o.root_velocity_time * o.root_velocity_time * glm::dot(r, r);
+  c.total = pose + o.joint_velocity_time * o.joint_velocity_time * vel +
+            o.root_velocity_time * o.root_velocity_time * glm::dot(r, r);
   return c;
 }
 
@@ -112,7 +114,8 @@ std::int32_t frames_ceil(double seconds, double dt) {
 }
 
 void check_frame_time(double dt) {
-  if (!(dt >= 1e-5 && dt <= 10.0)) throw Error("frame time must be in [1e-5, 10] s, got " + std::to_string(dt), at_field("frame_time"));
+  if (!(dt >= 1e-5 && dt <= 10.0))
+    throw Error("frame time must be in [1e-5, 10] s, got " + std::to_string(dt), at_field("frame_time"));
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -176,8 +179,8 @@ std::array<std::vector<glm::vec3>, 2> foot_tracks(const ModelSpaceClip& m, const
 
 double leg_length(const Skeleton& s) {
   const auto rest = rest_positions(s);
-  const std::array<std::array<Role, 3>, 2> legs{{{Role::LeftThigh, Role::LeftKnee, Role::LeftAnkle},
-                                                 {Role::RightThigh, Role::RightKnee, Role::RightAnkle}}};
+  const std::array<std::array<Role, 3>, 2> legs{
+      {{Role::LeftThigh, Role::LeftKnee, Role::LeftAnkle}, {Role::RightThigh, Role::RightKnee, Role::RightAnkle}}};
   double sum = 0;
   int count = 0;
   for (const auto& leg : legs) {
@@ -194,18 +197,23 @@ double leg_length(const Skeleton& s) {
 }
 
 void ContactOptions::validate() const {
-  if (!(height_fraction > 0 && height_fraction < 1)) throw Error("must be in (0, 1)", at_field("contacts.height_fraction"));
-  if (!(speed_fraction > 0 && speed_fraction < 100)) throw Error("must be in (0, 100)", at_field("contacts.speed_fraction"));
-  if (!(ground_percentile >= 0 && ground_percentile <= 1)) throw Error("must be in [0, 1]", at_field("contacts.ground_percentile"));
+  if (!(height_fraction > 0 && height_fraction < 1))
+    throw Error("must be in (0, 1)", at_field("contacts.height_fraction"));
+  if (!(speed_fraction > 0 && speed_fraction < 100))
+    throw Error("must be in (0, 100)", at_field("contacts.speed_fraction"));
+  if (!(ground_percentile >= 0 && ground_percentile <= 1))
+    throw Error("must be in [0, 1]", at_field("contacts.ground_percentile"));
   if (!(smoothing_s >= 0 && smoothing_s <= 1)) throw Error("must be in [0, 1] s", at_field("contacts.smoothing_s"));
   if (!(max_gap_s >= 0 && max_gap_s < 10)) throw Error("must be in [0, 10) s", at_field("contacts.max_gap_s"));
-  if (!(min_contact_s >= 0 && min_contact_s < 10)) throw Error("must be in [0, 10) s", at_field("contacts.min_contact_s"));
+  if (!(min_contact_s >= 0 && min_contact_s < 10))
+    throw Error("must be in [0, 10) s", at_field("contacts.min_contact_s"));
 }
 
 void CycleOptions::validate() const {
   if (!(min_period_s > 0 && min_period_s <= max_period_s && max_period_s <= 60))
     throw Error("need 0 < min_period_s <= max_period_s <= 60", at_field("min_period_s"));
-  if (!(root_velocity_time >= 0 && joint_velocity_time >= 0)) throw Error("must be >= 0", at_field("root_velocity_time"));
+  if (!(root_velocity_time >= 0 && joint_velocity_time >= 0))
+    throw Error("must be >= 0", at_field("root_velocity_time"));
   if (!(fundamental_tolerance >= 1)) throw Error("must be >= 1", at_field("fundamental_tolerance"));
   if (skip_frames < 0) throw Error("must be >= 0", at_field("skip_frames"));
   if (!(min_mean_speed >= 0)) throw Error("must be >= 0", at_field("min_mean_speed"));
@@ -240,7 +248,9 @@ ContactReport detect_foot_contacts(const Skeleton& skeleton, const ModelSpaceCli
       for (std::int32_t i = 0; i < F; ++i) {
         const std::int32_t lo = std::max(i - k, 0), hi = std::min(i + k, F - 1);
         const double speed =
-            hi > lo ? horizontal_distance(track[static_cast<std::size_t>(hi)], track[static_cast<std::size_t>(lo)]) / ((hi - lo) * dt) : 0.0;
+            hi > lo ? horizontal_distance(track[static_cast<std::size_t>(hi)], track[static_cast<std::size_t>(lo)]) /
+                          ((hi - lo) * dt)
+                    : 0.0;
         if (heights[static_cast<std::size_t>(i)] - ground < r.height_threshold && speed < r.speed_threshold)
           fc.in_contact[static_cast<std::size_t>(i)] = 1;
       }
@@ -260,7 +270,8 @@ ContactReport detect_foot_contacts(const Skeleton& skeleton, const ModelSpaceCli
       }
       std::int32_t e = i;
       while (e < F && fc.in_contact[static_cast<std::size_t>(e)]) ++e;
-      if (e - i >= min_len) fc.intervals.push_back({i, e});
+      if (e - i >= min_len)
+        fc.intervals.push_back({i, e});
       else
         for (std::int32_t g = i; g < e; ++g) fc.in_contact[static_cast<std::size_t>(g)] = 0;
       i = e;
@@ -276,8 +287,8 @@ namespace {
 // search frames x periods x points.
 void check_analysis_size(std::int64_t frames, std::int32_t joint_count, const CycleOptions& o) {
   if (frames * (joint_count + 1) > o.max_frame_joints)
-    throw Error("clip too long for cycle analysis: " + std::to_string(frames) + " frames x " + std::to_string(joint_count + 1) +
-                    " points exceeds " + std::to_string(o.max_frame_joints),
+    throw Error("clip too long for cycle analysis: " + std::to_string(frames) + " frames x " +
+                    std::to_string(joint_count + 1) + " points exceeds " + std::to_string(o.max_frame_joints),
                 at_field("max_frame_joints"));
 }
 
@@ -286,7 +297,8 @@ void check_analysis_size(std::int64_t frames, std::int32_t joint_count, const Cy
 // plus 2, when frame 0 matches the last frame extrapolated by one step in
 // the heading frame (RMS over the feature points below 2% of the leg
 // length `leg`, m; dt in s).
-bool is_loop(const Skeleton& skeleton, const Clip& input, const CycleOptions& o, double dt, double leg, std::int32_t max_p) {
+bool is_loop(const Skeleton& skeleton, const Clip& input, const CycleOptions& o, double dt, double leg,
+             std::int32_t max_p) {
   const std::int32_t N = input.frame_count;
   bool loop = o.loop == CycleOptions::Loop::Always;
   if (o.loop == CycleOptions::Loop::Auto && N < 2 * max_p + 2) {
@@ -329,7 +341,8 @@ PeriodCosts period_costs(const ModelSpaceClip& m, const Features& f, const Cycle
       const glm::vec3& rb = m.positions[at(a + p, m.joint_count, 0)];
       if (horizontal_distance(ra, rb) < o.min_mean_speed * p * dt) continue;
       const double cost = pair_cost(f, a, a + p, o).total;
-      if (cost < best[static_cast<std::size_t>(p)]) best[static_cast<std::size_t>(p)] = cost, c.best_a[static_cast<std::size_t>(p)] = a;
+      if (cost < best[static_cast<std::size_t>(p)])
+        best[static_cast<std::size_t>(p)] = cost, c.best_a[static_cast<std::size_t>(p)] = a;
     }
   }
   return c;
@@ -479,7 +492,9 @@ Clip make_cyclic(const Clip& clip, std::int32_t a, std::int32_t b) {
     if (glm::dot(qa, qb) < 0) qb = -qb;
     fix[static_cast<std::size_t>(j)] = glm::normalize(qa * glm::inverse(qb));
   }
-  const glm::vec3 height_fix(0.0f, clip.root_positions[static_cast<std::size_t>(a)].y - clip.root_positions[static_cast<std::size_t>(b)].y, 0.0f);
+  const glm::vec3 height_fix(
+      0.0f, clip.root_positions[static_cast<std::size_t>(a)].y - clip.root_positions[static_cast<std::size_t>(b)].y,
+      0.0f);
   for (std::int32_t i = 0; i < p; ++i) {
     const double w = static_cast<double>(i) / p;
     const std::int32_t src = a + i;
@@ -488,14 +503,17 @@ Clip make_cyclic(const Clip& clip, std::int32_t a, std::int32_t b) {
     glm::dquat root = yaw_rotation(psi) * glm::slerp(identity, root_fix, w) * s;
     out.rotations[at(i, J, 0)] = glm::quat(glm::normalize(root));
     for (std::int32_t j = 1; j < J; ++j) {
-      glm::dquat q = glm::slerp(identity, fix[static_cast<std::size_t>(j)], w) * glm::dquat(clip.rotations[at(src, J, j)]);
+      glm::dquat q =
+          glm::slerp(identity, fix[static_cast<std::size_t>(j)], w) * glm::dquat(clip.rotations[at(src, J, j)]);
       out.rotations[at(i, J, j)] = glm::quat(glm::normalize(q));
     }
-    out.root_positions[static_cast<std::size_t>(i)] = clip.root_positions[static_cast<std::size_t>(src)] + static_cast<float>(w) * height_fix;
+    out.root_positions[static_cast<std::size_t>(i)] =
+        clip.root_positions[static_cast<std::size_t>(src)] + static_cast<float>(w) * height_fix;
     if (has_t)
       for (std::int32_t j = 0; j < J; ++j)
         out.translations[at(i, J, j)] =
-            clip.translations[at(src, J, j)] + static_cast<float>(w) * (clip.translations[at(a, J, j)] - clip.translations[at(b, J, j)]);
+            clip.translations[at(src, J, j)] +
+            static_cast<float>(w) * (clip.translations[at(a, J, j)] - clip.translations[at(b, J, j)]);
   }
   return out;
 }
@@ -512,18 +530,22 @@ Clip repeat_cycle(const Clip& cycle, std::int32_t copies) {
   if (copies < 1 || copies > 4096) throw Error("repeat_cycle: copies must be in [1, 4096]");
   if (N < 3) throw Error("repeat_cycle: a cycle needs at least 3 frames");
   if (static_cast<std::int64_t>(N) * copies * std::max(J, 1) > (std::int64_t{1} << 25))
-    throw Error("repeat_cycle: result too long (" + std::to_string(N) + " frames x " + std::to_string(copies) + " copies)");
+    throw Error("repeat_cycle: result too long (" + std::to_string(N) + " frames x " + std::to_string(copies) +
+                " copies)");
   std::vector<double> psi(static_cast<std::size_t>(N));
   for (std::int32_t i = 0; i < N; ++i) {
     const double h = heading_of(cycle.rotations[at(i, J, 0)]);
-    psi[static_cast<std::size_t>(i)] = i == 0 ? h : psi[static_cast<std::size_t>(i - 1)] + wrap_angle(h - psi[static_cast<std::size_t>(i - 1)]);
+    psi[static_cast<std::size_t>(i)] =
+        i == 0 ? h : psi[static_cast<std::size_t>(i - 1)] + wrap_angle(h - psi[static_cast<std::size_t>(i - 1)]);
   }
   auto step = [&](std::int32_t i) {  // root step i -> i+1 in the heading frame of i
-    const glm::dvec3 d = glm::dvec3(cycle.root_positions[static_cast<std::size_t>(i + 1)] - cycle.root_positions[static_cast<std::size_t>(i)]);
+    const glm::dvec3 d = glm::dvec3(cycle.root_positions[static_cast<std::size_t>(i + 1)] -
+                                    cycle.root_positions[static_cast<std::size_t>(i)]);
     return yaw_rotation(-psi[static_cast<std::size_t>(i)]) * glm::dvec3(d.x, 0.0, d.z);
   };
   const glm::dvec3 last_step = 0.5 * (step(N - 2) + step(0));
-  const double last_turn = 0.5 * ((psi[static_cast<std::size_t>(N - 1)] - psi[static_cast<std::size_t>(N - 2)]) + (psi[1] - psi[0]));
+  const double last_turn =
+      0.5 * ((psi[static_cast<std::size_t>(N - 1)] - psi[static_cast<std::size_t>(N - 2)]) + (psi[1] - psi[0]));
   const double turn = psi[static_cast<std::size_t>(N - 1)] + last_turn - psi[0];  // per copy
   const glm::dvec3 r0(cycle.root_positions[0]);
   const glm::dvec3 rN = glm::dvec3(cycle.root_positions[static_cast<std::size_t>(N - 1)]) +
@@ -533,7 +555,7 @@ Clip repeat_cycle(const Clip& cycle, std::int32_t copies) {
   out.frame_time = cycle.frame_time;
   if (!cycle.translations.empty()) out.translations.resize(out.rotations.size());
   glm::dvec3 origin(r0.x, 0.0, r0.z);  // where copy k starts (horizontal)
-  double yaw = 0.0;                     // rotation of copy k
+  double yaw = 0.0;                    // rotation of copy k
   for (std::int32_t k = 0; k < copies; ++k) {
     const glm::dquat ry = yaw_rotation(yaw);
     for (std::int32_t i = 0; i < N; ++i) {

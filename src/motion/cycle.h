@@ -55,7 +55,7 @@ struct ContactInterval {
 
 struct FootContacts {
   std::vector<ContactInterval> intervals;
-  std::vector<std::uint8_t> in_contact;  // per frame, after gap filling
+  std::vector<std::uint8_t> in_contact;   // per frame, after gap filling
   std::array<double, 2> ground = {0, 0};  // ground level of ankle, toe (m)
 };
 
@@ -105,21 +105,21 @@ struct CycleOptions {
 };
 
 struct CycleReport {
-  bool found = false;          // a period in range was found
-  bool input_is_loop = false;  // the clip was analysed as a loop
+  bool found = false;            // a period in range was found
+  bool input_is_loop = false;    // the clip was analysed as a loop
   std::int32_t start_frame = 0;  // a
   std::int32_t end_frame = 0;    // b: frame b matches frame a (b may exceed the clip for loops)
   std::int32_t period_frames = 0;
   double period_s = 0.0;
-  double cost = 0.0;             // pose + velocity difference at (a, b), m^2
-  double pose_rms_m = 0.0;       // RMS joint position difference at (a, b)
-  std::int32_t steps = 0;        // contact onsets of both feet in [a, b)
-  double cadence = 0.0;          // steps per minute
-  double stride_length = 0.0;    // m per two steps
-  double mean_speed = 0.0;       // m/s along the (possibly curved) path
-  double turn_rate = 0.0;        // rad/s, positive = left (about +Y)
-  double displacement = 0.0;     // m, root travel over the cycle along the path
-  ContactReport contacts;        // over the analysed frames
+  double cost = 0.0;           // pose + velocity difference at (a, b), m^2
+  double pose_rms_m = 0.0;     // RMS joint position difference at (a, b)
+  std::int32_t steps = 0;      // contact onsets of both feet in [a, b)
+  double cadence = 0.0;        // steps per minute
+  double stride_length = 0.0;  // m per two steps
+  double mean_speed = 0.0;     // m/s along the (possibly curved) path
+  double turn_rate = 0.0;      // rad/s, positive = left (about +Y)
+  double displacement = 0.0;   // m, root travel over the cycle along the path
+  ContactReport contacts;      // over the analysed frames
 };
 
 // Finds the best loop of a locomotion clip and measures it. Needs the ankle

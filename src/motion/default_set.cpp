@@ -63,7 +63,8 @@ double swing_bump(double s) {
 }
 
 // Rotation taking the orthonormal frame (b0, w0, n0) to (b, w, n).
-dquat frame_rotation(const dvec3& b0, const dvec3& w0, const dvec3& n0, const dvec3& b, const dvec3& w, const dvec3& n) {
+dquat frame_rotation(const dvec3& b0, const dvec3& w0, const dvec3& n0, const dvec3& b, const dvec3& w,
+                     const dvec3& n) {
   const glm::dmat3 rest(b0, w0, n0);
   const glm::dmat3 world(b, w, n);
   return glm::normalize(glm::quat_cast(world * glm::transpose(rest)));
@@ -108,19 +109,19 @@ struct KeyedCurve {
 // Every amplitude of one gait. Angles in radians, lengths in metres,
 // phases as fractions of the stride measured from the left heel strike.
 struct Style {
-  double duty = 1.0;            // stance fraction of the stride
-  double u_flat = 0.0;          // foot flat (cycle fraction after touchdown)
-  double u_heel_off = 0.0;      // heel rise
-  double pitch_touchdown = 0;   // foot pitch at touchdown (<0 toes up: heel strike)
-  double pitch_toe_off = 0;     // foot pitch at toe-off (heel up)
+  double duty = 1.0;           // stance fraction of the stride
+  double u_flat = 0.0;         // foot flat (cycle fraction after touchdown)
+  double u_heel_off = 0.0;     // heel rise
+  double pitch_touchdown = 0;  // foot pitch at touchdown (<0 toes up: heel strike)
+  double pitch_toe_off = 0;    // foot pitch at toe-off (heel up)
   double pitch_mid_swing = 0;
-  double mid_swing_at = 0.8;    // cycle fraction of the mid-swing key
+  double mid_swing_at = 0.8;  // cycle fraction of the mid-swing key
   double toe_out = 0;
-  double half_width = 0.06;     // lateral ankle offset from the path
-  double lift = 0.05;           // extra swing clearance at the bump peak
-  double bob = 0.0;             // pelvis vertical half-amplitude (+: high at mid-stance)
-  double sway = 0.0;            // lateral pelvis shift towards the stance foot
-  double surge = 0.0;           // forward position oscillation (slowest at mid-stance)
+  double half_width = 0.06;  // lateral ankle offset from the path
+  double lift = 0.05;        // extra swing clearance at the bump peak
+  double bob = 0.0;          // pelvis vertical half-amplitude (+: high at mid-stance)
+  double sway = 0.0;         // lateral pelvis shift towards the stance foot
+  double surge = 0.0;        // forward position oscillation (slowest at mid-stance)
   double pelvis_yaw = 0, pelvis_list = 0, pelvis_tilt = 0;
   double list_peak = 0.12;      // cycle fraction where the left side is highest
   double crouch = 0.0;          // extra pelvis drop below the reach limit
@@ -131,7 +132,7 @@ struct Style {
   double arm_abduction = 10 * kDeg;
   double arm_flex_mean = 0, arm_flex_amp = 0;
   double elbow_mean = 20 * kDeg, elbow_amp = 0;
-  double turn_lean = 0.0;       // roll into the turn
+  double turn_lean = 0.0;  // roll into the turn
 };
 
 Style style_for(const LocomotionSpec& spec, const LocomotionTargets& t) {
@@ -341,13 +342,13 @@ struct LocomotionGenerator::Model {
     std::int32_t thigh = -1, knee = -1, ankle = -1, toe = -1;
     double upper = 0, lower = 0;  // bone lengths
     BoneFrame thigh_rest, shin_rest;
-    dvec3 ball;                  // ankle -> toe joint, rest (model) frame
-    dvec3 root_to_hip;           // rest offset of the hip joint from the root
-    double ankle_height = 0;     // rest height of the ankle joint
+    dvec3 ball;               // ankle -> toe joint, rest (model) frame
+    dvec3 root_to_hip;        // rest offset of the hip joint from the root
+    double ankle_height = 0;  // rest height of the ankle joint
   };
   std::array<Leg, 2> legs;
-  double root_height = 0;  // rest root height
-  double drop = 0;         // pelvis lowered so every target is reachable
+  double root_height = 0;      // rest root height
+  double drop = 0;             // pelvis lowered so every target is reachable
   double touchdown_ahead = 0;  // ankle ahead of the root path at touchdown, m
   double thigh_phase = 0;      // stride phase where the left thigh is most forward
 
@@ -368,8 +369,8 @@ struct LocomotionGenerator::Model {
     double arm_flex[2], elbow[2];
   };
   struct FootPose {
-    dvec3 ankle;  // target ankle joint position
-    dquat rot;    // foot world rotation
+    dvec3 ankle;           // target ankle joint position
+    dquat rot;             // foot world rotation
     double toe_pitch = 0;  // toe joint local pitch
     double yaw = 0;
   };
@@ -429,7 +430,8 @@ struct LocomotionGenerator::Model {
     const double t_touch = (k + offset) * period();
     const double t_pass = t_touch + ahead / spec.speed;  // root passes the ankle
     const double psi = heading(t_pass);
-    ankle = path(t_pass) + rot_y(psi) * dvec3(side * style.half_width, 0.0, 0.0) + dvec3(0.0, legs[f].ankle_height, 0.0);
+    ankle =
+        path(t_pass) + rot_y(psi) * dvec3(side * style.half_width, 0.0, 0.0) + dvec3(0.0, legs[f].ankle_height, 0.0);
     yaw = psi + side * style.toe_out;
   }
 
@@ -484,7 +486,8 @@ struct LocomotionGenerator::Model {
     const dvec3 a0 = ankle_about_ball(plant_k, yaw_k, theta_off, leg);
     const dvec3 v0 = ankle_about_ball_rate(yaw_k, theta_off, leg) * (rate_off / period());
     const dvec3 a1 = theta_on > 0.0 ? ankle_about_ball(plant_next, yaw_next, theta_on, leg) : plant_next;
-    const dvec3 v1 = theta_on > 0.0 ? ankle_about_ball_rate(yaw_next, theta_on, leg) * (rate_on / period()) : dvec3(0.0);
+    const dvec3 v1 =
+        theta_on > 0.0 ? ankle_about_ball_rate(yaw_next, theta_on, leg) * (rate_on / period()) : dvec3(0.0);
     p.ankle = hermite(a0, v0 * swing_time, a1, v1 * swing_time, sw) + dvec3(0.0, s.lift * swing_bump(sw), 0.0);
     p.yaw = yaw_k + (yaw_next - yaw_k) * smootherstep(sw);
     p.rot = rot_y(p.yaw) * rot_x(theta);
@@ -492,7 +495,9 @@ struct LocomotionGenerator::Model {
     return p;
   }
 
-  dvec3 hip_position(const Body& b, int f) const { return b.root_pos + b.root_rot * legs[static_cast<std::size_t>(f)].root_to_hip; }
+  dvec3 hip_position(const Body& b, int f) const {
+    return b.root_pos + b.root_rot * legs[static_cast<std::size_t>(f)].root_to_hip;
+  }
 
   // Pelvis drop needed at time t for both legs to reach with `ahead`.
   double needed_drop(double t, double ahead) const {
@@ -537,8 +542,10 @@ struct LocomotionGenerator::Model {
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
     for (int it = 0; it < 40; ++it) {
       const double x1 = hi_a - g * (hi_a - lo_a), x2 = lo_a + g * (hi_a - lo_a);
-      if (max_needed_drop(x1) < max_needed_drop(x2)) hi_a = x2;
-      else lo_a = x1;
+      if (max_needed_drop(x1) < max_needed_drop(x2))
+        hi_a = x2;
+      else
+        lo_a = x1;
     }
     touchdown_ahead = 0.5 * (lo_a + hi_a);
     best_drop = max_needed_drop(touchdown_ahead);
@@ -552,9 +559,12 @@ struct LocomotionGenerator::Model {
     if (!moving()) return;
     const double to_rate = 0.6 * s.pitch_toe_off / (s.duty - s.u_heel_off);
     const double ms_rate = (s.pitch_touchdown - s.pitch_toe_off) / (1.0 - s.duty);
-    pitch.keys = {{0.0, s.pitch_touchdown, 0.0},      {s.u_flat, 0.0, 0.0},
-                  {s.u_heel_off, 0.0, 0.0},           {s.duty, s.pitch_toe_off, to_rate},
-                  {s.mid_swing_at, s.pitch_mid_swing, ms_rate}, {1.0, s.pitch_touchdown, 0.0}};
+    pitch.keys = {{0.0, s.pitch_touchdown, 0.0},
+                  {s.u_flat, 0.0, 0.0},
+                  {s.u_heel_off, 0.0, 0.0},
+                  {s.duty, s.pitch_toe_off, to_rate},
+                  {s.mid_swing_at, s.pitch_mid_swing, ms_rate},
+                  {1.0, s.pitch_touchdown, 0.0}};
   }
 
   Model(const Skeleton& sk, const LocomotionSpec& sp) : skeleton(sk), spec(sp) {
@@ -567,8 +577,8 @@ struct LocomotionGenerator::Model {
     rest_pos.resize(static_cast<std::size_t>(J));
     for (std::int32_t j = 0; j < J; ++j) {
       const auto p = skeleton.parents[static_cast<std::size_t>(j)];
-      rest_pos[static_cast<std::size_t>(j)] =
-          (p < 0 ? dvec3(0.0) : rest_pos[static_cast<std::size_t>(p)]) + dvec3(skeleton.offsets[static_cast<std::size_t>(j)]);
+      rest_pos[static_cast<std::size_t>(j)] = (p < 0 ? dvec3(0.0) : rest_pos[static_cast<std::size_t>(p)]) +
+                                              dvec3(skeleton.offsets[static_cast<std::size_t>(j)]);
     }
     rule.assign(static_cast<std::size_t>(J), Rule::Identity);
     joint_side.assign(static_cast<std::size_t>(J), 0);
@@ -701,7 +711,8 @@ struct LocomotionGenerator::Model {
           const dvec3 hip = parent_pos + parent_rot * dvec3(skeleton.offsets[ji]);
           const FootPose& fp = feet[static_cast<std::size_t>(f)];
           dquat thigh_world;
-          solve_leg(leg, hip, fp.ankle, rot_y(fp.yaw) * dvec3(0, 0, 1), thigh_world, shin_target[static_cast<std::size_t>(f)]);
+          solve_leg(leg, hip, fp.ankle, rot_y(fp.yaw) * dvec3(0, 0, 1), thigh_world,
+                    shin_target[static_cast<std::size_t>(f)]);
           local = glm::inverse(parent_rot) * thigh_world;
           break;
         }
@@ -763,9 +774,9 @@ std::vector<LocomotionSpec> default_motion_specs() {
     return s;
   };
   const double turn = 30.0 * kDeg;
-  return {spec("idle", Gait::Stand, 0.0, 0.0),          spec("walk_slow", Gait::Walk, 1.0, 0.0),
-          spec("walk", Gait::Walk, 1.35, 0.0),          spec("walk_fast", Gait::Walk, 1.8, 0.0),
-          spec("run_slow", Gait::Run, 2.7, 0.0),        spec("run_fast", Gait::Run, 4.5, 0.0),
+  return {spec("idle", Gait::Stand, 0.0, 0.0),           spec("walk_slow", Gait::Walk, 1.0, 0.0),
+          spec("walk", Gait::Walk, 1.35, 0.0),           spec("walk_fast", Gait::Walk, 1.8, 0.0),
+          spec("run_slow", Gait::Run, 2.7, 0.0),         spec("run_fast", Gait::Run, 4.5, 0.0),
           spec("walk_turn_left", Gait::Walk, 1.2, turn), spec("walk_turn_right", Gait::Walk, 1.2, -turn)};
 }
 

@@ -66,10 +66,10 @@ Skeleton default_skeleton();
 struct LocomotionSpec {
   std::string name;
   biomech::Gait gait = biomech::Gait::Walk;
-  double speed = 1.35;      // mean root speed along the path, m/s (0 for Stand)
-  double turn_rate = 0.0;   // rad/s about +Y; positive turns left (towards +X)
+  double speed = 1.35;     // mean root speed along the path, m/s (0 for Stand)
+  double turn_rate = 0.0;  // rad/s about +Y; positive turns left (towards +X)
   double fps = 60.0;
-  std::int32_t strides = 1; // whole cycles in the clip (Stand: whole idle periods)
+  std::int32_t strides = 1;    // whole cycles in the clip (Stand: whole idle periods)
   double idle_period_s = 4.0;  // Stand only: one breath / weight-shift cycle
   // Throws Error naming the field when a value is out of its range
   // (speed must suit the gait: walk 0.5-2.2 m/s, run 1.8-7 m/s).
@@ -80,9 +80,9 @@ struct LocomotionSpec {
 // period is rounded to whole frames so clips are exactly cyclic; cadence
 // and stride are the figures after that rounding, speed is kept exact.
 struct LocomotionTargets {
-  double target_cadence = 0.0;   // steps/min from biomech, before rounding
-  double cadence = 0.0;          // steps/min actually generated
-  double period_s = 0.0;         // one stride (two steps), or the idle period
+  double target_cadence = 0.0;  // steps/min from biomech, before rounding
+  double cadence = 0.0;         // steps/min actually generated
+  double period_s = 0.0;        // one stride (two steps), or the idle period
   std::int32_t period_frames = 0;
   double stride_length = 0.0;    // m per stride (speed * period)
   double duty_factor = 1.0;      // fraction of the stride each foot is down

@@ -39,7 +39,8 @@ struct ModelSpaceClip {
   std::vector<glm::vec3> positions;
   std::vector<glm::quat> rotations;
   const glm::vec3& position(std::int32_t frame, std::int32_t joint) const {
-    return positions[static_cast<std::size_t>(frame) * static_cast<std::size_t>(joint_count) + static_cast<std::size_t>(joint)];
+    return positions[static_cast<std::size_t>(frame) * static_cast<std::size_t>(joint_count) +
+                     static_cast<std::size_t>(joint)];
   }
 };
 ModelSpaceClip forward_kinematics(const Skeleton& skeleton, const Clip& clip);

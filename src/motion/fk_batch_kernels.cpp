@@ -28,8 +28,8 @@ void BatchFkJob::run() const {
         const std::int32_t J = joint_count;
         std::int32_t f = frames[c];
         f = f < 0 ? 0 : (f > frame_count - 1 ? frame_count - 1 : f);
-        fk_pose(J, parents.data(), offsets.data(), clip_rotations.data() + static_cast<Index>(f) * J, nullptr, clip_roots[f],
-                out_positions.data() + c * J, out_rotations.data() + c * J);
+        fk_pose(J, parents.data(), offsets.data(), clip_rotations.data() + static_cast<Index>(f) * J, nullptr,
+                clip_roots[f], out_positions.data() + c * J, out_rotations.data() + c * J);
       },
       64);
 }

@@ -7,7 +7,8 @@ namespace throng::motion {
 
 ModelSpaceClip forward_kinematics(const Skeleton& skeleton, const Clip& clip) {
   const std::int32_t J = skeleton.joint_count();
-  if (clip.joint_count != J) throw Error("clip has " + std::to_string(clip.joint_count) + " joints, skeleton " + std::to_string(J));
+  if (clip.joint_count != J)
+    throw Error("clip has " + std::to_string(clip.joint_count) + " joints, skeleton " + std::to_string(J));
   ModelSpaceClip out;
   out.joint_count = J;
   out.frame_count = clip.frame_count;
@@ -32,8 +33,8 @@ ModelSpaceClip forward_kinematics(const Skeleton& skeleton, const Clip& clip) {
       "motion.fk_clip", clip.frame_count,
       THRONG_LAMBDA(Index f) {
         const Index base = f * J;
-        fk_pose(J, P.data(), O.data(), L.data() + base, has_translations ? T.data() + base : nullptr, R[f], outP.data() + base,
-                outR.data() + base);
+        fk_pose(J, P.data(), O.data(), L.data() + base, has_translations ? T.data() + base : nullptr, R[f],
+                outP.data() + base, outR.data() + base);
       },
       16);
   out.positions = positions.to_vector();

@@ -40,7 +40,8 @@ FootSkatingReport measure_foot_skating(const ModelSpaceClip& m, const ContactRep
           const double d = std::hypot(p1.x - p0.x, p1.z - p0.z);
           any_min = std::min(any_min, d);
           const double ground = fc.ground[p];
-          if (p0.y - ground < contacts.height_threshold && p1.y - ground < contacts.height_threshold) low_min = std::min(low_min, d);
+          if (p0.y - ground < contacts.height_threshold && p1.y - ground < contacts.height_threshold)
+            low_min = std::min(low_min, d);
         }
         slide += std::isfinite(low_min) ? low_min : (std::isfinite(any_min) ? any_min : 0.0);
       }
@@ -85,7 +86,8 @@ FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& cli
 void FootSkatingRecorder::track(std::vector<Index> characters, Index character_count, std::int32_t joint_count) {
   for (const Index c : characters)
     if (c < 0 || c >= character_count)
-      throw Error("character " + std::to_string(c) + " is not in [0, " + std::to_string(character_count) + ")", at_field("track"));
+      throw Error("character " + std::to_string(c) + " is not in [0, " + std::to_string(character_count) + ")",
+                  at_field("track"));
   tracked_ = std::move(characters);
   joints_ = joint_count;
   frames_ = 0;
@@ -106,7 +108,8 @@ FootSkatingRecorder::Frame FootSkatingRecorder::append(std::size_t t) {
   return {std::span<glm::vec3>(p).last(J), std::span<glm::quat>(r).last(J)};
 }
 
-FootSkatingReport FootSkatingRecorder::measure(const Skeleton& skeleton, double frame_time, const ContactOptions& options) const {
+FootSkatingReport FootSkatingRecorder::measure(const Skeleton& skeleton, double frame_time,
+                                               const ContactOptions& options) const {
   std::vector<double> slides;
   if (frames_ < 3 || !(frame_time > 0.0)) return summarise_foot_skating(slides);
   for (std::size_t t = 0; t < tracked_.size(); ++t) {

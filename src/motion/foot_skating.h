@@ -39,7 +39,8 @@ struct FootSkatingReport {
 // "mean 0.42 cm, p95 0.90 cm over 120 contacts", or "no contacts measured".
 std::string describe(const FootSkatingReport& r);
 
-FootSkatingReport measure_foot_skating(const ModelSpaceClip& model, const ContactReport& contacts, const FeetJoints& feet);
+FootSkatingReport measure_foot_skating(const ModelSpaceClip& model, const ContactReport& contacts,
+                                       const FeetJoints& feet);
 
 // Convenience: FK, contacts from the skeleton's roles, then the measure.
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options = {});

@@ -42,8 +42,9 @@ THRONG_HOST_DEVICE inline glm::quat rotation_between(const glm::vec3& a, const g
 // target. Returns false, changing nothing, for a degenerate leg: a bone
 // shorter than 1e-6 m, or a straight (or backward-bent) leg whose hinge lies
 // along the thigh.
-THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3& knee_offset, const glm::vec3& ankle_offset,
-                                           const glm::vec3& hinge, const glm::vec3& target, glm::quat& r_thigh, glm::quat& r_knee) {
+THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3& knee_offset,
+                                           const glm::vec3& ankle_offset, const glm::vec3& hinge,
+                                           const glm::vec3& target, glm::quat& r_thigh, glm::quat& r_knee) {
   const glm::vec3 upper = r_thigh * knee_offset;
   const glm::vec3 lower = r_knee * ankle_offset;
   const float l1 = glm::length(upper), l2 = glm::length(lower);
@@ -232,7 +233,8 @@ THRONG_HOST_DEVICE inline PlantedLegGoal planted_leg_goal(const BlendSpaceView& 
 // Stage 4. The pelvis drop (m, scale 1, >= 0) that brings a leg's target
 // within kReach of its length (thigh plus shin rest offsets), given the
 // drop the legs before it need: the larger of the two.
-THRONG_HOST_DEVICE inline float pelvis_drop_to_reach(const BlendSpaceView& v, int leg, const PlantedLegGoal& goal, float drop) {
+THRONG_HOST_DEVICE inline float pelvis_drop_to_reach(const BlendSpaceView& v, int leg, const PlantedLegGoal& goal,
+                                                     float drop) {
   const LegChain& chain = v.legs[leg];
   const std::int32_t knee = chain.joints[chain.count - 2], ankle = chain.joints[chain.count - 1];
   const float reach = kReach * (glm::length(v.offsets[knee]) + glm::length(v.offsets[ankle]));
@@ -245,14 +247,15 @@ THRONG_HOST_DEVICE inline float pelvis_drop_to_reach(const BlendSpaceView& v, in
 // Stage 5. Two-bone IK from the hip lowered by out.pelvis_drop (m) onto the
 // goal's target; on success, out.active[leg] and the local rotations of
 // thigh, knee and ankle (the foot keeps its blended world rotation).
-THRONG_HOST_DEVICE inline void solve_planted_leg(const BlendSpaceView& v, int leg, PlantedLegGoal goal, PlantedLegs& out) {
+THRONG_HOST_DEVICE inline void solve_planted_leg(const BlendSpaceView& v, int leg, PlantedLegGoal goal,
+                                                 PlantedLegs& out) {
   const LegChain& chain = v.legs[leg];
   const std::int32_t n = chain.count;
   const std::int32_t knee = chain.joints[n - 2], ankle = chain.joints[n - 1];
   BlendedLeg& b = goal.leg;
   const glm::vec3 lowered = b.hip - glm::vec3(0.0f, out.pelvis_drop, 0.0f);
-  if (!two_bone_ik(lowered, v.offsets[knee], v.offsets[ankle], glm::vec3(chain.hinge[0], chain.hinge[1], chain.hinge[2]),
-                   goal.target, b.thigh, b.knee))
+  if (!two_bone_ik(lowered, v.offsets[knee], v.offsets[ankle],
+                   glm::vec3(chain.hinge[0], chain.hinge[1], chain.hinge[2]), goal.target, b.thigh, b.knee))
     return;
   out.active[leg] = true;
   out.corrected[leg][0] = glm::inverse(b.hip_parent) * b.thigh;
@@ -260,7 +263,8 @@ THRONG_HOST_DEVICE inline void solve_planted_leg(const BlendSpaceView& v, int le
   out.corrected[leg][2] = glm::inverse(b.knee) * b.foot;
 }
 
-THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const CharacterFrame& f, const std::uint32_t* mask) {
+THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const CharacterFrame& f,
+                                                 const std::uint32_t* mask) {
   PlantedLegs out;
   if (!v.plant_feet || f.point.w <= 0.0f || f.point.w >= 1.0f) return out;
   PlantedLegGoal goal[2];

@@ -33,7 +33,8 @@ Location clip_field(const std::string& name, const std::string& field) {
 
 // The normalised mean of unit quaternions, each taken in the hemisphere of
 // the first (a good mean for rotations spread over less than ~90 degrees).
-glm::quat mean_rotation(const std::vector<glm::quat>& rotations, std::int32_t frames, std::int32_t joints, std::int32_t joint) {
+glm::quat mean_rotation(const std::vector<glm::quat>& rotations, std::int32_t frames, std::int32_t joints,
+                        std::int32_t joint) {
   const glm::dquat first(rotations[at(joint)]);
   glm::dquat sum(0, 0, 0, 0);
   for (std::int32_t f = 0; f < frames; ++f) {
@@ -49,8 +50,8 @@ glm::quat mean_rotation(const std::vector<glm::quat>& rotations, std::int32_t fr
 // thigh -> knee -> ankle is not a parent chain (or is too deep) gets none.
 std::array<LegChain, 2> leg_chains(const Skeleton& s) {
   std::array<LegChain, 2> legs{};
-  const std::array<std::array<Role, 3>, 2> roles{{{Role::LeftThigh, Role::LeftKnee, Role::LeftAnkle},
-                                                  {Role::RightThigh, Role::RightKnee, Role::RightAnkle}}};
+  const std::array<std::array<Role, 3>, 2> roles{
+      {{Role::LeftThigh, Role::LeftKnee, Role::LeftAnkle}, {Role::RightThigh, Role::RightKnee, Role::RightAnkle}}};
   for (std::size_t leg = 0; leg < 2; ++leg) {
     const std::int32_t knee = s.role(roles[leg][1]), ankle = s.role(roles[leg][2]);
     if (knee < 0 || ankle < 0 || s.parents[at(ankle)] != knee) continue;
@@ -136,7 +137,8 @@ void check_cycle(const Skeleton& skeleton, const Clip& cycle, const std::string&
   const std::int32_t J = skeleton.joint_count();
   const std::int32_t F = cycle.frame_count;
   if (cycle.joint_count != J)
-    throw Error("has " + std::to_string(cycle.joint_count) + " joints, the skeleton " + std::to_string(J), clip_field(name, "joints"));
+    throw Error("has " + std::to_string(cycle.joint_count) + " joints, the skeleton " + std::to_string(J),
+                clip_field(name, "joints"));
   if (F < 4) throw Error("a cycle needs at least 4 frames, got " + std::to_string(F), clip_field(name, "frames"));
   if (!(std::isfinite(cycle.frame_time) && cycle.frame_time > 0.0f))
     throw Error("frame time must be positive", clip_field(name, "frame_time"));
@@ -228,11 +230,13 @@ RootOnPath root_on_path(const Clip& ext, std::int32_t F, CyclePath& path) {
 // Frames of the foot events of a prepared cycle (in FootEvent order), from
 // the contacts of the cycle in its own motion over the middle of three
 // copies; -1 for a foot without exactly one touchdown and one liftoff there.
-std::array<std::int32_t, kFootEvents> foot_event_frames(const Skeleton& skeleton, const LocomotionClip& out, const ContactOptions& o) {
+std::array<std::int32_t, kFootEvents> foot_event_frames(const Skeleton& skeleton, const LocomotionClip& out,
+                                                        const ContactOptions& o) {
   const std::int32_t F = out.cycle.frame_count;
   std::array<std::int32_t, kFootEvents> event_frame{-1, -1, -1, -1};
   const ModelSpaceClip model = forward_kinematics(skeleton, cycle_in_world(out, 3));
-  const ContactReport contacts = detect_foot_contacts(skeleton, model, out.cycle.frame_time, FeetJoints::from_roles(skeleton), o);
+  const ContactReport contacts =
+      detect_foot_contacts(skeleton, model, out.cycle.frame_time, FeetJoints::from_roles(skeleton), o);
   for (int f = 0; f < 2; ++f) {
     std::int32_t downs = 0, ups = 0, down = -1, up = -1;
     for (const ContactInterval& c : contacts.feet[at(f)].intervals) {
@@ -288,7 +292,8 @@ std::array<float, 2> ankle_ground(const Skeleton& skeleton, const Clip& cycle) {
 // mocap feet roll about toes the skeleton lacks, so the ball moves faster
 // than the strict speed limit allows.
 std::vector<ContactInterval> rolled_contacts(const ModelSpaceClip& model, const LegChain& chain, const FootContacts& fc,
-                                             const ContactReport& contacts, float frame_time, const LocomotionOptions& o) {
+                                             const ContactReport& contacts, float frame_time,
+                                             const LocomotionOptions& o) {
   const std::int32_t ankle = chain.joints[chain.count - 1];
   const glm::vec3 ball(chain.ball[0], chain.ball[1], chain.ball[2]);
   std::vector<ContactInterval> intervals = fc.intervals;
@@ -298,9 +303,11 @@ std::vector<ContactInterval> rolled_contacts(const ModelSpaceClip& model, const 
     std::int32_t& e = intervals[k].end;
     while (e < limit) {
       const glm::dvec3 b = glm::dvec3(model.position(e, ankle) + model.rotations[frame_joint(model, e, ankle)] * ball);
-      const glm::dvec3 b0 = glm::dvec3(model.position(e - 1, ankle) + model.rotations[frame_joint(model, e - 1, ankle)] * ball);
+      const glm::dvec3 b0 =
+          glm::dvec3(model.position(e - 1, ankle) + model.rotations[frame_joint(model, e - 1, ankle)] * ball);
       const double speed = std::hypot(b.x - b0.x, b.z - b0.z) / frame_time;
-      if (!(b.y - ball_ground < contacts.height_threshold && speed < o.cleanup_speed_factor * contacts.speed_threshold)) break;
+      if (!(b.y - ball_ground < contacts.height_threshold && speed < o.cleanup_speed_factor * contacts.speed_threshold))
+        break;
       ++e;
     }
   }
@@ -322,8 +329,8 @@ struct AnklePins {
 // at its mean position. A frame whose correction would exceed max_cleanup_m
 // stays free; past the contact's middle it ends the pinning (the foot has
 // left, or the data disagrees with a plant).
-void pin_contact(const ModelSpaceClip& model, const LegChain& chain, double ground, const ContactInterval& in, double max_cleanup_m,
-                 AnklePins& pins) {
+void pin_contact(const ModelSpaceClip& model, const LegChain& chain, double ground, const ContactInterval& in,
+                 double max_cleanup_m, AnklePins& pins) {
   const std::int32_t ankle = chain.joints[chain.count - 1];
   const glm::vec3 ball(chain.ball[0], chain.ball[1], chain.ball[2]);
   const auto rotation = [&](std::int32_t i) { return model.rotations[frame_joint(model, i, ankle)]; };
@@ -343,7 +350,8 @@ void pin_contact(const ModelSpaceClip& model, const LegChain& chain, double grou
     anchor /= static_cast<double>(down);
     ball_anchor = anchor + glm::dvec3(rotation(rise - 1) * ball);
   } else {
-    for (std::int32_t i = in.begin; i < in.end; ++i) ball_anchor += glm::dvec3(model.position(i, ankle) + rotation(i) * ball);
+    for (std::int32_t i = in.begin; i < in.end; ++i)
+      ball_anchor += glm::dvec3(model.position(i, ankle) + rotation(i) * ball);
     ball_anchor /= static_cast<double>(in.end - in.begin);
   }
   for (std::int32_t i = in.begin; i < in.end; ++i) {
@@ -372,7 +380,8 @@ std::vector<glm::dvec3> faded_corrections(const AnklePins& pins, std::int32_t ra
       const std::int32_t before = i - d, after = i + d;
       const bool b = before >= 0 && pins.pinned[at(before)], a = after < frames && pins.pinned[at(after)];
       if (!a && !b) continue;
-      const glm::dvec3 near = b && a ? 0.5 * (correction[at(before)] + correction[at(after)]) : correction[at(b ? before : after)];
+      const glm::dvec3 near =
+          b && a ? 0.5 * (correction[at(before)] + correction[at(after)]) : correction[at(b ? before : after)];
       faded[at(i)] = near * (1.0 - static_cast<double>(d) / (ramp + 1));
       break;
     }
@@ -384,10 +393,11 @@ std::vector<glm::dvec3> faded_corrections(const AnklePins& pins, std::int32_t ra
 // frames, which are the cycle's: two-bone IK turns thigh and knee, the foot
 // keeps its world rotation; writes the local rotations of thigh, knee and
 // ankle into c.cycle. Returns `largest` raised to the largest correction.
-double correct_leg(const Skeleton& skeleton, const LegChain& chain, const ModelSpaceClip& model, const std::vector<glm::dvec3>& faded,
-                   LocomotionClip& c, double largest) {
+double correct_leg(const Skeleton& skeleton, const LegChain& chain, const ModelSpaceClip& model,
+                   const std::vector<glm::dvec3>& faded, LocomotionClip& c, double largest) {
   const std::int32_t F = c.cycle.frame_count;
-  const std::int32_t thigh = chain.joints[chain.count - 3], knee = chain.joints[chain.count - 2], ankle = chain.joints[chain.count - 1];
+  const std::int32_t thigh = chain.joints[chain.count - 3], knee = chain.joints[chain.count - 2],
+                     ankle = chain.joints[chain.count - 1];
   const auto rotation = [&](std::int32_t i, std::int32_t j) { return model.rotations[frame_joint(model, i, j)]; };
   const std::int32_t hip_parent = skeleton.parents[at(thigh)];
   const glm::vec3 hinge = knee_hinge(skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], {&c.cycle}, knee);
@@ -400,7 +410,8 @@ double correct_leg(const Skeleton& skeleton, const LegChain& chain, const ModelS
     glm::quat r_thigh = rotation(i, thigh);
     glm::quat r_knee = rotation(i, knee);
     const glm::quat r_foot = rotation(i, ankle);
-    if (!two_bone_ik(model.position(i, thigh), skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], hinge, target, r_thigh, r_knee))
+    if (!two_bone_ik(model.position(i, thigh), skeleton.offsets[at(knee)], skeleton.offsets[at(ankle)], hinge, target,
+                     r_thigh, r_knee))
       continue;
     c.cycle.rotation(k, thigh) = glm::normalize(glm::inverse(rotation(i, hip_parent)) * r_thigh);
     c.cycle.rotation(k, knee) = glm::normalize(glm::inverse(r_thigh) * r_knee);
@@ -411,7 +422,8 @@ double correct_leg(const Skeleton& skeleton, const LegChain& chain, const ModelS
 
 }  // namespace
 
-LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cycle, std::string name, const LocomotionOptions& o) {
+LocomotionClip prepare_locomotion_cycle(const Skeleton& skeleton, const Clip& cycle, std::string name,
+                                        const LocomotionOptions& o) {
   o.validate();
   skeleton.validate();
   check_cycle(skeleton, cycle, name);
@@ -461,8 +473,10 @@ double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& c, const Lo
   const std::array<LegChain, 2> legs = leg_chains(skeleton);
   const Clip world = cycle_in_world(c, 3);
   const ModelSpaceClip model = forward_kinematics(skeleton, world);
-  const ContactReport contacts = detect_foot_contacts(skeleton, model, c.cycle.frame_time, FeetJoints::from_roles(skeleton), o.contacts);
-  const std::int32_t ramp = std::max<std::int32_t>(1, static_cast<std::int32_t>(std::lround(o.contact_ramp_s / c.cycle.frame_time)));
+  const ContactReport contacts =
+      detect_foot_contacts(skeleton, model, c.cycle.frame_time, FeetJoints::from_roles(skeleton), o.contacts);
+  const std::int32_t ramp =
+      std::max<std::int32_t>(1, static_cast<std::int32_t>(std::lround(o.contact_ramp_s / c.cycle.frame_time)));
   const std::size_t frames = at(3 * F);
   double largest = 0.0;
   for (std::size_t leg = 0; leg < 2; ++leg) {
@@ -478,10 +492,12 @@ double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& c, const Lo
   return largest;
 }
 
-LocomotionClip prepare_locomotion_clip(const Skeleton& skeleton, const Clip& clip, std::string name, const LocomotionOptions& o) {
+LocomotionClip prepare_locomotion_clip(const Skeleton& skeleton, const Clip& clip, std::string name,
+                                       const LocomotionOptions& o) {
   o.validate();
   const CycleReport r = analyze_cycle(skeleton, clip, o.cycle);
-  if (!r.found) throw Error("no locomotion cycle found (see motion/cycle.h for the options)", clip_field(name, "cycle"));
+  if (!r.found)
+    throw Error("no locomotion cycle found (see motion/cycle.h for the options)", clip_field(name, "cycle"));
   LocomotionClip out = prepare_locomotion_cycle(skeleton, make_cyclic(clip, r), std::move(name), o);
   out.source_start_frame += r.start_frame;
   return out;
@@ -585,13 +601,15 @@ BlendSpace1D::BlendSpace1D(Skeleton skeleton, std::vector<LocomotionClip> clips,
     if (c.cycle.frame_count < 2 || c.cycle.rotations.size() != at(static_cast<std::int64_t>(c.cycle.frame_count) * J) ||
         c.cycle.root_positions.size() != at(c.cycle.frame_count) || c.mean_rotations.size() != at(J))
       throw Error("is not a prepared cycle (prepare_locomotion_clip)", where);
-    if (!(std::isfinite(c.speed) && c.speed >= 0.0 && std::isfinite(c.stride_m) && c.stride_m >= 0.0 && std::isfinite(c.period_s) &&
-          c.period_s > 0.0 && std::isfinite(c.turn_rad)))
+    if (!(std::isfinite(c.speed) && c.speed >= 0.0 && std::isfinite(c.stride_m) && c.stride_m >= 0.0 &&
+          std::isfinite(c.period_s) && c.period_s > 0.0 && std::isfinite(c.turn_rad)))
       throw Error("speed, stride and period must be finite, period positive", where);
     rows += c.cycle.frame_count;
   }
-  if (rows > (std::int64_t{1} << 24)) throw Error("too many frames in all (" + std::to_string(rows) + ")", at_field("blend_space.clips"));
-  std::stable_sort(clips_.begin(), clips_.end(), [](const LocomotionClip& a, const LocomotionClip& b) { return a.speed < b.speed; });
+  if (rows > (std::int64_t{1} << 24))
+    throw Error("too many frames in all (" + std::to_string(rows) + ")", at_field("blend_space.clips"));
+  std::stable_sort(clips_.begin(), clips_.end(),
+                   [](const LocomotionClip& a, const LocomotionClip& b) { return a.speed < b.speed; });
   for (std::size_t i = 1; i < clips_.size(); ++i)
     if (!(clips_[i].speed - clips_[i - 1].speed > 1e-3))
       throw Error("clips '" + clips_[i - 1].name + "' and '" + clips_[i].name + "' have the same speed (" +
@@ -612,7 +630,8 @@ BlendSpace1D::BlendSpace1D(Skeleton skeleton, std::vector<LocomotionClip> clips,
     info.ankle_ground[0] = c.ankle_ground[0];
     info.ankle_ground[1] = c.ankle_ground[1];
     clip_infos_.push_back(info);
-    std::copy(c.cycle.rotations.begin(), c.cycle.rotations.end(), stacked.rotations.begin() + static_cast<std::ptrdiff_t>(row) * J);
+    std::copy(c.cycle.rotations.begin(), c.cycle.rotations.end(),
+              stacked.rotations.begin() + static_cast<std::ptrdiff_t>(row) * J);
     std::copy(c.cycle.root_positions.begin(), c.cycle.root_positions.end(), stacked.root_positions.begin() + row);
     mean_rotations_.insert(mean_rotations_.end(), c.mean_rotations.begin(), c.mean_rotations.end());
     row += c.cycle.frame_count;
@@ -724,8 +743,8 @@ ModelSpaceClip animate_character(const BlendSpace1D& space, LocomotionCharacter 
   return out;
 }
 
-FootSkatingReport locomotion_foot_skating(const BlendSpace1D& space, float speed, double seconds, const LocomotionStep& step,
-                                          const ContactOptions& contacts) {
+FootSkatingReport locomotion_foot_skating(const BlendSpace1D& space, float speed, double seconds,
+                                          const LocomotionStep& step, const ContactOptions& contacts) {
   if (!(std::isfinite(seconds) && seconds > 0.0 && seconds < 3600.0))
     throw Error("must be in (0, 3600) s", at_field("locomotion_foot_skating.seconds"));
   const auto frames = static_cast<std::int32_t>(std::ceil(seconds / step.dt));

@@ -25,8 +25,8 @@ inline constexpr int kFootEvents = 4;
 const char* to_string(FootEvent e);
 
 struct LocomotionOptions {
-  CycleOptions cycle;        // raw clips: how the loop is found (e.g. skip_frames)
-  ContactOptions contacts;   // foot events of the cycle
+  CycleOptions cycle;       // raw clips: how the loop is found (e.g. skip_frames)
+  ContactOptions contacts;  // foot events of the cycle
   // Take a slight turn out of a clip meant to go straight (real mocap drifts
   // a few degrees per cycle): the path becomes a line, the root keeps its
   // motion relative to the turning path. A speed blend space wants this.
@@ -41,7 +41,7 @@ struct LocomotionOptions {
   // moves slower than contacts.speed_fraction times this (the push-off roll).
   double cleanup_speed_factor = 3.0;
   double max_cleanup_m = 0.04;  // frames that would need a larger correction are left free
-  void validate() const;  // Error naming the field
+  void validate() const;        // Error naming the field
 };
 
 // One locomotion cycle ready for synthesis.
@@ -53,10 +53,10 @@ struct LocomotionClip {
   // root_positions hold the root's offset from the path point in the path
   // frame (x left, y up, z forward; its mean over the cycle is 0 in x, z).
   Clip cycle;
-  double period_s = 0.0;   // seconds per cycle
-  double stride_m = 0.0;   // path length per cycle (two steps)
-  double turn_rad = 0.0;   // path heading change per cycle (0 when straightened)
-  double speed = 0.0;      // stride / period, m/s
+  double period_s = 0.0;          // seconds per cycle
+  double stride_m = 0.0;          // path length per cycle (two steps)
+  double turn_rad = 0.0;          // path heading change per cycle (0 when straightened)
+  double speed = 0.0;             // stride / period, m/s
   double turn_removed_rad = 0.0;  // what straightening took out per cycle
   // Phases of the foot events, -1 where the cycle has none (idle) or the
   // contacts are not one per foot per cycle.

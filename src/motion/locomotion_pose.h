@@ -19,8 +19,8 @@
 namespace throng::motion {
 
 // The synthesised local rotation of a joint: the blend, or the leg IK's.
-THRONG_HOST_DEVICE inline glm::quat synthesised_rotation(const BlendSpaceView& v, const CharacterFrame& f, const PlantedLegs& legs,
-                                                         std::int32_t joint) {
+THRONG_HOST_DEVICE inline glm::quat synthesised_rotation(const BlendSpaceView& v, const CharacterFrame& f,
+                                                         const PlantedLegs& legs, std::int32_t joint) {
   for (int leg = 0; leg < 2; ++leg) {
     if (!legs.active[leg]) continue;
     const LegChain& chain = v.legs[leg];
@@ -32,8 +32,8 @@ THRONG_HOST_DEVICE inline glm::quat synthesised_rotation(const BlendSpaceView& v
 
 // World position and rotation of every joint (reference: every joint
 // synthesised; the batch stage adds LOD masks and the cache).
-THRONG_HOST_DEVICE inline void synthesise_pose(const BlendSpaceView& v, const CharacterFrame& f, glm::vec3* out_positions,
-                                               glm::quat* out_rotations) {
+THRONG_HOST_DEVICE inline void synthesise_pose(const BlendSpaceView& v, const CharacterFrame& f,
+                                               glm::vec3* out_positions, glm::quat* out_rotations) {
   const PlantedLegs legs = plant_legs(v, f, nullptr);
   for (std::int32_t j = 0; j < v.joint_count; ++j) {
     const glm::quat local = synthesised_rotation(v, f, legs, j);

@@ -146,7 +146,8 @@ THRONG_HOST_DEVICE inline glm::quat clip_rotation(const BlendSpaceView& v, const
   if (r.t <= 0.0f) return q0;
   return interpolate_frames(q0, texel_quat(v.texture, joint, r.r1), r.t);
 }
-THRONG_HOST_DEVICE inline glm::quat clip_rotation(const BlendSpaceView& v, std::int32_t clip, float clip_phase, std::int32_t joint) {
+THRONG_HOST_DEVICE inline glm::quat clip_rotation(const BlendSpaceView& v, std::int32_t clip, float clip_phase,
+                                                  std::int32_t joint) {
   return clip_rotation(v, clip_rows(v, clip, clip_phase), joint);
 }
 // The root's offset from the path point (path frame, scale 1) in one clip.
@@ -162,8 +163,8 @@ THRONG_HOST_DEVICE inline glm::vec3 clip_root_offset(const BlendSpaceView& v, st
 
 // The blended local rotation of a joint: SLERP (shortest arc) of the two
 // clips' rotations by w; w = 0 and w = 1 return a clip's sample exactly.
-THRONG_HOST_DEVICE inline glm::quat blended_rotation(const BlendSpaceView& v, float w, const ClipRows& a, const ClipRows& b,
-                                                     std::int32_t joint) {
+THRONG_HOST_DEVICE inline glm::quat blended_rotation(const BlendSpaceView& v, float w, const ClipRows& a,
+                                                     const ClipRows& b, std::int32_t joint) {
   if (w <= 0.0f) return clip_rotation(v, a, joint);
   if (w >= 1.0f) return clip_rotation(v, b, joint);
   return slerp_shortest(clip_rotation(v, a, joint), clip_rotation(v, b, joint), w);

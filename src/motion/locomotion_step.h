@@ -73,15 +73,15 @@ THRONG_HOST_DEVICE inline void advance_locomotion(const BlendSpaceView& v, const
 struct CharacterFrame {
   BlendPoint point;
   ClipPhases phases[kSyncGroups];  // per sync group (SegmentSync)
-  ClipRows rows[kSyncGroups][2];    // the same as texture rows, clip a and clip b
-  float phase = 0.0f;  // canonical, [0, 1)
-  RootOffset root;     // in the path frame, scale 1
+  ClipRows rows[kSyncGroups][2];   // the same as texture rows, clip a and clip b
+  float phase = 0.0f;              // canonical, [0, 1)
+  RootOffset root;                 // in the path frame, scale 1
   glm::vec3 root_position{0.0f};
   glm::quat frame{1.0f, 0.0f, 0.0f, 0.0f};
   float scale = 1.0f;
 };
-THRONG_HOST_DEVICE inline CharacterFrame character_frame_at(const BlendSpaceView& v, const BlendPoint& point, float phase,
-                                                            glm::vec3 position, float yaw, float scale) {
+THRONG_HOST_DEVICE inline CharacterFrame character_frame_at(const BlendSpaceView& v, const BlendPoint& point,
+                                                            float phase, glm::vec3 position, float yaw, float scale) {
   CharacterFrame f;
   f.point = point;
   f.phase = wrap_phase(phase);
@@ -104,7 +104,8 @@ THRONG_HOST_DEVICE inline CharacterFrame character_frame(const BlendSpaceView& v
 }
 
 // A joint's blended local rotation at its sync group's phases.
-THRONG_HOST_DEVICE inline glm::quat joint_rotation(const BlendSpaceView& v, const CharacterFrame& f, std::int32_t joint) {
+THRONG_HOST_DEVICE inline glm::quat joint_rotation(const BlendSpaceView& v, const CharacterFrame& f,
+                                                   std::int32_t joint) {
   const std::uint8_t g = v.joint_group[joint];
   return blended_rotation(v, f.point.w, f.rows[g][0], f.rows[g][1], joint);
 }

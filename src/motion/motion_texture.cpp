@@ -24,8 +24,9 @@ MotionTexture make_motion_texture(const Skeleton& skeleton, const Clip& clip, Te
   const auto joints = static_cast<std::size_t>(J);
   if (clip.joint_count != J || clip.rotations.size() != frames * joints || clip.root_positions.size() != frames ||
       (!clip.translations.empty() && clip.translations.size() != frames * joints))
-    throw Error("motion texture: clip (" + std::to_string(clip.joint_count) + " joints, " + std::to_string(clip.frame_count) +
-                " frames) does not match the skeleton (" + std::to_string(J) + " joints) or its own arrays");
+    throw Error("motion texture: clip (" + std::to_string(clip.joint_count) + " joints, " +
+                std::to_string(clip.frame_count) + " frames) does not match the skeleton (" + std::to_string(J) +
+                " joints) or its own arrays");
   MotionTexture t;
   t.format = format;
   t.joint_count = J;
@@ -44,7 +45,8 @@ MotionTexture make_motion_texture(const Skeleton& skeleton, const Clip& clip, Te
       texel[2] = q.z;
       texel[3] = q.w;
       const bool root = skeleton.parents[j] < 0;
-      const glm::vec3 o = root ? clip.root_positions[f] : (clip.translations.empty() ? skeleton.offsets[j] : clip.translations[k]);
+      const glm::vec3 o =
+          root ? clip.root_positions[f] : (clip.translations.empty() ? skeleton.offsets[j] : clip.translations[k]);
       texel[4] = o.x;
       texel[5] = o.y;
       texel[6] = o.z;

@@ -30,8 +30,8 @@ enum class TexelFormat : std::uint8_t { Float32, Float16 };
 // usable inside kernels.
 struct MotionTextureView {
   TexelFormat format = TexelFormat::Float32;
-  std::int32_t width = 0;   // texels per row = 2 * joints
-  std::int32_t height = 0;  // rows = frames
+  std::int32_t width = 0;                     // texels per row = 2 * joints
+  std::int32_t height = 0;                    // rows = frames
   const float* texels_f32 = nullptr;          // 4 floats per texel
   const std::uint16_t* texels_f16 = nullptr;  // 4 halves per texel
   const std::int32_t* parents = nullptr;
@@ -42,8 +42,10 @@ struct MotionTextureView {
   // Outside the image it returns (0, 0, 0, 0), as robust buffer access does.
   THRONG_HOST_DEVICE glm::vec4 texel_fetch(std::int32_t x, std::int32_t y) const {
     if (x < 0 || y < 0 || x >= width || y >= height) return glm::vec4(0.0f);
-    const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 4;
-    if (format == TexelFormat::Float32) return glm::vec4(texels_f32[i], texels_f32[i + 1], texels_f32[i + 2], texels_f32[i + 3]);
+    const std::size_t i =
+        (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 4;
+    if (format == TexelFormat::Float32)
+      return glm::vec4(texels_f32[i], texels_f32[i + 1], texels_f32[i + 2], texels_f32[i + 3]);
     return glm::vec4(half_to_float(texels_f16[i]), half_to_float(texels_f16[i + 1]), half_to_float(texels_f16[i + 2]),
                      half_to_float(texels_f16[i + 3]));
   }
@@ -51,8 +53,8 @@ struct MotionTextureView {
 
 // FK of one row: model-space position and rotation of every joint. The
 // quaternion texel is renormalised (fp16 rounding leaves it slightly off unit).
-THRONG_HOST_DEVICE inline void fk_from_texture(const MotionTextureView& tex, std::int32_t frame, glm::vec3* out_positions,
-                                               glm::quat* out_rotations) {
+THRONG_HOST_DEVICE inline void fk_from_texture(const MotionTextureView& tex, std::int32_t frame,
+                                               glm::vec3* out_positions, glm::quat* out_rotations) {
   const std::int32_t joints = tex.joint_count();
   for (std::int32_t j = 0; j < joints; ++j) {
     const glm::vec4 r = tex.texel_fetch(2 * j, frame);

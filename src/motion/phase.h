@@ -78,8 +78,8 @@ THRONG_HOST_DEVICE inline glm::quat interpolate_frames(const glm::quat& a, const
 
 // Local rotations at a normalised phase by SLERP between the two
 // neighbouring frames of frame-major rotations[frame * joints + joint].
-THRONG_HOST_DEVICE inline void sample_cycle(const glm::quat* rotations, std::int32_t frames, std::int32_t joints, float phase,
-                                            glm::quat* out) {
+THRONG_HOST_DEVICE inline void sample_cycle(const glm::quat* rotations, std::int32_t frames, std::int32_t joints,
+                                            float phase, glm::quat* out) {
   const CyclePoint p = cycle_point(frames, phase);
   const glm::quat* a = rotations + static_cast<Index>(p.f0) * joints;
   const glm::quat* b = rotations + static_cast<Index>(p.f1) * joints;

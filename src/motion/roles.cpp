@@ -30,12 +30,12 @@ std::string body_part(std::string_view s) {
 // Words that may follow a one-letter side prefix ("lhand", "rShin"). They
 // keep "lowerback" or "leg" from being read as left + "owerback" / "eg".
 constexpr std::array<std::string_view, 52> kLimbWords = {
-    "hipjoint", "hip",    "upleg",    "upperleg", "thigh",  "femur",  "leg",     "knee",     "shin",      "calf",
-    "tibia",    "lowleg", "lowerleg", "foot",     "ankle",  "toe",    "ball",    "heel",     "arm",       "uparm",
-    "upperarm", "humerus", "shoulder", "shldr",   "collar", "clavicle", "forearm", "elbow",  "lowerarm",  "lowarm",
-    "radius",   "wrist",  "hand",     "finger",   "thumb",  "index",  "mid",     "middle",   "ring",      "pinky",
-    "pinkie",   "eye",    "ear",      "buttock",  "breast", "brow",   "cheek",   "lid",      "lip",       "mouth",
-    "pectoral", "scapula"};
+    "hipjoint", "hip",      "upleg",    "upperleg", "thigh",    "femur",    "leg",    "knee",     "shin",
+    "calf",     "tibia",    "lowleg",   "lowerleg", "foot",     "ankle",    "toe",    "ball",     "heel",
+    "arm",      "uparm",    "upperarm", "humerus",  "shoulder", "shldr",    "collar", "clavicle", "forearm",
+    "elbow",    "lowerarm", "lowarm",   "radius",   "wrist",    "hand",     "finger", "thumb",    "index",
+    "mid",      "middle",   "ring",     "pinky",    "pinkie",   "eye",      "ear",    "buttock",  "breast",
+    "brow",     "cheek",    "lid",      "lip",      "mouth",    "pectoral", "scapula"};
 
 bool starts_with_limb_word(std::string_view part) {
   for (std::string_view w : kLimbWords)
@@ -132,8 +132,11 @@ JointName split_joint_name(std::string_view name) {
   // Full words: "LeftUpLeg", "left_knee", "KneeLeft", "knee_left".
   if (l.rfind("left", 0) == 0 && try_side(Side::Left, name.substr(4), false)) return out;
   if (l.rfind("right", 0) == 0 && try_side(Side::Right, name.substr(5), false)) return out;
-  if (l.size() > 4 && l.compare(l.size() - 4, 4, "left") == 0 && try_side(Side::Left, name.substr(0, l.size() - 4), false)) return out;
-  if (l.size() > 5 && l.compare(l.size() - 5, 5, "right") == 0 && try_side(Side::Right, name.substr(0, l.size() - 5), false))
+  if (l.size() > 4 && l.compare(l.size() - 4, 4, "left") == 0 &&
+      try_side(Side::Left, name.substr(0, l.size() - 4), false))
+    return out;
+  if (l.size() > 5 && l.compare(l.size() - 5, 5, "right") == 0 &&
+      try_side(Side::Right, name.substr(0, l.size() - 5), false))
     return out;
   // One letter: "lShldr", "L_Knee", "lhumerus", "knee_l", "ThighL".
   if (l.size() > 1 && (l[0] == 'l' || l[0] == 'r')) {
@@ -145,7 +148,8 @@ JointName split_joint_name(std::string_view name) {
     const std::string_view rest = name.substr(0, name.size() - 1);
     // Only with a separator or a case change before it ("knee_l", "ThighL").
     const char before = name[name.size() - 2];
-    const bool marked = is_separator(before) || (name.back() >= 'A' && name.back() <= 'Z' && before >= 'a' && before <= 'z');
+    const bool marked =
+        is_separator(before) || (name.back() >= 'A' && name.back() <= 'Z' && before >= 'a' && before <= 'z');
     if (marked && try_side(side, rest, true)) return out;
   }
   out.side = Side::Center;
@@ -163,7 +167,8 @@ std::optional<Role> parse_role(std::string_view name) {
 std::vector<std::int32_t> chain_between(const Skeleton& skeleton, std::int32_t from, std::int32_t to) {
   std::vector<std::int32_t> chain;
   if (from < 0 || to < 0 || to == from) return chain;
-  for (std::int32_t p = skeleton.parents[static_cast<std::size_t>(to)]; p != from; p = skeleton.parents[static_cast<std::size_t>(p)]) {
+  for (std::int32_t p = skeleton.parents[static_cast<std::size_t>(to)]; p != from;
+       p = skeleton.parents[static_cast<std::size_t>(p)]) {
     if (p < 0) return {};
     chain.push_back(p);
   }
@@ -197,9 +202,10 @@ void assign_roles(Skeleton& s, const std::vector<RoleOverride>& overrides) {
 
   for (Side side : {Side::Left, Side::Right}) {
     const bool left = side == Side::Left;
-    const Limb leg = find_limb(f, side, {"leg", "knee", "shin", "calf", "tibia", "lowerleg", "leglower", "lowleg", "loleg"},
-                               {"upleg", "upperleg", "legupper", "thigh", "femur", "hip"}, {"ankle", "foot"},
-                               {"toe", "toes", "toebase", "ball"});
+    const Limb leg =
+        find_limb(f, side, {"leg", "knee", "shin", "calf", "tibia", "lowerleg", "leglower", "lowleg", "loleg"},
+                  {"upleg", "upperleg", "legupper", "thigh", "femur", "hip"}, {"ankle", "foot"},
+                  {"toe", "toes", "toebase", "ball"});
     set(left ? Role::LeftThigh : Role::RightThigh, leg.root);
     set(left ? Role::LeftKnee : Role::RightKnee, leg.middle);
     set(left ? Role::LeftAnkle : Role::RightAnkle, leg.end);

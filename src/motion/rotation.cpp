@@ -42,7 +42,8 @@ glm::dquat axis_rotation(int axis, double angle) {
 
 glm::dquat euler_to_quat(EulerOrder order, glm::dvec3 angles_xyz) {
   const auto a = euler_axes(order);
-  return axis_rotation(a[0], angles_xyz[a[0]]) * axis_rotation(a[1], angles_xyz[a[1]]) * axis_rotation(a[2], angles_xyz[a[2]]);
+  return axis_rotation(a[0], angles_xyz[a[0]]) * axis_rotation(a[1], angles_xyz[a[1]]) *
+         axis_rotation(a[2], angles_xyz[a[2]]);
 }
 
 glm::dvec3 quat_to_euler(EulerOrder order, const glm::dquat& q_in) {

@@ -9,9 +9,9 @@ namespace throng::motion {
 
 const char* to_string(Role r) {
   static constexpr const char* kNames[kRoleCount] = {
-      "hips",       "neck",        "head",       "left_shoulder", "right_shoulder", "left_elbow",
-      "right_elbow", "left_wrist", "right_wrist", "left_thigh",   "right_thigh",    "left_knee",
-      "right_knee", "left_ankle",  "right_ankle", "left_toe",     "right_toe"};
+      "hips",        "neck",       "head",        "left_shoulder", "right_shoulder", "left_elbow",
+      "right_elbow", "left_wrist", "right_wrist", "left_thigh",    "right_thigh",    "left_knee",
+      "right_knee",  "left_ankle", "right_ankle", "left_toe",      "right_toe"};
   const auto i = static_cast<std::size_t>(r);
   return i < kRoleCount ? kNames[i] : "unknown";
 }

@@ -16,13 +16,13 @@ enum class Role : std::uint8_t {
   Hips,
   Neck,
   Head,
-  LeftShoulder,   // upper arm joint (rotates the humerus)
+  LeftShoulder,  // upper arm joint (rotates the humerus)
   RightShoulder,
   LeftElbow,
   RightElbow,
   LeftWrist,
   RightWrist,
-  LeftThigh,      // hip joint (rotates the femur)
+  LeftThigh,  // hip joint (rotates the femur)
   RightThigh,
   LeftKnee,
   RightKnee,

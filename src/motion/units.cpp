@@ -34,8 +34,10 @@ std::optional<LengthUnit> parse_length_unit(std::string_view text) {
   std::string l(text);
   for (char& c : l) c = static_cast<char>((c >= 'A' && c <= 'Z') ? c - 'A' + 'a' : c);
   if (l == "m" || l == "metre" || l == "metres" || l == "meter" || l == "meters") return LengthUnit::Metre;
-  if (l == "cm" || l == "centimetre" || l == "centimetres" || l == "centimeter" || l == "centimeters") return LengthUnit::Centimetre;
-  if (l == "mm" || l == "millimetre" || l == "millimetres" || l == "millimeter" || l == "millimeters") return LengthUnit::Millimetre;
+  if (l == "cm" || l == "centimetre" || l == "centimetres" || l == "centimeter" || l == "centimeters")
+    return LengthUnit::Centimetre;
+  if (l == "mm" || l == "millimetre" || l == "millimetres" || l == "millimeter" || l == "millimeters")
+    return LengthUnit::Millimetre;
   if (l == "in" || l == "inch" || l == "inches") return LengthUnit::Inch;
   if (l == "cmu" || l == "asf") return LengthUnit::CmuAsf;
   return std::nullopt;
@@ -57,7 +59,8 @@ double leg_length(const Skeleton& s, Role thigh, Role ankle) {
 UnitGuess guess_length_unit(const Skeleton& s) {
   UnitGuess g;
   double nominal_m;
-  const double legs = std::max(leg_length(s, Role::LeftThigh, Role::LeftAnkle), leg_length(s, Role::RightThigh, Role::RightAnkle));
+  const double legs =
+      std::max(leg_length(s, Role::LeftThigh, Role::LeftAnkle), leg_length(s, Role::RightThigh, Role::RightAnkle));
   if (legs > 0.0) {
     g.measured = legs;
     g.from_legs = true;
@@ -83,7 +86,8 @@ UnitGuess guess_length_unit(const Skeleton& s) {
   }
   if (!(g.measured > 0.0) || !std::isfinite(g.measured)) return g;  // nothing to go by: metres
   double best = 1e300;
-  for (LengthUnit u : {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf}) {
+  for (LengthUnit u :
+       {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf}) {
     const double miss = std::abs(std::log(g.measured * metres_per_unit(u) / nominal_m));
     if (miss < best) {
       best = miss;

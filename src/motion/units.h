@@ -29,8 +29,8 @@ std::optional<LengthUnit> parse_length_unit(std::string_view text);
 // nearest candidate on a log scale.
 struct UnitGuess {
   LengthUnit unit = LengthUnit::Metre;
-  double measured = 0.0;      // the length measured, in file units
-  bool from_legs = false;     // leg length (true) or rest-pose extent
+  double measured = 0.0;   // the length measured, in file units
+  bool from_legs = false;  // leg length (true) or rest-pose extent
 };
 UnitGuess guess_length_unit(const Skeleton& skeleton_in_file_units);
 

@@ -32,7 +32,8 @@ struct Snapper {
   int unit(float v, const char* what) const {
     const double u = std::round(static_cast<double>(v) * scale);
     if (!std::isfinite(u) || std::fabs(u) > kUnitLimit)
-      throw Error(fmt::format("{} coordinate {} m is beyond the snapped range of +-{:.0f} m at this resolution", what, v, kUnitLimit / scale),
+      throw Error(fmt::format("{} coordinate {} m is beyond the snapped range of +-{:.0f} m at this resolution", what,
+                              v, kUnitLimit / scale),
                   at_field("free_space.resolution"));
     return static_cast<int>(u);
   }
@@ -62,8 +63,8 @@ sim::Ring to_ring(const IPolygon& p, double inv_scale) {
 void FreeSpaceOptions::validate() const {
   require(std::isfinite(resolution) && resolution >= 1e-6f && resolution <= 1.0f, "free_space.resolution",
           "resolution must be in [1e-6, 1] m");
-  require(std::isfinite(circle_tolerance) && circle_tolerance > 0 && circle_tolerance <= 1.0f, "free_space.circle_tolerance",
-          "circle tolerance must be in (0, 1] m");
+  require(std::isfinite(circle_tolerance) && circle_tolerance > 0 && circle_tolerance <= 1.0f,
+          "free_space.circle_tolerance", "circle tolerance must be in (0, 1] m");
   require(std::isfinite(margin) && margin >= 0, "free_space.margin", "margin must be >= 0");
   require(std::isfinite(cell_size) && cell_size >= 0, "free_space.cell_size", "cell size must be >= 0 (0 = automatic)");
 }
@@ -83,7 +84,8 @@ sim::Ring circumscribed_polygon(const sim::Circle& c, float tolerance) {
   ring.reserve(static_cast<std::size_t>(n));
   for (std::int32_t i = 0; i < n; ++i) {
     const double a = 2.0 * std::numbers::pi * i / n;
-    ring.emplace_back(static_cast<float>(c.center.x + R * std::cos(a)), static_cast<float>(c.center.y + R * std::sin(a)));
+    ring.emplace_back(static_cast<float>(c.center.x + R * std::cos(a)),
+                      static_cast<float>(c.center.y + R * std::sin(a)));
   }
   return ring;
 }
@@ -133,8 +135,8 @@ FreeSpace FreeSpace::build(const sim::Polygon* walkable, const std::vector<sim::
   } else {
     if (all.empty()) all.add(glm::vec2(0.0f));
     const glm::vec2 lo = all.min - glm::vec2(options.margin), hi = all.max + glm::vec2(options.margin);
-    domain.insert(bp::rectangle_data<int>(snap.unit(lo.x, "extent"), snap.unit(lo.y, "extent"), snap.unit(hi.x, "extent"),
-                                          snap.unit(hi.y, "extent")));
+    domain.insert(bp::rectangle_data<int>(snap.unit(lo.x, "extent"), snap.unit(lo.y, "extent"),
+                                          snap.unit(hi.x, "extent"), snap.unit(hi.y, "extent")));
   }
 
   const IPolygonSet free_set = domain - blocked;
@@ -178,7 +180,8 @@ void FreeSpace::index() {
   if (!(cell_ > 0)) {
     const glm::vec2 size = bounds_.size();
     const double area = std::max(1.0, static_cast<double>(size.x) * size.y);
-    cell_ = static_cast<float>(std::clamp(2.0 * std::sqrt(area / std::max<std::size_t>(1, boundary_.size())), 0.25, 64.0));
+    cell_ =
+        static_cast<float>(std::clamp(2.0 * std::sqrt(area / std::max<std::size_t>(1, boundary_.size())), 0.25, 64.0));
   }
   // Each edge is registered in the cells of its pieces' bounding boxes
   // (pieces no longer than a cell side), so a long diagonal wall stays cheap.
@@ -190,8 +193,10 @@ void FreeSpace::index() {
     for (int i = 0; i < pieces; ++i) {
       const glm::vec2 p0 = s.a + (s.b - s.a) * (static_cast<float>(i) / pieces);
       const glm::vec2 p1 = s.a + (s.b - s.a) * (static_cast<float>(i + 1) / pieces);
-      const std::int32_t x0 = sim::cell_coord(std::min(p0.x, p1.x), cell_), x1 = sim::cell_coord(std::max(p0.x, p1.x), cell_);
-      const std::int32_t y0 = sim::cell_coord(std::min(p0.y, p1.y), cell_), y1 = sim::cell_coord(std::max(p0.y, p1.y), cell_);
+      const std::int32_t x0 = sim::cell_coord(std::min(p0.x, p1.x), cell_),
+                         x1 = sim::cell_coord(std::max(p0.x, p1.x), cell_);
+      const std::int32_t y0 = sim::cell_coord(std::min(p0.y, p1.y), cell_),
+                         y1 = sim::cell_coord(std::max(p0.y, p1.y), cell_);
       for (std::int32_t y = y0; y <= y1; ++y)
         for (std::int32_t x = x0; x <= x1; ++x) pairs.emplace_back(sim::cell_key(x, y), static_cast<std::int32_t>(k));
     }
@@ -203,7 +208,8 @@ void FreeSpace::index() {
 
 std::int32_t FreeSpace::component_of(glm::vec2 p) const {
   for (std::size_t i = 0; i < components_.size(); ++i)
-    if (component_bounds_[i].contains(p) && sim::point_in_polygon(p, components_[i])) return static_cast<std::int32_t>(i);
+    if (component_bounds_[i].contains(p) && sim::point_in_polygon(p, components_[i]))
+      return static_cast<std::int32_t>(i);
   return -1;
 }
 
@@ -273,14 +279,17 @@ template <class Fn>
 void FreeSpace::for_cells_near_segment(glm::vec2 a, glm::vec2 b, float reach, Fn&& fn) const {
   const sim::GridView g = grid_.host_view();
   const float grow = reach + cell_;
-  const std::int32_t x0 = sim::cell_coord(std::min(a.x, b.x) - grow, cell_), x1 = sim::cell_coord(std::max(a.x, b.x) + grow, cell_);
-  const std::int32_t y0 = sim::cell_coord(std::min(a.y, b.y) - grow, cell_), y1 = sim::cell_coord(std::max(a.y, b.y) + grow, cell_);
+  const std::int32_t x0 = sim::cell_coord(std::min(a.x, b.x) - grow, cell_),
+                     x1 = sim::cell_coord(std::max(a.x, b.x) + grow, cell_);
+  const std::int32_t y0 = sim::cell_coord(std::min(a.y, b.y) - grow, cell_),
+                     y1 = sim::cell_coord(std::max(a.y, b.y) + grow, cell_);
   const float keep = reach + cell_ * 0.7072f;
   // The band of cells along a segment far longer than the geometry is dense
   // (kilometres of empty world) holds more cells than there are edges: then
   // every edge is offered instead, so a query costs at most one pass over
   // the boundary whatever the world's extent.
-  const double band_cells = (static_cast<double>(sim::length_of(b - a)) / cell_ + 2.0 * (grow / cell_ + 1.0)) * (2.0 * (grow / cell_ + 1.0));
+  const double band_cells =
+      (static_cast<double>(sim::length_of(b - a)) / cell_ + 2.0 * (grow / cell_ + 1.0)) * (2.0 * (grow / cell_ + 1.0));
   if (band_cells > static_cast<double>(boundary_.size())) {
     for (const sim::Segment& s : boundary_)
       if (!fn(s)) return;

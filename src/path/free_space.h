@@ -23,13 +23,13 @@
 namespace throng::path {
 
 struct FreeSpaceOptions {
-  float resolution = 0.001f;        // m per integer unit of the snapped geometry
-  float circle_tolerance = 0.01f;   // m: polygon vertices at most this far outside a circle
+  float resolution = 0.001f;       // m per integer unit of the snapped geometry
+  float circle_tolerance = 0.01f;  // m: polygon vertices at most this far outside a circle
   // Without a walkable region: the free space is the bounding box of the
   // obstacles (and of `extent` when set) grown by this margin.
   float margin = 2.0f;
-  sim::Aabb extent;                 // optional area to include (e.g. start and goal points)
-  float cell_size = 0.0f;           // index cell side; 0 = chosen from the geometry
+  sim::Aabb extent;        // optional area to include (e.g. start and goal points)
+  float cell_size = 0.0f;  // index cell side; 0 = chosen from the geometry
   // Throws Error naming the field for NaN, non-positive or absurd values.
   void validate() const;
 };

@@ -11,7 +11,8 @@
 
 namespace throng::path {
 
-CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& machine, std::span<const float> desired_speed) {
+CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& machine,
+                   std::span<const float> desired_speed) {
   if (!desired_speed.empty() && desired_speed.size() != paths.size())
     throw Error("one desired speed per path expected", at_field("match.speed"));
   CurveSet out;
@@ -21,8 +22,9 @@ CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& mach
   for (std::size_t p = 0; p < paths.size(); ++p) {
     const ResampledPath& path = paths[p];
     if (std::fabs(path.spacing - machine.spacing()) > 1e-6f * machine.spacing())
-      throw Error(fmt::format("path resampled every {} m, the machine's spacing is {} m", path.spacing, machine.spacing()),
-                  at_field(fmt::format("paths[{}]", p)));
+      throw Error(
+          fmt::format("path resampled every {} m, the machine's spacing is {} m", path.spacing, machine.spacing()),
+          at_field(fmt::format("paths[{}]", p)));
     std::vector<std::int32_t> state_of_mark;
     for (const std::string& name : path.mark_states) {
       const std::int32_t s = machine.state_index(name);
@@ -30,7 +32,8 @@ CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& mach
       state_of_mark.push_back(s);
     }
     const float v = desired_speed.empty() ? 0.0f : desired_speed[p];
-    if (!(v >= 0 && std::isfinite(v))) throw Error("desired speed must be >= 0", at_field(fmt::format("paths[{}].speed", p)));
+    if (!(v >= 0 && std::isfinite(v)))
+      throw Error("desired speed must be >= 0", at_field(fmt::format("paths[{}].speed", p)));
     const std::size_t curves = path.points.size() / k;
     for (std::size_t c = 0; c < curves; ++c) {
       std::int32_t required = -1;
@@ -49,7 +52,8 @@ CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& mach
 }
 
 void MatchOptions::validate() const {
-  if (!(speed_weight >= 0 && std::isfinite(speed_weight))) throw Error("speed weight must be >= 0", at_field("match.speed_weight"));
+  if (!(speed_weight >= 0 && std::isfinite(speed_weight)))
+    throw Error("speed weight must be >= 0", at_field("match.speed_weight"));
 }
 
 MatchGrid::MatchGrid(const MotionGraph& machine, const CurveSet& curves, const MatchOptions& options) {
@@ -132,8 +136,8 @@ std::pair<std::int32_t, double> best_end(const MotionGraph& m, std::int32_t a) {
 
 }  // namespace
 
-Sequence score_sequence(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost, std::int32_t path,
-                        std::span<const std::int32_t> grid_motions) {
+Sequence score_sequence(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost,
+                        std::int32_t path, std::span<const std::int32_t> grid_motions) {
   const auto& loco = machine.locomotion_segments();
   const auto motions = static_cast<std::int32_t>(loco.size());
   const std::int32_t c0 = curves.path_begin[static_cast<std::size_t>(path)];
@@ -152,8 +156,9 @@ Sequence score_sequence(const MotionGraph& machine, const CurveSet& curves, std:
       s.match_cost += e;
     }
     const MotionSegment& ms = machine.segments()[static_cast<std::size_t>(seg)];
-    geometric += curve_motion_distance(curves.points.data() + static_cast<std::size_t>(c0 + c) * static_cast<std::size_t>(curves.k),
-                                       curves.tangents[static_cast<std::size_t>(c0 + c)], ms.trajectory.data(), curves.k);
+    geometric += curve_motion_distance(
+        curves.points.data() + static_cast<std::size_t>(c0 + c) * static_cast<std::size_t>(curves.k),
+        curves.tangents[static_cast<std::size_t>(c0 + c)], ms.trajectory.data(), curves.k);
     if (c > 0) {
       const double t = machine.transition_cost(s.segments[static_cast<std::size_t>(c) - 1], seg);
       if (t == kInf) {
@@ -198,7 +203,8 @@ std::vector<Sequence> greedy_sequences(const MotionGraph& machine, const CurveSe
   return out;
 }
 
-std::vector<Sequence> repaired_greedy_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost) {
+std::vector<Sequence> repaired_greedy_sequences(const MotionGraph& machine, const CurveSet& curves,
+                                                std::span<const float> cost) {
   const auto& loco = machine.locomotion_segments();
   const auto motions = static_cast<std::int32_t>(loco.size());
   std::vector<Sequence> out(static_cast<std::size_t>(curves.path_count()));
@@ -236,12 +242,14 @@ std::vector<Sequence> dp_sequences(const MotionGraph& machine, const CurveSet& c
   const auto M = static_cast<std::int32_t>(loco.size());
   std::vector<Sequence> out(static_cast<std::size_t>(curves.path_count()));
   // Transition costs between grid motions, and into/out of the start/end states.
-  std::vector<double> tr(static_cast<std::size_t>(M) * static_cast<std::size_t>(M)), into(static_cast<std::size_t>(M)), outof(static_cast<std::size_t>(M));
+  std::vector<double> tr(static_cast<std::size_t>(M) * static_cast<std::size_t>(M)), into(static_cast<std::size_t>(M)),
+      outof(static_cast<std::size_t>(M));
   for (std::int32_t a = 0; a < M; ++a) {
     into[static_cast<std::size_t>(a)] = best_start(machine, loco[static_cast<std::size_t>(a)]).second;
     outof[static_cast<std::size_t>(a)] = best_end(machine, loco[static_cast<std::size_t>(a)]).second;
     for (std::int32_t b = 0; b < M; ++b)
-      tr[static_cast<std::size_t>(a * M + b)] = machine.transition_cost(loco[static_cast<std::size_t>(a)], loco[static_cast<std::size_t>(b)]);
+      tr[static_cast<std::size_t>(a * M + b)] =
+          machine.transition_cost(loco[static_cast<std::size_t>(a)], loco[static_cast<std::size_t>(b)]);
   }
   host_parallel_for("path.match_dp", curves.path_count(), [&](Index p) {
     const std::int32_t c0 = curves.path_begin[static_cast<std::size_t>(p)];
@@ -250,7 +258,8 @@ std::vector<Sequence> dp_sequences(const MotionGraph& machine, const CurveSet& c
     const auto sM = static_cast<std::size_t>(M);
     std::vector<double> D(static_cast<std::size_t>(n) * sM, kInf);
     std::vector<std::int32_t> from(static_cast<std::size_t>(n) * sM, -1);
-    for (std::int32_t m = 0; m < M; ++m) D[static_cast<std::size_t>(m)] = pair_cost(cost, M, c0, m) + into[static_cast<std::size_t>(m)];
+    for (std::int32_t m = 0; m < M; ++m)
+      D[static_cast<std::size_t>(m)] = pair_cost(cost, M, c0, m) + into[static_cast<std::size_t>(m)];
     for (std::int32_t c = 1; c < n; ++c)
       for (std::int32_t m = 0; m < M; ++m) {
         const double e = pair_cost(cost, M, c0 + c, m);
@@ -258,7 +267,8 @@ std::vector<Sequence> dp_sequences(const MotionGraph& machine, const CurveSet& c
         double low = kInf;
         std::int32_t arg = -1;
         for (std::int32_t q = 0; q < M; ++q) {
-          const double v = D[static_cast<std::size_t>(c - 1) * sM + static_cast<std::size_t>(q)] + tr[static_cast<std::size_t>(q * M + m)];
+          const double v = D[static_cast<std::size_t>(c - 1) * sM + static_cast<std::size_t>(q)] +
+                           tr[static_cast<std::size_t>(q * M + m)];
           if (v < low) {
             low = v;
             arg = q;
@@ -270,7 +280,8 @@ std::vector<Sequence> dp_sequences(const MotionGraph& machine, const CurveSet& c
     double low = kInf;
     std::int32_t arg = -1;
     for (std::int32_t m = 0; m < M; ++m) {
-      const double v = D[static_cast<std::size_t>(n - 1) * sM + static_cast<std::size_t>(m)] + outof[static_cast<std::size_t>(m)];
+      const double v =
+          D[static_cast<std::size_t>(n - 1) * sM + static_cast<std::size_t>(m)] + outof[static_cast<std::size_t>(m)];
       if (v < low) {
         low = v;
         arg = m;

@@ -40,7 +40,8 @@ inline constexpr float kNoMatch = 3.0e38f;  // cost of a forbidden (curve, motio
 
 // E(c, m) for one pair: k points of the curve, its unit start tangent and
 // the motion's k trajectory points.
-THRONG_HOST_DEVICE inline float curve_motion_distance(const glm::vec2* curve, glm::vec2 tangent, const glm::vec2* motion, std::int32_t k) {
+THRONG_HOST_DEVICE inline float curve_motion_distance(const glm::vec2* curve, glm::vec2 tangent,
+                                                      const glm::vec2* motion, std::int32_t k) {
   const glm::vec2 p0 = curve[0];
   float sum = 0.0f;
   for (std::int32_t i = 0; i < k; ++i) {
@@ -67,7 +68,8 @@ struct CurveSet {
 // Cuts every path into whole curves of machine.k() points (the tail shorter
 // than d is left out). Marks must name states of the machine (Error otherwise).
 // desired_speed: one per path, or empty (0 = any).
-CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& machine, std::span<const float> desired_speed = {});
+CurveSet cut_paths(std::span<const ResampledPath> paths, const MotionGraph& machine,
+                   std::span<const float> desired_speed = {});
 
 // The grid job: cost[c * motions + m] = E(c, m) (+ speed term), or kNoMatch.
 struct MatchGridJob {
@@ -130,18 +132,18 @@ struct Sequence {
   std::vector<std::int32_t> segments;  // machine segment ids, one per curve
   std::int32_t start_segment = -1;
   std::int32_t end_segment = -1;
-  double match_cost = 0;        // sum of E over the curves (kNoMatch pairs count as such)
-  double transition_cost = 0;   // sum over consecutive pairs (legal ones), start and end included
-  std::int32_t illegal = 0;     // transitions the machine forbids
-  double path_error = 0;        // mean distance per point (the geometric part of E), m
+  double match_cost = 0;       // sum of E over the curves (kNoMatch pairs count as such)
+  double transition_cost = 0;  // sum over consecutive pairs (legal ones), start and end included
+  std::int32_t illegal = 0;    // transitions the machine forbids
+  double path_error = 0;       // mean distance per point (the geometric part of E), m
   double total() const { return illegal > 0 ? INFINITY : match_cost + transition_cost; }
 };
 
 // Scores a given sequence of grid motion indices for the curves of path p.
 // start/end segments are chosen as the cheapest legal ones (or the cheapest
 // at all, counted illegal, when none is legal).
-Sequence score_sequence(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost, std::int32_t path,
-                        std::span<const std::int32_t> grid_motions);
+Sequence score_sequence(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost,
+                        std::int32_t path, std::span<const std::int32_t> grid_motions);
 
 // Greedy: each curve's best motion (the grid's argmin).
 std::vector<Sequence> greedy_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost,
@@ -149,7 +151,8 @@ std::vector<Sequence> greedy_sequences(const MotionGraph& machine, const CurveSe
 // Greedy repaired to legality: each curve takes its best motion among those
 // its predecessor may be followed by (the last also must reach the end
 // state); illegal > 0 when even that fails.
-std::vector<Sequence> repaired_greedy_sequences(const MotionGraph& machine, const CurveSet& curves, std::span<const float> cost);
+std::vector<Sequence> repaired_greedy_sequences(const MotionGraph& machine, const CurveSet& curves,
+                                                std::span<const float> cost);
 // Dynamic programming over the machine's transitions, per path in parallel
 // ("path.match_dp"): the legal sequence of least total cost (illegal > 0
 // only when no legal sequence exists).

@@ -31,7 +31,8 @@ void MatchGridJob::run() const {
           j.cost[i] = kNoMatch;
           return;
         }
-        float e = curve_motion_distance(j.curve_points.data() + c * j.k, j.curve_tangents[c], j.motion_points.data() + m * j.k, j.k);
+        float e = curve_motion_distance(j.curve_points.data() + c * j.k, j.curve_tangents[c],
+                                        j.motion_points.data() + m * j.k, j.k);
         const float v = j.curve_speed[c];
         if (v > 0.0f) e += j.speed_weight * static_cast<float>(j.k) * fabsf(j.motion_speed[m] - v);
         j.cost[i] = e;

@@ -44,7 +44,8 @@ MatchRun match_paths(const MotionGraph& machine, const std::vector<PathInput>& i
     }
   });
   for (std::size_t i = 0; i < errors.size(); ++i)
-    if (!errors[i].empty()) throw Error(errors[i], at_field("paths[" + std::to_string(i) + "] (" + inputs[i].name + ")"));
+    if (!errors[i].empty())
+      throw Error(errors[i], at_field("paths[" + std::to_string(i) + "] (" + inputs[i].name + ")"));
   run.resample_ms = ms_since(t0);
 
   std::vector<float> speeds;
@@ -82,7 +83,9 @@ MatchRun match_paths(const MotionGraph& machine, const std::vector<PathInput>& i
     r.greedy_illegal = greedy[p].illegal;
     r.greedy_error = greedy[p].path_error;
     r.dp_error = dp[p].path_error;
-    for (std::int32_t s : dp[p].segments) r.dp_states.push_back(machine.states()[static_cast<std::size_t>(machine.segments()[static_cast<std::size_t>(s)].state)].name);
+    for (std::int32_t s : dp[p].segments)
+      r.dp_states.push_back(
+          machine.states()[static_cast<std::size_t>(machine.segments()[static_cast<std::size_t>(s)].state)].name);
   }
   const double points = std::max<double>(1.0, static_cast<double>(run.curves) * k);
   run.greedy.path_error = eg / points;
@@ -135,14 +138,16 @@ sim::World random_obstacle_world(const RandomWorldOptions& o) {
   return sim::World::build(spec, 4.0f, {}, Memory::Host);
 }
 
-std::vector<PathQuery> random_queries(const Planner& planner, std::int64_t count, std::uint64_t seed, float min_distance) {
+std::vector<PathQuery> random_queries(const Planner& planner, std::int64_t count, std::uint64_t seed,
+                                      float min_distance) {
   const sim::Aabb b = planner.space().bounds();
   if (b.empty()) throw Error("the planner's free space is empty", at_field("random_queries"));
   Rng rng(seed, 0x9a7);
   const float need = planner.options().radius + 0.1f;
   auto sample = [&]() -> glm::vec2 {
     for (int attempt = 0; attempt < 10000; ++attempt) {
-      const glm::vec2 p(static_cast<float>(rng.uniform(b.min.x, b.max.x)), static_cast<float>(rng.uniform(b.min.y, b.max.y)));
+      const glm::vec2 p(static_cast<float>(rng.uniform(b.min.x, b.max.x)),
+                        static_cast<float>(rng.uniform(b.min.y, b.max.y)));
       if (planner.space().clearance(p) >= need) return p;
     }
     throw Error("found no free point with room for the agent", at_field("random_queries"));

@@ -30,8 +30,10 @@ void PlanOptions::validate() const {
   if (!(std::isfinite(clearance_weight) && clearance_weight >= 0))
     throw Error("clearance weight must be >= 0", at_field("plan.clearance_weight"));
   if (!std::isfinite(shortcut_clearance) || (shortcut_clearance >= 0 && shortcut_clearance < radius))
-    throw Error("shortcut clearance must be >= radius (or negative for the default)", at_field("plan.shortcut_clearance"));
-  if (!(std::isfinite(corner_radius) && corner_radius >= 0)) throw Error("corner radius must be >= 0", at_field("plan.corner_radius"));
+    throw Error("shortcut clearance must be >= radius (or negative for the default)",
+                at_field("plan.shortcut_clearance"));
+  if (!(std::isfinite(corner_radius) && corner_radius >= 0))
+    throw Error("corner radius must be >= 0", at_field("plan.corner_radius"));
   if (attach_candidates < 1) throw Error("attach candidates must be >= 1", at_field("plan.attach_candidates"));
   free_space.validate();
 }
@@ -116,8 +118,8 @@ float edge_total(std::span<const float> cumulative_cost, const RoadmapEdge& edge
 
 // The attachment of start s and goal g (both on an edge); s_from_a and
 // g_from_a are their costs from their edges' node a.
-Attachment attachment(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const EdgePoint& s, const EdgePoint& g,
-                      float s_from_a, float g_from_a) {
+Attachment attachment(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const EdgePoint& s,
+                      const EdgePoint& g, float s_from_a, float g_from_a) {
   Attachment at;
   at.s = s;
   at.g = g;
@@ -135,7 +137,8 @@ Attachment attachment(const Roadmap& m, std::span<const float> cumulative_cost, 
 // A* from S (node n, the start) to G (node n + 1, the goal) over the roadmap
 // nodes. Returns the chain of nodes S..G, empty when G is not reached (or
 // start and goal lie in different components).
-std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const Attachment& at) {
+std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q,
+                                 const Attachment& at) {
   const std::int32_t n = m.node_count();
   const std::int32_t S = n, G = n + 1;
   const RoadmapEdge& se = at.se;
@@ -143,7 +146,9 @@ std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumula
   if (m.node_component[static_cast<std::size_t>(se.a)] != m.node_component[static_cast<std::size_t>(ge.a)]) return {};
   std::vector<float> cost(static_cast<std::size_t>(n + 2), INFINITY);
   std::vector<std::int32_t> parent(static_cast<std::size_t>(n + 2), -1);
-  auto h = [&](std::int32_t v) { return v == G ? 0.0f : sim::length_of((v == S ? q.start : m.nodes[static_cast<std::size_t>(v)]) - q.goal); };
+  auto h = [&](std::int32_t v) {
+    return v == G ? 0.0f : sim::length_of((v == S ? q.start : m.nodes[static_cast<std::size_t>(v)]) - q.goal);
+  };
   using Entry = std::pair<float, std::int32_t>;  // (f, node): ties broken by node index
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
   auto relax = [&](std::int32_t from, std::int32_t to, float c) {
@@ -169,7 +174,8 @@ std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumula
     }
     if (v == ge.a) relax(v, G, at.g_from_a + at.g_attach);
     if (v == ge.b) relax(v, G, at.g_total - at.g_from_a + at.g_attach);
-    for (std::int32_t k = m.adjacency_begin[static_cast<std::size_t>(v)]; k < m.adjacency_begin[static_cast<std::size_t>(v) + 1]; ++k) {
+    for (std::int32_t k = m.adjacency_begin[static_cast<std::size_t>(v)];
+         k < m.adjacency_begin[static_cast<std::size_t>(v) + 1]; ++k) {
       const std::int32_t e = m.adjacency[static_cast<std::size_t>(k)];
       const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
       relax(v, edge.a == v ? edge.b : edge.a, edge_total(cumulative_cost, edge));
@@ -184,10 +190,12 @@ std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumula
 
 // Appends the polyline of the cheapest edge joining nodes u and v, from u
 // to v (what the search relaxed between them).
-void append_cheapest_edge(const Roadmap& m, std::span<const float> cumulative_cost, std::int32_t u, std::int32_t v, std::vector<glm::vec2>& raw) {
+void append_cheapest_edge(const Roadmap& m, std::span<const float> cumulative_cost, std::int32_t u, std::int32_t v,
+                          std::vector<glm::vec2>& raw) {
   std::int32_t best = -1;
   float best_cost = INFINITY;
-  for (std::int32_t a = m.adjacency_begin[static_cast<std::size_t>(u)]; a < m.adjacency_begin[static_cast<std::size_t>(u) + 1]; ++a) {
+  for (std::int32_t a = m.adjacency_begin[static_cast<std::size_t>(u)];
+       a < m.adjacency_begin[static_cast<std::size_t>(u) + 1]; ++a) {
     const std::int32_t e = m.adjacency[static_cast<std::size_t>(a)];
     const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(e)];
     if (!((edge.a == u && edge.b == v) || (edge.a == v && edge.b == u))) continue;
@@ -206,8 +214,8 @@ void append_cheapest_edge(const Roadmap& m, std::span<const float> cumulative_co
 
 // The roadmap polyline (m) of a found chain S..G: start, its attach point,
 // the edges between the chain's nodes, the goal's attach point, goal.
-std::vector<glm::vec2> chain_polyline(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const Attachment& at,
-                                      const std::vector<std::int32_t>& chain) {
+std::vector<glm::vec2> chain_polyline(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q,
+                                      const Attachment& at, const std::vector<std::int32_t>& chain) {
   const EdgePoint& s = at.s;
   const EdgePoint& g = at.g;
   const RoadmapEdge& se = at.se;
@@ -223,7 +231,8 @@ std::vector<glm::vec2> chain_polyline(const Roadmap& m, std::span<const float> c
       for (std::int32_t i = s.piece; i > g.piece; --i) push_point(raw, m.edge_point(s.edge, i));
   } else {
     append_partial(m, s, chain[1] == se.b && !(chain[1] == se.a && at.s_from_a <= at.s_total - at.s_from_a), raw);
-    for (std::size_t k = 1; k + 2 < chain.size(); ++k) append_cheapest_edge(m, cumulative_cost, chain[k], chain[k + 1], raw);
+    for (std::size_t k = 1; k + 2 < chain.size(); ++k)
+      append_cheapest_edge(m, cumulative_cost, chain[k], chain[k + 1], raw);
     // From the last node along the goal's edge to its attach point.
     const std::int32_t last = chain[chain.size() - 2];
     const bool from_a = last == ge.a && !(last == ge.b && at.g_total - at.g_from_a < at.g_from_a);
@@ -327,10 +336,12 @@ std::vector<glm::vec2> Planner::round_corners(std::span<const glm::vec2> poly, f
         for (int k = 0; k <= steps; ++k) {
           const float ang = side * turn * static_cast<float>(k) / static_cast<float>(steps);
           const glm::vec2 r0 = t1 - centre;
-          pts.push_back(centre + glm::vec2(r0.x * std::cos(ang) - r0.y * std::sin(ang), r0.x * std::sin(ang) + r0.y * std::cos(ang)));
+          pts.push_back(centre + glm::vec2(r0.x * std::cos(ang) - r0.y * std::sin(ang),
+                                           r0.x * std::sin(ang) + r0.y * std::cos(ang)));
         }
         bool clear = true;
-        for (std::size_t k = 1; k < pts.size() && clear; ++k) clear = space_.segment_clear(pts[k - 1], pts[k], options_.radius);
+        for (std::size_t k = 1; k < pts.size() && clear; ++k)
+          clear = space_.segment_clear(pts[k - 1], pts[k], options_.radius);
         if (clear) arc = std::move(pts);
       }
     }
@@ -346,9 +357,8 @@ std::vector<glm::vec2> Planner::round_corners(std::span<const glm::vec2> poly, f
 
 std::vector<PlannedPath> Planner::plan_all(std::span<const PathQuery> queries) const {
   std::vector<PlannedPath> out(queries.size());
-  host_parallel_for("path.plan", static_cast<Index>(queries.size()), [&](Index i) {
-    out[static_cast<std::size_t>(i)] = plan(queries[static_cast<std::size_t>(i)]);
-  });
+  host_parallel_for("path.plan", static_cast<Index>(queries.size()),
+                    [&](Index i) { out[static_cast<std::size_t>(i)] = plan(queries[static_cast<std::size_t>(i)]); });
   return out;
 }
 

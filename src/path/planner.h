@@ -23,8 +23,8 @@
 namespace throng::path {
 
 struct PlanOptions {
-  float radius = 0.25f;            // m: the agent's radius
-  float clearance_weight = 1.0f;   // >= 0: how much narrow passages cost
+  float radius = 0.25f;           // m: the agent's radius
+  float clearance_weight = 1.0f;  // >= 0: how much narrow passages cost
   // Clearance the shortcuts keep, m; below 0: radius + 0.05 m (room for the
   // spline's rounding of corners).
   float shortcut_clearance = -1.0f;
@@ -50,10 +50,10 @@ const char* to_string(PlanStatus s);
 
 struct PlannedPath {
   PlanStatus status = PlanStatus::Unreachable;
-  std::vector<glm::vec2> points;  // smoothed polyline from start to goal (empty unless Found)
+  std::vector<glm::vec2> points;          // smoothed polyline from start to goal (empty unless Found)
   std::vector<glm::vec2> roadmap_points;  // the same before smoothing
-  float length = 0.0f;            // m, of `points`
-  float min_clearance = 0.0f;     // m: smallest distance from `points` to an obstacle
+  float length = 0.0f;                    // m, of `points`
+  float min_clearance = 0.0f;             // m: smallest distance from `points` to an obstacle
   bool found() const { return status == PlanStatus::Found; }
 };
 

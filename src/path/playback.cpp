@@ -14,8 +14,8 @@ namespace {
 
 struct Item {
   std::int32_t segment;
-  glm::vec2 place;     // where the segment's origin goes
-  float turn;          // map rotation applied to the clip
+  glm::vec2 place;  // where the segment's origin goes
+  float turn;       // map rotation applied to the clip
   double start, duration;
   std::int32_t curve;  // -1 for the start and end segments
 };
@@ -23,7 +23,8 @@ struct Item {
 // The segments of `sequence` laid end to end along `path`: where each
 // segment's origin goes, the turn applied to it and its start (s); `total`
 // gets the length of them all (s).
-std::vector<Item> lay_out(const MotionGraph& machine, const ResampledPath& path, const Sequence& sequence, double& total) {
+std::vector<Item> lay_out(const MotionGraph& machine, const ResampledPath& path, const Sequence& sequence,
+                          double& total) {
   const std::int32_t k = machine.k();
   const auto curves = static_cast<std::int32_t>(sequence.segments.size());
   const auto& segs = machine.segments();
@@ -56,10 +57,12 @@ std::vector<Item> lay_out(const MotionGraph& machine, const ResampledPath& path,
 // `curve` (k points a curve, the curves either side included).
 double deviation(const ResampledPath& path, std::int32_t k, std::int32_t curve, glm::vec2 g) {
   const std::int64_t lo = std::max<std::int64_t>(0, (static_cast<std::int64_t>(curve) - 1) * k);
-  const std::int64_t hi = std::min<std::int64_t>(static_cast<std::int64_t>(path.points.size()) - 1, (static_cast<std::int64_t>(curve) + 2) * k);
+  const std::int64_t hi = std::min<std::int64_t>(static_cast<std::int64_t>(path.points.size()) - 1,
+                                                 (static_cast<std::int64_t>(curve) + 2) * k);
   double d = INFINITY;
   for (std::int64_t i = lo; i < hi; ++i)
-    d = std::min(d, static_cast<double>(sim::distance_to_segment(g, path.points[static_cast<std::size_t>(i)], path.points[static_cast<std::size_t>(i) + 1])));
+    d = std::min(d, static_cast<double>(sim::distance_to_segment(g, path.points[static_cast<std::size_t>(i)],
+                                                                 path.points[static_cast<std::size_t>(i) + 1])));
   if (hi <= lo) d = sim::length_of(g - path.points[static_cast<std::size_t>(lo)]);
   return d;
 }

@@ -28,11 +28,11 @@
 namespace throng::path {
 
 struct Playback {
-  motion::Clip clip;                  // world (Y-up), the machine's fps
-  std::vector<glm::vec2> root_ground; // per frame, map coordinates
+  motion::Clip clip;                   // world (Y-up), the machine's fps
+  std::vector<glm::vec2> root_ground;  // per frame, map coordinates
   std::int32_t first_matched_frame = 0, matched_frames = 0;
-  double deviation_mean = 0;          // m
-  double deviation_max = 0;           // m
+  double deviation_mean = 0;  // m
+  double deviation_max = 0;   // m
 };
 
 // `sequence` from greedy_sequences / dp_sequences for this path (its curves

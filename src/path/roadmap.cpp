@@ -111,7 +111,8 @@ std::vector<DVec> discretize(DVec v0, DVec v1, const Site& s0, const Site& s1, b
     const double dx = xs[i + 1] - xs[i];
     const double slope = std::max(std::fabs(xs[i] - px), std::fabs(xs[i + 1] - px)) / py;
     const double len = std::fabs(dx) * std::sqrt(1 + slope * slope);
-    const int k = static_cast<int>(std::clamp(std::ceil(len / std::max(chord, 1e-9)), 1.0, static_cast<double>(kMaxPieces)));
+    const int k =
+        static_cast<int>(std::clamp(std::ceil(len / std::max(chord, 1e-9)), 1.0, static_cast<double>(kMaxPieces)));
     for (int j = 0; j < k; ++j) pts.push_back(at(xs[i] + dx * j / k));
   }
   pts.front() = v0;
@@ -123,7 +124,8 @@ struct UnionFind {
   std::vector<std::int32_t> parent;
   explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
   std::int32_t find(std::int32_t x) {
-    while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    while (parent[static_cast<std::size_t>(x)] != x)
+      x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
     return x;
   }
   void join(std::int32_t a, std::int32_t b) {
@@ -158,8 +160,8 @@ struct Run {
 // Points i..j of `pts` (clearances c, all >= keep), extended to where the
 // clearance crosses `keep` on the pieces before and after, repeated points
 // dropped (a cut at a sample point). Units.
-Run kept_run(const std::vector<DVec>& pts, const std::vector<double>& c, std::size_t i, std::size_t j, const Site& s0, const Site& s1,
-             double keep) {
+Run kept_run(const std::vector<DVec>& pts, const std::vector<double>& c, std::size_t i, std::size_t j, const Site& s0,
+             const Site& s1, double keep) {
   std::vector<DVec> run;
   std::vector<double> run_c;
   if (i > 0) {
@@ -210,9 +212,11 @@ class RoadmapBuilder {
   // roadmap edge; its ends are the edge's vertices where they coincide,
   // else new nodes. Skipped when it is a loop of zero length.
   void add_edge(const VoronoiDiagram::edge_type& edge, DVec v0, DVec v1, const Run& poly) {
-    const bool starts_at_vertex = norm(poly.pts.front() - v0) <= 1e-9, ends_at_vertex = norm(poly.pts.back() - v1) <= 1e-9;
+    const bool starts_at_vertex = norm(poly.pts.front() - v0) <= 1e-9,
+               ends_at_vertex = norm(poly.pts.back() - v1) <= 1e-9;
     RoadmapEdge e;
-    e.a = starts_at_vertex ? node_of_vertex(edge.vertex0(), poly.c.front()) : add_node(poly.pts.front(), poly.c.front());
+    e.a =
+        starts_at_vertex ? node_of_vertex(edge.vertex0(), poly.c.front()) : add_node(poly.pts.front(), poly.c.front());
     e.b = ends_at_vertex ? node_of_vertex(edge.vertex1(), poly.c.back()) : add_node(poly.pts.back(), poly.c.back());
     e.point_begin = static_cast<std::int32_t>(map_.points.size());
     e.point_count = static_cast<std::int32_t>(poly.pts.size());
@@ -236,8 +240,9 @@ class RoadmapBuilder {
 // One finite primary Voronoi edge: discretized (tol, step in units), kept
 // only inside free space, and cut into runs of clearance >= keep (units),
 // each added as a roadmap edge. Counts map.inside_edges.
-void add_voronoi_edge(const FreeSpace& space, const VoronoiDiagram::edge_type& edge, const std::vector<bp::segment_data<int>>& segments, double tol,
-                      double step, double keep, Roadmap& map, RoadmapBuilder& builder) {
+void add_voronoi_edge(const FreeSpace& space, const VoronoiDiagram::edge_type& edge,
+                      const std::vector<bp::segment_data<int>>& segments, double tol, double step, double keep,
+                      Roadmap& map, RoadmapBuilder& builder) {
   const double res = space.resolution();
   const Site s0 = site_of(*edge.cell(), segments), s1 = site_of(*edge.twin()->cell(), segments);
   const DVec v0{edge.vertex0()->x(), edge.vertex0()->y()}, v1{edge.vertex1()->x(), edge.vertex1()->y()};
@@ -282,7 +287,8 @@ void link_nodes(Roadmap& map) {
   for (std::size_t k = 0; k < map.edges.size(); ++k) {
     const RoadmapEdge& e = map.edges[k];
     map.adjacency[static_cast<std::size_t>(cursor[static_cast<std::size_t>(e.a)]++)] = static_cast<std::int32_t>(k);
-    if (e.b != e.a) map.adjacency[static_cast<std::size_t>(cursor[static_cast<std::size_t>(e.b)]++)] = static_cast<std::int32_t>(k);
+    if (e.b != e.a)
+      map.adjacency[static_cast<std::size_t>(cursor[static_cast<std::size_t>(e.b)]++)] = static_cast<std::int32_t>(k);
     uf.join(e.a, e.b);
   }
   map.node_component.resize(n);
@@ -333,7 +339,8 @@ std::vector<EdgePoint> Roadmap::nearest_points(glm::vec2 p, std::int32_t limit) 
     EdgePoint ep;
     ep.edge = static_cast<std::int32_t>(e);
     for (std::int32_t i = 0; i + 1 < edge.point_count; ++i) {
-      const glm::vec2 a = points[static_cast<std::size_t>(edge.point_begin + i)], b = points[static_cast<std::size_t>(edge.point_begin + i + 1)];
+      const glm::vec2 a = points[static_cast<std::size_t>(edge.point_begin + i)],
+                      b = points[static_cast<std::size_t>(edge.point_begin + i + 1)];
       float t = 0;
       const glm::vec2 q = sim::closest_point_on_segment(p, a, b, &t);
       const float d = sim::length_of(p - q);
@@ -346,7 +353,9 @@ std::vector<EdgePoint> Roadmap::nearest_points(glm::vec2 p, std::int32_t limit) 
     }
     if (ep.distance < INFINITY) best.push_back(ep);
   }
-  auto closer = [](const EdgePoint& x, const EdgePoint& y) { return x.distance < y.distance || (x.distance == y.distance && x.edge < y.edge); };
+  auto closer = [](const EdgePoint& x, const EdgePoint& y) {
+    return x.distance < y.distance || (x.distance == y.distance && x.edge < y.edge);
+  };
   const std::size_t k = std::min(best.size(), static_cast<std::size_t>(std::max(0, limit)));
   std::partial_sort(best.begin(), best.begin() + static_cast<std::ptrdiff_t>(k), best.end(), closer);
   best.resize(k);

@@ -32,11 +32,11 @@ struct RoadmapOptions {
 };
 
 struct RoadmapEdge {
-  std::int32_t a = 0, b = 0;        // node indices
-  std::int32_t point_begin = 0;     // polyline points [point_begin, point_begin + point_count), from a to b
+  std::int32_t a = 0, b = 0;     // node indices
+  std::int32_t point_begin = 0;  // polyline points [point_begin, point_begin + point_count), from a to b
   std::int32_t point_count = 0;
-  float length = 0.0f;              // m
-  float min_clearance = 0.0f;       // m
+  float length = 0.0f;         // m
+  float min_clearance = 0.0f;  // m
 };
 
 // A point on an edge: polyline piece `piece` (from point piece to piece + 1)
@@ -54,16 +54,16 @@ struct Roadmap {
   std::vector<glm::vec2> nodes;
   std::vector<float> node_clearance;
   std::vector<RoadmapEdge> edges;
-  std::vector<glm::vec2> points;        // every edge's polyline, edge after edge
-  std::vector<float> point_clearance;   // clearance at each polyline point
+  std::vector<glm::vec2> points;       // every edge's polyline, edge after edge
+  std::vector<float> point_clearance;  // clearance at each polyline point
   // Adjacency (CSR): the edges at node n are adjacency[adjacency_begin[n] .. adjacency_begin[n + 1]).
   std::vector<std::int32_t> adjacency_begin;
   std::vector<std::int32_t> adjacency;
   std::vector<std::int32_t> node_component;  // connected component of each node
 
   // Statistics of the build.
-  std::int64_t voronoi_edges = 0;   // finite primary edges of the diagram
-  std::int64_t inside_edges = 0;    // of those, in free space
+  std::int64_t voronoi_edges = 0;  // finite primary edges of the diagram
+  std::int64_t inside_edges = 0;   // of those, in free space
 
   std::int32_t node_count() const { return static_cast<std::int32_t>(nodes.size()); }
   std::int32_t edge_count() const { return static_cast<std::int32_t>(edges.size()); }

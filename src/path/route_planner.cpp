@@ -20,7 +20,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 void RoutePlannerOptions::validate() const {
-  if (!(std::isfinite(wall_margin) && wall_margin >= 0)) throw Error("wall margin must be >= 0", at_field("planning.wall_margin"));
+  if (!(std::isfinite(wall_margin) && wall_margin >= 0))
+    throw Error("wall margin must be >= 0", at_field("planning.wall_margin"));
   if (!(std::isfinite(clearance_weight) && clearance_weight >= 0))
     throw Error("clearance weight must be >= 0", at_field("planning.clearance_weight"));
 }
@@ -93,14 +94,16 @@ const Planner& RoadmapRoutePlanner::planner_for(float radius) const {
     it = planners_.emplace(radius, Planner::build(std::move(space), options_.plan_options(radius))).first;
     ++stats_.roadmaps;
     stats_.build_seconds += seconds_since(t0);
-    spdlog::debug("route planner: roadmap for radius {} m: {} nodes, {} edges", radius, it->second.roadmap().node_count(),
-                  it->second.roadmap().edge_count());
+    spdlog::debug("route planner: roadmap for radius {} m: {} nodes, {} edges", radius,
+                  it->second.roadmap().node_count(), it->second.roadmap().edge_count());
   }
   return it->second;
 }
 
-std::vector<std::vector<glm::vec2>> RoadmapRoutePlanner::plan(const sim::World& world, std::span<const glm::vec2> starts,
-                                                              std::span<const glm::vec2> goals, float agent_radius) const {
+std::vector<std::vector<glm::vec2>> RoadmapRoutePlanner::plan(const sim::World& world,
+                                                              std::span<const glm::vec2> starts,
+                                                              std::span<const glm::vec2> goals,
+                                                              float agent_radius) const {
   if (starts.size() != goals.size())
     throw Error(fmt::format("{} starts but {} goals", starts.size(), goals.size()), at_field("planning"));
   std::vector<std::vector<glm::vec2>> routes(starts.size());
@@ -154,9 +157,11 @@ std::vector<std::vector<glm::vec2>> RoadmapRoutePlanner::plan(const sim::World& 
   stats_.planned += planned;
   stats_.fallback += fallback;
   if (fallback > 0)
-    spdlog::warn("route planner: {} of {} agents (radius {} m) found no roadmap route (goal too close to a wall, or a gap narrower "
-                 "than the agent); they walk straight to their goal",
-                 fallback, n, agent_radius);
+    spdlog::warn(
+        "route planner: {} of {} agents (radius {} m) found no roadmap route (goal too close to a wall, or a gap "
+        "narrower "
+        "than the agent); they walk straight to their goal",
+        fallback, n, agent_radius);
   return routes;
 }
 

@@ -41,24 +41,25 @@ struct RoutePlannerOptions {
 // What the planner did so far (all plan() calls together).
 struct RoutePlannerStats {
   std::int64_t queries = 0;
-  std::int64_t straight = 0;   // the straight line was clear
-  std::int64_t planned = 0;    // routed over the roadmap
-  std::int64_t fallback = 0;   // no roadmap route: straight line
-  std::int32_t roadmaps = 0;   // roadmaps built (one per radius)
-  double build_seconds = 0;    // free space and roadmaps
-  double plan_seconds = 0;     // queries
+  std::int64_t straight = 0;  // the straight line was clear
+  std::int64_t planned = 0;   // routed over the roadmap
+  std::int64_t fallback = 0;  // no roadmap route: straight line
+  std::int32_t roadmaps = 0;  // roadmaps built (one per radius)
+  double build_seconds = 0;   // free space and roadmaps
+  double plan_seconds = 0;    // queries
 };
 
 class RoadmapRoutePlanner final : public sim::RoutePlanner {
  public:
   explicit RoadmapRoutePlanner(RoutePlannerOptions options = {});
-  std::vector<std::vector<glm::vec2>> plan(const sim::World& world, std::span<const glm::vec2> starts, std::span<const glm::vec2> goals,
-                                           float agent_radius) const override;
+  std::vector<std::vector<glm::vec2>> plan(const sim::World& world, std::span<const glm::vec2> starts,
+                                           std::span<const glm::vec2> goals, float agent_radius) const override;
   RoutePlannerStats stats() const;
 
  private:
   // Callers hold mutex_.
-  const FreeSpace& space_for(const sim::World& world, std::span<const glm::vec2> starts, std::span<const glm::vec2> goals) const;
+  const FreeSpace& space_for(const sim::World& world, std::span<const glm::vec2> starts,
+                             std::span<const glm::vec2> goals) const;
   const Planner& planner_for(float radius) const;
   FreeSpace build_space() const;  // of world_ with space_options_; errors name `planning`
 
@@ -66,7 +67,7 @@ class RoadmapRoutePlanner final : public sim::RoutePlanner {
   mutable std::mutex mutex_;
   mutable const sim::World* world_ = nullptr;
   mutable FreeSpaceOptions space_options_;
-  mutable std::unique_ptr<FreeSpace> space_;  // until the first roadmap takes it over
+  mutable std::unique_ptr<FreeSpace> space_;   // until the first roadmap takes it over
   mutable std::map<float, Planner> planners_;  // by radius
   mutable RoutePlannerStats stats_;
 };

@@ -113,7 +113,8 @@ void emit(ResampledPath& out, const HermiteSpline& spline, std::int32_t piece, f
   out.arc.push_back(static_cast<float>(at_arc));
   float dev = INFINITY;
   for (std::int32_t k = std::max(0, piece - 1); k <= std::min(spline.piece_count() - 1, piece + 1); ++k)
-    dev = std::min(dev, sim::distance_to_segment(out.points.back(), knots[static_cast<std::size_t>(k)], knots[static_cast<std::size_t>(k) + 1]));
+    dev = std::min(dev, sim::distance_to_segment(out.points.back(), knots[static_cast<std::size_t>(k)],
+                                                 knots[static_cast<std::size_t>(k) + 1]));
   out.max_polyline_deviation = std::max(out.max_polyline_deviation, dev);
 }
 
@@ -143,14 +144,16 @@ void place_points(const HermiteSpline& spline, const ArcTable& table, float spac
       (far_enough(spline.position(b.piece, ua + mid * (b.u - ua))) ? hi : lo) = mid;
     }
     emit(out, spline, b.piece, ua + hi * (b.u - ua), a.arc + hi * (b.arc - a.arc));
-    if (out.points.size() > 50'000'000) throw Error("path needs more than 50,000,000 points: raise the spacing", at_field("resample.spacing"));
+    if (out.points.size() > 50'000'000)
+      throw Error("path needs more than 50,000,000 points: raise the spacing", at_field("resample.spacing"));
   }
 }
 
 // Sets out.fixed_state (and out.mark_states) from the marks. Polyline arc
 // length equals the chord-length knot parameter, so it maps to spline arc
 // length (m) by interpolating between knots.
-void apply_marks(std::span<const PathMark> marks, const HermiteSpline& spline, const ArcTable& table, ResampledPath& out) {
+void apply_marks(std::span<const PathMark> marks, const HermiteSpline& spline, const ArcTable& table,
+                 ResampledPath& out) {
   const auto& kt = spline.knot_params();
   out.fixed_state.assign(out.points.size(), -1);
   auto spline_arc = [&](float poly_arc) {
@@ -164,7 +167,8 @@ void apply_marks(std::span<const PathMark> marks, const HermiteSpline& spline, c
   for (std::size_t k = 0; k < marks.size(); ++k) {
     const PathMark& m = marks[k];
     if (!(std::isfinite(m.from) && std::isfinite(m.to) && m.from >= 0 && m.to > m.from))
-      throw Error(fmt::format("mark needs 0 <= from < to, got [{}, {}]", m.from, m.to), at_field(fmt::format("marks[{}]", k)));
+      throw Error(fmt::format("mark needs 0 <= from < to, got [{}, {}]", m.from, m.to),
+                  at_field(fmt::format("marks[{}]", k)));
     if (m.state.empty()) throw Error("mark needs a state", at_field(fmt::format("marks[{}].state", k)));
     auto found = std::find(out.mark_states.begin(), out.mark_states.end(), m.state);
     const auto id = static_cast<std::int32_t>(found - out.mark_states.begin());
@@ -179,7 +183,8 @@ void apply_marks(std::span<const PathMark> marks, const HermiteSpline& spline, c
 
 // Stages: densified knots, the spline and its arc-length table, points at
 // the spacing, marks.
-ResampledPath resample_path(std::span<const glm::vec2> polyline, const ResampleOptions& options, std::span<const PathMark> marks) {
+ResampledPath resample_path(std::span<const glm::vec2> polyline, const ResampleOptions& options,
+                            std::span<const PathMark> marks) {
   options.validate();
   const std::vector<glm::vec2> dense = densify(polyline, options.max_knot_spacing);
   const HermiteSpline spline(dense);

@@ -51,9 +51,9 @@ struct PathMark {
 };
 
 struct ResampleOptions {
-  float spacing = 0.0225f;         // s, m: the clips' root step per frame
-  float max_knot_spacing = 1.0f;   // m: polyline edges longer than this get extra knots
-  void validate() const;           // throws Error naming the field
+  float spacing = 0.0225f;        // s, m: the clips' root step per frame
+  float max_knot_spacing = 1.0f;  // m: polyline edges longer than this get extra knots
+  void validate() const;          // throws Error naming the field
 };
 
 // T1 (and T2): points every `spacing` metres of arc length along the spline,
@@ -63,11 +63,11 @@ struct ResampledPath {
   float spacing = 0.0f;
   std::vector<glm::vec2> points;
   std::vector<glm::vec2> tangents;
-  std::vector<float> arc;                // arc length of each point along the spline
-  std::vector<std::int32_t> fixed_state; // -1 = free
-  std::vector<std::string> mark_states;  // names, one per mark
-  float spline_length = 0.0f;            // m
-  float max_polyline_deviation = 0.0f;   // m: largest distance from a sample to the input polyline
+  std::vector<float> arc;                 // arc length of each point along the spline
+  std::vector<std::int32_t> fixed_state;  // -1 = free
+  std::vector<std::string> mark_states;   // names, one per mark
+  float spline_length = 0.0f;             // m
+  float max_polyline_deviation = 0.0f;    // m: largest distance from a sample to the input polyline
 };
 
 // Fits the spline through `polyline` and resamples it. Marks are given in

@@ -33,7 +33,8 @@ FramePos frame_pos(const motion::Clip& clip, double t0, double fps, double t) {
 
 glm::vec2 MachineClip::raw_root(double t) const {
   const FramePos p = frame_pos(clip, time_of_first_frame, fps, t);
-  const glm::vec3 r = glm::mix(clip.root_positions[static_cast<std::size_t>(p.f0)], clip.root_positions[static_cast<std::size_t>(p.f1)], p.w);
+  const glm::vec3 r = glm::mix(clip.root_positions[static_cast<std::size_t>(p.f0)],
+                               clip.root_positions[static_cast<std::size_t>(p.f1)], p.w);
   return ground_from_world(r);
 }
 
@@ -58,8 +59,10 @@ void MotionGraph::pose(std::int32_t seg, double t, std::vector<glm::quat>& rotat
   const FramePos p = frame_pos(c.clip, c.time_of_first_frame, c.fps, s.start_time + t);
   const std::int32_t J = c.clip.joint_count;
   rotations.resize(static_cast<std::size_t>(J));
-  for (std::int32_t j = 0; j < J; ++j) rotations[static_cast<std::size_t>(j)] = glm::slerp(c.clip.rotation(p.f0, j), c.clip.rotation(p.f1, j), p.w);
-  root = glm::mix(c.clip.root_positions[static_cast<std::size_t>(p.f0)], c.clip.root_positions[static_cast<std::size_t>(p.f1)], p.w);
+  for (std::int32_t j = 0; j < J; ++j)
+    rotations[static_cast<std::size_t>(j)] = glm::slerp(c.clip.rotation(p.f0, j), c.clip.rotation(p.f1, j), p.w);
+  root = glm::mix(c.clip.root_positions[static_cast<std::size_t>(p.f0)],
+                  c.clip.root_positions[static_cast<std::size_t>(p.f1)], p.w);
 }
 
 namespace {
@@ -76,9 +79,12 @@ struct Names {
 void check_limits(const StateMachineSpec& spec) {
   if (!(spec.fps >= 1 && spec.fps <= 1000)) fail("fps must be in [1, 1000]", at_field("fps"));
   if (!(spec.spacing >= 1e-3f && spec.spacing <= 1.0f)) fail("spacing must be in [0.001, 1] m", at_field("spacing"));
-  if (spec.points_per_segment < 2 || spec.points_per_segment > 4096) fail("points_per_segment must be in [2, 4096]", at_field("points_per_segment"));
-  if (spec.transition_frames < 0 || spec.transition_frames > 240) fail("transition_frames must be in [0, 240]", at_field("transition_frames"));
-  if (!(spec.pose_weight >= 0 && std::isfinite(spec.pose_weight))) fail("pose_weight must be >= 0", at_field("pose_weight"));
+  if (spec.points_per_segment < 2 || spec.points_per_segment > 4096)
+    fail("points_per_segment must be in [2, 4096]", at_field("points_per_segment"));
+  if (spec.transition_frames < 0 || spec.transition_frames > 240)
+    fail("transition_frames must be in [0, 240]", at_field("transition_frames"));
+  if (!(spec.pose_weight >= 0 && std::isfinite(spec.pose_weight)))
+    fail("pose_weight must be >= 0", at_field("pose_weight"));
   if (spec.states.empty()) fail("a machine needs at least one state", at_field("states"));
   std::size_t segment_total = 0;
   for (const StateSpec& s : spec.states) segment_total += s.segments.size();
@@ -106,7 +112,8 @@ std::vector<MachineGroup> name_groups(const StateMachineSpec& spec, Names& names
     // No cycles: walk up at most group-count steps.
     std::int32_t up = it->second;
     for (std::size_t steps = 0; up >= 0; ++steps, up = groups[static_cast<std::size_t>(up)].parent)
-      if (steps > spec.groups.size() || up == static_cast<std::int32_t>(i)) fail("group '" + g.name + "' is its own ancestor", g.where);
+      if (steps > spec.groups.size() || up == static_cast<std::int32_t>(i))
+        fail("group '" + g.name + "' is its own ancestor", g.where);
   }
   return groups;
 }
@@ -124,12 +131,14 @@ void name_clips(const StateMachineSpec& spec, Names& names) {
 // States in spec order (no segments yet), checking their segments; fills
 // names.state_of. Returns how far into each clip the segments reach
 // (seconds; d = segment arc length, m), to size the clip's samples.
-std::vector<double> name_states(const StateMachineSpec& spec, double d, Names& names, std::vector<MachineState>& states) {
+std::vector<double> name_states(const StateMachineSpec& spec, double d, Names& names,
+                                std::vector<MachineState>& states) {
   const double fps = spec.fps;
   std::vector<double> clip_end(spec.clips.size(), 0.0);
   for (const StateSpec& s : spec.states) {
     if (s.name.empty()) fail("a state needs a name", s.where);
-    if (names.state_of.count(s.name) || names.group_of.count(s.name)) fail("state '" + s.name + "' is defined twice (or is also a group)", s.where);
+    if (names.state_of.count(s.name) || names.group_of.count(s.name))
+      fail("state '" + s.name + "' is defined twice (or is also a group)", s.where);
     names.state_of[s.name] = static_cast<std::int32_t>(states.size());
     MachineState st;
     st.name = s.name;
@@ -146,9 +155,11 @@ std::vector<double> name_states(const StateMachineSpec& spec, double d, Names& n
       if (!(seg.start_frame >= 0 && seg.start_frame <= 36000)) fail("start frame must be in [0, 36000]", seg.where);
       if (!(seg.frames >= 0 && seg.frames <= 36000)) fail("frames must be in [0, 36000]", seg.where);
       const motion::LocomotionSpec& ls = spec.clips[static_cast<std::size_t>(it->second)].spec;
-      if (s.locomotion && !(ls.speed > 0)) fail("a locomotion segment needs a moving clip ('" + seg.clip + "' stands)", seg.where);
+      if (s.locomotion && !(ls.speed > 0))
+        fail("a locomotion segment needs a moving clip ('" + seg.clip + "' stands)", seg.where);
       // Generous: the smoothed root may be a little slower than the clip's speed.
-      const double need = seg.start_frame / fps + (s.locomotion ? 1.5 * d / ls.speed : seg.frames / fps + 4.0 * ls.idle_period_s);
+      const double need =
+          seg.start_frame / fps + (s.locomotion ? 1.5 * d / ls.speed : seg.frames / fps + 4.0 * ls.idle_period_s);
       auto& end = clip_end[static_cast<std::size_t>(it->second)];
       end = std::max(end, need);
     }
@@ -159,7 +170,8 @@ std::vector<double> name_states(const StateMachineSpec& spec, double d, Names& n
 
 // Clip `c` generated at the spec's fps and sampled from before 0
 // (transitions, smoothing) to past `clip_end` (s), the segments' reach.
-MachineClip sample_clip(const ClipSpec& c, const StateMachineSpec& spec, const motion::Skeleton& skeleton, double clip_end) {
+MachineClip sample_clip(const ClipSpec& c, const StateMachineSpec& spec, const motion::Skeleton& skeleton,
+                        double clip_end) {
   const double fps = spec.fps;
   motion::LocomotionSpec ls = c.spec;
   ls.fps = fps;
@@ -176,7 +188,8 @@ MachineClip sample_clip(const ClipSpec& c, const StateMachineSpec& spec, const m
   const double pad = (mc.period_frames + 2.0 * spec.transition_frames + 4.0) / fps;
   mc.time_of_first_frame = -pad;
   const auto frames = static_cast<std::int32_t>(std::ceil((clip_end + 2.0 * pad) * fps)) + 1;
-  if (frames > 100'000) fail("clip would need more than 100,000 frames (lower the start frames or raise the speed)", c.where);
+  if (frames > 100'000)
+    fail("clip would need more than 100,000 frames (lower the start frames or raise the speed)", c.where);
   mc.clip.resize(frames, skeleton.joint_count());
   mc.clip.frame_time = static_cast<float>(1.0 / fps);
   std::vector<glm::quat> rot(static_cast<std::size_t>(skeleton.joint_count()));
@@ -202,7 +215,8 @@ void stand(MotionSegment& ms, const MachineClip& mc, const SegmentSpec& seg, dou
 // Clip times (s) at smoothed-root arc lengths j * spacing, j = 0..k, from
 // `start` on: a march in quarter frames, linear inside a step. Fails past
 // `limit` + 1 s (the clip's end); d = k * spacing, m, for the message.
-std::vector<double> arc_times(const MachineClip& mc, const SegmentSpec& seg, const StateMachineSpec& spec, double start, double limit, double d) {
+std::vector<double> arc_times(const MachineClip& mc, const SegmentSpec& seg, const StateMachineSpec& spec, double start,
+                              double limit, double d) {
   const double fps = spec.fps;
   const double dt = 0.25 / fps;
   double t = start, arc = 0;
@@ -235,7 +249,8 @@ float smoothed_heading(const MachineClip& mc, double fps, double t) {
 // A locomotion segment (ms.start_time set, s) covering d metres of smoothed
 // root: its k point times and trajectory in its own frame, duration (s),
 // speed (m/s), end point and end heading (rad).
-void walk(MotionSegment& ms, const MachineClip& mc, const SegmentSpec& seg, const StateMachineSpec& spec, double limit, double d) {
+void walk(MotionSegment& ms, const MachineClip& mc, const SegmentSpec& seg, const StateMachineSpec& spec, double limit,
+          double d) {
   const double fps = spec.fps;
   std::vector<double> times = arc_times(mc, seg, spec, ms.start_time, limit, d);
   const double t_end = times.back();
@@ -247,12 +262,14 @@ void walk(MotionSegment& ms, const MachineClip& mc, const SegmentSpec& seg, cons
   ms.heading = static_cast<float>(smoothed_heading(mc, fps, ms.start_time));
   for (double tt : ms.times) ms.trajectory.push_back(rotate_ccw(mc.smoothed_root(tt) - ms.origin, -ms.heading));
   ms.end_point = rotate_ccw(mc.smoothed_root(t_end) - ms.origin, -ms.heading);
-  ms.end_heading = static_cast<float>(std::remainder(smoothed_heading(mc, fps, t_end) - ms.heading, 2.0 * std::numbers::pi));
+  ms.end_heading =
+      static_cast<float>(std::remainder(smoothed_heading(mc, fps, t_end) - ms.heading, 2.0 * std::numbers::pi));
 }
 
 // Indices of the states `name` stands for: the state itself, or every state
 // with the group among its ancestors (in state order).
-std::vector<std::int32_t> states_under(const std::string& name, const Location& where, const Names& names, const std::vector<MachineState>& states,
+std::vector<std::int32_t> states_under(const std::string& name, const Location& where, const Names& names,
+                                       const std::vector<MachineState>& states,
                                        const std::vector<MachineGroup>& groups) {
   std::vector<std::int32_t> out;
   if (auto it = names.state_of.find(name); it != names.state_of.end()) return std::vector<std::int32_t>{it->second};
@@ -269,8 +286,9 @@ std::vector<std::int32_t> states_under(const std::string& name, const Location& 
 
 // Edges expanded to states (every state under `from` to every state under
 // `to`): allowed and edge_cost, S x S row-major, cost the cheapest edge's.
-void expand_edges(const StateMachineSpec& spec, const Names& names, const std::vector<MachineState>& states, const std::vector<MachineGroup>& groups,
-                  std::vector<std::uint8_t>& allowed, std::vector<float>& edge_cost) {
+void expand_edges(const StateMachineSpec& spec, const Names& names, const std::vector<MachineState>& states,
+                  const std::vector<MachineGroup>& groups, std::vector<std::uint8_t>& allowed,
+                  std::vector<float>& edge_cost) {
   const std::size_t S = states.size();
   allowed.assign(S * S, 0);
   edge_cost.assign(S * S, INFINITY);
@@ -288,14 +306,16 @@ void expand_edges(const StateMachineSpec& spec, const Names& names, const std::v
 // Joint positions (m) of segment `seg` at t seconds after its start,
 // relative to the root and turned into its heading frame (heading = twist
 // of the root rotation about +Y).
-std::vector<glm::vec3> heading_frame_pose(const MotionGraph& m, const motion::Skeleton& skeleton, std::int32_t seg, double t) {
+std::vector<glm::vec3> heading_frame_pose(const MotionGraph& m, const motion::Skeleton& skeleton, std::int32_t seg,
+                                          double t) {
   const std::int32_t J = skeleton.joint_count();
   std::vector<glm::quat> rot;
   glm::vec3 root;
   m.pose(seg, t, rot, root);
   std::vector<glm::vec3> pos(static_cast<std::size_t>(J));
   std::vector<glm::quat> wrot(static_cast<std::size_t>(J));
-  motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), rot.data(), nullptr, root, pos.data(), wrot.data());
+  motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), rot.data(), nullptr, root, pos.data(),
+                  wrot.data());
   const glm::quat unyaw = glm::angleAxis(static_cast<float>(-motion::heading_of(rot[0])), glm::vec3(0, 1, 0));
   for (glm::vec3& p : pos) p = unyaw * (p - root);
   return pos;
@@ -304,7 +324,8 @@ std::vector<glm::vec3> heading_frame_pose(const MotionGraph& m, const motion::Sk
 // Transition costs, M x M row-major over m's segments: INFINITY where the
 // states may not follow, else edge cost + pose_weight * k * mean joint
 // mismatch (m) between a's last pose and b's first.
-std::vector<float> transition_costs(const MotionGraph& m, const StateMachineSpec& spec, const motion::Skeleton& skeleton) {
+std::vector<float> transition_costs(const MotionGraph& m, const StateMachineSpec& spec,
+                                    const motion::Skeleton& skeleton) {
   const std::int32_t J = skeleton.joint_count();
   const std::vector<MotionSegment>& segments = m.segments();
   const std::size_t M = segments.size();
@@ -319,9 +340,11 @@ std::vector<float> transition_costs(const MotionGraph& m, const StateMachineSpec
       const std::int32_t sa = segments[a].state, sb = segments[b].state;
       if (!m.allowed(sa, sb)) continue;
       double mismatch = 0;
-      for (std::int32_t j = 0; j < J; ++j) mismatch += glm::length(last[a][static_cast<std::size_t>(j)] - first[b][static_cast<std::size_t>(j)]);
+      for (std::int32_t j = 0; j < J; ++j)
+        mismatch += glm::length(last[a][static_cast<std::size_t>(j)] - first[b][static_cast<std::size_t>(j)]);
       mismatch /= std::max(1, J);
-      transition[a * M + b] = m.edge_cost(sa, sb) + static_cast<float>(spec.pose_weight * spec.points_per_segment * mismatch);
+      transition[a * M + b] =
+          m.edge_cost(sa, sb) + static_cast<float>(spec.pose_weight * spec.points_per_segment * mismatch);
     }
   return transition;
 }
@@ -342,7 +365,8 @@ MotionGraph MotionGraph::build(const StateMachineSpec& spec, const motion::Skele
   m.groups_ = name_groups(spec, names);
   name_clips(spec, names);
   const std::vector<double> clip_end = name_states(spec, d, names, m.states_);
-  for (std::size_t i = 0; i < spec.clips.size(); ++i) m.clips_.push_back(sample_clip(spec.clips[i], spec, skeleton, clip_end[i]));
+  for (std::size_t i = 0; i < spec.clips.size(); ++i)
+    m.clips_.push_back(sample_clip(spec.clips[i], spec, skeleton, clip_end[i]));
 
   for (std::size_t si = 0; si < spec.states.size(); ++si) {
     const StateSpec& s = spec.states[si];

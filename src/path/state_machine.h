@@ -49,14 +49,14 @@ struct ClipSpec {
 
 struct SegmentSpec {
   std::string clip;
-  double start_frame = 0;   // where the segment starts in the clip
-  double frames = 0;        // non-locomotion states: length in frames (0 = the clip's period)
+  double start_frame = 0;  // where the segment starts in the clip
+  double frames = 0;       // non-locomotion states: length in frames (0 = the clip's period)
   Location where;
 };
 
 struct StateSpec {
   std::string name;
-  std::string group;        // may be empty
+  std::string group;  // may be empty
   bool locomotion = true;
   std::vector<SegmentSpec> segments;
   Location where;
@@ -64,25 +64,25 @@ struct StateSpec {
 
 struct GroupSpec {
   std::string name;
-  std::string parent;       // may be empty
+  std::string parent;  // may be empty
   Location where;
 };
 
 struct EdgeSpec {
-  std::string from, to;     // state or group names
-  float cost = 0.0f;        // added to every transition it allows (m of path error)
+  std::string from, to;  // state or group names
+  float cost = 0.0f;     // added to every transition it allows (m of path error)
   Location where;
 };
 
 struct StateMachineSpec {
   std::string name = "machine";
   double fps = 60.0;
-  float spacing = 0.0225f;             // s, m
+  float spacing = 0.0225f;               // s, m
   std::int32_t points_per_segment = 64;  // k
   std::int32_t transition_frames = 8;
-  float pose_weight = 1.0f;            // transition cost per metre of mean joint mismatch, times k
-  std::string start_state;             // the sequence starts after this state ("" = free)
-  std::string end_state;               // and ends before it
+  float pose_weight = 1.0f;  // transition cost per metre of mean joint mismatch, times k
+  std::string start_state;   // the sequence starts after this state ("" = free)
+  std::string end_state;     // and ends before it
   std::vector<ClipSpec> clips;
   std::vector<GroupSpec> groups;
   std::vector<StateSpec> states;
@@ -92,21 +92,21 @@ struct StateMachineSpec {
 // ---- the built machine ----------------------------------------------------------
 
 struct MotionSegment {
-  std::string name;          // "walk_forward/0"
+  std::string name;  // "walk_forward/0"
   std::int32_t state = 0;
   std::int32_t clip = 0;
-  double start_time = 0;     // s, in the clip's own timeline (frame / fps)
-  double duration = 0;       // s: time to cover d (locomotion) or the given frames
-  float speed = 0;           // m/s: mean root speed over the segment
+  double start_time = 0;  // s, in the clip's own timeline (frame / fps)
+  double duration = 0;    // s: time to cover d (locomotion) or the given frames
+  float speed = 0;        // m/s: mean root speed over the segment
   // Locomotion: k points at arc length 0, s, ..., (k-1)s in the segment's
   // frame, and the clip time of each. The segment's frame maps a map point x
   // (the ground projection of the smoothed root) to R(-heading) (x - origin).
   std::vector<glm::vec2> trajectory;
   std::vector<double> times;
   glm::vec2 origin{0.0f};
-  float heading = 0.0f;      // rad, map heading of the smoothed root at start
-  glm::vec2 end_point{0.0f}; // where the segment ends (arc length d), in its frame
-  float end_heading = 0.0f;  // rad, in its frame
+  float heading = 0.0f;       // rad, map heading of the smoothed root at start
+  glm::vec2 end_point{0.0f};  // where the segment ends (arc length d), in its frame
+  float end_heading = 0.0f;   // rad, in its frame
 };
 
 struct MachineState {
@@ -126,7 +126,7 @@ struct MachineGroup {
 struct MachineClip {
   std::string name;
   std::shared_ptr<const motion::LocomotionGenerator> generator;
-  motion::Clip clip;               // frames at the machine's fps, covering every segment and its transitions
+  motion::Clip clip;  // frames at the machine's fps, covering every segment and its transitions
   double fps = 60.0;
   double time_of_first_frame = 0;  // s: generator time of clip frame 0 (negative: padding before t = 0)
   std::int32_t period_frames = 0;
@@ -152,17 +152,23 @@ class MotionGraph {
   const std::vector<MachineGroup>& groups() const { return groups_; }
   const std::vector<MotionSegment>& segments() const { return segments_; }
   std::int32_t segment_count() const { return static_cast<std::int32_t>(segments_.size()); }
-  std::int32_t state_index(const std::string& name) const;  // -1 when absent
+  std::int32_t state_index(const std::string& name) const;   // -1 when absent
   std::int32_t start_state() const { return start_state_; }  // -1 = none
   std::int32_t end_state() const { return end_state_; }
 
   // May state b follow state a?
-  bool allowed(std::int32_t a, std::int32_t b) const { return allowed_[static_cast<std::size_t>(a) * states_.size() + static_cast<std::size_t>(b)] != 0; }
-  float edge_cost(std::int32_t a, std::int32_t b) const { return edge_cost_[static_cast<std::size_t>(a) * states_.size() + static_cast<std::size_t>(b)]; }
+  bool allowed(std::int32_t a, std::int32_t b) const {
+    return allowed_[static_cast<std::size_t>(a) * states_.size() + static_cast<std::size_t>(b)] != 0;
+  }
+  float edge_cost(std::int32_t a, std::int32_t b) const {
+    return edge_cost_[static_cast<std::size_t>(a) * states_.size() + static_cast<std::size_t>(b)];
+  }
   // Cost of segment b after segment a: INFINITY when their states may not
   // follow each other, else edge cost + pose_weight * k * mean joint mismatch
   // between a's last pose and b's first (in each root's heading frame).
-  float transition_cost(std::int32_t a, std::int32_t b) const { return transition_[static_cast<std::size_t>(a) * segments_.size() + static_cast<std::size_t>(b)]; }
+  float transition_cost(std::int32_t a, std::int32_t b) const {
+    return transition_[static_cast<std::size_t>(a) * segments_.size() + static_cast<std::size_t>(b)];
+  }
   // Locomotion segments only, in order: what the matching grid holds.
   const std::vector<std::int32_t>& locomotion_segments() const { return locomotion_; }
 

@@ -116,8 +116,8 @@ io::LoadedScenario load(const py::object& source) {
 }  // namespace throng::python
 
 // At file scope: the macro defines the module's extern "C" entry point.
-using namespace throng;           // NOLINT(google-build-using-namespace)
-using namespace throng::python;   // NOLINT(google-build-using-namespace)
+using namespace throng;          // NOLINT(google-build-using-namespace)
+using namespace throng::python;  // NOLINT(google-build-using-namespace)
 
 PYBIND11_MODULE(throng, m) {
   m.doc() = "throng crowd simulation: load scenarios, step simulations, read the crowd as NumPy arrays";
@@ -141,22 +141,26 @@ PYBIND11_MODULE(throng, m) {
   py::class_<io::LoadedScenario>(m, "Scenario", "A scenario as read from YAML (docs/scenarios.md)")
       .def_property_readonly("name", [](const io::LoadedScenario& s) { return s.spec.name; })
       .def_property_readonly("description", [](const io::LoadedScenario& s) { return s.spec.description; })
-      .def_property_readonly("source", [](const io::LoadedScenario& s) { return s.source.file; },
-                             "The file read, \"builtin:<name>\" or \"<dict>\"")
+      .def_property_readonly(
+          "source", [](const io::LoadedScenario& s) { return s.source.file; },
+          "The file read, \"builtin:<name>\" or \"<dict>\"")
       .def_property_readonly("agent_count", [](const io::LoadedScenario& s) { return s.spec.total_agents(); })
       .def_property_readonly("dt", [](const io::LoadedScenario& s) { return s.spec.dt; })
       .def_property_readonly("seed", [](const io::LoadedScenario& s) { return s.spec.seed; })
-      .def_property_readonly("duration_steps", [](const io::LoadedScenario& s) { return s.spec.step_count(); },
-                             "Steps in the scenario's duration (what `throng run` runs)")
-      .def_property_readonly("groups",
-                             [](const io::LoadedScenario& s) {
-                               std::vector<std::pair<std::string, std::int64_t>> g;
-                               for (const sim::GroupSpec& group : s.spec.groups) g.emplace_back(group.name, group.count);
-                               return g;
-                             },
-                             "(name, count) of each group")
+      .def_property_readonly(
+          "duration_steps", [](const io::LoadedScenario& s) { return s.spec.step_count(); },
+          "Steps in the scenario's duration (what `throng run` runs)")
+      .def_property_readonly(
+          "groups",
+          [](const io::LoadedScenario& s) {
+            std::vector<std::pair<std::string, std::int64_t>> g;
+            for (const sim::GroupSpec& group : s.spec.groups) g.emplace_back(group.name, group.count);
+            return g;
+          },
+          "(name, count) of each group")
       .def("__repr__", [](const io::LoadedScenario& s) {
-        return "<throng.Scenario " + s.spec.name + " from " + s.source.file + ", " + std::to_string(s.spec.total_agents()) + " agents>";
+        return "<throng.Scenario " + s.spec.name + " from " + s.source.file + ", " +
+               std::to_string(s.spec.total_agents()) + " agents>";
       });
 
   m.def("load_scenario", &load, py::arg("source"),
@@ -164,8 +168,10 @@ PYBIND11_MODULE(throng, m) {
         "Errors raise throng.Error naming the file (or \"<dict>\"), line and key.");
 
   py::class_<PySimulation>(m, "Simulation", "A crowd simulation built from a scenario as `throng run` builds it")
-      .def(py::init([](const py::object& scenario, std::optional<std::uint64_t> seed, std::optional<std::int64_t> agents) {
-             io::LoadedScenario loaded = py::isinstance<io::LoadedScenario>(scenario) ? scenario.cast<io::LoadedScenario>() : load(scenario);
+      .def(py::init([](const py::object& scenario, std::optional<std::uint64_t> seed,
+                       std::optional<std::int64_t> agents) {
+             io::LoadedScenario loaded =
+                 py::isinstance<io::LoadedScenario>(scenario) ? scenario.cast<io::LoadedScenario>() : load(scenario);
              return std::make_unique<PySimulation>(std::move(loaded), seed, agents);
            }),
            py::arg("scenario"), py::arg("seed") = py::none(), py::arg("agents") = py::none(),
@@ -173,7 +179,8 @@ PYBIND11_MODULE(throng, m) {
            "agents: total agent count, the groups keeping their proportions (as `throng run --agents`).")
       .def("step", &PySimulation::step, py::arg("n") = 1, "Advances n steps of dt")
       .def_property_readonly("scenario", &PySimulation::scenario, py::return_value_policy::copy)
-      .def_property_readonly("time", [](const PySimulation& s) { return s.sim().time(); }, "Simulated seconds")
+      .def_property_readonly(
+          "time", [](const PySimulation& s) { return s.sim().time(); }, "Simulated seconds")
       .def_property_readonly("steps", [](const PySimulation& s) { return s.sim().steps_done(); })
       .def_property_readonly("dt", [](const PySimulation& s) { return s.sim().spec().dt; })
       .def_property_readonly("seed", [](const PySimulation& s) { return s.sim().spec().seed; })
@@ -181,24 +188,32 @@ PYBIND11_MODULE(throng, m) {
       .def_property_readonly("active_count", [](const PySimulation& s) { return s.sim().active_count(); })
       .def_property_readonly("arrived_count", [](const PySimulation& s) { return s.sim().arrived_count(); })
       .def_property_readonly("all_arrived", [](const PySimulation& s) { return s.sim().all_arrived(); })
-      .def_property_readonly("positions", [](const PySimulation& s) { return vec2_array(s.sim().positions()); },
-                             "(n, 2) float32 copy, metres")
-      .def_property_readonly("velocities", [](const PySimulation& s) { return vec2_array(s.sim().velocities()); },
-                             "(n, 2) float32 copy, m/s")
-      .def_property_readonly("goals", [](const PySimulation& s) { return vec2_array(s.sim().crowd().goal.to_vector()); },
-                             "(n, 2) float32 copy: the end of each agent's current leg (its current waypoint)")
-      .def_property_readonly("headings", [](const PySimulation& s) { return float_array(s.sim().headings()); },
-                             "(n,) float32 copy, radians from +x")
-      .def_property_readonly("radii", [](const PySimulation& s) { return float_array(s.sim().crowd().radius.to_vector()); },
-                             "(n,) float32 copy, metres")
-      .def_property_readonly("arrival_times", [](const PySimulation& s) { return float_array(s.sim().arrival_times()); },
-                             "(n,) float32 copy, seconds; -1 until the agent arrived")
-      .def_property_readonly("active", [](const PySimulation& s) { return flag_array(s.sim().flags(), sim::kAgentActive); },
-                             "(n,) bool copy: simulated (not despawned)")
-      .def_property_readonly("arrived", [](const PySimulation& s) { return flag_array(s.sim().flags(), sim::kAgentArrived); },
-                             "(n,) bool copy: reached its goal at least once")
+      .def_property_readonly(
+          "positions", [](const PySimulation& s) { return vec2_array(s.sim().positions()); },
+          "(n, 2) float32 copy, metres")
+      .def_property_readonly(
+          "velocities", [](const PySimulation& s) { return vec2_array(s.sim().velocities()); },
+          "(n, 2) float32 copy, m/s")
+      .def_property_readonly(
+          "goals", [](const PySimulation& s) { return vec2_array(s.sim().crowd().goal.to_vector()); },
+          "(n, 2) float32 copy: the end of each agent's current leg (its current waypoint)")
+      .def_property_readonly(
+          "headings", [](const PySimulation& s) { return float_array(s.sim().headings()); },
+          "(n,) float32 copy, radians from +x")
+      .def_property_readonly(
+          "radii", [](const PySimulation& s) { return float_array(s.sim().crowd().radius.to_vector()); },
+          "(n,) float32 copy, metres")
+      .def_property_readonly(
+          "arrival_times", [](const PySimulation& s) { return float_array(s.sim().arrival_times()); },
+          "(n,) float32 copy, seconds; -1 until the agent arrived")
+      .def_property_readonly(
+          "active", [](const PySimulation& s) { return flag_array(s.sim().flags(), sim::kAgentActive); },
+          "(n,) bool copy: simulated (not despawned)")
+      .def_property_readonly(
+          "arrived", [](const PySimulation& s) { return flag_array(s.sim().flags(), sim::kAgentArrived); },
+          "(n,) bool copy: reached its goal at least once")
       .def("__repr__", [](const PySimulation& s) {
-        return "<throng.Simulation " + s.sim().spec().name + ", " + std::to_string(s.sim().agent_count()) + " agents, step " +
-               std::to_string(s.sim().steps_done()) + ">";
+        return "<throng.Simulation " + s.sim().spec().name + ", " + std::to_string(s.sim().agent_count()) +
+               " agents, step " + std::to_string(s.sim().steps_done()) + ">";
       });
 }

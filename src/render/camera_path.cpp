@@ -31,7 +31,8 @@ bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && st
 // Uniform Catmull-Rom between b and c (a before, d after), u in [0, 1].
 glm::vec3 catmull_rom(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, float u) {
   const float u2 = u * u, u3 = u2 * u;
-  return 0.5f * ((2.0f * b) + (c - a) * u + (2.0f * a - 5.0f * b + 4.0f * c - d) * u2 + (3.0f * b - a - 3.0f * c + d) * u3);
+  return 0.5f *
+         ((2.0f * b) + (c - a) * u + (2.0f * a - 5.0f * b + 4.0f * c - d) * u2 + (3.0f * b - a - 3.0f * c + d) * u3);
 }
 }  // namespace
 
@@ -42,23 +43,29 @@ void CameraPath::validate() const {
   }
   Camera probe = lens;
   // Away from the target across `up`, so that only the lens is checked.
-  const glm::vec3 across = std::abs(glm::normalize(probe.up).z) < 0.9f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
+  const glm::vec3 across =
+      std::abs(glm::normalize(probe.up).z) < 0.9f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
   probe.position = probe.target + across;
   probe.validate();  // everything but the placement
   if (kind == Kind::Orbit) {
     const CameraOrbit& o = orbit;
     if (!finite(o.centre)) throw Error("must be finite", at_field("camera.orbit.centre"));
-    if (!(o.radius > 0.0f) || !std::isfinite(o.radius)) throw Error("must be positive", at_field("camera.orbit.radius"));
-    if (!std::isfinite(o.height) || !std::isfinite(o.target_height)) throw Error("must be finite", at_field("camera.orbit.height"));
-    if (!std::isfinite(o.angular_speed) || !std::isfinite(o.start_angle)) throw Error("must be finite", at_field("camera.orbit.angular_speed"));
+    if (!(o.radius > 0.0f) || !std::isfinite(o.radius))
+      throw Error("must be positive", at_field("camera.orbit.radius"));
+    if (!std::isfinite(o.height) || !std::isfinite(o.target_height))
+      throw Error("must be finite", at_field("camera.orbit.height"));
+    if (!std::isfinite(o.angular_speed) || !std::isfinite(o.start_angle))
+      throw Error("must be finite", at_field("camera.orbit.angular_speed"));
     return;
   }
-  if (keys.size() < 2) throw Error(fmt::format("a fly-over needs at least 2 keys, not {}", keys.size()), at_field("camera.keys"));
+  if (keys.size() < 2)
+    throw Error(fmt::format("a fly-over needs at least 2 keys, not {}", keys.size()), at_field("camera.keys"));
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const CameraKey& k = keys[i];
     if (!std::isfinite(k.time) || (i > 0 && !(k.time > keys[i - 1].time)))
       throw Error("times must be finite and increasing", at_field(fmt::format("camera.keys[{}].time", i)));
-    if (!finite(k.position) || !finite(k.target)) throw Error("must be finite", at_field(fmt::format("camera.keys[{}]", i)));
+    if (!finite(k.position) || !finite(k.target))
+      throw Error("must be finite", at_field(fmt::format("camera.keys[{}]", i)));
     if (glm::length(k.position - k.target) <= 1e-4f)
       throw Error("position and target coincide", at_field(fmt::format("camera.keys[{}]", i)));
   }
@@ -135,7 +142,8 @@ CameraPath animate_camera(const Camera& camera, CameraPath::Kind kind, float per
   const glm::vec3 across = centre + glm::vec3(-offset.x, camera.position.y, -offset.y);
   const glm::vec3 over = centre + glm::vec3(0.0f, camera.position.y * 1.2f + 2.0f, 0.0f);
   p.keys = {{0.0f, start, camera.target},
-            {0.5f * period, over + 0.25f * (start - centre) * glm::vec3(1, 0, 1), camera.target - 0.5f * (start - centre) * glm::vec3(1, 0, 1)},
+            {0.5f * period, over + 0.25f * (start - centre) * glm::vec3(1, 0, 1),
+             camera.target - 0.5f * (start - centre) * glm::vec3(1, 0, 1)},
             {period, across, camera.target}};
   return p;
 }

@@ -11,7 +11,7 @@
 namespace throng::render {
 
 struct CameraKey {
-  float time = 0.0f;           // seconds, increasing along the path
+  float time = 0.0f;  // seconds, increasing along the path
   glm::vec3 position{0.0f};
   glm::vec3 target{0.0f};
 };
@@ -19,8 +19,8 @@ struct CameraKey {
 struct CameraPath {
   enum class Kind : std::uint8_t { Fixed, Orbit, Flyover };
   Kind kind = Kind::Orbit;
-  Camera lens;            // fov, viewport, clip planes; position/target for Fixed
-  CameraOrbit orbit;      // Orbit
+  Camera lens;                  // fov, viewport, clip planes; position/target for Fixed
+  CameraOrbit orbit;            // Orbit
   std::vector<CameraKey> keys;  // Flyover: Catmull-Rom through positions and targets, held after the last
   // Throws Error naming the field ("camera.keys[2].time").
   void validate() const;

@@ -22,11 +22,14 @@ void check_size(Index size, Index want, const char* field) {
 }  // namespace
 
 void CullJob::validate() const {
-  if (rigs.count < 1 || rigs.count > kMaxRenderRigs) throw Error(fmt::format("must be in 1..{}", kMaxRenderRigs), at_field("cull.rigs.count"));
+  if (rigs.count < 1 || rigs.count > kMaxRenderRigs)
+    throw Error(fmt::format("must be in 1..{}", kMaxRenderRigs), at_field("cull.rigs.count"));
   for (std::int32_t r = 0; r < rigs.count; ++r)
-    if (!(rigs.rig[r].bounding_radius > 0.0f)) throw Error("must be positive", at_field(fmt::format("cull.rigs[{}].bounding_radius", r)));
+    if (!(rigs.rig[r].bounding_radius > 0.0f))
+      throw Error("must be positive", at_field(fmt::format("cull.rigs[{}].bounding_radius", r)));
   if (joint_count < 0) throw Error("must be >= 0", at_field("cull.joint_count"));
-  if (group_flags.size() % group_count() != 0) throw Error("not a whole number of characters", at_field("cull.group_flags"));
+  if (group_flags.size() % group_count() != 0)
+    throw Error("not a whole number of characters", at_field("cull.group_flags"));
   const Index n = group_flags.size() / group_count();
   if (joint_count > 0) {
     if (rigs.count != 1) throw Error("joint frames are of one rig", at_field("cull.rigs.count"));
@@ -36,7 +39,8 @@ void CullJob::validate() const {
     check_size(palette_offsets.size(), n, "cull.palette_offsets");
     if (!character_rigs.empty()) check_size(character_rigs.size(), n, "cull.character_rigs");
   }
-  if (force_tier < -1 || force_tier >= kDrawTiers) throw Error(fmt::format("must be in -1..{}", kDrawTiers - 1), at_field("cull.force_tier"));
+  if (force_tier < -1 || force_tier >= kDrawTiers)
+    throw Error(fmt::format("must be in -1..{}", kDrawTiers - 1), at_field("cull.force_tier"));
   if (!flags.empty()) check_size(flags.size(), n, "cull.flags");
   if (!(fine_min_pixels >= 0.0f)) throw Error("must be >= 0", at_field("cull.fine_min_pixels"));
   if (!(lines_max_pixels >= 0.0f)) throw Error("must be >= 0", at_field("cull.lines_max_pixels"));
@@ -46,7 +50,8 @@ DrawGroups draw_groups(const CullJob& job, Span<const std::uint32_t> slots, Inde
   DrawGroups groups;
   groups.count = job.group_count();
   const Index n = job.character_count();
-  if (slots.size() != groups.count * n) throw Error(fmt::format("size {} where {} is needed", slots.size(), groups.count * n), at_field("cull.slots"));
+  if (slots.size() != groups.count * n)
+    throw Error(fmt::format("size {} where {} is needed", slots.size(), groups.count * n), at_field("cull.slots"));
   // Where each group's slots begin: the scan at the group's first entry.
   Index starts[kMaxDrawGroups + 1] = {};
   for (std::int32_t g = 1; g < groups.count && n > 0; ++g) {
@@ -70,19 +75,23 @@ void PackJob::validate() const {
   const Index n = character_count();
   if (joint_count <= 0) throw Error("must be positive", at_field("pack.joint_count"));
   if (points.size() < joint_count) throw Error("fewer points than joints", at_field("pack.points"));
-  if (group_flags.size() % kDrawTiers != 0) throw Error("not a whole number of characters", at_field("pack.group_flags"));
+  if (group_flags.size() % kDrawTiers != 0)
+    throw Error("not a whole number of characters", at_field("pack.group_flags"));
   check_size(joint_positions.size(), n * joint_count, "pack.joint_positions");
   check_size(joint_rotations.size(), n * joint_count, "pack.joint_rotations");
   check_size(slots.size(), group_flags.size(), "pack.slots");
   check_levels(lod_levels, n, "pack.lod_levels");
   if (out_points.size() % points.size() != 0)
-    throw Error(fmt::format("{} packed points is not a whole number of {}-point slots", out_points.size(), points.size()),
-                at_field("pack.out_points"));
+    throw Error(
+        fmt::format("{} packed points is not a whole number of {}-point slots", out_points.size(), points.size()),
+        at_field("pack.out_points"));
 }
 
 void PalettePackJob::validate() const {
-  if (groups.count < 1 || groups.count > kMaxDrawGroups) throw Error(fmt::format("must be in 1..{}", kMaxDrawGroups), at_field("pack.groups.count"));
-  if (group_flags.size() % groups.count != 0) throw Error("not a whole number of characters", at_field("pack.group_flags"));
+  if (groups.count < 1 || groups.count > kMaxDrawGroups)
+    throw Error(fmt::format("must be in 1..{}", kMaxDrawGroups), at_field("pack.groups.count"));
+  if (group_flags.size() % groups.count != 0)
+    throw Error("not a whole number of characters", at_field("pack.group_flags"));
   const Index n = character_count();
   check_size(slots.size(), group_flags.size(), "pack.slots");
   if (joint_count > 0) {
@@ -91,7 +100,8 @@ void PalettePackJob::validate() const {
     check_size(inverse_bind.size(), joint_count, "pack.inverse_bind");
     if (!scales.empty()) check_size(scales.size(), n, "pack.scales");
     for (std::int32_t g = 0; g < groups.count; ++g)
-      if (groups.joints[g] != joint_count) throw Error("joint frames are of one rig", at_field(fmt::format("pack.groups.joints[{}]", g)));
+      if (groups.joints[g] != joint_count)
+        throw Error("joint frames are of one rig", at_field(fmt::format("pack.groups.joints[{}]", g)));
   } else {
     check_size(palette_offsets.size(), n, "pack.palette_offsets");
   }

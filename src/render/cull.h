@@ -51,7 +51,7 @@ struct CullRigs {
 
 struct CullJob {
   CameraView camera;
-  CullRigs rigs;  // joint frames: one
+  CullRigs rigs;                  // joint frames: one
   float fine_min_pixels = 40.0f;  // image radius from which the fine mesh is used
   float lines_max_pixels = 4.0f;  // image radius below which bones are lines
   bool cull = true;               // false: every character is visible
@@ -78,7 +78,9 @@ struct CullJob {
   Span<std::uint32_t> group_flags;
 
   std::int32_t group_count() const { return rigs.count * kDrawTiers; }
-  Index character_count() const { return joint_count > 0 ? joint_positions.size() / joint_count : palette_offsets.size(); }
+  Index character_count() const {
+    return joint_count > 0 ? joint_positions.size() / joint_count : palette_offsets.size();
+  }
   void validate() const;  // Error naming the span or parameter
   void run() const;       // parallel_for "render.cull"
 };
@@ -89,7 +91,7 @@ struct DrawGroups {
   std::int32_t count = 0;
   Index first_slot[kMaxDrawGroups] = {};
   Index slots[kMaxDrawGroups] = {};
-  Index first_matrix[kMaxDrawGroups] = {};  // PalettePackJob: slots of earlier groups times their joint counts
+  Index first_matrix[kMaxDrawGroups] = {};   // PalettePackJob: slots of earlier groups times their joint counts
   std::int32_t joints[kMaxDrawGroups] = {};  // per slot of the group
   Index visible() const { return count > 0 ? first_slot[count - 1] + slots[count - 1] : 0; }
   Index matrices() const { return count > 0 ? first_matrix[count - 1] + slots[count - 1] * joints[count - 1] : 0; }
@@ -105,8 +107,8 @@ Index scan_draw_slots(Span<const std::uint32_t> group_flags, Span<std::uint32_t>
 DrawGroups draw_groups(const CullJob& job, Span<const std::uint32_t> slots, Index visible);
 
 // The slot of character c (or -1) and its group, from the flags and their scan.
-THRONG_HOST_DEVICE inline Index slot_of(Span<const std::uint32_t> flags, Span<const std::uint32_t> slots, Index n, std::int32_t groups,
-                                        Index c, std::int32_t& group) {
+THRONG_HOST_DEVICE inline Index slot_of(Span<const std::uint32_t> flags, Span<const std::uint32_t> slots, Index n,
+                                        std::int32_t groups, Index c, std::int32_t& group) {
   for (std::int32_t g = 0; g < groups; ++g)
     if (flags[g * n + c] != 0u) {
       group = g;

@@ -14,39 +14,40 @@ void CullJob::run() const {
   validate();
   const Index n = character_count();
   const std::int32_t groups = group_count();
-  parallel_for("render.cull", n, THRONG_JOB_LAMBDA(Index c) {
-    for (std::int32_t g = 0; g < groups; ++g) group_flags[g * n + c] = 0u;
-    if (!flags.empty() && (flags[c] & visible_bits) != visible_bits) return;
-    std::int32_t r = 0;
-    glm::vec3 root(0.0f);
-    float s = 1.0f;
-    if (joint_count > 0) {
-      root = joint_positions[c * joint_count];
-      if (!scales.empty()) s = scales[c];
-    } else {
-      r = character_rigs.empty() ? 0 : character_rigs[c];
-      if (r < 0 || r >= rigs.count) return;
-      const Index first = palette_offsets[c];
-      if (first < 0 || first + rigs.rig[r].joint_count > palettes.size()) return;
-      const anim::Mat3x4 m = palettes[first];
-      root = anim::transform_point(m, rigs.rig[r].root_bind);
-      s = glm::length(glm::vec3(m.r0.x, m.r1.x, m.r2.x));
-    }
-    const float radius = rigs.rig[r].bounding_radius * s;
-    const glm::vec3 centre = to_camera_space(camera, root);
-    const bool visible = !cull || !anim::sphere_outside_view(centre, radius, camera);
-    if (!visible) return;
-    // Image radius of the bounding sphere against the tiers' limits (the
-    // whole viewport when the camera is inside it or it straddles the
-    // camera plane): focal * radius / depth >= limit, without dividing.
-    const float depth = -centre.z;
-    const float size = camera.focal_px * radius;
-    const bool close = depth <= radius;
-    const bool fine = close || size >= fine_min_pixels * depth;
-    const bool lines = !close && size < lines_max_pixels * depth;
-    const std::int32_t tier = force_tier >= 0 ? force_tier : (fine ? 0 : (lines ? 2 : 1));
-    group_flags[(r * kDrawTiers + tier) * n + c] = 1u;
-  });
+  parallel_for(
+      "render.cull", n, THRONG_JOB_LAMBDA(Index c) {
+        for (std::int32_t g = 0; g < groups; ++g) group_flags[g * n + c] = 0u;
+        if (!flags.empty() && (flags[c] & visible_bits) != visible_bits) return;
+        std::int32_t r = 0;
+        glm::vec3 root(0.0f);
+        float s = 1.0f;
+        if (joint_count > 0) {
+          root = joint_positions[c * joint_count];
+          if (!scales.empty()) s = scales[c];
+        } else {
+          r = character_rigs.empty() ? 0 : character_rigs[c];
+          if (r < 0 || r >= rigs.count) return;
+          const Index first = palette_offsets[c];
+          if (first < 0 || first + rigs.rig[r].joint_count > palettes.size()) return;
+          const anim::Mat3x4 m = palettes[first];
+          root = anim::transform_point(m, rigs.rig[r].root_bind);
+          s = glm::length(glm::vec3(m.r0.x, m.r1.x, m.r2.x));
+        }
+        const float radius = rigs.rig[r].bounding_radius * s;
+        const glm::vec3 centre = to_camera_space(camera, root);
+        const bool visible = !cull || !anim::sphere_outside_view(centre, radius, camera);
+        if (!visible) return;
+        // Image radius of the bounding sphere against the tiers' limits (the
+        // whole viewport when the camera is inside it or it straddles the
+        // camera plane): focal * radius / depth >= limit, without dividing.
+        const float depth = -centre.z;
+        const float size = camera.focal_px * radius;
+        const bool close = depth <= radius;
+        const bool fine = close || size >= fine_min_pixels * depth;
+        const bool lines = !close && size < lines_max_pixels * depth;
+        const std::int32_t tier = force_tier >= 0 ? force_tier : (fine ? 0 : (lines ? 2 : 1));
+        group_flags[(r * kDrawTiers + tier) * n + c] = 1u;
+      });
 }
 
 void PackJob::run() const {
@@ -56,7 +57,8 @@ void PackJob::run() const {
   const Index slot_count = out_points.size() / P;
   const Index level_stride = lod_levels.empty() || n == 0 ? 0 : lod_levels.size() / n;
   parallel_for(
-      "render.pack", n, THRONG_JOB_LAMBDA(Index c) {
+      "render.pack", n,
+      THRONG_JOB_LAMBDA(Index c) {
         std::int32_t group = 0;
         const Index slot = slot_of(group_flags, slots, n, kDrawTiers, c, group);
         if (slot < 0 || slot >= slot_count) return;
@@ -77,7 +79,8 @@ void PalettePackJob::run() const {
   validate();
   const Index n = character_count();
   parallel_for(
-      "render.pack_palettes", n, THRONG_JOB_LAMBDA(Index c) {
+      "render.pack_palettes", n,
+      THRONG_JOB_LAMBDA(Index c) {
         std::int32_t group = -1;
         const Index slot = slot_of(group_flags, slots, n, groups.count, c, group);
         if (slot < 0) return;
@@ -87,7 +90,8 @@ void PalettePackJob::run() const {
         if (joint_count > 0) {
           const float s = scales.empty() ? 1.0f : scales[c];
           for (std::int32_t j = 0; j < joint_count; ++j) {
-            anim::Mat3x4 world = anim::mat3x4_from(joint_rotations[c * joint_count + j], joint_positions[c * joint_count + j]);
+            anim::Mat3x4 world =
+                anim::mat3x4_from(joint_rotations[c * joint_count + j], joint_positions[c * joint_count + j]);
             world.r0 = glm::vec4(glm::vec3(world.r0) * s, world.r0.w);
             world.r1 = glm::vec4(glm::vec3(world.r1) * s, world.r1.w);
             world.r2 = glm::vec4(glm::vec3(world.r2) * s, world.r2.w);
@@ -96,7 +100,8 @@ void PalettePackJob::run() const {
         } else {
           const Index first = palette_offsets[c];
           const bool in_range = first >= 0 && first + joints <= palettes.size();  // CullJob leaves others out
-          for (std::int32_t j = 0; j < joints; ++j) out_palettes[at + j] = in_range ? palettes[first + j] : anim::collapse_to(glm::vec3(0.0f));
+          for (std::int32_t j = 0; j < joints; ++j)
+            out_palettes[at + j] = in_range ? palettes[first + j] : anim::collapse_to(glm::vec3(0.0f));
         }
       },
       256);

@@ -26,15 +26,19 @@ GlFramebuffer make_framebuffer() {
 }
 void check_complete(const char* what) {
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-  if (status != GL_FRAMEBUFFER_COMPLETE) throw Error(fmt::format("framebuffer incomplete (0x{:04x})", status), at_field(what));
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    throw Error(fmt::format("framebuffer incomplete (0x{:04x})", status), at_field(what));
 }
 }  // namespace
 
 OffscreenTarget::OffscreenTarget(std::int32_t width, std::int32_t height, std::int32_t samples)
     : width_(width), height_(height), samples_(samples) {
-  if (width < 1 || width > 16384) throw Error(fmt::format("width {} is outside 1..16384", width), at_field("render.width"));
-  if (height < 1 || height > 16384) throw Error(fmt::format("height {} is outside 1..16384", height), at_field("render.height"));
-  if (samples < 0 || samples > 16) throw Error(fmt::format("{} samples is outside 0..16", samples), at_field("render.samples"));
+  if (width < 1 || width > 16384)
+    throw Error(fmt::format("width {} is outside 1..16384", width), at_field("render.width"));
+  if (height < 1 || height > 16384)
+    throw Error(fmt::format("height {} is outside 1..16384", height), at_field("render.height"));
+  if (samples < 0 || samples > 16)
+    throw Error(fmt::format("{} samples is outside 0..16", samples), at_field("render.samples"));
   GLint max_samples = 1;
   glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
   if (samples_ > max_samples) samples_ = max_samples;

@@ -39,8 +39,9 @@ GLuint compile_shader(std::string_view program, GLenum stage, std::string_view s
     std::string log(static_cast<std::size_t>(log_length > 0 ? log_length : 1), '\0');
     glGetShaderInfoLog(s, log_length, nullptr, log.data());
     glDeleteShader(s);
-    throw Error(fmt::format("{} shader does not compile: {}", stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log.c_str()),
-                at_field(std::string(program)));
+    throw Error(
+        fmt::format("{} shader does not compile: {}", stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log.c_str()),
+        at_field(std::string(program)));
   }
   return s;
 }
@@ -53,7 +54,8 @@ void check_gl_version() {
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
   if (major * 10 + minor < 43)
-    throw Error(fmt::format("the renderer needs OpenGL 4.3 or later; this context is {}.{} ({})", major, minor, gl_description()));
+    throw Error(fmt::format("the renderer needs OpenGL 4.3 or later; this context is {}.{} ({})", major, minor,
+                            gl_description()));
 }
 
 void check_gl(std::string_view what) {
@@ -103,7 +105,8 @@ GlProgram make_program(std::string_view name, std::string_view vertex_source, st
   glAttachShader(program.get(), vs);
   glAttachShader(program.get(), fs);
   if (feedback.size() > 0)
-    glTransformFeedbackVaryings(program.get(), static_cast<GLsizei>(feedback.size()), feedback.begin(), GL_INTERLEAVED_ATTRIBS);
+    glTransformFeedbackVaryings(program.get(), static_cast<GLsizei>(feedback.size()), feedback.begin(),
+                                GL_INTERLEAVED_ATTRIBS);
   glLinkProgram(program.get());
   glDeleteShader(vs);
   glDeleteShader(fs);
@@ -150,7 +153,8 @@ namespace throng::render {
 void pin_gl_libraries() {
   dl_iterate_phdr(
       [](dl_phdr_info* info, std::size_t, void*) {
-        if (info->dlpi_name != nullptr && info->dlpi_name[0] != '\0') dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+        if (info->dlpi_name != nullptr && info->dlpi_name[0] != '\0')
+          dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
         return 0;
       },
       nullptr);

@@ -119,9 +119,11 @@ bool software_renderer() {
 
 HeadlessContext::HeadlessContext(const HeadlessOptions& o) : state_(std::make_unique<State>()) {
   if (o.gl_major * 10 + o.gl_minor < 43)
-    throw Error(fmt::format("OpenGL {}.{} requested; the renderer needs 4.3 or later", o.gl_major, o.gl_minor), at_field("gl_version"));
+    throw Error(fmt::format("OpenGL {}.{} requested; the renderer needs 4.3 or later", o.gl_major, o.gl_minor),
+                at_field("gl_version"));
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-  auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  auto get_platform_display =
+      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (get_platform_display == nullptr || !has_extension(client, "EGL_EXT_platform_base"))
     throw Error("EGL has no platform displays (EGL_EXT_platform_base): install libegl1 and libegl-mesa0");
 
@@ -129,12 +131,16 @@ HeadlessContext::HeadlessContext(const HeadlessOptions& o) : state_(std::make_un
   // 1. Hardware EGL devices (skipping Mesa's software device).
   if (o.prefer_hardware && has_extension(client, "EGL_EXT_platform_device")) {
     auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
-    auto query_device_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+    auto query_device_string =
+        reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
     EGLint count = 0;
     std::vector<EGLDeviceEXT> devices(16);
-    if (query_devices != nullptr && query_devices(static_cast<EGLint>(devices.size()), devices.data(), &count) == EGL_TRUE) {
+    if (query_devices != nullptr &&
+        query_devices(static_cast<EGLint>(devices.size()), devices.data(), &count) == EGL_TRUE) {
       for (EGLint i = 0; i < count && state_->context == EGL_NO_CONTEXT; ++i) {
-        const char* ext = query_device_string != nullptr ? query_device_string(devices[static_cast<std::size_t>(i)], EGL_EXTENSIONS) : nullptr;
+        const char* ext = query_device_string != nullptr
+                              ? query_device_string(devices[static_cast<std::size_t>(i)], EGL_EXTENSIONS)
+                              : nullptr;
         if (has_extension(ext, "EGL_MESA_device_software")) continue;
         EGLDisplay d = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<std::size_t>(i)], nullptr);
         EGLContext c = try_context(d, o, fmt::format("EGL device {}", i), why);
@@ -157,8 +163,9 @@ HeadlessContext::HeadlessContext(const HeadlessOptions& o) : state_(std::make_un
     }
   }
   if (state_->context == EGL_NO_CONTEXT)
-    throw Error(fmt::format("no headless OpenGL {}.{} context: {}install Mesa's EGL (libegl-mesa0, libgl1-mesa-dri) or a GPU driver",
-                            o.gl_major, o.gl_minor, why));
+    throw Error(fmt::format(
+        "no headless OpenGL {}.{} context: {}install Mesa's EGL (libegl-mesa0, libgl1-mesa-dri) or a GPU driver",
+        o.gl_major, o.gl_minor, why));
   software_ = software_renderer();
   check_gl_version();
   pin_gl_libraries();
@@ -166,7 +173,8 @@ HeadlessContext::HeadlessContext(const HeadlessOptions& o) : state_(std::make_un
 
 HeadlessContext::~HeadlessContext() {
   if (state_ && state_->display != EGL_NO_DISPLAY) {
-    if (eglGetCurrentContext() == state_->context) eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (eglGetCurrentContext() == state_->context)
+      eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(state_->display, state_->context);
     release_display(state_->display);
   }

@@ -27,7 +27,8 @@ void write_png(const std::string& path, const Image& image) {
     channels = 3;
   }
   OutputFile file(path);
-  if (stbi_write_png(file.writing_path().c_str(), image.width, image.height, channels, data, image.width * channels) == 0)
+  if (stbi_write_png(file.writing_path().c_str(), image.width, image.height, channels, data, image.width * channels) ==
+      0)
     throw Error("cannot write the PNG file (is its folder there, is the disk full?)", at_field(path));
   file.commit();
 }
@@ -51,7 +52,8 @@ ImageDifference compare_images(const Image& a, const Image& b, std::int32_t thre
   for (std::size_t p = 0; p < pixels; ++p) {
     std::int32_t worst = 0;
     for (std::size_t c = 0; c < 3; ++c) {
-      const std::int32_t diff = std::abs(static_cast<std::int32_t>(a.rgba[p * 4 + c]) - static_cast<std::int32_t>(b.rgba[p * 4 + c]));
+      const std::int32_t diff =
+          std::abs(static_cast<std::int32_t>(a.rgba[p * 4 + c]) - static_cast<std::int32_t>(b.rgba[p * 4 + c]));
       sum += diff;
       worst = std::max(worst, diff);
     }
@@ -68,7 +70,8 @@ ImageDifference compare_images(const Image& a, const Image& b, std::int32_t thre
 std::int32_t colour_distance(const Image& image, std::int32_t x, std::int32_t y, const std::uint8_t rgb[3]) {
   const std::uint8_t* p = image.pixel(x, y);
   std::int32_t worst = 0;
-  for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(static_cast<std::int32_t>(p[c]) - static_cast<std::int32_t>(rgb[c])));
+  for (int c = 0; c < 3; ++c)
+    worst = std::max(worst, std::abs(static_cast<std::int32_t>(p[c]) - static_cast<std::int32_t>(rgb[c])));
   return worst;
 }
 

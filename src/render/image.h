@@ -14,10 +14,12 @@ struct Image {
   std::vector<std::uint8_t> rgba;
 
   Image() = default;
-  Image(std::int32_t w, std::int32_t h) : width(w), height(h), rgba(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4u, 0) {}
+  Image(std::int32_t w, std::int32_t h)
+      : width(w), height(h), rgba(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4u, 0) {}
   bool empty() const { return width <= 0 || height <= 0; }
   const std::uint8_t* pixel(std::int32_t x, std::int32_t y) const {
-    return rgba.data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 4u;
+    return rgba.data() +
+           (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 4u;
   }
 };
 

@@ -10,7 +10,8 @@
 namespace throng::render {
 
 Mesh unit_sphere(std::int32_t slices, std::int32_t stacks) {
-  if (slices < 3 || stacks < 2) throw Error(fmt::format("sphere needs slices >= 3 and stacks >= 2, not {} x {}", slices, stacks));
+  if (slices < 3 || stacks < 2)
+    throw Error(fmt::format("sphere needs slices >= 3 and stacks >= 2, not {} x {}", slices, stacks));
   Mesh m;
   const float pi = 3.14159265358979f;
   for (std::int32_t i = 0; i <= stacks; ++i) {
@@ -48,7 +49,8 @@ void add_ring(ObstacleMesh& out, const std::vector<glm::vec2>& ring, bool solid_
     const glm::vec2 n_map = side * glm::vec2(d.y, -d.x) / len;
     const glm::vec3 n = world_from_ground(n_map);
     const auto base = static_cast<std::uint32_t>(out.walls.positions.size());
-    for (const glm::vec3& p : {world_from_ground(a), world_from_ground(b), world_from_ground(b, h), world_from_ground(a, h)}) {
+    for (const glm::vec3& p :
+         {world_from_ground(a), world_from_ground(b), world_from_ground(b, h), world_from_ground(a, h)}) {
       out.walls.positions.push_back(p);
       out.walls.normals.push_back(n);
     }
@@ -63,8 +65,10 @@ void add_ring(ObstacleMesh& out, const std::vector<glm::vec2>& ring, bool solid_
 }
 }  // namespace
 
-ObstacleMesh extrude_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles, const ObstacleStyle& style) {
-  if (!(style.height > 0.0f) || !std::isfinite(style.height)) throw Error("must be positive and finite", at_field("obstacles.height"));
+ObstacleMesh extrude_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles,
+                               const ObstacleStyle& style) {
+  if (!(style.height > 0.0f) || !std::isfinite(style.height))
+    throw Error("must be positive and finite", at_field("obstacles.height"));
   if (style.circle_segments < 3 || style.circle_segments > 4096)
     throw Error("must be within 3..4096", at_field("obstacles.circle_segments"));
   ObstacleMesh out;

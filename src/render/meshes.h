@@ -32,6 +32,7 @@ struct ObstacleMesh {
   std::vector<glm::vec3> cap_triangles;  // three vertices a triangle
   float height = 0.0f;
 };
-ObstacleMesh extrude_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles, const ObstacleStyle& style);
+ObstacleMesh extrude_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles,
+                               const ObstacleStyle& style);
 
 }  // namespace throng::render

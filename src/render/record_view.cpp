@@ -17,7 +17,8 @@ void HeadlessViewOptions::validate() const {
   record.validate();
   if (frames < 1) throw Error("must be at least 1", at_field("--frames"));
   if (!(speed > 0.0 && speed <= 100.0)) throw Error("must be within (0, 100]", at_field("--speed"));
-  if (!(camera_period > 0.0f) || !std::isfinite(camera_period)) throw Error("must be positive seconds", at_field("--camera-period"));
+  if (!(camera_period > 0.0f) || !std::isfinite(camera_period))
+    throw Error("must be positive seconds", at_field("--camera-period"));
   if (camera) camera->validate();
 }
 

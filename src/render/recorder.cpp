@@ -101,7 +101,9 @@ void Recorder::set_world(const sim::World& world, const ObstacleStyle& style) {
   show_world(s_->renderer, world, style);
 }
 
-RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses) { return add_frame(camera, poses, s_->spec.options); }
+RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses) {
+  return add_frame(camera, poses, s_->spec.options);
+}
 
 RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options) {
   State& s = *s_;

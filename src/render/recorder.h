@@ -26,9 +26,9 @@ RecordOutput parse_record_output(const std::string& text, const std::string& fie
 
 struct RecordSpec {
   RecordOutput output = RecordOutput::Video;
-  std::string folder = ".";               // created when missing
-  std::string video_name = "crowd.mp4";   // Video
-  std::string frame_prefix = "frame_";    // Frames: frame_00000.png, ...
+  std::string folder = ".";              // created when missing
+  std::string video_name = "crowd.mp4";  // Video
+  std::string frame_prefix = "frame_";   // Frames: frame_00000.png, ...
   std::int32_t width = 960;
   std::int32_t height = 540;
   double fps = 30.0;

@@ -30,15 +30,19 @@ constexpr std::int32_t kCoarseSlices = 4, kCoarseStacks = 2;
 
 // Colours of joint-LOD levels 0.. (finest first), after the spirit of the
 // 2019 paper's Figure 8: warm near, cool far.
-constexpr float kLodPalette[16][3] = {{0.85f, 0.22f, 0.18f}, {0.95f, 0.62f, 0.12f}, {0.32f, 0.70f, 0.28f}, {0.22f, 0.50f, 0.88f},
-                                      {0.55f, 0.35f, 0.80f}, {0.15f, 0.70f, 0.72f}, {0.85f, 0.40f, 0.65f}, {0.55f, 0.55f, 0.55f},
-                                      {0.40f, 0.25f, 0.15f}, {0.90f, 0.85f, 0.30f}, {0.20f, 0.35f, 0.35f}, {0.65f, 0.80f, 0.40f},
-                                      {0.30f, 0.30f, 0.60f}, {0.75f, 0.55f, 0.45f}, {0.45f, 0.60f, 0.75f}, {0.35f, 0.35f, 0.35f}};
+constexpr float kLodPalette[16][3] = {
+    {0.85f, 0.22f, 0.18f}, {0.95f, 0.62f, 0.12f}, {0.32f, 0.70f, 0.28f}, {0.22f, 0.50f, 0.88f},
+    {0.55f, 0.35f, 0.80f}, {0.15f, 0.70f, 0.72f}, {0.85f, 0.40f, 0.65f}, {0.55f, 0.55f, 0.55f},
+    {0.40f, 0.25f, 0.15f}, {0.90f, 0.85f, 0.30f}, {0.20f, 0.35f, 0.35f}, {0.65f, 0.80f, 0.40f},
+    {0.30f, 0.30f, 0.60f}, {0.75f, 0.55f, 0.45f}, {0.45f, 0.60f, 0.75f}, {0.35f, 0.35f, 0.35f}};
 // Clothing colours when not colouring by LOD (skinned mode: shirts).
-constexpr float kClothes[8][3] = {{0.80f, 0.30f, 0.25f}, {0.25f, 0.45f, 0.75f}, {0.90f, 0.75f, 0.35f}, {0.35f, 0.60f, 0.40f},
-                                  {0.55f, 0.40f, 0.65f}, {0.85f, 0.55f, 0.40f}, {0.30f, 0.30f, 0.35f}, {0.85f, 0.85f, 0.80f}};
-constexpr float kTrouserColours[4][3] = {{0.20f, 0.22f, 0.30f}, {0.35f, 0.30f, 0.25f}, {0.15f, 0.15f, 0.17f}, {0.45f, 0.42f, 0.35f}};
-constexpr float kSkinTones[4][3] = {{0.93f, 0.76f, 0.63f}, {0.78f, 0.57f, 0.42f}, {0.55f, 0.38f, 0.26f}, {0.36f, 0.24f, 0.17f}};
+constexpr float kClothes[8][3] = {{0.80f, 0.30f, 0.25f}, {0.25f, 0.45f, 0.75f}, {0.90f, 0.75f, 0.35f},
+                                  {0.35f, 0.60f, 0.40f}, {0.55f, 0.40f, 0.65f}, {0.85f, 0.55f, 0.40f},
+                                  {0.30f, 0.30f, 0.35f}, {0.85f, 0.85f, 0.80f}};
+constexpr float kTrouserColours[4][3] = {
+    {0.20f, 0.22f, 0.30f}, {0.35f, 0.30f, 0.25f}, {0.15f, 0.15f, 0.17f}, {0.45f, 0.42f, 0.35f}};
+constexpr float kSkinTones[4][3] = {
+    {0.93f, 0.76f, 0.63f}, {0.78f, 0.57f, 0.42f}, {0.55f, 0.38f, 0.26f}, {0.36f, 0.24f, 0.17f}};
 
 struct GpuMesh {
   GlVertexArray vao;
@@ -60,21 +64,23 @@ GpuMesh upload_mesh(const Mesh& m) {
   }
   glBindVertexArray(g.vao.get());
   glBindBuffer(GL_ARRAY_BUFFER, g.vertices.get());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(interleaved.size() * sizeof(float)), interleaved.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(interleaved.size() * sizeof(float)), interleaved.data(),
+               GL_STATIC_DRAW);
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<const void*>(3 * sizeof(float)));
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.indices.get());
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.indices.size() * sizeof(std::uint32_t)), m.indices.data(),
-               GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.indices.size() * sizeof(std::uint32_t)),
+               m.indices.data(), GL_STATIC_DRAW);
   glBindVertexArray(0);
   g.index_count = static_cast<GLsizei>(m.indices.size());
   return g;
 }
 
 // A skinned mesh with its per-vertex style (body part, material).
-GpuMesh upload_skinned_mesh(const anim::SkinnedMesh& m, const std::vector<std::uint8_t>& parts, const std::vector<std::uint8_t>& materials) {
+GpuMesh upload_skinned_mesh(const anim::SkinnedMesh& m, const std::vector<std::uint8_t>& parts,
+                            const std::vector<std::uint8_t>& materials) {
   struct Vertex {
     glm::vec3 position, normal;
     glm::u16vec4 joints;
@@ -91,7 +97,8 @@ GpuMesh upload_skinned_mesh(const anim::SkinnedMesh& m, const std::vector<std::u
   g.indices = make_buffer();
   glBindVertexArray(g.vao.get());
   glBindBuffer(GL_ARRAY_BUFFER, g.vertices.get());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(),
+               GL_STATIC_DRAW);
   const auto at = [](std::size_t offset) { return reinterpret_cast<const void*>(offset); };
   constexpr auto stride = static_cast<GLsizei>(sizeof(Vertex));
   glEnableVertexAttribArray(0);
@@ -105,8 +112,8 @@ GpuMesh upload_skinned_mesh(const anim::SkinnedMesh& m, const std::vector<std::u
   glEnableVertexAttribArray(4);
   glVertexAttribIPointer(4, 2, GL_UNSIGNED_BYTE, stride, at(offsetof(Vertex, style)));
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.indices.get());
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.indices.size() * sizeof(std::uint32_t)), m.indices.data(),
-               GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(m.indices.size() * sizeof(std::uint32_t)),
+               m.indices.data(), GL_STATIC_DRAW);
   glBindVertexArray(0);
   g.index_count = static_cast<GLsizei>(m.indices.size());
   g.vertex_count = static_cast<GLsizei>(m.positions.size());
@@ -192,9 +199,11 @@ void RenderOptions::validate() const {
     throw Error("must be finite and >= 0", at_field("render.fine_min_pixels"));
   if (!(lines_max_pixels >= 0.0f) || !std::isfinite(lines_max_pixels))
     throw Error("must be finite and >= 0", at_field("render.lines_max_pixels"));
-  if (!(fog_distance >= 0.0f) || !std::isfinite(fog_distance)) throw Error("must be finite and >= 0", at_field("render.fog_distance"));
+  if (!(fog_distance >= 0.0f) || !std::isfinite(fog_distance))
+    throw Error("must be finite and >= 0", at_field("render.fog_distance"));
   for (int c = 0; c < 3; ++c)
-    if (!(background[c] >= 0.0f && background[c] <= 1.0f)) throw Error("channels must be within 0..1", at_field("render.background"));
+    if (!(background[c] >= 0.0f && background[c] <= 1.0f))
+      throw Error("channels must be within 0..1", at_field("render.background"));
 }
 
 struct Renderer::State {
@@ -206,7 +215,7 @@ struct Renderer::State {
   std::size_t points_capacity = 0, palettes_capacity = 0, tags_capacity = 0;
   GLint64 max_block_bytes = 1 << 27;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   GLint block_alignment = 256;        // GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT
-  GlVertexArray empty_vao;  // attribute-less draws (ground, bins)
+  GlVertexArray empty_vao;            // attribute-less draws (ground, bins)
   Memory tables_memory = Memory::Host;
   Buffer<RigPoint> rig_points;
   Buffer<anim::Mat3x4> inverse_bind;  // skin rig 0: palettes from joint frames
@@ -233,17 +242,20 @@ struct Renderer::State {
   void ensure_tables(Memory memory);
   // Cull, slots: the draw groups of this frame (force_tier >= 0: everyone
   // visible, in that tier).
-  DrawGroups cull(const Camera* camera, const CharacterPoses& poses, const RenderOptions& options, RenderMode mode, std::int32_t force_tier);
+  DrawGroups cull(const Camera* camera, const CharacterPoses& poses, const RenderOptions& options, RenderMode mode,
+                  std::int32_t force_tier);
   void pack_points(const CharacterPoses& poses, const DrawGroups& groups);
   void pack_palettes(const CharacterPoses& poses, const DrawGroups& groups);
   // Binds the palette rows and tags of slots [first, first + count) of a
   // group and sets the program's bases; the rest of the group goes in later calls.
-  void bind_slot_range(const GlProgram& program, const DrawGroups& groups, std::int32_t group, Index first, Index count);
+  void bind_slot_range(const GlProgram& program, const DrawGroups& groups, std::int32_t group, Index first,
+                       Index count);
   Index slots_per_draw(std::int32_t joints) const;
 
   // Stages of Renderer::render. prepare: cull, slots, packing; the visible,
   // fine, lines and instance counts into stats; returns the frame's draw groups.
-  DrawGroups prepare(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options, RenderStats& stats);
+  DrawGroups prepare(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options,
+                     RenderStats& stats);
   // The ground square (a metre grid when grid), the bins heat map, the paths.
   void draw_ground(const FrameView& view, bool grid);
   void draw_bins(const FrameView& view);
@@ -258,7 +270,8 @@ struct Renderer::State {
 Renderer::Renderer(const JointRig& rig) : Renderer(CrowdRigs{rig, {}}) {}
 
 Renderer::Renderer(const CrowdRigs& rigs) : s_(std::make_unique<State>()) {
-  if (rigs.joints.joint_count == 0 && rigs.skins.empty()) throw Error("neither a joint rig nor a skinned mesh", at_field("rigs"));
+  if (rigs.joints.joint_count == 0 && rigs.skins.empty())
+    throw Error("neither a joint rig nor a skinned mesh", at_field("rigs"));
   if (rigs.joints.joint_count != 0) rigs.joints.validate();
   if (rigs.skins.size() > static_cast<std::size_t>(kMaxRenderRigs))
     throw Error(fmt::format("{} skin rigs, at most {}", rigs.skins.size(), kMaxRenderRigs), at_field("rigs.skins"));
@@ -268,7 +281,8 @@ Renderer::Renderer(const CrowdRigs& rigs) : s_(std::make_unique<State>()) {
   s_->joints = make_program("render.joints", shaders::kJointsVertex, shaders::kLitFragment);
   s_->joint_lines = make_program("render.joint_lines", shaders::kJointLinesVertex, shaders::kLitFragment);
   s_->skinned = make_program("render.skinned", shaders::kSkinnedVertex, shaders::kLitFragment);
-  s_->skin_capture = make_program("render.skin_capture", shaders::kSkinnedVertex, shaders::kLitFragment, {"v_world", "v_normal"});
+  s_->skin_capture =
+      make_program("render.skin_capture", shaders::kSkinnedVertex, shaders::kLitFragment, {"v_world", "v_normal"});
   s_->walls = make_program("render.obstacles", shaders::kStaticVertex, shaders::kLitFragment);
   s_->ground = make_program("render.ground", shaders::kGroundVertex, shaders::kGroundFragment);
   s_->bins = make_program("render.bins", shaders::kGroundVertex, shaders::kBinsFragment);
@@ -277,7 +291,8 @@ Renderer::Renderer(const CrowdRigs& rigs) : s_(std::make_unique<State>()) {
   s_->coarse_sphere = upload_mesh(unit_sphere(kCoarseSlices, kCoarseStacks));
   for (const SkinRig& skin : rigs.skins) {
     std::array<GpuMesh, kDrawTiers> meshes;
-    for (std::size_t t = 0; t < meshes.size(); ++t) meshes[t] = upload_skinned_mesh(skin.meshes[t], skin.parts[t], skin.materials[t]);
+    for (std::size_t t = 0; t < meshes.size(); ++t)
+      meshes[t] = upload_skinned_mesh(skin.meshes[t], skin.parts[t], skin.materials[t]);
     s_->skin_meshes.push_back(std::move(meshes));
   }
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &s_->max_block_bytes);
@@ -292,7 +307,8 @@ Renderer::Renderer(const CrowdRigs& rigs) : s_(std::make_unique<State>()) {
   for (const RigBone& b : rigs.joints.bones) bones.push_back({b.from, b.to, b.radius, 0.0f});
   s_->bones_ssbo = make_buffer();
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, s_->bones_ssbo.get());
-  glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(std::max<std::size_t>(1, bones.size()) * sizeof(GpuBone)),
+  glBufferData(GL_SHADER_STORAGE_BUFFER,
+               static_cast<GLsizeiptr>(std::max<std::size_t>(1, bones.size()) * sizeof(GpuBone)),
                bones.empty() ? nullptr : bones.data(), GL_STATIC_DRAW);
   s_->points_ssbo = make_buffer();
   s_->palettes_ssbo = make_buffer();
@@ -306,12 +322,13 @@ void Renderer::State::ensure_tables(Memory memory) {
     if (tables_memory == memory) return;
   }
   if (rigs.joints.joint_count > 0) rig_points = Buffer<RigPoint>(std::span<const RigPoint>(rigs.joints.points), memory);
-  if (!rigs.skins.empty()) inverse_bind = Buffer<anim::Mat3x4>(std::span<const anim::Mat3x4>(rigs.skins.front().inverse_bind), memory);
+  if (!rigs.skins.empty())
+    inverse_bind = Buffer<anim::Mat3x4>(std::span<const anim::Mat3x4>(rigs.skins.front().inverse_bind), memory);
   tables_memory = memory;
 }
 
-DrawGroups Renderer::State::cull(const Camera* camera, const CharacterPoses& poses, const RenderOptions& options, RenderMode mode,
-                                 std::int32_t force_tier) {
+DrawGroups Renderer::State::cull(const Camera* camera, const CharacterPoses& poses, const RenderOptions& options,
+                                 RenderMode mode, std::int32_t force_tier) {
   const Index n = poses.character_count();
   const Memory memory = current_memory();
   ensure_tables(memory);
@@ -368,7 +385,8 @@ void Renderer::State::pack_points(const CharacterPoses& poses, const DrawGroups&
   ScopedTimer upload("render.upload");
   if (current_memory() == Memory::Host) {
     // Pack straight into the GL buffer.
-    void* mapped = glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(bytes), GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+    void* mapped = glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(bytes),
+                                    GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
     if (mapped == nullptr) throw Error("cannot map the points buffer", at_field("render.upload"));
     pack.out_points = Span<glm::vec4>(static_cast<glm::vec4*>(mapped), visible * P);
     try {
@@ -411,7 +429,8 @@ void Renderer::State::pack_palettes(const CharacterPoses& poses, const DrawGroup
     // Pack straight into the GL buffers.
     const auto map = [](const GlBuffer& b, std::size_t bytes) {
       glBindBuffer(GL_SHADER_STORAGE_BUFFER, b.get());
-      return glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(bytes), GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+      return glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(bytes),
+                              GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
     };
     const auto unmap = [](const GlBuffer& b) {
       glBindBuffer(GL_SHADER_STORAGE_BUFFER, b.get());
@@ -457,19 +476,23 @@ Index Renderer::State::slots_per_draw(std::int32_t joint_count) const {
   return std::max<Index>(1, usable / (static_cast<Index>(joint_count) * static_cast<Index>(sizeof(anim::Mat3x4))));
 }
 
-void Renderer::State::bind_slot_range(const GlProgram& program, const DrawGroups& groups, std::int32_t group, Index first, Index count) {
+void Renderer::State::bind_slot_range(const GlProgram& program, const DrawGroups& groups, std::int32_t group,
+                                      Index first, Index count) {
   const auto align = static_cast<Index>(block_alignment);
   const Index per_slot = groups.joints[group];
   const Index palette_byte = (groups.first_matrix[group] + first * per_slot) * static_cast<Index>(sizeof(anim::Mat3x4));
   const Index palette_start = palette_byte - palette_byte % align;
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, palettes_ssbo.get(), static_cast<GLintptr>(palette_start),
-                    static_cast<GLsizeiptr>(palette_byte - palette_start + count * per_slot * static_cast<Index>(sizeof(anim::Mat3x4))));
+                    static_cast<GLsizeiptr>(palette_byte - palette_start +
+                                            count * per_slot * static_cast<Index>(sizeof(anim::Mat3x4))));
   const Index tag_byte = (groups.first_slot[group] + first) * static_cast<Index>(sizeof(glm::uvec2));
   const Index tag_start = tag_byte - tag_byte % align;
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, tags_ssbo.get(), static_cast<GLintptr>(tag_start),
                     static_cast<GLsizeiptr>(tag_byte - tag_start + count * static_cast<Index>(sizeof(glm::uvec2))));
-  glUniform1i(uniform(program, "u_row_base"), static_cast<GLint>((palette_byte - palette_start) / static_cast<Index>(sizeof(glm::vec4))));
-  glUniform1i(uniform(program, "u_slot_base"), static_cast<GLint>((tag_byte - tag_start) / static_cast<Index>(sizeof(glm::uvec2))));
+  glUniform1i(uniform(program, "u_row_base"),
+              static_cast<GLint>((palette_byte - palette_start) / static_cast<Index>(sizeof(glm::vec4))));
+  glUniform1i(uniform(program, "u_slot_base"),
+              static_cast<GLint>((tag_byte - tag_start) / static_cast<Index>(sizeof(glm::uvec2))));
   glUniform1i(uniform(program, "u_joint_count"), static_cast<GLint>(per_slot));
 }
 
@@ -478,7 +501,8 @@ Renderer::~Renderer() = default;
 const CrowdRigs& Renderer::rigs() const { return s_->rigs; }
 const JointRig& Renderer::rig() const { return s_->rigs.joints; }
 
-void Renderer::set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles, const ObstacleStyle& style) {
+void Renderer::set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles,
+                             const ObstacleStyle& style) {
   const ObstacleMesh mesh = extrude_obstacles(polygons, circles, style);
   s_->has_obstacles = !mesh.walls.indices.empty();
   s_->obstacle_walls = upload_mesh(mesh.walls);
@@ -486,8 +510,8 @@ void Renderer::set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::
   s_->caps_vbo = make_buffer();
   glBindVertexArray(s_->caps_vao.get());
   glBindBuffer(GL_ARRAY_BUFFER, s_->caps_vbo.get());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.cap_triangles.size() * sizeof(glm::vec3)), mesh.cap_triangles.data(),
-               GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.cap_triangles.size() * sizeof(glm::vec3)),
+               mesh.cap_triangles.data(), GL_STATIC_DRAW);
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
   glBindVertexArray(0);
@@ -504,7 +528,8 @@ void Renderer::set_paths(const std::vector<MapPolyline>& paths) {
     s_->path_first.push_back(static_cast<GLint>(vertices.size()));
     s_->path_count.push_back(static_cast<GLsizei>(p.size()));
     for (const glm::vec2& q : p) {
-      if (!std::isfinite(q.x) || !std::isfinite(q.y)) throw Error("path points must be finite", at_field("render.paths"));
+      if (!std::isfinite(q.x) || !std::isfinite(q.y))
+        throw Error("path points must be finite", at_field("render.paths"));
       vertices.push_back(world_from_ground(q, 0.03f));
     }
   }
@@ -512,7 +537,8 @@ void Renderer::set_paths(const std::vector<MapPolyline>& paths) {
   s_->paths_vbo = make_buffer();
   glBindVertexArray(s_->paths_vao.get());
   glBindBuffer(GL_ARRAY_BUFFER, s_->paths_vbo.get());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(glm::vec3)), vertices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(glm::vec3)), vertices.data(),
+               GL_STATIC_DRAW);
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
   glBindVertexArray(0);
@@ -528,9 +554,11 @@ void Renderer::set_bins(const BinsOverlay& bins) {
   GLint max_size = 0;
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
   if (bins.columns > max_size || bins.rows > max_size)
-    throw Error(fmt::format("{} x {} bins exceed the GPU's texture size {}", bins.columns, bins.rows, max_size), at_field("bins.columns"));
+    throw Error(fmt::format("{} x {} bins exceed the GPU's texture size {}", bins.columns, bins.rows, max_size),
+                at_field("bins.columns"));
   std::vector<std::uint32_t> counts(static_cast<std::size_t>(bins.counts.size()));
-  for (Index i = 0; i < bins.counts.size(); ++i) counts[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(std::max(bins.counts[i], 0));
+  for (Index i = 0; i < bins.counts.size(); ++i)
+    counts[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(std::max(bins.counts[i], 0));
   if (!s_->bins_texture) s_->bins_texture = make_texture();
   glBindTexture(GL_TEXTURE_2D, s_->bins_texture.get());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
@@ -540,12 +568,15 @@ void Renderer::set_bins(const BinsOverlay& bins) {
   check_gl("render.bins");
 }
 
-DrawGroups Renderer::State::prepare(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options, RenderStats& stats) {
+DrawGroups Renderer::State::prepare(const Camera& camera, const CharacterPoses& poses, const RenderOptions& options,
+                                    RenderStats& stats) {
   const bool skinned_mode = options.mode == RenderMode::Skinned;
   // Cull, give every visible character a slot, pack its points or palette.
   const DrawGroups groups = cull(&camera, poses, options, options.mode, -1);
-  if (skinned_mode) pack_palettes(poses, groups);
-  else pack_points(poses, groups);
+  if (skinned_mode)
+    pack_palettes(poses, groups);
+  else
+    pack_points(poses, groups);
   for (std::int32_t g = 0; g < groups.count; ++g) {
     if (g % kDrawTiers == static_cast<int>(DrawTier::Fine)) stats.fine += groups.slots[g];
     if (g % kDrawTiers == static_cast<int>(DrawTier::Lines)) stats.lines += groups.slots[g];
@@ -595,7 +626,8 @@ void Renderer::State::draw_paths(const FrameView& view) {
   glMultiDrawArrays(GL_LINE_STRIP, path_first.data(), path_count.data(), static_cast<GLsizei>(path_first.size()));
 }
 
-void Renderer::State::draw_joint_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours, RenderStats& stats) {
+void Renderer::State::draw_joint_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours,
+                                            RenderStats& stats) {
   // One instance per (visible character, bone); fine slots first. Both joint
   // programs read the same storage buffers and colour uniforms.
   const JointRig& rig = rigs.joints;
@@ -609,7 +641,8 @@ void Renderer::State::draw_joint_characters(const FrameView& view, const DrawGro
     if (slot_count <= 0) return;
     glUniform1i(uniform(joints, "u_slot_base"), static_cast<GLint>(slot_base));
     glBindVertexArray(mesh.vao.get());
-    glDrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(slot_count * rig.bone_count()));
+    glDrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr,
+                            static_cast<GLsizei>(slot_count * rig.bone_count()));
     stats.triangles += slot_count * rig.bone_count() * (mesh.index_count / 3);
   };
   draw(fine_sphere, 0, fine_total);
@@ -624,7 +657,8 @@ void Renderer::State::draw_joint_characters(const FrameView& view, const DrawGro
   }
 }
 
-void Renderer::State::draw_skinned_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours, RenderStats& stats) {
+void Renderer::State::draw_skinned_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours,
+                                              RenderStats& stats) {
   set_lighting(skinned, view);
   glUniform1i(uniform(skinned, "u_colour_by_lod"), lod_colours ? 1 : 0);
   glUniform3fv(uniform(skinned, "u_lod_palette"), 16, &kLodPalette[0][0]);
@@ -633,17 +667,21 @@ void Renderer::State::draw_skinned_characters(const FrameView& view, const DrawG
   glUniform3fv(uniform(skinned, "u_skin"), 4, &kSkinTones[0][0]);
   for (std::int32_t g = 0; g < groups.count; ++g) {
     if (groups.slots[g] == 0) continue;
-    const GpuMesh& mesh = skin_meshes[static_cast<std::size_t>(g / kDrawTiers)][static_cast<std::size_t>(g % kDrawTiers)];
+    const GpuMesh& mesh =
+        skin_meshes[static_cast<std::size_t>(g / kDrawTiers)][static_cast<std::size_t>(g % kDrawTiers)];
     const bool lines = g % kDrawTiers == static_cast<int>(DrawTier::Lines);
-    if (lines) glDisable(GL_CULL_FACE);
-    else glEnable(GL_CULL_FACE);
+    if (lines)
+      glDisable(GL_CULL_FACE);
+    else
+      glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
     glBindVertexArray(mesh.vao.get());
     const Index per_draw = slots_per_draw(groups.joints[g]);
     for (Index first = 0; first < groups.slots[g]; first += per_draw) {
       const Index count = std::min(per_draw, groups.slots[g] - first);
       bind_slot_range(skinned, groups, g, first, count);
-      glDrawElementsInstanced(lines ? GL_LINES : GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(count));
+      glDrawElementsInstanced(lines ? GL_LINES : GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr,
+                              static_cast<GLsizei>(count));
     }
     if (!lines) stats.triangles += groups.slots[g] * (mesh.index_count / 3);
   }
@@ -721,7 +759,8 @@ SkinCapture Renderer::capture_skinned(const CharacterPoses& poses, DrawTier tier
   SkinCapture out;
   out.vertices = mesh.vertex_count;
   const Index n = groups.slots[t];
-  if (n != poses.character_count()) throw Error("characters with palettes out of range cannot be captured", at_field("poses.palette_offsets"));
+  if (n != poses.character_count())
+    throw Error("characters with palettes out of range cannot be captured", at_field("poses.palette_offsets"));
   if (n == 0) return out;
   const std::size_t floats = static_cast<std::size_t>(n) * static_cast<std::size_t>(mesh.vertex_count) * 6u;
   // Draws need a complete framebuffer even with rasterisation off (a

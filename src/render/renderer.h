@@ -53,13 +53,13 @@ struct RenderOptions {
 
 struct RenderStats {
   Index characters = 0;
-  Index visible = 0;       // after culling
-  Index fine = 0;          // of them with the fine mesh
-  Index lines = 0;         // of them as lines
-  Index instances = 0;     // ellipsoids (joint mode) or meshes (skinned mode) drawn
-  Index triangles = 0;     // character triangles submitted (lines not counted)
-  double prepare_ms = 0;   // cull + pack + upload (CPU)
-  double submit_ms = 0;    // issuing draws (the GPU may still be working)
+  Index visible = 0;      // after culling
+  Index fine = 0;         // of them with the fine mesh
+  Index lines = 0;        // of them as lines
+  Index instances = 0;    // ellipsoids (joint mode) or meshes (skinned mode) drawn
+  Index triangles = 0;    // character triangles submitted (lines not counted)
+  double prepare_ms = 0;  // cull + pack + upload (CPU)
+  double submit_ms = 0;   // issuing draws (the GPU may still be working)
 };
 
 // Colour of joint-LOD level `level` (0 = finest), shared with the viewer's legend.
@@ -68,7 +68,7 @@ glm::vec3 lod_level_colour(std::int32_t level);
 // Skinned vertices read back from the GPU (transform feedback): the same
 // vertex shader as drawing, for testing against anim::skin_reference.
 struct SkinCapture {
-  std::int32_t vertices = 0;        // per character (the tier's mesh)
+  std::int32_t vertices = 0;         // per character (the tier's mesh)
   std::vector<glm::vec3> positions;  // characters * vertices, character-major, world
   std::vector<glm::vec3> normals;
 };
@@ -86,7 +86,8 @@ class Renderer {
   const CrowdRigs& rigs() const;
   const JointRig& rig() const;  // rigs().joints
   // Static scene: obstacles of the simulation's map, uploaded once.
-  void set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles, const ObstacleStyle& style = {});
+  void set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles,
+                     const ObstacleStyle& style = {});
   // Paths drawn when options.paths; an empty list clears them.
   void set_paths(const std::vector<MapPolyline>& paths);
   // Bins drawn when options.bins (counts copied; call again to update).

@@ -24,18 +24,22 @@ RenderMode parse_render_mode(const std::string& text, const std::string& field) 
 
 void JointRig::validate() const {
   if (joint_count <= 0 || joint_count > anim::kMaxLodJoints)
-    throw Error(fmt::format("joint count {} is outside 1..{}", joint_count, anim::kMaxLodJoints), at_field("rig.joint_count"));
+    throw Error(fmt::format("joint count {} is outside 1..{}", joint_count, anim::kMaxLodJoints),
+                at_field("rig.joint_count"));
   if (point_count() < joint_count) throw Error("fewer points than joints", at_field("rig.points"));
   for (std::int32_t i = 0; i < point_count(); ++i) {
     const RigPoint& p = points[static_cast<std::size_t>(i)];
     if (p.joint < 0 || p.joint >= joint_count || (i < joint_count && p.joint != i))
       throw Error(fmt::format("joint {} out of range", p.joint), at_field(fmt::format("rig.points[{}].joint", i)));
-    if (p.part >= anim::kBodyPartCount) throw Error("body part out of range", at_field(fmt::format("rig.points[{}].part", i)));
+    if (p.part >= anim::kBodyPartCount)
+      throw Error("body part out of range", at_field(fmt::format("rig.points[{}].part", i)));
   }
   for (std::size_t b = 0; b < bones.size(); ++b) {
     const RigBone& bone = bones[b];
-    if (bone.from < 0 || bone.from >= point_count()) throw Error("point out of range", at_field(fmt::format("rig.bones[{}].from", b)));
-    if (bone.to < 0 || bone.to >= point_count()) throw Error("point out of range", at_field(fmt::format("rig.bones[{}].to", b)));
+    if (bone.from < 0 || bone.from >= point_count())
+      throw Error("point out of range", at_field(fmt::format("rig.bones[{}].from", b)));
+    if (bone.to < 0 || bone.to >= point_count())
+      throw Error("point out of range", at_field(fmt::format("rig.bones[{}].to", b)));
     if (!(bone.radius > 0.0f) || !std::isfinite(bone.radius))
       throw Error("radius must be positive and finite", at_field(fmt::format("rig.bones[{}].radius", b)));
   }
@@ -101,13 +105,17 @@ JointRig make_joint_rig(const motion::Skeleton& s) {
 
 void SkinRig::validate() const {
   if (joint_count <= 0 || joint_count > anim::kMaxRigJoints)
-    throw Error(fmt::format("joint count {} is outside 1..{}", joint_count, anim::kMaxRigJoints), at_field("skin.joint_count"));
-  if (inverse_bind.size() != static_cast<std::size_t>(joint_count)) throw Error("one matrix per joint", at_field("skin.inverse_bind"));
-  if (bind_positions.size() != static_cast<std::size_t>(joint_count)) throw Error("one position per joint", at_field("skin.bind_positions"));
+    throw Error(fmt::format("joint count {} is outside 1..{}", joint_count, anim::kMaxRigJoints),
+                at_field("skin.joint_count"));
+  if (inverse_bind.size() != static_cast<std::size_t>(joint_count))
+    throw Error("one matrix per joint", at_field("skin.inverse_bind"));
+  if (bind_positions.size() != static_cast<std::size_t>(joint_count))
+    throw Error("one position per joint", at_field("skin.bind_positions"));
   for (int t = 0; t < kDrawTiers; ++t) {
     const anim::SkinnedMesh& m = meshes[static_cast<std::size_t>(t)];
     const std::string field = fmt::format("skin.meshes[{}]", t);
-    if (m.joint_count != joint_count) throw Error(fmt::format("bound to {} joints, the rig has {}", m.joint_count, joint_count), at_field(field));
+    if (m.joint_count != joint_count)
+      throw Error(fmt::format("bound to {} joints, the rig has {}", m.joint_count, joint_count), at_field(field));
     const bool lines = t + 1 == kDrawTiers;
     try {
       if (lines) {  // SkinnedMesh checks triangles: check the vertices, then the lines here
@@ -122,9 +130,11 @@ void SkinRig::validate() const {
     }
     if (lines && m.indices.size() % 2 != 0) throw Error("not whole lines", at_field(field + ".indices"));
     for (std::uint32_t i : m.indices)
-      if (i >= static_cast<std::uint32_t>(m.vertex_count())) throw Error("vertex index out of range", at_field(field + ".indices"));
+      if (i >= static_cast<std::uint32_t>(m.vertex_count()))
+        throw Error("vertex index out of range", at_field(field + ".indices"));
     const auto V = static_cast<std::size_t>(m.vertex_count());
-    if (parts[static_cast<std::size_t>(t)].size() != V) throw Error("one part per vertex", at_field(fmt::format("skin.parts[{}]", t)));
+    if (parts[static_cast<std::size_t>(t)].size() != V)
+      throw Error("one part per vertex", at_field(fmt::format("skin.parts[{}]", t)));
     if (materials[static_cast<std::size_t>(t)].size() != V)
       throw Error("one material per vertex", at_field(fmt::format("skin.materials[{}]", t)));
     for (std::uint8_t p : parts[static_cast<std::size_t>(t)])
@@ -201,15 +211,18 @@ SkinRig make_skin_rig(const anim::Rig& rig) {
   std::vector<std::uint8_t> material(static_cast<std::size_t>(J), kShirt);
   for (std::int32_t j = 0; j < J; ++j) {
     const auto part = static_cast<anim::BodyPart>(part_of[static_cast<std::size_t>(j)]);
-    if (part == anim::BodyPart::LeftLeg || part == anim::BodyPart::RightLeg) material[static_cast<std::size_t>(j)] = kTrousers;
-    if (at_or_below(s, j, {Role::Neck, Role::Head, Role::LeftWrist, Role::RightWrist})) material[static_cast<std::size_t>(j)] = kSkin;
+    if (part == anim::BodyPart::LeftLeg || part == anim::BodyPart::RightLeg)
+      material[static_cast<std::size_t>(j)] = kTrousers;
+    if (at_or_below(s, j, {Role::Neck, Role::Head, Role::LeftWrist, Role::RightWrist}))
+      material[static_cast<std::size_t>(j)] = kSkin;
   }
   // Chain length from the root to every joint in the bind pose.
   std::vector<float> reach(static_cast<std::size_t>(J), 0.0f);
   for (std::int32_t j = 1; j < J; ++j) {
     const std::int32_t p = s.parents[static_cast<std::size_t>(j)];
     reach[static_cast<std::size_t>(j)] =
-        reach[static_cast<std::size_t>(p)] + glm::distance(rig.bind_positions[static_cast<std::size_t>(p)], rig.bind_positions[static_cast<std::size_t>(j)]);
+        reach[static_cast<std::size_t>(p)] +
+        glm::distance(rig.bind_positions[static_cast<std::size_t>(p)], rig.bind_positions[static_cast<std::size_t>(j)]);
   }
   float radius = 0.0f;
   for (int t = 0; t < kDrawTiers; ++t) {
@@ -253,18 +266,22 @@ void CharacterPoses::validate(const CrowdRigs& crowd, RenderMode mode) const {
       throw Error("give joint frames or palettes, not both", at_field("poses.palettes"));
     if (!rigs.empty()) throw Error("joint frames are of one rig: leave rigs empty", at_field("poses.rigs"));
     if (joint_positions.size() % joint_count != 0)
-      throw Error(fmt::format("{} positions is not a whole number of {}-joint characters", joint_positions.size(), joint_count),
-                  at_field("poses.joint_positions"));
+      throw Error(
+          fmt::format("{} positions is not a whole number of {}-joint characters", joint_positions.size(), joint_count),
+          at_field("poses.joint_positions"));
     n = character_count();
     if (joint_rotations.size() != n * joint_count)
       throw Error(fmt::format("{} rotations for {} characters of {} joints", joint_rotations.size(), n, joint_count),
                   at_field("poses.joint_rotations"));
     if (!scales.empty() && scales.size() != n)
       throw Error(fmt::format("{} scales for {} characters", scales.size(), n), at_field("poses.scales"));
-    const std::int32_t rig_joints =
-        mode == RenderMode::Joints ? crowd.joints.joint_count : (crowd.skins.empty() ? 0 : crowd.skins.front().joint_count);
-    if (mode == RenderMode::Joints && rig_joints == 0) throw Error("the renderer has no joint rig", at_field("render.mode"));
-    if (mode == RenderMode::Skinned && crowd.skins.empty()) throw Error("the renderer has no skinned mesh", at_field("render.mode"));
+    const std::int32_t rig_joints = mode == RenderMode::Joints
+                                        ? crowd.joints.joint_count
+                                        : (crowd.skins.empty() ? 0 : crowd.skins.front().joint_count);
+    if (mode == RenderMode::Joints && rig_joints == 0)
+      throw Error("the renderer has no joint rig", at_field("render.mode"));
+    if (mode == RenderMode::Skinned && crowd.skins.empty())
+      throw Error("the renderer has no skinned mesh", at_field("render.mode"));
     if (rig_joints != joint_count)
       throw Error(fmt::format("{} joints, the rig has {}", joint_count, rig_joints), at_field("poses.joint_count"));
   } else if (!palette_offsets.empty() || !palettes.empty()) {
@@ -280,9 +297,11 @@ void CharacterPoses::validate(const CrowdRigs& crowd, RenderMode mode) const {
     throw Error("joint frames need joint_count > 0", at_field("poses.joint_count"));
   }
   if (!lod_levels.empty() && lod_levels.size() != n && lod_levels.size() != n * anim::kBodyPartCount)
-    throw Error(fmt::format("{} levels for {} characters (want 0, {} or {})", lod_levels.size(), n, n, n * anim::kBodyPartCount),
+    throw Error(fmt::format("{} levels for {} characters (want 0, {} or {})", lod_levels.size(), n, n,
+                            n * anim::kBodyPartCount),
                 at_field("poses.lod_levels"));
-  if (!flags.empty() && flags.size() != n) throw Error(fmt::format("{} flags for {} characters", flags.size(), n), at_field("poses.flags"));
+  if (!flags.empty() && flags.size() != n)
+    throw Error(fmt::format("{} flags for {} characters", flags.size(), n), at_field("poses.flags"));
 }
 
 CharacterPoses poses_of(const anim::CrowdAnimator& crowd) {
@@ -304,7 +323,8 @@ CharacterPoses poses_of(const anim::CrowdAnimator& crowd, const sim::CrowdState&
 
 CharacterPoses poses_of(const anim::StreamCrowd& crowd, Span<const anim::Mat3x4> palettes) {
   if (palettes.size() != crowd.palette_size())
-    throw Error(fmt::format("{} matrices, the crowd needs {}", palettes.size(), crowd.palette_size()), at_field("poses.palettes"));
+    throw Error(fmt::format("{} matrices, the crowd needs {}", palettes.size(), crowd.palette_size()),
+                at_field("poses.palettes"));
   CharacterPoses p;
   p.palettes = palettes;
   p.palette_offsets = crowd.palette_offsets();
@@ -313,7 +333,8 @@ CharacterPoses poses_of(const anim::StreamCrowd& crowd, Span<const anim::Mat3x4>
 }
 
 void BinsOverlay::validate() const {
-  if (!(cell_size > 0.0f) || !std::isfinite(cell_size)) throw Error("must be positive and finite", at_field("bins.cell_size"));
+  if (!(cell_size > 0.0f) || !std::isfinite(cell_size))
+    throw Error("must be positive and finite", at_field("bins.cell_size"));
   if (columns < 0 || rows < 0 || static_cast<Index>(columns) * rows > (Index{1} << 26))
     throw Error(fmt::format("{} x {} cells is out of range", columns, rows), at_field("bins.columns"));
   if (counts.size() != static_cast<Index>(columns) * rows)

@@ -54,7 +54,7 @@ struct RigPoint {
 struct RigBone {
   std::int32_t from = 0;  // into JointRig::points
   std::int32_t to = 0;
-  float radius = 0.05f;   // semi-axis across the bone, metres
+  float radius = 0.05f;  // semi-axis across the bone, metres
 };
 
 struct JointRig {
@@ -112,7 +112,7 @@ SkinRig make_skin_rig(const anim::Rig& rig);
 // Everything the renderer can draw a crowd with. Joint mode needs `joints`
 // (a skeleton's rig); skinned mode one SkinRig per rig index of the poses.
 struct CrowdRigs {
-  JointRig joints;              // joint_count 0: joint mode unavailable
+  JointRig joints;  // joint_count 0: joint mode unavailable
   std::vector<SkinRig> skins;
 };
 // The joint rig and the mannequin of one skeleton (anim::make_rig).

@@ -4,44 +4,45 @@ namespace throng::render::shaders {
 
 // Lighting shared by every lit program: a sun, a sky/ground hemisphere and
 // a little fog towards the background colour.
-#define THRONG_LIGHTING                                                         \
-  "uniform vec3 u_background;\n"                                                \
-  "uniform vec3 u_camera;\n"                                                    \
-  "uniform float u_fog_distance;\n"                                             \
-  "vec3 shade(vec3 albedo, vec3 n, vec3 world) {\n"                             \
-  "  vec3 sun = normalize(vec3(0.45, 0.8, 0.35));\n"                            \
-  "  float diffuse = max(dot(n, sun), 0.0);\n"                                  \
-  "  float sky = 0.5 + 0.5 * n.y;\n"                                            \
-  "  vec3 c = albedo * (0.62 * diffuse + 0.22 + 0.22 * sky);\n"                 \
-  "  float d = length(world - u_camera) / u_fog_distance;\n"                    \
-  "  return mix(c, u_background, clamp(d * d, 0.0, 1.0));\n"                    \
+#define THRONG_LIGHTING                                         \
+  "uniform vec3 u_background;\n"                                \
+  "uniform vec3 u_camera;\n"                                    \
+  "uniform float u_fog_distance;\n"                             \
+  "vec3 shade(vec3 albedo, vec3 n, vec3 world) {\n"             \
+  "  vec3 sun = normalize(vec3(0.45, 0.8, 0.35));\n"            \
+  "  float diffuse = max(dot(n, sun), 0.0);\n"                  \
+  "  float sky = 0.5 + 0.5 * n.y;\n"                            \
+  "  vec3 c = albedo * (0.62 * diffuse + 0.22 + 0.22 * sky);\n" \
+  "  float d = length(world - u_camera) / u_fog_distance;\n"    \
+  "  return mix(c, u_background, clamp(d * d, 0.0, 1.0));\n"    \
   "}\n"
 
 // What both joint programs read: packed points, the bone table, colours.
-#define THRONG_JOINT_INPUTS                                                                 \
-  "layout(std430, binding = 0) readonly buffer Points { vec4 points[]; };\n"               \
-  "struct Bone { int from_point; int to_point; float radius; float pad; };\n"             \
-  "layout(std430, binding = 1) readonly buffer Bones { Bone bones[]; };\n"                 \
-  "uniform mat4 u_view_projection;\n"                                                      \
-  "uniform int u_bone_count;\n"                                                            \
-  "uniform int u_point_count;\n"                                                           \
-  "uniform int u_slot_base;\n"                                                             \
-  "uniform int u_colour_by_lod;\n"                                                         \
-  "uniform vec3 u_lod_palette[16];\n"                                                      \
-  "uniform vec3 u_clothes[8];\n"                                                           \
-  "out vec3 v_world;\n"                                                                    \
-  "out vec3 v_normal;\n"                                                                   \
-  "flat out vec3 v_albedo;\n"                                                              \
-  "// A packed point's w: LOD level in the low 4 bits, character id above.\n"             \
-  "vec3 albedo_of(float tag_w) {\n"                                                        \
-  "  int tag = int(tag_w);\n"                                                              \
-  "  if (u_colour_by_lod != 0) return u_lod_palette[tag & 15];\n"                          \
-  "  int id = tag >> 4;\n"                                                                 \
-  "  return u_clothes[(id * 5 + (id >> 3)) & 7];\n"                                        \
+#define THRONG_JOINT_INPUTS                                                   \
+  "layout(std430, binding = 0) readonly buffer Points { vec4 points[]; };\n"  \
+  "struct Bone { int from_point; int to_point; float radius; float pad; };\n" \
+  "layout(std430, binding = 1) readonly buffer Bones { Bone bones[]; };\n"    \
+  "uniform mat4 u_view_projection;\n"                                         \
+  "uniform int u_bone_count;\n"                                               \
+  "uniform int u_point_count;\n"                                              \
+  "uniform int u_slot_base;\n"                                                \
+  "uniform int u_colour_by_lod;\n"                                            \
+  "uniform vec3 u_lod_palette[16];\n"                                         \
+  "uniform vec3 u_clothes[8];\n"                                              \
+  "out vec3 v_world;\n"                                                       \
+  "out vec3 v_normal;\n"                                                      \
+  "flat out vec3 v_albedo;\n"                                                 \
+  "// A packed point's w: LOD level in the low 4 bits, character id above.\n" \
+  "vec3 albedo_of(float tag_w) {\n"                                           \
+  "  int tag = int(tag_w);\n"                                                 \
+  "  if (u_colour_by_lod != 0) return u_lod_palette[tag & 15];\n"             \
+  "  int id = tag >> 4;\n"                                                    \
+  "  return u_clothes[(id * 5 + (id >> 3)) & 7];\n"                           \
   "}\n"
 
-const char* const kJointsVertex = "#version 430 core\n"
-                                   "layout(location = 0) in vec3 a_position;  // unit sphere\n" THRONG_JOINT_INPUTS R"(
+const char* const kJointsVertex =
+    "#version 430 core\n"
+    "layout(location = 0) in vec3 a_position;  // unit sphere\n" THRONG_JOINT_INPUTS R"(
 void main() {
   int slot = u_slot_base + gl_InstanceID / u_bone_count;
   Bone bone = bones[gl_InstanceID % u_bone_count];
@@ -139,12 +140,13 @@ void main() {
 }
 )";
 
-const char* const kLitFragment = "#version 430 core\n"
-                                  "in vec3 v_world;\n"
-                                  "in vec3 v_normal;\n"
-                                  "flat in vec3 v_albedo;\n"
-                                  "out vec4 o_colour;\n" THRONG_LIGHTING
-                                  "void main() { o_colour = vec4(shade(v_albedo, normalize(v_normal), v_world), 1.0); }\n";
+const char* const kLitFragment =
+    "#version 430 core\n"
+    "in vec3 v_world;\n"
+    "in vec3 v_normal;\n"
+    "flat in vec3 v_albedo;\n"
+    "out vec4 o_colour;\n" THRONG_LIGHTING
+    "void main() { o_colour = vec4(shade(v_albedo, normalize(v_normal), v_world), 1.0); }\n";
 
 const char* const kStaticVertex = R"(#version 430 core
 layout(location = 0) in vec3 a_position;
@@ -175,12 +177,13 @@ void main() {
 }
 )";
 
-const char* const kGroundFragment = "#version 430 core\n"
-                                     "in vec3 v_world;\n"
-                                     "out vec4 o_colour;\n"
-                                     "uniform vec3 u_ground;\n"
-                                     "uniform vec3 u_line;\n"
-                                     "uniform int u_grid;\n" THRONG_LIGHTING R"(
+const char* const kGroundFragment =
+    "#version 430 core\n"
+    "in vec3 v_world;\n"
+    "out vec4 o_colour;\n"
+    "uniform vec3 u_ground;\n"
+    "uniform vec3 u_line;\n"
+    "uniform int u_grid;\n" THRONG_LIGHTING R"(
 // Coverage of grid lines of the given spacing, about one pixel wide,
 // fading out where the lines are closer than a few pixels apart.
 float grid(vec2 p, float spacing) {

@@ -114,7 +114,8 @@ void VideoSpec::validate() const {
     throw Error(fmt::format("{} must be even and within 2..8192 (H.264 in yuv420p)", width), at_field("video.width"));
   if (height < 2 || height > 8192 || height % 2 != 0)
     throw Error(fmt::format("{} must be even and within 2..8192 (H.264 in yuv420p)", height), at_field("video.height"));
-  if (!(fps > 0.0 && fps <= 240.0) || !std::isfinite(fps)) throw Error(fmt::format("{} is outside (0, 240]", fps), at_field("video.fps"));
+  if (!(fps > 0.0 && fps <= 240.0) || !std::isfinite(fps))
+    throw Error(fmt::format("{} is outside (0, 240]", fps), at_field("video.fps"));
   if (crf < 0 || crf > 51) throw Error(fmt::format("{} is outside 0..51", crf), at_field("video.crf"));
   if (ffmpeg.empty()) throw Error("no executable", at_field("video.ffmpeg"));
 }
@@ -127,8 +128,10 @@ bool ffmpeg_available(const std::string& executable) {
 VideoWriter::VideoWriter(const VideoSpec& spec) : spec_(spec), file_(spec.path, OutputFile::OnFailure::KeepPartial) {
   spec.validate();
   if (!ffmpeg_available(spec.ffmpeg))
-    throw Error(fmt::format("'{}' does not run: install ffmpeg (bash scripts/setup.sh --deps, or apt-get install ffmpeg)", spec.ffmpeg),
-                at_field("video.ffmpeg"));
+    throw Error(
+        fmt::format("'{}' does not run: install ffmpeg (bash scripts/setup.sh --deps, or apt-get install ffmpeg)",
+                    spec.ffmpeg),
+        at_field("video.ffmpeg"));
   char log_template[] = "/tmp/throng-ffmpeg-XXXXXX";
   const int log_fd = mkstemp(log_template);
   if (log_fd < 0) throw Error("cannot create a log file for ffmpeg in /tmp", at_field("video.ffmpeg"));
@@ -138,11 +141,36 @@ VideoWriter::VideoWriter(const VideoSpec& spec) : spec_(spec), file_(spec.path, 
     ::close(log_fd);
     throw Error("cannot create a pipe to ffmpeg", at_field("video.ffmpeg"));
   }
-  const std::vector<std::string> args = {spec.ffmpeg, "-hide_banner", "-loglevel", "error", "-nostdin", "-y", "-f", "rawvideo",
-                                         "-pixel_format", "rgba", "-video_size", fmt::format("{}x{}", spec.width, spec.height),
-                                         "-framerate", fmt::format("{}", spec.fps), "-i", "pipe:0", "-an", "-c:v", "libx264",
-                                         "-preset", "veryfast", "-crf", fmt::format("{}", spec.crf), "-pix_fmt", "yuv420p",
-                                         "-movflags", "+faststart", "-f", "mp4", file_.writing_path()};
+  const std::vector<std::string> args = {spec.ffmpeg,
+                                         "-hide_banner",
+                                         "-loglevel",
+                                         "error",
+                                         "-nostdin",
+                                         "-y",
+                                         "-f",
+                                         "rawvideo",
+                                         "-pixel_format",
+                                         "rgba",
+                                         "-video_size",
+                                         fmt::format("{}x{}", spec.width, spec.height),
+                                         "-framerate",
+                                         fmt::format("{}", spec.fps),
+                                         "-i",
+                                         "pipe:0",
+                                         "-an",
+                                         "-c:v",
+                                         "libx264",
+                                         "-preset",
+                                         "veryfast",
+                                         "-crf",
+                                         fmt::format("{}", spec.crf),
+                                         "-pix_fmt",
+                                         "yuv420p",
+                                         "-movflags",
+                                         "+faststart",
+                                         "-f",
+                                         "mp4",
+                                         file_.writing_path()};
   // "-nostdin" only stops ffmpeg reading keys; the frames come via pipe:0.
   pid_ = spawn(args, fds[0], log_fd, fds[1]);
   ::close(fds[0]);
@@ -155,7 +183,8 @@ VideoWriter::VideoWriter(const VideoSpec& spec) : spec_(spec), file_(spec.path, 
 }
 
 VideoWriter::~VideoWriter() {
-  if (const int code = close_stream(); code != 0) spdlog::error("video {}: ffmpeg failed (exit {}): {}", spec_.path, code, tail_of(log_path_));
+  if (const int code = close_stream(); code != 0)
+    spdlog::error("video {}: ffmpeg failed (exit {}): {}", spec_.path, code, tail_of(log_path_));
   if (!log_path_.empty()) std::remove(log_path_.c_str());
 }
 
@@ -170,7 +199,8 @@ void VideoWriter::fail(const std::string& what) {
 
 void VideoWriter::write(const Image& frame) {
   if (frame.width != spec_.width || frame.height != spec_.height)
-    throw Error(fmt::format("frame is {}x{}, the video {}x{}", frame.width, frame.height, spec_.width, spec_.height), at_field(spec_.path));
+    throw Error(fmt::format("frame is {}x{}, the video {}x{}", frame.width, frame.height, spec_.width, spec_.height),
+                at_field(spec_.path));
   if (pipe_ < 0) throw Error("the video is already finished", at_field(spec_.path));
   if (!write_all(pipe_, frame.rgba.data(), frame.rgba.size())) fail("ffmpeg stopped reading frames");
   ++frames_;
@@ -187,7 +217,9 @@ int VideoWriter::close_stream() {
 
 void VideoWriter::finish() {
   if (file_.committed()) return;
-  if (failed_) throw Error(fmt::format("the video failed earlier; what was written is in {}", file_.writing_path()), at_field(spec_.path));
+  if (failed_)
+    throw Error(fmt::format("the video failed earlier; what was written is in {}", file_.writing_path()),
+                at_field(spec_.path));
   if (const int code = close_stream(); code != 0)
     throw Error(fmt::format("ffmpeg failed (exit {}): {}", code, tail_of(log_path_)), at_field(spec_.path));
   file_.commit();

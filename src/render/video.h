@@ -13,13 +13,13 @@
 namespace throng::render {
 
 struct VideoSpec {
-  std::string path;            // .mp4
-  std::int32_t width = 960;    // even (yuv420p)
-  std::int32_t height = 540;   // even
+  std::string path;           // .mp4
+  std::int32_t width = 960;   // even (yuv420p)
+  std::int32_t height = 540;  // even
   double fps = 30.0;
-  std::int32_t crf = 23;       // H.264 quality: 0 (lossless) .. 51 (worst)
+  std::int32_t crf = 23;          // H.264 quality: 0 (lossless) .. 51 (worst)
   std::string ffmpeg = "ffmpeg";  // executable name or path
-  void validate() const;       // Error naming the field ("video.width")
+  void validate() const;          // Error naming the field ("video.width")
 };
 
 // True when `ffmpeg -version` runs.

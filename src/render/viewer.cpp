@@ -42,7 +42,8 @@ struct GlfwSession {
     if (glfwInit() != GLFW_TRUE) {
       const char* why = nullptr;
       glfwGetError(&why);
-      throw Error(fmt::format("cannot open a window ({}): run it on a desktop, or under xvfb-run", why != nullptr ? why : "no display"));
+      throw Error(fmt::format("cannot open a window ({}): run it on a desktop, or under xvfb-run",
+                              why != nullptr ? why : "no display"));
     }
   }
   ~GlfwSession() { glfwTerminate(); }
@@ -52,12 +53,13 @@ struct GlfwSession {
 struct OrbitControl {
   glm::vec3 target{0.0f, 1.0f, 0.0f};
   float distance = 30.0f;
-  float yaw = 0.6f;    // about +Y
-  float pitch = 0.55f; // above the horizon
+  float yaw = 0.6f;     // about +Y
+  float pitch = 0.55f;  // above the horizon
   Camera camera(const Camera& lens) const {
     Camera c = lens;
     c.target = target;
-    c.position = target + distance * glm::vec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+    c.position = target + distance * glm::vec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch),
+                                               std::cos(pitch) * std::cos(yaw));
     c.up = glm::vec3(0.0f, 1.0f, 0.0f);
     return c;
   }
@@ -136,7 +138,8 @@ Image read_window(std::int32_t width, std::int32_t height) {
   const std::size_t row = static_cast<std::size_t>(width) * 4u;
   std::vector<std::uint8_t> flipped(image.rgba.size());
   for (std::int32_t y = 0; y < height; ++y)
-    std::copy_n(image.rgba.data() + static_cast<std::size_t>(height - 1 - y) * row, row, flipped.data() + static_cast<std::size_t>(y) * row);
+    std::copy_n(image.rgba.data() + static_cast<std::size_t>(height - 1 - y) * row, row,
+                flipped.data() + static_cast<std::size_t>(y) * row);
   image.rgba.swap(flipped);
   for (std::size_t i = 3; i < image.rgba.size(); i += 4) image.rgba[i] = 255;
   return image;
@@ -232,8 +235,8 @@ void install_input(GLFWwindow* window, InputState& input) {
 struct LoopState {
   InputState input;
   RenderOptions render_options;
-  std::vector<float> thresholds;  // joint LOD, square pixels, as the panel's sliders set them
-  double t = 0.0;                 // animation seconds shown
+  std::vector<float> thresholds;               // joint LOD, square pixels, as the panel's sliders set them
+  double t = 0.0;                              // animation seconds shown
   std::chrono::steady_clock::time_point last;  // when the previous frame began
   double frame_ms = 0.0;                       // wall time per frame, smoothed
   RenderStats stats;                           // of the last frame drawn
@@ -270,8 +273,8 @@ Camera frame_camera(const OrbitControl& orbit, std::int32_t width, std::int32_t 
 // Bins overlay: counts the visible agents (ground positions, m) per cell of
 // the simulation's bin size around the scene's centre into state.bin_counts
 // and hands the grid to the renderer.
-void show_bins(const ViewerScene& scene, const anim::CrowdAnimator& animator, const CharacterPoses& poses, float extent, Index n,
-               std::vector<std::int32_t>& bin_counts, Renderer& renderer) {
+void show_bins(const ViewerScene& scene, const anim::CrowdAnimator& animator, const CharacterPoses& poses, float extent,
+               Index n, std::vector<std::int32_t>& bin_counts, Renderer& renderer) {
   // Agents per cell (the simulation's bin size), cells aligned with its bins.
   const float cell = scene.bin_size();
   const glm::vec2 corner = glm::floor((ground_from_world(scene.centre()) - glm::vec2(extent)) / cell) * cell;
@@ -330,7 +333,8 @@ void draw_lod_section(LoopState& state, anim::CrowdAnimator& animator, const ani
 
 // Panel: the scene's title and status, counts of the last frame, frame time
 // (ms) and time shown (s); its controls edit state.input and state.render_options.
-void draw_panel(LoopState& state, ViewerScene& scene, anim::CrowdAnimator& animator, const anim::FrameStats& animated, Index n) {
+void draw_panel(LoopState& state, ViewerScene& scene, anim::CrowdAnimator& animator, const anim::FrameStats& animated,
+                Index n) {
   InputState& input = state.input;
   RenderOptions& render_options = state.render_options;
   const RenderStats& stats = state.stats;
@@ -339,9 +343,10 @@ void draw_panel(LoopState& state, ViewerScene& scene, anim::CrowdAnimator& anima
   ImGui::Begin(scene.title().c_str());
   const std::string status = scene.status();
   if (!status.empty()) ImGui::TextUnformatted(status.c_str());
-  ImGui::Text("agents %lld, visible %lld (%lld near)", static_cast<long long>(stats.characters), static_cast<long long>(stats.visible),
-              static_cast<long long>(stats.fine));
-  ImGui::Text("frame %.1f ms, time %.1f s, %.1fM triangles", state.frame_ms, state.t, static_cast<double>(stats.triangles) / 1e6);
+  ImGui::Text("agents %lld, visible %lld (%lld near)", static_cast<long long>(stats.characters),
+              static_cast<long long>(stats.visible), static_cast<long long>(stats.fine));
+  ImGui::Text("frame %.1f ms, time %.1f s, %.1fM triangles", state.frame_ms, state.t,
+              static_cast<double>(stats.triangles) / 1e6);
   ImGui::Checkbox("paused", &input.paused);
   ImGui::SameLine();
   if (ImGui::Button("step")) input.step = true;
@@ -349,7 +354,8 @@ void draw_panel(LoopState& state, ViewerScene& scene, anim::CrowdAnimator& anima
   if (ImGui::SliderFloat("speed", &speed, 0.0f, 4.0f, "%.2fx")) input.speed = speed;
   const char* modes[] = {"joints", "skinned"};
   int mode_index = input.mode == RenderMode::Joints ? 0 : 1;
-  if (ImGui::Combo("mode (M)", &mode_index, modes, 2)) input.mode = mode_index == 0 ? RenderMode::Joints : RenderMode::Skinned;
+  if (ImGui::Combo("mode (M)", &mode_index, modes, 2))
+    input.mode = mode_index == 0 ? RenderMode::Joints : RenderMode::Skinned;
   ImGui::Checkbox("LOD colours", &input.lod_colours);
   ImGui::SameLine();
   ImGui::Checkbox("grid", &render_options.grid);
@@ -360,7 +366,8 @@ void draw_panel(LoopState& state, ViewerScene& scene, anim::CrowdAnimator& anima
   ImGui::Checkbox("paths", &render_options.paths);
   ImGui::SameLine();
   ImGui::Checkbox("bins", &render_options.bins);
-  if (ImGui::CollapsingHeader("Joint LOD", ImGuiTreeNodeFlags_DefaultOpen)) draw_lod_section(state, animator, animated, n);
+  if (ImGui::CollapsingHeader("Joint LOD", ImGuiTreeNodeFlags_DefaultOpen))
+    draw_lod_section(state, animator, animated, n);
   if (ImGui::CollapsingHeader("Stages (median ms)", ImGuiTreeNodeFlags_DefaultOpen)) {
     const std::vector<KernelStat> kernels = KernelTimings::global().stats();  // largest total first
     for (std::size_t k = 0; k < std::min<std::size_t>(kernels.size(), 10); ++k)
@@ -384,7 +391,8 @@ void draw_overlay(const ViewerOptions& options, LoopState& state, ViewerScene& s
 
 // Present: counts the frame in result.frames, swaps; on the last scripted
 // frame saves options.screenshot (width x height pixels) first and closes the window after.
-void present(GLFWwindow* window, const ViewerOptions& options, bool scripted, std::int32_t width, std::int32_t height, ViewerResult& result) {
+void present(GLFWwindow* window, const ViewerOptions& options, bool scripted, std::int32_t width, std::int32_t height,
+             ViewerResult& result) {
   ++result.frames;
   const bool last_frame = scripted && result.frames >= options.frames;
   if (last_frame && !options.screenshot.empty()) write_png(options.screenshot, read_window(width, height));

@@ -69,7 +69,7 @@ struct ViewerOptions {
   bool bins = false;  // start with the agents-per-cell overlay on
   RenderMode mode = RenderMode::Skinned;
   bool lod_colours = false;  // joint-LOD level colours instead of clothes (a debug view)
-  void validate() const;  // Error naming the option ("--width")
+  void validate() const;     // Error naming the option ("--width")
 };
 
 struct ViewerResult {

@@ -17,9 +17,11 @@ THRONG_HOST_DEVICE inline std::int32_t atomic_fetch_add(std::int32_t* p, std::in
 }
 
 // Stores `desired` when *p == expected; returns the value found.
-THRONG_HOST_DEVICE inline std::uint64_t atomic_compare_swap(std::uint64_t* p, std::uint64_t expected, std::uint64_t desired) {
+THRONG_HOST_DEVICE inline std::uint64_t atomic_compare_swap(std::uint64_t* p, std::uint64_t expected,
+                                                            std::uint64_t desired) {
 #if defined(__CUDA_ARCH__)
-  return static_cast<std::uint64_t>(atomicCAS(reinterpret_cast<unsigned long long*>(p), static_cast<unsigned long long>(expected),
+  return static_cast<std::uint64_t>(atomicCAS(reinterpret_cast<unsigned long long*>(p),
+                                              static_cast<unsigned long long>(expected),
                                               static_cast<unsigned long long>(desired)));
 #else
   __atomic_compare_exchange_n(p, &expected, desired, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED);

@@ -56,8 +56,8 @@ struct CfsAgent {
 
 // R_ij + A_ij of neighbour j at q with velocity w and radius rj; `parked`:
 // j stands at its goal for good.
-THRONG_HOST_DEVICE inline glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj, bool parked,
-                                                       const CollisionFreeSpeedParams& m) {
+THRONG_HOST_DEVICE inline glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj,
+                                                       bool parked, const CollisionFreeSpeedParams& m) {
   const glm::vec2 d = q - i.p;
   const float dist = length_of(d);
   if (dist <= 1e-6f) return glm::vec2(0.0f);  // coincident: the contact passes separate them
@@ -140,6 +140,8 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_turn(glm::vec2 previous, glm::vec2 wante
 // surface: beyond it exp((r - d) / Dw) is below 1e-4 of the strength.
 THRONG_HOST_DEVICE inline float cfs_wall_reach(const CollisionFreeSpeedParams& m) { return 9.2f * m.wall_range; }
 // Neighbours repel within this gap (exp(-9.2) ~ 1e-4 of the strength).
-THRONG_HOST_DEVICE inline float cfs_neighbour_reach(const CollisionFreeSpeedParams& m) { return 9.2f * m.neighbour_range; }
+THRONG_HOST_DEVICE inline float cfs_neighbour_reach(const CollisionFreeSpeedParams& m) {
+  return 9.2f * m.neighbour_range;
+}
 
 }  // namespace throng::sim

@@ -50,29 +50,39 @@ bool region_contains(const Region& r, glm::vec2 p) {
 }
 
 void check_region(const Region& r, const std::string& field, float max_extent) {
-  auto finite = [&](glm::vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::fabs(p.x) <= max_extent && std::fabs(p.y) <= max_extent; };
+  auto finite = [&](glm::vec2 p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::fabs(p.x) <= max_extent && std::fabs(p.y) <= max_extent;
+  };
   switch (r.kind) {
     case Region::Kind::rect:
-      if (!finite(r.min) || !finite(r.max)) throw Error("rect corners must be finite numbers within the extent limit", at_field(field + ".rect"));
-      if (!(r.max.x > r.min.x && r.max.y > r.min.y)) throw Error("rect needs max > min in x and y", at_field(field + ".rect"));
+      if (!finite(r.min) || !finite(r.max))
+        throw Error("rect corners must be finite numbers within the extent limit", at_field(field + ".rect"));
+      if (!(r.max.x > r.min.x && r.max.y > r.min.y))
+        throw Error("rect needs max > min in x and y", at_field(field + ".rect"));
       break;
     case Region::Kind::disc:
     case Region::Kind::ring:
       if (!finite(r.center)) throw Error("center must be finite numbers within the extent limit", at_field(field));
-      if (!std::isfinite(r.radius) || r.radius < 0 || r.radius > max_extent) throw Error("radius must be >= 0", at_field(field + ".radius"));
-      if (r.kind == Region::Kind::disc && !(r.radius > 0)) throw Error("disc radius must be > 0", at_field(field + ".radius"));
-      if (!std::isfinite(r.spacing) || r.spacing < 0 || r.spacing > max_extent) throw Error("spacing must be >= 0", at_field(field + ".spacing"));
+      if (!std::isfinite(r.radius) || r.radius < 0 || r.radius > max_extent)
+        throw Error("radius must be >= 0", at_field(field + ".radius"));
+      if (r.kind == Region::Kind::disc && !(r.radius > 0))
+        throw Error("disc radius must be > 0", at_field(field + ".radius"));
+      if (!std::isfinite(r.spacing) || r.spacing < 0 || r.spacing > max_extent)
+        throw Error("spacing must be >= 0", at_field(field + ".spacing"));
       break;
     case Region::Kind::polygon:
       if (r.polygon.outer.size() < 3) throw Error("polygon needs at least 3 vertices", at_field(field + ".polygon"));
       for (glm::vec2 p : r.polygon.outer)
-        if (!finite(p)) throw Error("polygon vertices must be finite numbers within the extent limit", at_field(field + ".polygon"));
-      if (find_self_intersection(r.polygon.outer)) throw Error("spawn polygon is self-intersecting", at_field(field + ".polygon"));
+        if (!finite(p))
+          throw Error("polygon vertices must be finite numbers within the extent limit", at_field(field + ".polygon"));
+      if (find_self_intersection(r.polygon.outer))
+        throw Error("spawn polygon is self-intersecting", at_field(field + ".polygon"));
       break;
     case Region::Kind::points:
       for (std::size_t i = 0; i < r.points.size(); ++i)
         if (!finite(r.points[i]))
-          throw Error("a point must be finite numbers within the extent limit", at_field(fmt::format("{}.points[{}]", field, i)));
+          throw Error("a point must be finite numbers within the extent limit",
+                      at_field(fmt::format("{}.points[{}]", field, i)));
       break;
   }
 }
@@ -95,7 +105,9 @@ class Occupancy {
     return -1;
   }
   bool overlaps(glm::vec2 p, float r, float gap) const { return find(p, r, gap) >= 0; }
-  void add(glm::vec2 p, float r, std::int64_t id) { cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r, id}); }
+  void add(glm::vec2 p, float r, std::int64_t id) {
+    cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r, id});
+  }
 
  private:
   struct Entry {
@@ -114,8 +126,10 @@ class Occupancy {
 template <class Keep>
 std::int64_t hex_sites(const Aabb& b, double a, double jitter, Rng& rng, const Keep& keep) {
   const double w = b.size().x, h = b.size().y, row = a * 0.5 * std::sqrt(3.0);
-  const auto nx = static_cast<std::int64_t>(std::floor(w / a)) + 1, ny = static_cast<std::int64_t>(std::floor(h / row)) + 1;
-  const double x0 = b.min.x + (w - static_cast<double>(nx - 1) * a) * 0.5, y0 = b.min.y + (h - static_cast<double>(ny - 1) * row) * 0.5;
+  const auto nx = static_cast<std::int64_t>(std::floor(w / a)) + 1,
+             ny = static_cast<std::int64_t>(std::floor(h / row)) + 1;
+  const double x0 = b.min.x + (w - static_cast<double>(nx - 1) * a) * 0.5,
+               y0 = b.min.y + (h - static_cast<double>(ny - 1) * row) * 0.5;
   std::int64_t sites = 0;
   for (std::int64_t j = 0; j < ny; ++j) {
     const bool odd = (j & 1) != 0;
@@ -161,8 +175,10 @@ void check_goal(const GoalSpec& goal, const std::string& gf, const ScenarioLimit
     throw Error("goal coordinates must be finite numbers within the extent limit", at_field(gf));
   if (goal.kind == GoalSpec::Kind::Random) {
     check_region(goal.region, gf + ".random", limits.max_extent);
-    if (goal.region.kind == Region::Kind::ring) throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
-    if (goal.region.kind == Region::Kind::points) throw Error("a list of points is not an area to draw goals from", at_field(gf + ".random"));
+    if (goal.region.kind == Region::Kind::ring)
+      throw Error("a ring is not an area to draw goals from", at_field(gf + ".random"));
+    if (goal.region.kind == Region::Kind::points)
+      throw Error("a list of points is not an area to draw goals from", at_field(gf + ".random"));
   }
 }
 
@@ -174,28 +190,37 @@ void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::s
     throw Error(fmt::format("radius must be a positive number (got {})", G.radius), at_field(field + ".radius"));
   const float step = spec.model.max_speed * spec.dt;
   if (step > 0.9f * G.radius)
-    throw Error(fmt::format("dt * model.max_speed = {:.3g} m must stay below 0.9 * radius = {:.3g} m, else agents could step "
-                            "through walls: lower dt or max_speed",
-                            step, 0.9f * G.radius),
-                at_field(field + ".radius"));
+    throw Error(
+        fmt::format("dt * model.max_speed = {:.3g} m must stay below 0.9 * radius = {:.3g} m, else agents could step "
+                    "through walls: lower dt or max_speed",
+                    step, 0.9f * G.radius),
+        at_field(field + ".radius"));
   if (2.0f * G.radius + 2.0f * step > cell || G.radius > spec.model.max_radius())
-    throw Error(fmt::format("radius {} m is too large for the {} model (at most {:.3g} m, and 2 * radius + 2 * dt * max_speed within its "
+    throw Error(fmt::format("radius {} m is too large for the {} model (at most {:.3g} m, and 2 * radius + 2 * dt * "
+                            "max_speed within its "
                             "bins of side {:.3g} m)",
                             G.radius, to_string(spec.model.kind), spec.model.max_radius(), cell),
                 at_field(field + ".radius"));
   const SpeedSpec& S = G.speed;
-  if (!std::isfinite(S.mean) || !(S.mean > 0)) throw Error(fmt::format("mean speed must be > 0 (got {})", S.mean), at_field(field + ".speed.mean"));
-  if (!std::isfinite(S.stddev) || S.stddev < 0) throw Error(fmt::format("stddev must be >= 0 (got {})", S.stddev), at_field(field + ".speed.stddev"));
-  if (!std::isfinite(S.min) || !(S.min > 0)) throw Error(fmt::format("min speed must be > 0 (got {})", S.min), at_field(field + ".speed.min"));
-  if (!std::isfinite(S.max) || S.max < S.min) throw Error("max speed must be >= min speed", at_field(field + ".speed.max"));
+  if (!std::isfinite(S.mean) || !(S.mean > 0))
+    throw Error(fmt::format("mean speed must be > 0 (got {})", S.mean), at_field(field + ".speed.mean"));
+  if (!std::isfinite(S.stddev) || S.stddev < 0)
+    throw Error(fmt::format("stddev must be >= 0 (got {})", S.stddev), at_field(field + ".speed.stddev"));
+  if (!std::isfinite(S.min) || !(S.min > 0))
+    throw Error(fmt::format("min speed must be > 0 (got {})", S.min), at_field(field + ".speed.min"));
+  if (!std::isfinite(S.max) || S.max < S.min)
+    throw Error("max speed must be >= min speed", at_field(field + ".speed.max"));
   if (S.max > spec.model.max_speed)
-    throw Error(fmt::format("speed.max {} exceeds model.max_speed {}", S.max, spec.model.max_speed), at_field(field + ".speed.max"));
+    throw Error(fmt::format("speed.max {} exceeds model.max_speed {}", S.max, spec.model.max_speed),
+                at_field(field + ".speed.max"));
   if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
-    throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius), at_field(field + ".arrival_radius"));
+    throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius),
+                at_field(field + ".arrival_radius"));
 }
 
 // Group G (field groups[g]): its body, spawn region and route points.
-void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string& field, float cell, const ScenarioLimits& limits) {
+void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string& field, float cell,
+                 const ScenarioLimits& limits) {
   check_group_body(spec, G, field, cell);
   if (static_cast<std::int64_t>(G.waypoints.size()) > limits.max_waypoints)
     throw Error(fmt::format("more than {} waypoints", limits.max_waypoints), at_field(field + ".waypoints"));
@@ -203,7 +228,8 @@ void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string
   if (G.spawn.kind == Region::Kind::points && static_cast<std::int64_t>(G.spawn.points.size()) != G.count)
     throw Error(fmt::format("{} points for a count of {}: give one point per agent", G.spawn.points.size(), G.count),
                 at_field(field + ".spawn.points"));
-  for (std::size_t w = 0; w < G.waypoints.size(); ++w) check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w), limits);
+  for (std::size_t w = 0; w < G.waypoints.size(); ++w)
+    check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w), limits);
   check_goal(G.goal, field + ".goal", limits);
 }
 
@@ -211,9 +237,11 @@ void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string
 // field); returns the largest agent radius, m.
 float check_scenario(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits) {
   spec.model.validate();
-  if (!(spec.dt > 0) || !(spec.dt <= 10.0f)) throw Error(fmt::format("time step must be in (0, 10] s (got {})", spec.dt), at_field("dt"));
+  if (!(spec.dt > 0) || !(spec.dt <= 10.0f))
+    throw Error(fmt::format("time step must be in (0, 10] s (got {})", spec.dt), at_field("dt"));
   const std::int64_t total = spec.total_agents();
-  if (total > limits.max_agents) throw Error(fmt::format("{} agents exceed the limit of {}", total, limits.max_agents), at_field("groups"));
+  if (total > limits.max_agents)
+    throw Error(fmt::format("{} agents exceed the limit of {}", total, limits.max_agents), at_field("groups"));
   if (spec.groups.empty()) throw Error("a scenario needs at least one group", at_field("groups"));
   float max_radius = 0.0f;
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
@@ -222,9 +250,12 @@ float check_scenario(const ScenarioSpec& spec, const World& world, const Scenari
   }
   std::int64_t total_waypoints = 0;
   for (const GroupSpec& G : spec.groups)
-    total_waypoints += G.count * static_cast<std::int64_t>(G.arrival == ArrivalBehaviour::Loop ? 2 * G.waypoints.size() + 2 : G.waypoints.size() + 1);
+    total_waypoints +=
+        G.count * static_cast<std::int64_t>(G.arrival == ArrivalBehaviour::Loop ? 2 * G.waypoints.size() + 2
+                                                                                : G.waypoints.size() + 1);
   if (total_waypoints > 4 * limits.max_agents)
-    throw Error(fmt::format("{} waypoints in all (agents x route points) exceed the limit of {}", total_waypoints, 4 * limits.max_agents),
+    throw Error(fmt::format("{} waypoints in all (agents x route points) exceed the limit of {}", total_waypoints,
+                            4 * limits.max_agents),
                 at_field("groups"));
   return max_radius;
 }
@@ -256,7 +287,8 @@ void add_group_extent(const GroupSpec& G, Aabb& extent) {
 
 // The reachability raster over everything the agents could need, or null
 // in an open world (no walkable area, no obstacle).
-std::unique_ptr<Reachability> make_reachability(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits) {
+std::unique_ptr<Reachability> make_reachability(const ScenarioSpec& spec, const World& world,
+                                                const ScenarioLimits& limits) {
   if (!world.has_walkable() && world.polygons().empty() && world.circles().empty()) return nullptr;
   Aabb extent = world.bounds();
   if (!world.has_walkable()) {
@@ -288,19 +320,24 @@ std::vector<glm::vec2> place_on_ring(const Placement& at) {
   if (!(R > 0)) throw Error("a ring needs radius > 0 or spacing > 0", at_field(at.field + ".spawn.ring"));
   const double chord = G.count > 1 ? 2.0 * R * std::sin(kPi / static_cast<double>(G.count)) : 2.0 * R + 2.0 * r;
   if (chord < 2.0 * r + at.gap)
-    throw Error(fmt::format("{} agents of radius {} do not fit on a ring of radius {:.3g} m (neighbours {:.3g} m apart)", G.count, r, R, chord),
-                at_field(at.field + ".spawn"));
+    throw Error(
+        fmt::format("{} agents of radius {} do not fit on a ring of radius {:.3g} m (neighbours {:.3g} m apart)",
+                    G.count, r, R, chord),
+        at_field(at.field + ".spawn"));
   std::vector<glm::vec2> chosen;
   for (std::int64_t k = 0; k < G.count; ++k) {
     const double a = 2.0 * kPi * static_cast<double>(k) / static_cast<double>(G.count);
-    const glm::vec2 p = G.spawn.center + glm::vec2(static_cast<float>(R * std::cos(a)), static_cast<float>(R * std::sin(a)));
+    const glm::vec2 p =
+        G.spawn.center + glm::vec2(static_cast<float>(R * std::cos(a)), static_cast<float>(R * std::sin(a)));
     if (!at.world.disc_fits(p, at.wall_clearance)) {
       const std::string blocked = at.world.what_blocks(p);
-      throw Error(fmt::format("agent {} at {} does not fit: {}", k, point_text(p), blocked.empty() ? "too close to a wall" : blocked),
+      throw Error(fmt::format("agent {} at {} does not fit: {}", k, point_text(p),
+                              blocked.empty() ? "too close to a wall" : blocked),
                   at_field(at.field + ".spawn"));
     }
     if (at.placed.overlaps(p, r, at.gap))
-      throw Error(fmt::format("agent {} at {} overlaps an agent of an earlier group", k, point_text(p)), at_field(at.field + ".spawn"));
+      throw Error(fmt::format("agent {} at {} overlaps an agent of an earlier group", k, point_text(p)),
+                  at_field(at.field + ".spawn"));
     chosen.push_back(p);
   }
   return chosen;
@@ -320,17 +357,20 @@ std::vector<glm::vec2> place_at_points(const Placement& at) {
     if (!at.world.disc_fits(p, at.wall_clearance)) {
       const std::string blocked = at.world.what_blocks(p);
       throw Error(fmt::format("an agent of radius {} m at {} does not fit: {}", r, point_text(p),
-                              blocked.empty() ? fmt::format("closer than {:.3g} m to a wall", at.wall_clearance) : "it lies " + blocked),
+                              blocked.empty() ? fmt::format("closer than {:.3g} m to a wall", at.wall_clearance)
+                                              : "it lies " + blocked),
                   at_field(pf));
     }
     if (const std::int64_t other = own.find(p, r, 0.0f); other >= 0)
-      throw Error(fmt::format("an agent at {} overlaps the one at points[{}] {}: centres {:.3g} m apart, less than 2 * radius = {:.3g} m",
+      throw Error(fmt::format("an agent at {} overlaps the one at points[{}] {}: centres {:.3g} m apart, less than 2 * "
+                              "radius = {:.3g} m",
                               point_text(p), other, point_text(G.spawn.points[static_cast<std::size_t>(other)]),
                               length_of(p - G.spawn.points[static_cast<std::size_t>(other)]), 2.0f * r),
                   at_field(pf));
     if (const std::int64_t other = at.placed.find(p, r, 0.0f); other >= 0)
       throw Error(fmt::format("an agent at {} overlaps agent {} of groups[{}] at {}", point_text(p), other,
-                              at.out.group[static_cast<std::size_t>(other)], point_text(at.out.position[static_cast<std::size_t>(other)])),
+                              at.out.group[static_cast<std::size_t>(other)],
+                              point_text(at.out.position[static_cast<std::size_t>(other)])),
                   at_field(pf));
     own.add(p, r, static_cast<std::int64_t>(k));
     chosen.push_back(p);
@@ -346,13 +386,15 @@ std::vector<glm::vec2> lattice_candidates(const Placement& at, std::uint64_t see
   const double d = 2.0 * at.r + at.gap;
   const double max_sites = 8.0 * static_cast<double>(G.count) + 4.0e6;
   if (hex_site_count(b, d) < static_cast<double>(G.count))
-    throw Error(fmt::format("{} agents of radius {} m cannot fit in the spawn region ({:.3g} x {:.3g} m)", G.count, at.r, b.size().x, b.size().y),
+    throw Error(fmt::format("{} agents of radius {} m cannot fit in the spawn region ({:.3g} x {:.3g} m)", G.count,
+                            at.r, b.size().x, b.size().y),
                 at_field(at.field + ".spawn"));
   const double wanted = 3.0 * static_cast<double>(G.count);
   const double area = region_area(G.spawn);
   double a = area > 0 ? std::max(d, hex_spacing(wanted / area)) : d;
   if (hex_site_count(b, a) > max_sites)
-    throw Error(fmt::format("the spawn region ({:.3g} x {:.3g} m) is too elongated for agents of radius {} m", b.size().x, b.size().y, at.r),
+    throw Error(fmt::format("the spawn region ({:.3g} x {:.3g} m) is too elongated for agents of radius {} m",
+                            b.size().x, b.size().y, at.r),
                 at_field(at.field + ".spawn"));
   std::vector<glm::vec2> candidates;
   for (int pass = 0;; ++pass) {
@@ -364,12 +406,14 @@ std::vector<glm::vec2> lattice_candidates(const Placement& at, std::uint64_t see
     std::int64_t visited = 0;
     const std::int64_t sites = hex_sites(b, a, (a - d) * 0.5, rng, [&](glm::vec2 p) {
       if ((++visited & 4095) == 0) setup_checkpoint("placing agents");
-      if (region_contains(G.spawn, p) && at.world.disc_fits(p, at.wall_clearance) && !at.placed.overlaps(p, at.r, 0.99f * at.gap))
+      if (region_contains(G.spawn, p) && at.world.disc_fits(p, at.wall_clearance) &&
+          !at.placed.overlaps(p, at.r, 0.99f * at.gap))
         candidates.push_back(p);
     });
     if (static_cast<std::int64_t>(candidates.size()) >= G.count || a <= d) break;
     // Free area as seen by this lattice; at least a 20 % denser lattice next.
-    const double free_area = static_cast<double>(b.size().x) * b.size().y * static_cast<double>(candidates.size()) / static_cast<double>(sites);
+    const double free_area = static_cast<double>(b.size().x) * b.size().y * static_cast<double>(candidates.size()) /
+                             static_cast<double>(sites);
     double next = free_area > 0 ? hex_spacing(wanted / free_area) : d;
     next = std::max(d, std::min(next, 0.8 * a));
     if (hex_site_count(b, next) > max_sites) break;
@@ -397,11 +441,14 @@ std::vector<glm::vec2> place_on_lattice(const Placement& at, std::uint64_t seed,
     const glm::vec2 centre = (b.min + b.max) * 0.5f;
     const std::string blocked = at.world.what_blocks(centre);
     if (candidates.empty() && !blocked.empty())
-      throw Error(fmt::format("the spawn region lies {}: no free place for an agent", blocked), at_field(at.field + ".spawn"));
-    throw Error(fmt::format("room for only {} of {} agents of radius {} m in the spawn region (obstacles, walls and other groups "
-                            "take the rest)",
-                            candidates.size(), G.count, at.r),
-                at_field(at.field + ".spawn"));
+      throw Error(fmt::format("the spawn region lies {}: no free place for an agent", blocked),
+                  at_field(at.field + ".spawn"));
+    throw Error(
+        fmt::format(
+            "room for only {} of {} agents of radius {} m in the spawn region (obstacles, walls and other groups "
+            "take the rest)",
+            candidates.size(), G.count, at.r),
+        at_field(at.field + ".spawn"));
   }
   Rng rng(seed, 0x5e1ec7000000ull + g);
   // Choose count of them at random, then keep lattice order (neighbours
@@ -438,8 +485,8 @@ struct RouteContext {
 // Route point `goal` (field gf) of an agent that spawned at p and comes
 // from `from`: a point, or one drawn from a region with arng (free for a
 // disc of radius r and reachable from `from`).
-glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std::string& gf, glm::vec2 p, glm::vec2 from, std::int64_t agent,
-                       Rng& arng) {
+glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std::string& gf, glm::vec2 p,
+                       glm::vec2 from, std::int64_t agent, Rng& arng) {
   glm::vec2 q(0.0f);
   switch (goal.kind) {
     case GoalSpec::Kind::Point: q = goal.value; break;
@@ -449,11 +496,14 @@ glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std:
       const Aabb rb = region_bounds(goal.region);
       bool found = false;
       for (int attempt = 0; attempt < 200 && !found; ++attempt) {
-        q = glm::vec2(static_cast<float>(arng.uniform(rb.min.x, rb.max.x)), static_cast<float>(arng.uniform(rb.min.y, rb.max.y)));
-        found = region_contains(goal.region, q) && ctx.world.disc_fits(q, ctx.r) && (!ctx.reach || ctx.reach->connected(from, q));
+        q = glm::vec2(static_cast<float>(arng.uniform(rb.min.x, rb.max.x)),
+                      static_cast<float>(arng.uniform(rb.min.y, rb.max.y)));
+        found = region_contains(goal.region, q) && ctx.world.disc_fits(q, ctx.r) &&
+                (!ctx.reach || ctx.reach->connected(from, q));
       }
       if (!found)
-        throw Error(fmt::format("found no free place reachable from {} for agent {} in the goal region", point_text(from), agent),
+        throw Error(fmt::format("found no free place reachable from {} for agent {} in the goal region",
+                                point_text(from), agent),
                     at_field(gf + ".random"));
       break;
     }
@@ -464,23 +514,26 @@ glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std:
 // Errors unless route point q (field gf) of `agent` lies in the world, free
 // and reachable from `from`. Planned routes go around obstacles; only a
 // missing path is an error.
-void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std::int64_t agent, const std::string& gf) {
+void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std::int64_t agent,
+                       const std::string& gf) {
   const float max_extent = ctx.limits.max_extent;
   if (!std::isfinite(q.x) || !std::isfinite(q.y) || std::fabs(q.x) > max_extent || std::fabs(q.y) > max_extent)
     throw Error(fmt::format("goal {} of agent {} is beyond the extent limit", point_text(q), agent), at_field(gf));
   if (const std::string blocked = ctx.world.what_blocks(q); !blocked.empty())
     throw Error(fmt::format("goal {} of agent {} lies {}", point_text(q), agent, blocked), at_field(gf));
   if (ctx.reach && !ctx.reach->connected(from, q))
-    throw Error(fmt::format("goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
-                            point_text(q), agent, point_text(from), ctx.reach->cell_size()),
-                at_field(gf));
+    throw Error(
+        fmt::format(
+            "goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
+            point_text(q), agent, point_text(from), ctx.reach->cell_size()),
+        at_field(gf));
 }
 
 // Appends group g's agents at `chosen` to `out` (position, radius, speed
 // drawn per agent, group) and to `placed`; returns every agent's waypoints
 // and goal resolved, stride waypoints + 1.
-std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& spec, std::size_t g, const std::vector<glm::vec2>& chosen,
-                                  Occupancy& placed, CrowdHost& out) {
+std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& spec, std::size_t g,
+                                  const std::vector<glm::vec2>& chosen, Occupancy& placed, CrowdHost& out) {
   const GroupSpec& G = spec.groups[g];
   const std::string field = fmt::format("groups[{}]", g);
   const auto first_agent = static_cast<std::int64_t>(out.position.size());
@@ -489,11 +542,13 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
   for (std::size_t k = 0; k < chosen.size(); ++k) {
     const glm::vec2 p = chosen[k];
     const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
-    if ((k & 4095) == 4095) setup_checkpoint("choosing goals", static_cast<double>(k) / static_cast<double>(chosen.size()));
+    if ((k & 4095) == 4095)
+      setup_checkpoint("choosing goals", static_cast<double>(k) / static_cast<double>(chosen.size()));
     placed.add(p, ctx.r, agent);
     Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
-    const double speed = std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
-                                    static_cast<double>(G.speed.min), static_cast<double>(G.speed.max));
+    const double speed =
+        std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
+                   static_cast<double>(G.speed.min), static_cast<double>(G.speed.max));
     out.position.push_back(p);
     out.radius.push_back(ctx.r);
     out.pref_speed.push_back(static_cast<float>(speed));
@@ -515,14 +570,16 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
 // their waypoints (or, for a goal without waypoints, the planner's points
 // in between, when there is a planner), the goal, the way back for a loop,
 // and the heading towards the first point.
-void add_routes(const GroupSpec& G, const std::string& field, const std::vector<glm::vec2>& chosen, const std::vector<glm::vec2>& resolved,
-                const World& world, const RoutePlanner* planner, const ScenarioLimits& limits, float r, CrowdHost& out) {
+void add_routes(const GroupSpec& G, const std::string& field, const std::vector<glm::vec2>& chosen,
+                const std::vector<glm::vec2>& resolved, const World& world, const RoutePlanner* planner,
+                const ScenarioLimits& limits, float r, CrowdHost& out) {
   const std::size_t W = G.waypoints.size();
   std::vector<std::vector<glm::vec2>> planned;
   if (planner != nullptr && W == 0 && !chosen.empty()) {
     planned = planner->plan(world, chosen, resolved, r);
     if (planned.size() != chosen.size())
-      throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()), at_field(field + ".goal"));
+      throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()),
+                  at_field(field + ".goal"));
   }
   for (std::size_t k = 0; k < chosen.size(); ++k) {
     const glm::vec2 p = chosen[k];
@@ -531,7 +588,8 @@ void add_routes(const GroupSpec& G, const std::string& field, const std::vector<
     std::span<const glm::vec2> via(resolved.data() + k * (W + 1), W);
     if (!planned.empty()) via = planned[k];
     if (static_cast<std::int64_t>(via.size()) > limits.max_waypoints)
-      throw Error(fmt::format("a planned route has {} points, more than {}", via.size(), limits.max_waypoints), at_field(field + ".goal"));
+      throw Error(fmt::format("a planned route has {} points, more than {}", via.size(), limits.max_waypoints),
+                  at_field(field + ".goal"));
     out.waypoints.insert(out.waypoints.end(), via.begin(), via.end());
     out.waypoints.push_back(resolved[k * (W + 1) + W]);
     out.waypoint_goal.push_back(static_cast<std::int32_t>(out.waypoints.size()) - 1 - begin);
@@ -548,7 +606,8 @@ void add_routes(const GroupSpec& G, const std::string& field, const std::vector<
 
 }  // namespace
 
-CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits, const RoutePlanner* planner) {
+CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const ScenarioLimits& limits,
+                      const RoutePlanner* planner) {
   const float max_radius = check_scenario(spec, world, limits);
   const std::unique_ptr<Reachability> reach = make_reachability(spec, world, limits);
   CrowdHost out;

@@ -27,19 +27,19 @@ struct CrowdState {
   Index count = 0;
   Buffer<glm::vec2> position;
   Buffer<glm::vec2> velocity;
-  Buffer<float> heading;      // radians, from +x
-  Buffer<float> radius;       // m
-  Buffer<float> pref_speed;   // m/s
-  Buffer<glm::vec2> path_start;  // start of the current leg
-  Buffer<glm::vec2> goal;        // end of the current leg (current waypoint)
-  Buffer<std::int32_t> waypoint_begin;   // into waypoints
+  Buffer<float> heading;                // radians, from +x
+  Buffer<float> radius;                 // m
+  Buffer<float> pref_speed;             // m/s
+  Buffer<glm::vec2> path_start;         // start of the current leg
+  Buffer<glm::vec2> goal;               // end of the current leg (current waypoint)
+  Buffer<std::int32_t> waypoint_begin;  // into waypoints
   Buffer<std::int32_t> waypoint_count;
   Buffer<std::int32_t> waypoint_cursor;  // current waypoint, 0-based
   Buffer<std::int32_t> waypoint_goal;    // the waypoint whose arrival counts as arriving
   Buffer<std::int32_t> group;
   Buffer<std::uint8_t> flags;
-  Buffer<float> arrival_time;  // s, -1 until arrived
-  Buffer<glm::vec2> waypoints;    // every agent's waypoint list, flattened
+  Buffer<float> arrival_time;   // s, -1 until arrived
+  Buffer<glm::vec2> waypoints;  // every agent's waypoint list, flattened
   Buffer<GroupRuntime> groups;
 };
 
@@ -59,8 +59,8 @@ struct CrowdHost {
 class RoutePlanner {
  public:
   virtual ~RoutePlanner() = default;
-  virtual std::vector<std::vector<glm::vec2>> plan(const World& world, std::span<const glm::vec2> starts, std::span<const glm::vec2> goals,
-                                                   float agent_radius) const = 0;
+  virtual std::vector<std::vector<glm::vec2>> plan(const World& world, std::span<const glm::vec2> starts,
+                                                   std::span<const glm::vec2> goals, float agent_radius) const = 0;
 };
 
 // Places every group's agents without overlaps in free space, draws their

@@ -37,7 +37,8 @@ RunResult FrameLoop::run(const RunControl& control) {
     ++result_.steps;
     result_.all_arrived = all_arrived();
     result_.interrupted = interrupted();
-    f = {sim_.steps_done(), sim_.time(), result_.steps >= control.max_steps || result_.all_arrived || result_.interrupted};
+    f = {sim_.steps_done(), sim_.time(),
+         result_.steps >= control.max_steps || result_.all_arrived || result_.interrupted};
     run_stages(f, false);
   }
   result_.interrupted = result_.interrupted || (result_.steps == 0 && interrupted());
@@ -83,7 +84,8 @@ nlohmann::json timings_section(std::int64_t steps, const std::vector<std::pair<s
     if (k.name.rfind("sim.", 0) != 0) continue;
     const std::size_t dot = k.name.find('.', 4);
     const std::string stage = k.name.substr(4, dot == std::string::npos ? std::string::npos : dot - 4);
-    if (stage == "bin" || stage == "sense" || stage == "steer" || stage == "sense_steer" || stage == "move") sim_stages[stage] += k.total_ms;
+    if (stage == "bin" || stage == "sense" || stage == "steer" || stage == "sense_steer" || stage == "move")
+      sim_stages[stage] += k.total_ms;
   }
   const double per = steps > 0 ? 1.0 / static_cast<double>(steps) : 0.0;
   nlohmann::json stages = nlohmann::json::object();

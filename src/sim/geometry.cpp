@@ -14,7 +14,8 @@ int orient(glm::vec2 a, glm::vec2 b, glm::vec2 c) {
 }
 // c lies within the bounding box of [a, b] (used once collinear).
 bool within_box(glm::vec2 a, glm::vec2 b, glm::vec2 c) {
-  return std::min(a.x, b.x) <= c.x && c.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= c.y && c.y <= std::max(a.y, b.y);
+  return std::min(a.x, b.x) <= c.x && c.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= c.y &&
+         c.y <= std::max(a.y, b.y);
 }
 }  // namespace
 
@@ -53,7 +54,8 @@ bool segments_intersect(glm::vec2 a, glm::vec2 b, glm::vec2 c, glm::vec2 d, glm:
       const double rx = static_cast<double>(b.x) - a.x, ry = static_cast<double>(b.y) - a.y;
       const double sx = static_cast<double>(d.x) - c.x, sy = static_cast<double>(d.y) - c.y;
       const double den = rx * sy - ry * sx;
-      const double t = den != 0 ? ((static_cast<double>(c.x) - a.x) * sy - (static_cast<double>(c.y) - a.y) * sx) / den : 0.0;
+      const double t =
+          den != 0 ? ((static_cast<double>(c.x) - a.x) * sy - (static_cast<double>(c.y) - a.y) * sx) / den : 0.0;
       *point = glm::vec2(static_cast<float>(a.x + t * rx), static_cast<float>(a.y + t * ry));
     }
     return true;
@@ -84,7 +86,8 @@ std::optional<EdgePair> find_self_intersection(const Ring& ring) {
   std::iota(order.begin(), order.end(), 0);
   auto min_x = [&](std::int64_t e) { return std::min(vtx(e).x, vtx(e + 1).x); };
   auto max_x = [&](std::int64_t e) { return std::max(vtx(e).x, vtx(e + 1).x); };
-  std::sort(order.begin(), order.end(), [&](std::int64_t x, std::int64_t y) { return min_x(x) < min_x(y) || (min_x(x) == min_x(y) && x < y); });
+  std::sort(order.begin(), order.end(),
+            [&](std::int64_t x, std::int64_t y) { return min_x(x) < min_x(y) || (min_x(x) == min_x(y) && x < y); });
   for (std::size_t k = 0; k < order.size(); ++k) {
     const std::int64_t e = order[k];
     const float right = max_x(e);

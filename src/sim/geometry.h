@@ -73,7 +73,8 @@ THRONG_HOST_DEVICE inline glm::vec2 clamp_length(glm::vec2 a, float max_length) 
 }
 
 // Closest point to p on segment [a, b]; t in [0, 1] is its parameter.
-THRONG_HOST_DEVICE inline glm::vec2 closest_point_on_segment(glm::vec2 p, glm::vec2 a, glm::vec2 b, float* t_out = nullptr) {
+THRONG_HOST_DEVICE inline glm::vec2 closest_point_on_segment(glm::vec2 p, glm::vec2 a, glm::vec2 b,
+                                                             float* t_out = nullptr) {
   const glm::vec2 ab = b - a;
   const float l2 = dot2(ab, ab);
   float t = l2 > 0.0f ? dot2(p - a, ab) / l2 : 0.0f;
@@ -94,8 +95,10 @@ THRONG_HOST_DEVICE inline bool segment_meets_box(glm::vec2 a, glm::vec2 b, glm::
   auto clip = [&](float p, float q) {  // the part with p t <= q
     if (p == 0.0f) return q >= 0.0f;
     const float t = q / p;
-    if (p < 0.0f) t0 = fmaxf(t0, t);
-    else t1 = fminf(t1, t);
+    if (p < 0.0f)
+      t0 = fmaxf(t0, t);
+    else
+      t1 = fminf(t1, t);
     return t0 <= t1;
   };
   return clip(-d.x, a.x - lo.x) && clip(d.x, hi.x - a.x) && clip(-d.y, a.y - lo.y) && clip(d.y, hi.y - a.y);

@@ -48,7 +48,9 @@ GridView StaticGrid::view() const {
 }
 
 GridView StaticGrid::host_view() const {
-  return {cell_size_, mask_, Span<const std::uint64_t>(host_keys_.data(), static_cast<Index>(host_keys_.size())),
+  return {cell_size_,
+          mask_,
+          Span<const std::uint64_t>(host_keys_.data(), static_cast<Index>(host_keys_.size())),
           Span<const std::int32_t>(host_start_.data(), static_cast<Index>(host_start_.size())),
           Span<const std::int32_t>(host_count_.data(), static_cast<Index>(host_count_.size())),
           Span<const std::int32_t>(host_items_.data(), static_cast<Index>(host_items_.size()))};
@@ -67,7 +69,8 @@ Index AgentGrid::occupied_cells() const {
 
 std::size_t AgentGrid::bytes() const {
   return static_cast<std::size_t>(keys_.size()) * sizeof(std::uint64_t) +
-         static_cast<std::size_t>(start_.size() + count_.size() + cursor_.size() + items_.size() + slot_of_agent_.size()) *
+         static_cast<std::size_t>(start_.size() + count_.size() + cursor_.size() + items_.size() +
+                                  slot_of_agent_.size()) *
              sizeof(std::int32_t);
 }
 

@@ -46,9 +46,7 @@ THRONG_HOST_DEVICE inline std::int32_t key_cy(std::uint64_t key) {
 }
 // Colour of the four-colour batches: cells of one colour are two apart in x
 // or y, so their 3x3 neighbourhoods never include each other.
-THRONG_HOST_DEVICE inline int cell_colour(std::uint64_t key) {
-  return (key_cx(key) & 1) | ((key_cy(key) & 1) << 1);
-}
+THRONG_HOST_DEVICE inline int cell_colour(std::uint64_t key) { return (key_cx(key) & 1) | ((key_cy(key) & 1) << 1); }
 
 THRONG_HOST_DEVICE inline std::uint64_t mix_key(std::uint64_t k) {
   // splitmix64 finaliser: neighbouring cells land far apart in the table.

@@ -68,40 +68,44 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
   auto items = items_.span();
   auto slot_of = slot_of_agent_.span();
 
-  parallel_for("sim.bin.clear", cap, THRONG_LAMBDA(Index s) {
-    keys[s] = kEmptyCell;
-    count[s] = 0;
-    cursor[s] = 0;
-  });
+  parallel_for(
+      "sim.bin.clear", cap, THRONG_LAMBDA(Index s) {
+        keys[s] = kEmptyCell;
+        count[s] = 0;
+        cursor[s] = 0;
+      });
   // Histogram: find or claim the agent's cell slot, count it.
-  parallel_for("sim.bin.count", n, THRONG_LAMBDA(Index i) {
-    if ((flags[i] & 1u) == 0) {
-      slot_of[i] = -1;
-      return;
-    }
-    const std::uint64_t key = cell_key(cell_coord(positions[i].x, cell), cell_coord(positions[i].y, cell));
-    std::uint64_t s = home_slot(key, mask);
-    for (;;) {
-      std::uint64_t found = atomic_load(&keys[static_cast<Index>(s)]);
-      if (found == kEmptyCell) found = atomic_compare_swap(&keys[static_cast<Index>(s)], kEmptyCell, key);
-      if (found == kEmptyCell || found == key) break;
-      s = (s + 1) & mask;
-    }
-    slot_of[i] = static_cast<std::int32_t>(s);
-    atomic_fetch_add(&count[static_cast<Index>(s)], 1);
-  });
+  parallel_for(
+      "sim.bin.count", n, THRONG_LAMBDA(Index i) {
+        if ((flags[i] & 1u) == 0) {
+          slot_of[i] = -1;
+          return;
+        }
+        const std::uint64_t key = cell_key(cell_coord(positions[i].x, cell), cell_coord(positions[i].y, cell));
+        std::uint64_t s = home_slot(key, mask);
+        for (;;) {
+          std::uint64_t found = atomic_load(&keys[static_cast<Index>(s)]);
+          if (found == kEmptyCell) found = atomic_compare_swap(&keys[static_cast<Index>(s)], kEmptyCell, key);
+          if (found == kEmptyCell || found == key) break;
+          s = (s + 1) & mask;
+        }
+        slot_of[i] = static_cast<std::int32_t>(s);
+        atomic_fetch_add(&count[static_cast<Index>(s)], 1);
+      });
   binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
   // Scatter in arbitrary order, then sort each run by agent index.
-  parallel_for("sim.bin.scatter", n, THRONG_LAMBDA(Index i) {
-    const std::int32_t s = slot_of[i];
-    if (s < 0) return;
-    const std::int32_t k = atomic_fetch_add(&cursor[s], 1);
-    items[start[s] + k] = static_cast<std::int32_t>(i);
-  });
-  parallel_for("sim.bin.sort", cap, THRONG_LAMBDA(Index s) {
-    const std::int32_t c = count[s];
-    if (c > 1) sort_run(items.data() + start[s], c);
-  });
+  parallel_for(
+      "sim.bin.scatter", n, THRONG_LAMBDA(Index i) {
+        const std::int32_t s = slot_of[i];
+        if (s < 0) return;
+        const std::int32_t k = atomic_fetch_add(&cursor[s], 1);
+        items[start[s] + k] = static_cast<std::int32_t>(i);
+      });
+  parallel_for(
+      "sim.bin.sort", cap, THRONG_LAMBDA(Index s) {
+        const std::int32_t c = count[s];
+        if (c > 1) sort_run(items.data() + start[s], c);
+      });
 }
 
 }  // namespace throng::sim

@@ -23,14 +23,15 @@ namespace throng::sim {
 class Simulation;
 
 struct OverlapStats {
-  Index touching = 0;         // pairs overlapping at all (discs closer than the sum of radii)
-  Index pairs = 0;            // pairs overlapping by more than the tolerance
-  float max_depth = 0.0f;     // deepest overlap, m (0 when none)
-  float min_separation = INFINITY;  // smallest gap between discs, m (negative = overlap); inf when no two agents are within the bins' reach
+  Index touching = 0;      // pairs overlapping at all (discs closer than the sum of radii)
+  Index pairs = 0;         // pairs overlapping by more than the tolerance
+  float max_depth = 0.0f;  // deepest overlap, m (0 when none)
+  float min_separation =
+      INFINITY;  // smallest gap between discs, m (negative = overlap); inf when no two agents are within the bins' reach
 };
 // Active agents only; `reach` (>= twice the largest radius) sizes the bins.
-OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags, float tolerance,
-                              float reach);
+OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags,
+                              float tolerance, float reach);
 
 // The deepest pair overlap the steering models keep to, m: a third of the
 // 0.25 m radius (docs/simulation.md, "Acceptance", where the acceptance
@@ -60,7 +61,7 @@ ArrivalStats arrival_stats(const std::vector<float>& arrival_times);
 // `goals`): agents that swirl sideways in a jam move fast and advance slowly,
 // and only the advance carries a flow. |v| is kept apart, labelled.
 struct AreaSample {
-  double area = 0;                  // m^2
+  double area = 0;  // m^2
   Index agents = 0;
   double density = 0;               // agents / m^2
   double mean_speed = 0;            // m/s along the desired direction (0 when empty; negative = backwards)
@@ -96,7 +97,8 @@ struct VoronoiSample {
   double covered = 0;          // m^2 of the area inside some agent's cell
 };
 VoronoiSample measure_area_voronoi(std::span<const glm::vec2> positions, std::span<const glm::vec2> velocities,
-                                   std::span<const glm::vec2> goals, std::span<const std::uint8_t> flags, const Aabb& area, float cutoff);
+                                   std::span<const glm::vec2> goals, std::span<const std::uint8_t> flags,
+                                   const Aabb& area, float cutoff);
 
 // The Voronoi cell of every point among `points` (host), cut to the disc of
 // radius `cutoff`, as a convex polygon counter-clockwise; the building block
@@ -140,9 +142,9 @@ THRONG_HOST_DEVICE inline int step_crossing(glm::vec2 p0, glm::vec2 p1, glm::vec
 // t1, ordered by agent, then line: the same list for any thread count or
 // backend. `lines` in current_memory(); `bounds` holds every line (agents
 // whose step stays outside it are skipped).
-std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before, Span<const glm::vec2> after,
-                                         Span<const std::uint8_t> flags_after, Span<const Segment> lines, const Aabb& bounds, double t0,
-                                         double t1);
+std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before,
+                                         Span<const glm::vec2> after, Span<const std::uint8_t> flags_after,
+                                         Span<const Segment> lines, const Aabb& bounds, double t0, double t1);
 
 // Flow through a line by the N-t curve (method A of Liao et al. 2014): of
 // `times`, one direction's crossing times in increasing order, the mean flow
@@ -172,8 +174,8 @@ struct LaneOrder {
   double order = 0;   // mean phi_j (0 when no agent has neighbours in its band)
   Index counted = 0;  // agents with at least one neighbour in their band
 };
-LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<glm::vec2>& goals, const std::vector<std::uint8_t>& flags,
-                     glm::vec2 axis, float band, float reach);
+LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<glm::vec2>& goals,
+                     const std::vector<std::uint8_t>& flags, glm::vec2 axis, float band, float reach);
 
 // Mean speed of active agents.
 double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> flags);
@@ -187,7 +189,8 @@ struct DensityHistogram {
   float bin_width = 0.5f;
   std::array<std::int64_t, kDensityBins> agents{};
 };
-DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, float cell = 2.0f, float bin_width = 0.5f);
+DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, float cell = 2.0f,
+                                   float bin_width = 0.5f);
 
 // Stuck agents. An agent is stuck when, for more than `threshold_s` of
 // simulated time in a row, it is active, still steering (not kAgentStopped),
@@ -208,14 +211,14 @@ struct StuckOptions {
 inline constexpr std::size_t kStuckExamples = 10;
 struct StuckExample {
   Index agent = 0;
-  double time = 0;        // s, when it became stuck the first time
+  double time = 0;       // s, when it became stuck the first time
   glm::vec2 position{};  // where
 };
 struct StuckStats {
-  Index agents = 0;        // distinct agents ever stuck
-  Index now = 0;           // stuck at the last update
-  Index max_at_once = 0;   // most stuck at one update
-  double first_time = -1;  // s, when the first became stuck; -1 while none has
+  Index agents = 0;                    // distinct agents ever stuck
+  Index now = 0;                       // stuck at the last update
+  Index max_at_once = 0;               // most stuck at one update
+  double first_time = -1;              // s, when the first became stuck; -1 while none has
   std::vector<StuckExample> examples;  // the first kStuckExamples to become stuck, by time, then agent
 };
 // Follows the crowd step by step: update() once after every step. Per-agent
@@ -227,8 +230,9 @@ class StuckTracker {
   explicit StuckTracker(StuckOptions options = {}) : options_(options) {}
   // The step of length dt that ended at `time`. Spans in current_memory();
   // `reach` (>= twice the largest radius) sizes the bins of the probe.
-  void update(const World& world, Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> radii,
-              Span<const glm::vec2> goals, Span<const std::uint8_t> flags, float reach, double time, double dt);
+  void update(const World& world, Span<const glm::vec2> positions, Span<const glm::vec2> velocities,
+              Span<const float> radii, Span<const glm::vec2> goals, Span<const std::uint8_t> flags, float reach,
+              double time, double dt);
   // The simulation's last step.
   void update(const Simulation& sim);
   const StuckOptions& options() const { return options_; }
@@ -242,7 +246,7 @@ class StuckTracker {
  private:
   StuckOptions options_;
   AgentGrid bins_;
-  Buffer<std::int32_t> rest_;  // steps in a row at rest with the way free
+  Buffer<std::int32_t> rest_;   // steps in a row at rest with the way free
   Buffer<std::uint8_t> state_;  // kStuck* bits (metrics_stuck.cpp)
   StuckStats stats_;
 };

@@ -52,7 +52,9 @@ struct CountPair {
   double sum;
 };
 struct CombineCount {
-  THRONG_HOST_DEVICE CountPair operator()(const CountPair& a, const CountPair& b) const { return {a.count + b.count, a.sum + b.sum}; }
+  THRONG_HOST_DEVICE CountPair operator()(const CountPair& a, const CountPair& b) const {
+    return {a.count + b.count, a.sum + b.sum};
+  }
 };
 
 struct AreaAcc {
@@ -77,8 +79,8 @@ struct CombineHistogram {
 };
 }  // namespace
 
-OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags, float tolerance,
-                              float reach) {
+OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags,
+                              float tolerance, float reach) {
   AgentGrid grid(reach);
   grid.rebuild(positions, flags);
   const OverlapAcc acc = parallel_reduce("sim.metrics.overlaps", positions.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
@@ -112,7 +114,8 @@ AreaSample measure_area(Span<const glm::vec2> positions, Span<const glm::vec2> v
       "sim.metrics.area", positions.size(), AreaAcc{0, 0.0, 0.0},
       THRONG_LAMBDA(Index i)->AreaAcc {
         const glm::vec2 p = positions[i];
-        if ((flags[i] & kAgentActive) == 0 || p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) return {0, 0.0, 0.0};
+        if ((flags[i] & kAgentActive) == 0 || p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y)
+          return {0, 0.0, 0.0};
         const glm::vec2 v = velocities[i];
         return {1, static_cast<double>(speed_towards(v, p, goals[i])), static_cast<double>(length_of(v))};
       },
@@ -139,16 +142,18 @@ struct CrossingRecord {
 // Whether agent i's step may cross a line: active before and after, and
 // the step's box meets the lines' box (most agents are far from every line).
 THRONG_HOST_DEVICE inline bool may_cross(Index i, Span<const glm::vec2> before, Span<const std::uint8_t> flags_before,
-                                         Span<const glm::vec2> after, Span<const std::uint8_t> flags_after, glm::vec2 lo, glm::vec2 hi) {
+                                         Span<const glm::vec2> after, Span<const std::uint8_t> flags_after,
+                                         glm::vec2 lo, glm::vec2 hi) {
   if ((flags_before[i] & kAgentActive) == 0 || (flags_after[i] & kAgentActive) == 0) return false;
   const glm::vec2 p0 = before[i], p1 = after[i];
-  return !((p0.x < lo.x && p1.x < lo.x) || (p0.x > hi.x && p1.x > hi.x) || (p0.y < lo.y && p1.y < lo.y) || (p0.y > hi.y && p1.y > hi.y));
+  return !((p0.x < lo.x && p1.x < lo.x) || (p0.x > hi.x && p1.x > hi.x) || (p0.y < lo.y && p1.y < lo.y) ||
+           (p0.y > hi.y && p1.y > hi.y));
 }
 }  // namespace
 
-std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before, Span<const glm::vec2> after,
-                                         Span<const std::uint8_t> flags_after, Span<const Segment> lines, const Aabb& bounds, double t0,
-                                         double t1) {
+std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before,
+                                         Span<const glm::vec2> after, Span<const std::uint8_t> flags_after,
+                                         Span<const Segment> lines, const Aabb& bounds, double t0, double t1) {
   const Index n = after.size();
   if (n == 0 || lines.size() == 0 || bounds.empty()) return {};
   const glm::vec2 lo = bounds.min, hi = bounds.max;
@@ -157,31 +162,35 @@ std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<cons
   // count each agent's crossings, place them by a prefix sum, then write.
   Buffer<Index> offsets(n, current_memory());
   const Span<Index> count = offsets.span();
-  parallel_for("sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
-    Index c = 0;
-    if (may_cross(i, before, flags_before, after, flags_after, lo, hi)) {
-      double s = 0;
-      for (Index k = 0; k < line_count; ++k) c += step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s) != 0 ? 1 : 0;
-    }
-    count[i] = c;
-  });
+  parallel_for(
+      "sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
+        Index c = 0;
+        if (may_cross(i, before, flags_before, after, flags_after, lo, hi)) {
+          double s = 0;
+          for (Index k = 0; k < line_count; ++k)
+            c += step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s) != 0 ? 1 : 0;
+        }
+        count[i] = c;
+      });
   const Index total = exclusive_scan("sim.metrics.line_crossings", Span<const Index>(count), count);
   if (total == 0) return {};
   Buffer<CrossingRecord> records(total, current_memory());
   const Span<CrossingRecord> out = records.span();
   const Span<const Index> first = offsets.span();
-  parallel_for("sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
-    if (!may_cross(i, before, flags_before, after, flags_after, lo, hi)) return;
-    Index at = first[i];
-    for (Index k = 0; k < line_count; ++k) {
-      double s = 0;
-      const int d = step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s);
-      if (d != 0) out[at++] = CrossingRecord{s, i, static_cast<std::int32_t>(k), d};
-    }
-  });
+  parallel_for(
+      "sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
+        if (!may_cross(i, before, flags_before, after, flags_after, lo, hi)) return;
+        Index at = first[i];
+        for (Index k = 0; k < line_count; ++k) {
+          double s = 0;
+          const int d = step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s);
+          if (d != 0) out[at++] = CrossingRecord{s, i, static_cast<std::int32_t>(k), d};
+        }
+      });
   std::vector<LineCrossing> crossings;
   crossings.reserve(static_cast<std::size_t>(total));
-  for (const CrossingRecord& r : records.to_vector()) crossings.push_back({t0 + r.fraction * (t1 - t0), r.agent, r.line, r.direction});
+  for (const CrossingRecord& r : records.to_vector())
+    crossings.push_back({t0 + r.fraction * (t1 - t0), r.agent, r.line, r.direction});
   return crossings;
 }
 
@@ -196,7 +205,8 @@ double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> fla
   return c.count > 0 ? c.sum / static_cast<double>(c.count) : 0.0;
 }
 
-DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, float cell, float bin_width) {
+DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, float cell,
+                                   float bin_width) {
   AgentGrid grid(cell);
   grid.rebuild(positions, flags);
   const GridView g = grid.view();

@@ -7,8 +7,8 @@
 
 namespace throng::sim {
 
-LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<glm::vec2>& goals, const std::vector<std::uint8_t>& flags,
-                     glm::vec2 axis, float band, float reach) {
+LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<glm::vec2>& goals,
+                     const std::vector<std::uint8_t>& flags, glm::vec2 axis, float band, float reach) {
   const glm::vec2 across = perp_left(axis);
   auto heading_sign = [&](std::size_t i) { return dot2(goals[i] - positions[i], axis) >= 0.0f ? 1 : -1; };
   LaneOrder out;

@@ -33,7 +33,8 @@ CrowdMetricsStage::CrowdMetricsStage(const Simulation& sim, MetricsOptions optio
   if (m.areas.empty()) m.areas.push_back({"default", default_measurement_area(sim)});
   for (std::size_t k = 0; k < m.areas.size(); ++k)
     if (!(m.areas[k].rect.size().x > 0 && m.areas[k].rect.size().y > 0))
-      throw Error("the measurement area needs a positive width and height", at_field(fmt::format("measurement.areas[{}].rect", k)));
+      throw Error("the measurement area needs a positive width and height",
+                  at_field(fmt::format("measurement.areas[{}].rect", k)));
   std::vector<Segment> lines;
   for (std::size_t k = 0; k < m.lines.size(); ++k) {
     const MeasurementLine& l = m.lines[k];
@@ -53,9 +54,9 @@ void CrowdMetricsStage::record_crossings(const Simulation& sim, const FrameInfo&
   if (previous_frame_ >= 0) {
     // Agents added since the frame before have no step to cross with.
     const Index n = std::min(previous_position_.size(), c.position.size());
-    const std::vector<LineCrossing> found =
-        line_crossings(previous_position_.span().subspan(0, n), previous_flags_.span().subspan(0, n), c.position.span().subspan(0, n),
-                       c.flags.span().subspan(0, n), lines_.span(), line_bounds_, previous_time_, frame.time);
+    const std::vector<LineCrossing> found = line_crossings(
+        previous_position_.span().subspan(0, n), previous_flags_.span().subspan(0, n), c.position.span().subspan(0, n),
+        c.flags.span().subspan(0, n), lines_.span(), line_bounds_, previous_time_, frame.time);
     // The list is in agent order; sorted by time within the step, every
     // N-t curve only climbs.
     std::vector<LineTimes> step(line_times_.size());
@@ -64,7 +65,8 @@ void CrowdMetricsStage::record_crossings(const Simulation& sim, const FrameInfo&
       (x.direction > 0 ? t.positive : t.negative).push_back(x.time);
     }
     for (std::size_t k = 0; k < step.size(); ++k) {
-      for (auto [from, to] : {std::pair{&step[k].positive, &line_times_[k].positive}, std::pair{&step[k].negative, &line_times_[k].negative}}) {
+      for (auto [from, to] : {std::pair{&step[k].positive, &line_times_[k].positive},
+                              std::pair{&step[k].negative, &line_times_[k].negative}}) {
         std::stable_sort(from->begin(), from->end());
         to->insert(to->end(), from->begin(), from->end());
       }
@@ -88,18 +90,23 @@ void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame
   const CrowdState& c = sim.crowd();
   Sample s;
   s.time = frame.time;
-  s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_tolerance, sim.contact_cell());
-  s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), options_.penetration_tolerance);
+  s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_tolerance,
+                                sim.contact_cell());
+  s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(),
+                                               options_.penetration_tolerance);
   s.mean_speed = mean_speed(c.velocity.span(), c.flags.span());
-  const std::vector<glm::vec2> position = c.position.to_vector(), velocity = c.velocity.to_vector(), goal = c.goal.to_vector();
+  const std::vector<glm::vec2> position = c.position.to_vector(), velocity = c.velocity.to_vector(),
+                               goal = c.goal.to_vector();
   const std::vector<std::uint8_t> flags = c.flags.to_vector();
   for (const MeasurementArea& a : options_.measurement.areas)
-    s.areas.push_back({measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), a.rect),
-                       measure_area_voronoi(position, velocity, goal, flags, a.rect, options_.measurement.voronoi_cutoff)});
+    s.areas.push_back(
+        {measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), a.rect),
+         measure_area_voronoi(position, velocity, goal, flags, a.rect, options_.measurement.voronoi_cutoff)});
   const DensityHistogram h = density_histogram(c.position.span(), c.flags.span());
   density_.cell = h.cell;
   density_.bin_width = h.bin_width;
-  for (int b = 0; b < kDensityBins; ++b) density_.agents[static_cast<std::size_t>(b)] += h.agents[static_cast<std::size_t>(b)];
+  for (int b = 0; b < kDensityBins; ++b)
+    density_.agents[static_cast<std::size_t>(b)] += h.agents[static_cast<std::size_t>(b)];
   accumulate(s);
   samples_.push(std::move(s));
 }
@@ -149,14 +156,17 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
         {"max_pairs", t.max_pairs},
         {"max_depth_m", t.max_depth}}},
       {"min_separation_m", finite_or_null(t.min_separation)},
-      {"obstacle_penetrations", {{"tolerance_m", options_.penetration_tolerance}, {"at_end", last.penetrations}, {"max", t.max_penetrations}}},
+      {"obstacle_penetrations",
+       {{"tolerance_m", options_.penetration_tolerance}, {"at_end", last.penetrations}, {"max", t.max_penetrations}}},
       {"mean_speed_mps", {{"at_end", last.mean_speed}, {"over_samples", taken > 0 ? t.speed_sum / taken : 0.0}}},
   };
   nlohmann::json bins = nlohmann::json::array();
   for (int b = 0; b < kDensityBins; ++b)
-    bins.push_back({{"min_density", static_cast<double>(b) * density_.bin_width},
-                    {"max_density", b + 1 < kDensityBins ? nlohmann::json(static_cast<double>(b + 1) * density_.bin_width) : nlohmann::json(nullptr)},
-                    {"agent_samples", density_.agents[static_cast<std::size_t>(b)]}});
+    bins.push_back(
+        {{"min_density", static_cast<double>(b) * density_.bin_width},
+         {"max_density", b + 1 < kDensityBins ? nlohmann::json(static_cast<double>(b + 1) * density_.bin_width)
+                                              : nlohmann::json(nullptr)},
+         {"agent_samples", density_.agents[static_cast<std::size_t>(b)]}});
   stats["density_histogram"] = {{"cell_m", density_.cell}, {"bin_width_per_m2", density_.bin_width}, {"bins", bins}};
 
   // Fundamental diagram: samples of the first measurement area grouped by density.
@@ -177,13 +187,16 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
   }
   const MeasurementSpec& spec = options_.measurement;
   const Aabb& m = spec.areas.front().rect;
-  stats["fundamental_diagram"] = {{"area", {{"min", {m.min.x, m.min.y}}, {"max", {m.max.x, m.max.y}}}},
-                                  {"speed", "m/s along each agent's desired direction (towards its current goal); speed_magnitude: mean |v|"},
-                                  {"flow", "specific flow, density x speed, 1/(m s)"},
-                                  {"voronoi_density", "Voronoi density (Steffen & Seyfried 2010), 1/m^2; voronoi_speed: Voronoi-weighted speed along the desired direction, m/s"},
-                                  {"density_bin_width_per_m2", options_.density_bin_width},
-                                  {"bins", diagram},
-                                  {"samples", series}};
+  stats["fundamental_diagram"] = {
+      {"area", {{"min", {m.min.x, m.min.y}}, {"max", {m.max.x, m.max.y}}}},
+      {"speed", "m/s along each agent's desired direction (towards its current goal); speed_magnitude: mean |v|"},
+      {"flow", "specific flow, density x speed, 1/(m s)"},
+      {"voronoi_density",
+       "Voronoi density (Steffen & Seyfried 2010), 1/m^2; voronoi_speed: Voronoi-weighted speed along the desired "
+       "direction, m/s"},
+      {"density_bin_width_per_m2", options_.density_bin_width},
+      {"bins", diagram},
+      {"samples", series}};
   stats["measurement"] = measurement_section(kept);
   stats["stuck_agents"] = stuck_section();
 }
@@ -192,7 +205,8 @@ nlohmann::json CrowdMetricsStage::stuck_section() const {
   const StuckOptions& o = stuck_.options();
   const StuckStats& s = stuck_.stats();
   nlohmann::json examples = nlohmann::json::array();
-  for (const StuckExample& e : s.examples) examples.push_back({{"agent", e.agent}, {"time_s", e.time}, {"position", {e.position.x, e.position.y}}});
+  for (const StuckExample& e : s.examples)
+    examples.push_back({{"agent", e.agent}, {"time_s", e.time}, {"position", {e.position.x, e.position.y}}});
   return {{"threshold_s", o.threshold_s},
           {"speed_below", o.speed_below},
           {"probe_gap_m", o.gap},
@@ -207,11 +221,16 @@ nlohmann::json CrowdMetricsStage::area_sample_json(double time, const AreaMeasur
   const AreaSample& a = m.classic;
   const VoronoiSample& v = m.voronoi;
   // Each classic value beside its Voronoi one; the flows are density x speed.
-  return {{"time", time}, {"agents", a.agents},
-          {"density", a.density}, {"voronoi_density", v.density},
-          {"speed", a.mean_speed}, {"voronoi_speed", v.speed},
-          {"speed_magnitude", a.mean_speed_magnitude}, {"voronoi_speed_magnitude", v.speed_magnitude},
-          {"flow", a.flow}, {"voronoi_flow", v.density * v.speed}};
+  return {{"time", time},
+          {"agents", a.agents},
+          {"density", a.density},
+          {"voronoi_density", v.density},
+          {"speed", a.mean_speed},
+          {"voronoi_speed", v.speed},
+          {"speed_magnitude", a.mean_speed_magnitude},
+          {"voronoi_speed_magnitude", v.speed_magnitude},
+          {"flow", a.flow},
+          {"voronoi_flow", v.density * v.speed}};
 }
 
 nlohmann::json CrowdMetricsStage::measurement_section(const std::vector<Sample>& kept) const {
@@ -226,8 +245,12 @@ nlohmann::json CrowdMetricsStage::measurement_section(const std::vector<Sample>&
     if (k < totals_.area_sums.size())
       for (const auto& [key, sum] : totals_.area_sums[k]) mean[key] = sum / static_cast<double>(samples_.seen());
     const Aabb& r = spec.areas[k].rect;
-    areas.push_back({{"name", spec.areas[k].name}, {"min", {r.min.x, r.min.y}}, {"max", {r.max.x, r.max.y}},
-                     {"area_m2", static_cast<double>(r.size().x) * r.size().y}, {"mean", mean}, {"samples", series}});
+    areas.push_back({{"name", spec.areas[k].name},
+                     {"min", {r.min.x, r.min.y}},
+                     {"max", {r.max.x, r.max.y}},
+                     {"area_m2", static_cast<double>(r.size().x) * r.size().y},
+                     {"mean", mean},
+                     {"samples", series}});
   }
   nlohmann::json lines = nlohmann::json::array();
   for (std::size_t k = 0; k < spec.lines.size(); ++k) {

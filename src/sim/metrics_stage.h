@@ -96,7 +96,7 @@ class CrowdMetricsStage : public FrameStage {
   ThinnedSeries<Sample> samples_{kMaxSeriesSamples};
   Totals totals_;
   std::map<std::int64_t, DensityBin> fd_bins_;  // by floor(density / bin width)
-  DensityHistogram density_;  // summed over samples (agent-samples per bin)
+  DensityHistogram density_;                    // summed over samples (agent-samples per bin)
   // Lines: crossings are seen between consecutive frames, so the stage keeps
   // the positions and flags of the frame before.
   Buffer<Segment> lines_;

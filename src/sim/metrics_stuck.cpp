@@ -48,7 +48,9 @@ struct StuckCounts {
   Index now, first;
 };
 struct CombineStuck {
-  THRONG_HOST_DEVICE StuckCounts operator()(const StuckCounts& a, const StuckCounts& b) const { return {a.now + b.now, a.first + b.first}; }
+  THRONG_HOST_DEVICE StuckCounts operator()(const StuckCounts& a, const StuckCounts& b) const {
+    return {a.now + b.now, a.first + b.first};
+  }
 };
 
 // Copies `old` into the front of a buffer of n elements, zeros after it.
@@ -66,8 +68,9 @@ std::int32_t StuckTracker::threshold_steps(double dt) const {
   return static_cast<std::int32_t>(std::floor(options_.threshold_s / dt + 1e-6)) + 1;
 }
 
-void StuckTracker::update(const World& world, Span<const glm::vec2> positions, Span<const glm::vec2> velocities, Span<const float> radii,
-                          Span<const glm::vec2> goals, Span<const std::uint8_t> flags, float reach, double time, double dt) {
+void StuckTracker::update(const World& world, Span<const glm::vec2> positions, Span<const glm::vec2> velocities,
+                          Span<const float> radii, Span<const glm::vec2> goals, Span<const std::uint8_t> flags,
+                          float reach, double time, double dt) {
   const Index n = positions.size();
   if (rest_.size() != n) {
     rest_ = grown(rest_, n);
@@ -75,21 +78,29 @@ void StuckTracker::update(const World& world, Span<const glm::vec2> positions, S
   }
   if (bins_.cell_size() != reach) bins_ = AgentGrid(reach);
   bins_.rebuild(positions, flags);
-  const AtRestInFreeSpace at_rest{bins_.view(), world.view(), positions, velocities, radii, goals, flags,
-                                    static_cast<float>(options_.speed_below), static_cast<float>(options_.gap)};
+  const AtRestInFreeSpace at_rest{bins_.view(),
+                                  world.view(),
+                                  positions,
+                                  velocities,
+                                  radii,
+                                  goals,
+                                  flags,
+                                  static_cast<float>(options_.speed_below),
+                                  static_cast<float>(options_.gap)};
   const std::int32_t threshold = threshold_steps(dt);
   const Span<std::int32_t> rest = rest_.span();
   const Span<std::uint8_t> state = state_.span();
-  parallel_for("sim.metrics.stuck", n, THRONG_LAMBDA(Index i) {
-    const std::int32_t steps = at_rest(i) ? rest[i] + 1 : 0;
-    rest[i] = steps;
-    const std::uint8_t was = state[i];
-    const bool stuck = steps >= threshold;
-    std::uint8_t s = was & kStuckEver;
-    if (stuck) s |= kStuckNow | kStuckEver;
-    if (stuck && (was & kStuckEver) == 0) s |= kStuckFirst;
-    state[i] = s;
-  });
+  parallel_for(
+      "sim.metrics.stuck", n, THRONG_LAMBDA(Index i) {
+        const std::int32_t steps = at_rest(i) ? rest[i] + 1 : 0;
+        rest[i] = steps;
+        const std::uint8_t was = state[i];
+        const bool stuck = steps >= threshold;
+        std::uint8_t s = was & kStuckEver;
+        if (stuck) s |= kStuckNow | kStuckEver;
+        if (stuck && (was & kStuckEver) == 0) s |= kStuckFirst;
+        state[i] = s;
+      });
   const Span<const std::uint8_t> done = state_.span();
   const StuckCounts c = parallel_reduce(
       "sim.metrics.stuck", n, StuckCounts{0, 0},
@@ -113,8 +124,8 @@ void StuckTracker::update(const World& world, Span<const glm::vec2> positions, S
 
 void StuckTracker::update(const Simulation& sim) {
   const CrowdState& c = sim.crowd();
-  update(sim.world(), c.position.span(), c.velocity.span(), c.radius.span(), c.goal.span(), c.flags.span(), sim.contact_cell(), sim.time(),
-         static_cast<double>(sim.spec().dt));
+  update(sim.world(), c.position.span(), c.velocity.span(), c.radius.span(), c.goal.span(), c.flags.span(),
+         sim.contact_cell(), sim.time(), static_cast<double>(sim.spec().dt));
 }
 
 }  // namespace throng::sim

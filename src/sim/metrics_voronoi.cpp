@@ -70,7 +70,9 @@ class NearGrid {
   }
 
  private:
-  Index coord(double offset, Index cells) const { return std::clamp<Index>(static_cast<Index>(offset / side_), 0, cells - 1); }
+  Index coord(double offset, Index cells) const {
+    return std::clamp<Index>(static_cast<Index>(offset / side_), 0, cells - 1);
+  }
   Index cell_of(Index i) const {
     const glm::dvec2 p(points_[static_cast<std::size_t>(i)]);
     return coord(p.y - lo_.y, ny_) * nx_ + coord(p.x - lo_.x, nx_);
@@ -152,7 +154,8 @@ std::vector<ConvexPolygon> voronoi_cells(std::span<const glm::vec2> points, floa
 }
 
 VoronoiSample measure_area_voronoi(std::span<const glm::vec2> positions, std::span<const glm::vec2> velocities,
-                                   std::span<const glm::vec2> goals, std::span<const std::uint8_t> flags, const Aabb& area, float cutoff) {
+                                   std::span<const glm::vec2> goals, std::span<const std::uint8_t> flags,
+                                   const Aabb& area, float cutoff) {
   VoronoiSample s;
   // In double like the cells: float differences would put the area's size
   // off the sum of the cell parts by a float rounding.
@@ -161,7 +164,8 @@ VoronoiSample measure_area_voronoi(std::span<const glm::vec2> positions, std::sp
   // A cell stays within `cutoff` of its agent, and only agents within twice
   // that can cut it: agents farther than 3 cut-offs from the area play no part.
   auto near_area = [&](glm::vec2 p, float margin) {
-    return p.x >= area.min.x - margin && p.x <= area.max.x + margin && p.y >= area.min.y - margin && p.y <= area.max.y + margin;
+    return p.x >= area.min.x - margin && p.x <= area.max.x + margin && p.y >= area.min.y - margin &&
+           p.y <= area.max.y + margin;
   };
   std::vector<Index> members, inside;
   for (std::size_t i = 0; i < positions.size(); ++i) {

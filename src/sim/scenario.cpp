@@ -15,7 +15,8 @@ namespace {
 void check_range(float v, float lo, float hi, bool lo_inclusive, const char* field, const char* what) {
   const bool above = lo_inclusive ? v >= lo : v > lo;
   if (!std::isfinite(v) || !above || v > hi)
-    throw Error(fmt::format("{} must be {} {} and at most {} (got {})", what, lo_inclusive ? ">=" : ">", lo, hi, v), at_field(field));
+    throw Error(fmt::format("{} must be {} {} and at most {} (got {})", what, lo_inclusive ? ">=" : ">", lo, hi, v),
+                at_field(field));
 }
 }  // namespace
 
@@ -28,7 +29,8 @@ void ModelParams::validate() const {
   check_range(relaxation_time, 0.0f, 100.0f, false, "model.relaxation_time", "relaxation time (s)");
   check_range(probe_margin, 0.0f, 100.0f, true, "model.probe_margin", "probe margin (m)");
   if (contact_iterations < 0 || contact_iterations > 64)
-    throw Error(fmt::format("contact iterations must be in [0, 64] (got {})", contact_iterations), at_field("model.contact_iterations"));
+    throw Error(fmt::format("contact iterations must be in [0, 64] (got {})", contact_iterations),
+                at_field("model.contact_iterations"));
   if (contact_extra_iterations < 0 || contact_extra_iterations > 64)
     throw Error(fmt::format("extra contact iterations must be in [0, 64] (got {})", contact_extra_iterations),
                 at_field("model.contact_extra_iterations"));
@@ -72,7 +74,8 @@ ModelKind parse_model_kind(const std::string& text, const std::string& field) {
   if (text == "priority") return ModelKind::Priority;
   if (text == "ttc") return ModelKind::Ttc;
   if (text == "social_force") return ModelKind::SocialForce;
-  throw Error("unknown model type '" + text + "' (collision_free_speed, priority, ttc or social_force)", at_field(field));
+  throw Error("unknown model type '" + text + "' (collision_free_speed, priority, ttc or social_force)",
+              at_field(field));
 }
 
 const char* to_string(ArrivalBehaviour a) {
@@ -123,10 +126,12 @@ Camera overview_camera(const Aabb& extent) {
 void scale_agent_counts(ScenarioSpec& spec, std::int64_t total) {
   const auto groups = static_cast<std::int64_t>(spec.groups.size());
   if (groups == 0) throw Error("the scenario has no groups to resize", at_field("--agents"));
-  if (total < groups) throw Error(fmt::format("need at least one agent per group ({} groups)", groups), at_field("--agents"));
+  if (total < groups)
+    throw Error(fmt::format("need at least one agent per group ({} groups)", groups), at_field("--agents"));
   for (std::size_t g = 0; g < spec.groups.size(); ++g)
     if (spec.groups[g].spawn.kind == Region::Kind::points)
-      throw Error(fmt::format("groups[{}] spawns at {} fixed points and cannot be resized", g, spec.groups[g].spawn.points.size()),
+      throw Error(fmt::format("groups[{}] spawns at {} fixed points and cannot be resized", g,
+                              spec.groups[g].spawn.points.size()),
                   at_field("--agents"));
   const std::int64_t old_total = spec.total_agents();
   std::vector<std::int64_t> counts(spec.groups.size(), 1);
@@ -134,13 +139,15 @@ void scale_agent_counts(ScenarioSpec& spec, std::int64_t total) {
   std::int64_t assigned = 0;
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
     // Equal shares when the scenario has no agents to take proportions from.
-    const double share = old_total > 0 ? static_cast<double>(spec.groups[g].count) / static_cast<double>(old_total) : 1.0 / static_cast<double>(groups);
+    const double share = old_total > 0 ? static_cast<double>(spec.groups[g].count) / static_cast<double>(old_total)
+                                       : 1.0 / static_cast<double>(groups);
     const double exact = share * static_cast<double>(total - groups);
     counts[g] += static_cast<std::int64_t>(std::floor(exact));
     assigned += counts[g];
     remainders.push_back({exact - std::floor(exact), g});
   }
-  std::stable_sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::stable_sort(remainders.begin(), remainders.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
   for (std::size_t k = 0; assigned < total; k = (k + 1) % remainders.size(), ++assigned) ++counts[remainders[k].second];
   for (std::size_t g = 0; g < spec.groups.size(); ++g) spec.groups[g].count = counts[g];
 }

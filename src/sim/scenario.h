@@ -53,12 +53,13 @@ struct CollisionFreeSpeedParams {
 // to 0.5 s); the paper senses 10 m, this engine 4 m (the bins' side); the
 // largest acceleration 20 m/s^2 as the paper's reference code.
 struct TtcParams {
-  float strength = 1.5f;          // m^2: k, scale of the interaction energy E = k tau^-2 exp(-tau/tau0) (m^2/s^2, per unit mass)
-  float time_horizon = 3.0f;      // s: tau0, beyond which interactions fade exponentially
-  float relaxation_time = 0.5f;   // s: xi, the goal term (v_pref e0 - v) / xi
-  float sensing_radius = 4.0f;    // m: neighbours whose centre lies within this are considered
-  float max_acceleration = 20.0f; // m/s^2: the total force is clamped to this
-  float side_bias = 0.5f;         // keep right: share of |F_ij| also pushed right of the relative velocity (0 = the paper's)
+  float strength =
+      1.5f;  // m^2: k, scale of the interaction energy E = k tau^-2 exp(-tau/tau0) (m^2/s^2, per unit mass)
+  float time_horizon = 3.0f;       // s: tau0, beyond which interactions fade exponentially
+  float relaxation_time = 0.5f;    // s: xi, the goal term (v_pref e0 - v) / xi
+  float sensing_radius = 4.0f;     // m: neighbours whose centre lies within this are considered
+  float max_acceleration = 20.0f;  // m/s^2: the total force is clamped to this
+  float side_bias = 0.5f;  // keep right: share of |F_ij| also pushed right of the relative velocity (0 = the paper's)
 };
 
 // Parameters of the social force model (social_force.h). Defaults: m, tau,
@@ -69,16 +70,17 @@ struct TtcParams {
 // engine's four-way and circle encounters, docs/simulation.md); the sensing
 // radius, the substep and the keep-right bias are this engine's.
 struct SocialForceParams {
-  float mass = 80.0f;               // kg: m
-  float relaxation_time = 0.5f;     // s: tau, the driving term m (v0 e0 - v) / tau
-  float strength = 2000.0f;         // N: A, the social repulsion at contact
-  float range = 0.08f;              // m: B, its decay length
-  float body_stiffness = 1.2e5f;    // kg/s^2: k, the body force k g(r_ij - d_ij)
-  float friction = 2.4e5f;          // kg/(m s): kappa, the sliding friction kappa g(r_ij - d_ij) dv^t
-  float anisotropy = 1.0f;          // lambda: weight of the social repulsion from behind (1 = isotropic, the 2000 paper's)
-  float sensing_radius = 2.0f;      // m: neighbours whose centre lies within this are felt
-  float max_substep = 0.01f;        // s: the step is integrated in substeps of at most this (the body force's stiffness)
-  float side_bias = 2.5f;           // keep right: share of the social repulsion also pushed right of the relative velocity (0 = the paper's)
+  float mass = 80.0f;             // kg: m
+  float relaxation_time = 0.5f;   // s: tau, the driving term m (v0 e0 - v) / tau
+  float strength = 2000.0f;       // N: A, the social repulsion at contact
+  float range = 0.08f;            // m: B, its decay length
+  float body_stiffness = 1.2e5f;  // kg/s^2: k, the body force k g(r_ij - d_ij)
+  float friction = 2.4e5f;        // kg/(m s): kappa, the sliding friction kappa g(r_ij - d_ij) dv^t
+  float anisotropy = 1.0f;      // lambda: weight of the social repulsion from behind (1 = isotropic, the 2000 paper's)
+  float sensing_radius = 2.0f;  // m: neighbours whose centre lies within this are felt
+  float max_substep = 0.01f;    // s: the step is integrated in substeps of at most this (the body force's stiffness)
+  float side_bias =
+      2.5f;  // keep right: share of the social repulsion also pushed right of the relative velocity (0 = the paper's)
 };
 
 // The steering model and its parameters, and those of the move stage.
@@ -88,14 +90,14 @@ struct ModelParams {
   TtcParams ttc;
   SocialForceParams sf;
   // The priority model (the paper's):
-  float pred_time = 1.0f;          // s: prediction horizon (predTime)
-  float max_force = 4.0f;          // m/s^2: largest steering acceleration
-  float personal_space = 0.15f;    // m: observation radius = radius + personal_space
-  float lane_half_width = 0.5f;    // m: path following steers back beyond this
-  float relaxation_time = 0.5f;    // s: path following reaches the desired velocity in about this
-  float probe_margin = 0.1f;       // m: probe half-width = radius + probe_margin
+  float pred_time = 1.0f;        // s: prediction horizon (predTime)
+  float max_force = 4.0f;        // m/s^2: largest steering acceleration
+  float personal_space = 0.15f;  // m: observation radius = radius + personal_space
+  float lane_half_width = 0.5f;  // m: path following steers back beyond this
+  float relaxation_time = 0.5f;  // s: path following reaches the desired velocity in about this
+  float probe_margin = 0.1f;     // m: probe half-width = radius + probe_margin
   // Every model:
-  float max_speed = 2.0f;          // m/s: no agent is faster (maxVelocity)
+  float max_speed = 2.0f;               // m/s: no agent is faster (maxVelocity)
   std::int32_t contact_iterations = 4;  // contact/obstacle projection passes per step (the added constraint)
   // More passes, at most this many, while the last found a pair overlapping
   // by more than contact_tolerance (a jam; see sim/simulation.h).
@@ -115,7 +117,9 @@ struct ModelParams {
   }
   // The largest agent radius the bins allow (time to collision and social
   // force: as the collision-free speed model).
-  THRONG_HOST_DEVICE float max_radius() const { return kind == ModelKind::Priority ? pred_time * max_speed : kCfsMaxRadius; }
+  THRONG_HOST_DEVICE float max_radius() const {
+    return kind == ModelKind::Priority ? pred_time * max_speed : kCfsMaxRadius;
+  }
   static constexpr float kCfsMaxRadius = 0.5f;  // m
   // Throws Error naming the field ("model.pred_time") for NaN, negative or
   // out-of-range values.
@@ -184,8 +188,8 @@ struct GroupSpec {
 };
 
 struct OutputSpec {
-  std::string dir;          // empty = out/<name>
-  std::int64_t every = 0;   // trajectory frame stride; 0 = about one frame per simulated second
+  std::string dir;         // empty = out/<name>
+  std::int64_t every = 0;  // trajectory frame stride; 0 = about one frame per simulated second
   bool trajectories = true;
   bool stats = true;
 };
@@ -193,17 +197,17 @@ struct OutputSpec {
 // A generated obstacle field: `count` shapes placed at random in `region`.
 struct ScatterSpec {
   std::int64_t count = 0;
-  Region region;              // Rect
-  float min_size = 1.0f;      // m: circle diameter or rectangle side
+  Region region;          // Rect
+  float min_size = 1.0f;  // m: circle diameter or rectangle side
   float max_size = 4.0f;
-  float clearance = 2.0f;     // m: free gap kept between scattered shapes
+  float clearance = 2.0f;  // m: free gap kept between scattered shapes
   std::uint64_t seed = 1;
 };
 
 struct WorldSpec {
   bool has_walkable = false;
-  Polygon walkable;                       // outer boundary and holes
-  std::vector<Polygon> polygons;          // obstacle polygons
+  Polygon walkable;                         // outer boundary and holes
+  std::vector<Polygon> polygons;            // obstacle polygons
   std::vector<std::string> polygon_fields;  // "world.obstacles[3]" per polygon
   std::vector<Circle> circles;
   std::vector<std::string> circle_fields;
@@ -233,9 +237,9 @@ struct MeasurementSpec {
 struct ScenarioSpec {
   std::string name = "scenario";
   std::string description;
-  float dt = 0.1f;            // s
-  std::int64_t steps = 0;     // derived from duration when 0
-  float duration = 60.0f;     // s
+  float dt = 0.1f;                // s
+  std::int64_t steps = 0;         // derived from duration when 0
+  float duration = 60.0f;         // s
   bool stop_when_arrived = true;  // end the run early once every agent has arrived
   std::uint64_t seed = 1;
   SchedulerKind scheduler = SchedulerKind::DoubleBuffer;
@@ -264,12 +268,12 @@ struct ScenarioSpec {
 struct ScenarioLimits {
   std::int64_t max_agents = 20'000'000;
   std::int64_t max_steps = 100'000'000;
-  std::int64_t max_vertices = 1'000'000;   // all polygons together
-  std::int64_t max_obstacles = 1'000'000;  // polygons + circles + scattered
-  std::int64_t max_waypoints = 1'000;      // per group
+  std::int64_t max_vertices = 1'000'000;     // all polygons together
+  std::int64_t max_obstacles = 1'000'000;    // polygons + circles + scattered
+  std::int64_t max_waypoints = 1'000;        // per group
   std::int64_t max_grid_items = 64'000'000;  // obstacle cell registrations
-  std::int32_t raster_resolution = 1024;   // cells per side of the reachability raster
-  float max_extent = 1.0e6f;               // m: coordinates beyond +-this are rejected
+  std::int32_t raster_resolution = 1024;     // cells per side of the reachability raster
+  float max_extent = 1.0e6f;                 // m: coordinates beyond +-this are rejected
 };
 
 // A camera looking down on the map rectangle `extent` from the south-west at

@@ -28,7 +28,8 @@ THRONG_HOST_DEVICE inline ObstacleSense sense_obstacles(const WorldView& w, cons
     best.force = f;
   };
   for_each_wall_near(w, pr.origin, [&](const Segment& s) { consider(probe_segment(pr, s.a, s.b)); });
-  for_each_in_cell(w.circle_grid, pr.origin, [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
+  for_each_in_cell(w.circle_grid, pr.origin,
+                   [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
   return best;
 }
 
@@ -42,8 +43,9 @@ struct NeighbourArrays {
 
 // Neighbour j as a candidate threat of the agent at p: kept in `best` when
 // it is active, within the query radius and more urgent.
-THRONG_HOST_DEVICE inline void consider_neighbour(Threat& best, Index j, Index self, glm::vec2 p, glm::vec2 v, glm::vec2 forward,
-                                                  float radius, const NeighbourArrays& n, const ModelParams& m, float query2) {
+THRONG_HOST_DEVICE inline void consider_neighbour(Threat& best, Index j, Index self, glm::vec2 p, glm::vec2 v,
+                                                  glm::vec2 forward, float radius, const NeighbourArrays& n,
+                                                  const ModelParams& m, float query2) {
   const glm::vec2 q = n.position[j];
   if (length2(q - p) >= query2 || j == self || (n.flags[j] & kAgentActive) == 0) return;
   // An agent standing at its goal is passed like a post: no personal space,
@@ -58,9 +60,9 @@ THRONG_HOST_DEVICE inline void consider_neighbour(Threat& best, Index j, Index s
 // beyond the query radius or wholly behind the agent are skipped (a threat
 // must be ahead); `slack` widens both tests by how far neighbours may have
 // moved since they were binned (0 when positions are those binned).
-THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self, glm::vec2 p,
-                                                  glm::vec2 v, glm::vec2 forward, float radius, const NeighbourArrays& n,
-                                                  const ModelParams& m, float slack) {
+THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int32_t cx, std::int32_t cy, Index self,
+                                                  glm::vec2 p, glm::vec2 v, glm::vec2 forward, float radius,
+                                                  const NeighbourArrays& n, const ModelParams& m, float slack) {
   Threat best;
   const float query = m.query_radius();
   const float query2 = query * query;
@@ -77,14 +79,16 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
       const Index s = bins.find(cx + dx, cy + dy);
       if (s < 0) continue;
       const std::int32_t b = bins.start[s], count = bins.count[s];
-      for (std::int32_t k = 0; k < count; ++k) consider_neighbour(best, bins.items[b + k], self, p, v, forward, radius, n, m, query2);
+      for (std::int32_t k = 0; k < count; ++k)
+        consider_neighbour(best, bins.items[b + k], self, p, v, forward, radius, n, m, query2);
     }
   return best;
 }
 
 // The same over every agent: the O(N^2) reference.
-THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec2 p, glm::vec2 v, glm::vec2 forward, float radius,
-                                                            const NeighbourArrays& n, const ModelParams& m) {
+THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec2 p, glm::vec2 v, glm::vec2 forward,
+                                                            float radius, const NeighbourArrays& n,
+                                                            const ModelParams& m) {
   Threat best;
   const float query2 = m.query_radius() * m.query_radius();
   for (Index j = 0; j < n.position.size(); ++j) consider_neighbour(best, j, self, p, v, forward, radius, n, m, query2);
@@ -114,8 +118,9 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 // `self` are skipped here. Walls and circles come from the agent's cell of
 // the world's halo grids (everything within one cell side).
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, Index self, const CfsAgent& me, float v0, float dt,
-                                                            const NeighbourArrays& n, const ModelParams& m,
+THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, Index self, const CfsAgent& me,
+                                                            float v0, float dt, const NeighbourArrays& n,
+                                                            const ModelParams& m,
                                                             const ForEachCandidate& for_each_candidate) {
   const CollisionFreeSpeedParams& c = m.cfs;
   const float query2 = m.query_radius() * m.query_radius();
@@ -135,9 +140,11 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   for_each_wall_point(w, me.p, wall_point);
   glm::vec2 sum = e0 + walls;
   for_each_candidate([&](Index j) {
-    if (is_neighbour(j)) sum += cfs_neighbour_push(me, n.position[j], n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
+    if (is_neighbour(j))
+      sum += cfs_neighbour_push(me, n.position[j], n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
   });
-  const glm::vec2 e = cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
+  const glm::vec2 e =
+      cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
   if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
   // The time gap is kept to where neighbours will be in anticipation_time
   // (one crossing the agent's path will have left it); no step may end in a
@@ -171,8 +178,9 @@ struct ForceAgent {
 // `for_each_candidate` visits them (the 3x3 bins, or all agents for the
 // reference), so the sum is the same for any thread count.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, const ForceAgent& me, const NeighbourArrays& n,
-                                              const ModelParams& m, const ForEachCandidate& for_each_candidate) {
+THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, const ForceAgent& me,
+                                              const NeighbourArrays& n, const ModelParams& m,
+                                              const ForEachCandidate& for_each_candidate) {
   const TtcParams& t = m.ttc;
   const float sense2 = t.sensing_radius * t.sensing_radius;
   glm::vec2 f = ttc_goal_force(me.v, me.pref_speed, me.e0, t);
@@ -199,8 +207,8 @@ THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, co
 // order `for_each_candidate` visits them (the sum is the same for any
 // thread count); h: the substep (sf_contact_force).
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index self, const ForceAgent& me, float t, float h,
-                                                   const NeighbourArrays& n, const SocialForceParams& s,
+THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index self, const ForceAgent& me, float t,
+                                                   float h, const NeighbourArrays& n, const SocialForceParams& s,
                                                    const ForEachCandidate& for_each_candidate) {
   const float sense2 = s.sensing_radius * s.sensing_radius;
   glm::vec2 f = sf_driving_force(me.v, me.pref_speed, me.e0, s);
@@ -221,8 +229,9 @@ THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index sel
 // max_speed, then p), against neighbours moving on at constant velocity.
 // Returns the step's mean velocity, the displacement / dt.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 social_force_velocity(const WorldView& w, Index self, ForceAgent me, float dt, const NeighbourArrays& n,
-                                                          const ModelParams& m, const ForEachCandidate& for_each_candidate) {
+THRONG_HOST_DEVICE inline glm::vec2 social_force_velocity(const WorldView& w, Index self, ForceAgent me, float dt,
+                                                          const NeighbourArrays& n, const ModelParams& m,
+                                                          const ForEachCandidate& for_each_candidate) {
   const SocialForceParams& s = m.sf;
   const int substeps = sf_substeps(dt, s);
   const float h = dt / static_cast<float>(substeps);
@@ -238,7 +247,8 @@ THRONG_HOST_DEVICE inline glm::vec2 social_force_velocity(const WorldView& w, In
 // Deterministic unit direction for two agents at exactly the same point.
 THRONG_HOST_DEVICE inline glm::vec2 tie_direction(Index i, Index j) {
   const Index lo = i < j ? i : j, hi = i < j ? j : i;
-  const std::uint64_t h = mix_key(static_cast<std::uint64_t>(lo) * 0x9e3779b97f4a7c15ull + static_cast<std::uint64_t>(hi));
+  const std::uint64_t h =
+      mix_key(static_cast<std::uint64_t>(lo) * 0x9e3779b97f4a7c15ull + static_cast<std::uint64_t>(hi));
   const float a = static_cast<float>(h >> 40) * (6.2831853f / 16777216.0f);
   const glm::vec2 u(cosf(a), sinf(a));
   return i < j ? u : -u;
@@ -248,9 +258,9 @@ THRONG_HOST_DEVICE inline glm::vec2 tie_direction(Index i, Index j) {
 // pair is pushed apart, this agent taking half of the overlap. `deepest`
 // becomes the deepest of those overlaps (m; 0 when none).
 // Candidates: the contact bins' cells `cells` (the 3x3 around the agent's).
-THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cells3x3& cells, Index self, glm::vec2 p, float radius,
-                                                 Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags,
-                                                 float& deepest) {
+THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cells3x3& cells, Index self, glm::vec2 p,
+                                                 float radius, Span<const glm::vec2> positions, Span<const float> radii,
+                                                 Span<const std::uint8_t> flags, float& deepest) {
   glm::vec2 push(0.0f);
   deepest = 0.0f;
   for_each_in_cells(bins, cells, [&](std::int32_t j) {
@@ -272,8 +282,8 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cel
 // the centre lies on a wall. `clear` becomes true when a pass found nothing
 // to move: the disc then keeps its radius from every wall and circle of
 // the cell (what the move stage's acceptance asks), with no need to measure.
-THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w, const ObstacleCell& cell, glm::vec2 p, float r,
-                                                             glm::vec2 anchor, bool& clear) {
+THRONG_HOST_DEVICE inline glm::vec2 project_out_of_obstacles(const WorldView& w, const ObstacleCell& cell, glm::vec2 p,
+                                                             float r, glm::vec2 anchor, bool& clear) {
   clear = false;
   for (int pass = 0; pass < 2 && !clear; ++pass) {
     bool touched = false;

@@ -9,10 +9,10 @@
 namespace throng::sim {
 
 AgentArrays arrays_of(CrowdState& c) {
-  return {c.position.span(),        c.velocity.span(),       c.heading.span(),        c.radius.span(),
-          c.pref_speed.span(),      c.path_start.span(),     c.goal.span(),           c.waypoint_begin.span(),
-          c.waypoint_count.span(),  c.waypoint_cursor.span(), c.waypoint_goal.span(), c.group.span(),
-          c.flags.span(),           c.arrival_time.span(),   c.waypoints.span(),      c.groups.span()};
+  return {c.position.span(),       c.velocity.span(),        c.heading.span(),       c.radius.span(),
+          c.pref_speed.span(),     c.path_start.span(),      c.goal.span(),          c.waypoint_begin.span(),
+          c.waypoint_count.span(), c.waypoint_cursor.span(), c.waypoint_goal.span(), c.group.span(),
+          c.flags.span(),          c.arrival_time.span(),    c.waypoints.span(),     c.groups.span()};
 }
 
 Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& options)
@@ -63,7 +63,8 @@ void Simulation::bin() {
 void Simulation::sense_and_steer(const StepContext& ctx) {
   const AgentArrays a = arrays_of(crowd_);
   if (neighbours_ == NeighbourSearch::AllPairs) {
-    if (scheduler_ != SchedulerKind::DoubleBuffer) throw Error("the all-pairs reference runs with the double buffer only", at_field("scheduler"));
+    if (scheduler_ != SchedulerKind::DoubleBuffer)
+      throw Error("the all-pairs reference runs with the double buffer only", at_field("scheduler"));
     sense_all_pairs(ctx, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else if (scheduler_ == SchedulerKind::DoubleBuffer) {

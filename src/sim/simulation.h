@@ -95,26 +95,28 @@ void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm:
 // The naive reference for the sense stage: every agent against every other,
 // O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
-void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed, Span<glm::vec2> out_position);
+void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed,
+                         Span<glm::vec2> out_position);
 // Both: the move cells around each binned agent's anchor (its position at
 // the start of the step).
 void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells);
 // Contact passes write, per agent, the deepest overlap the pass found
 // before pushing (`depth`, m; 0 for inactive agents).
 // Double buffer: one contact pass from `in` to `out`.
-void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                            Span<const glm::vec2> in, Span<glm::vec2> out, Span<float> depth);
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
+                            Span<const MoveCells> cells, Span<const glm::vec2> in, Span<glm::vec2> out,
+                            Span<float> depth);
 // Four colour: sense + steer, then each contact pass, in place on a.position
 // and a.velocity, colour by colour.
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a);
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                          Span<float> depth);
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
+                          Span<const MoveCells> cells, Span<float> depth);
 // The deepest of the per-agent overlaps a contact pass wrote.
 float deepest_contact(Span<const float> depth);
 // Both: accepts or rejects each moved position, sets velocity, heading,
 // arrivals and waypoints. `moved` may alias a.position.
-void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                   Span<const glm::vec2> moved);
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
+                   Span<const MoveCells> cells, Span<const glm::vec2> moved);
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to);
 // Agents whose flags have `bit` set (deterministic reduction).
 Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit);

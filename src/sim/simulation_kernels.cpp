@@ -19,7 +19,8 @@ constexpr float kAcceptFraction = 0.95f;  // of the radius: largest accepted dis
 // crowd streams through a door side by side, and an agent the crowd pushed
 // past the point must not turn back against the stream to touch it.
 constexpr float kWaypointHalfWidth = 1.5f;  // m
-THRONG_HOST_DEVICE inline bool passed_waypoint(glm::vec2 p, glm::vec2 leg_start, glm::vec2 waypoint, float arrival_radius) {
+THRONG_HOST_DEVICE inline bool passed_waypoint(glm::vec2 p, glm::vec2 leg_start, glm::vec2 waypoint,
+                                               float arrival_radius) {
   const glm::vec2 along = normalize_or(waypoint - leg_start, glm::vec2(0.0f));
   if (length2(along) == 0.0f || dot2(p - waypoint, along) <= 0.0f) return false;
   const float half = arrival_radius > kWaypointHalfWidth ? arrival_radius : kWaypointHalfWidth;
@@ -39,14 +40,17 @@ THRONG_HOST_DEVICE inline glm::vec2 waypoint_aim(glm::vec2 p, glm::vec2 leg_star
   return waypoint + across * fminf(fmaxf(offset, -kWaypointHalfWidth), kWaypointHalfWidth);
 }
 
-THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) { return (flags & kAgentActive) != 0 && (flags & kAgentStopped) == 0; }
+THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
+  return (flags & kAgentActive) != 0 && (flags & kAgentStopped) == 0;
+}
 
 // Sense under the priority model: the higher-priority force of one agent,
 // obstacle avoidance or else agent avoidance (zero when neither applies).
 // `neighbours(p, v, forward, radius)` finds the most urgent threat: from the
 // 3x3 bins, or all pairs.
 template <class Neighbours>
-THRONG_HOST_DEVICE inline glm::vec2 sense_priority(const StepContext& ctx, const AgentArrays& a, Index i, const Neighbours& neighbours) {
+THRONG_HOST_DEVICE inline glm::vec2 sense_priority(const StepContext& ctx, const AgentArrays& a, Index i,
+                                                   const Neighbours& neighbours) {
   const ModelParams& m = ctx.model;
   const glm::vec2 p = a.position[i], v = a.velocity[i];
   const float r = a.radius[i];
@@ -78,7 +82,8 @@ THRONG_HOST_DEVICE inline ForceAgent force_agent(const AgentArrays& a, Index i) 
 
 // Sense under the time-to-collision model: the agent's total acceleration.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i, const ForEachCandidate& for_each_candidate) {
+THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i,
+                                              const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
   return ttc_force(ctx.world, i, force_agent(a, i), n, ctx.model, for_each_candidate);
 }
@@ -106,7 +111,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, con
 // sensed); collision-free speed: the new velocity; time to collision: the
 // total acceleration; social force: the step's mean velocity. Neighbours come from the 3x3 bins around (cx, cy), the
 // agent's cell.
-THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx, std::int32_t cy) {
+THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx,
+                                                 std::int32_t cy) {
   if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
@@ -124,8 +130,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
 // velocity as it is (a first-order model); time to collision: the sensed
 // acceleration, up to max_speed; social force: the sensed mean velocity
 // (the model integrated its substeps in the sense stage).
-THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentArrays& a, Index i, glm::vec2 sensed, glm::vec2& out_p,
-                                           glm::vec2& out_v) {
+THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentArrays& a, Index i, glm::vec2 sensed,
+                                           glm::vec2& out_p, glm::vec2& out_v) {
   const glm::vec2 p = a.position[i], v = a.velocity[i];
   if (!is_steering(a.flags[i])) {
     out_p = p;
@@ -150,16 +156,17 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
 // The move stage accepts a position only if it keeps the disc off every
 // wall and is short enough that it cannot have crossed one (see the header).
 // `known_clear`: the caller already knows the disc is off every wall.
-THRONG_HOST_DEVICE inline bool acceptable_move(const StepContext& ctx, const MoveCells& cells, glm::vec2 from, glm::vec2 p, float r,
-                                               bool known_clear = false) {
+THRONG_HOST_DEVICE inline bool acceptable_move(const StepContext& ctx, const MoveCells& cells, glm::vec2 from,
+                                               glm::vec2 p, float r, bool known_clear = false) {
   const bool short_enough = length2(p - from) <= (kAcceptFraction * r) * (kAcceptFraction * r);
   return short_enough && (known_clear || wall_clearance(ctx.world, cells.obstacles, p, r) >= r - kWallTolerance);
 }
 
 // One contact pass for one agent reading positions P; `deepest` becomes the
 // deepest overlap of the agent the pass found (before its push).
-THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i, const MoveCells& cells,
-                                                  glm::vec2 anchor, Span<const glm::vec2> P, float& deepest) {
+THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const AgentArrays& a, Index i,
+                                                  const MoveCells& cells, glm::vec2 anchor, Span<const glm::vec2> P,
+                                                  float& deepest) {
   glm::vec2 p = P[i];
   deepest = 0.0f;
   if ((a.flags[i] & kAgentActive) == 0) return p;
@@ -247,7 +254,9 @@ struct ContactsDoubleBuffer {
   Span<const MoveCells> cells;
   Span<glm::vec2> out;
   Span<float> depth;
-  THRONG_HOST_DEVICE void operator()(Index i) const { out[i] = contact_agent(ctx, a, i, cells[i], anchor[i], in, depth[i]); }
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    out[i] = contact_agent(ctx, a, i, cells[i], anchor[i], in, depth[i]);
+  }
 };
 
 // Four colour: one launch per colour over the table slots; a slot of that
@@ -355,7 +364,8 @@ void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec
   parallel_for("sim.sense.all_pairs", a.position.size(), SenseAllPairs{ctx, a, sensed}, 16);
 }
 
-void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed, Span<glm::vec2> out_position) {
+void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed,
+                         Span<glm::vec2> out_position) {
   parallel_for("sim.steer", a.position.size(), Steer{ctx, a, sensed, out_position}, kAgentGrain);
 }
 
@@ -363,19 +373,23 @@ void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveC
   parallel_for("sim.move.cells", anchor.size(), FindMoveCells{ctx, anchor, cells}, kAgentGrain);
 }
 
-void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                            Span<const glm::vec2> in, Span<glm::vec2> out, Span<float> depth) {
-  parallel_for("sim.move.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, cells, out, depth}, kAgentGrain);
+void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
+                            Span<const MoveCells> cells, Span<const glm::vec2> in, Span<glm::vec2> out,
+                            Span<float> depth) {
+  parallel_for("sim.move.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, cells, out, depth},
+               kAgentGrain);
 }
 
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
-  for (int c = 0; c < 4; ++c) parallel_for("sim.sense_steer.colour", ctx.bins.capacity(), SenseSteerColour{ctx, a, c}, kSlotGrain);
+  for (int c = 0; c < 4; ++c)
+    parallel_for("sim.sense_steer.colour", ctx.bins.capacity(), SenseSteerColour{ctx, a, c}, kSlotGrain);
 }
 
-void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                          Span<float> depth) {
+void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
+                          Span<const MoveCells> cells, Span<float> depth) {
   for (int c = 0; c < 4; ++c)
-    parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(), ContactsColour{ctx, a, anchor, cells, depth, c}, kSlotGrain);
+    parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(),
+                 ContactsColour{ctx, a, anchor, cells, depth, c}, kSlotGrain);
 }
 
 float deepest_contact(Span<const float> depth) {
@@ -384,13 +398,14 @@ float deepest_contact(Span<const float> depth) {
       THRONG_LAMBDA(float x, float y)->float { return x > y ? x : y; });
 }
 
-void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor, Span<const MoveCells> cells,
-                   Span<const glm::vec2> moved) {
+void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
+                   Span<const MoveCells> cells, Span<const glm::vec2> moved) {
   parallel_for("sim.move.finalize", a.position.size(), Finalize{ctx, a, anchor, cells, moved});
 }
 
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to) {
-  parallel_for("sim.move.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
+  parallel_for(
+      "sim.move.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
 }
 
 Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit) {

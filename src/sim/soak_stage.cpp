@@ -14,7 +14,8 @@ namespace throng::sim {
 namespace {
 
 std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 double mib(std::uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
@@ -51,8 +52,10 @@ SoakCheck SoakCheckStage::measure(const Simulation& sim, const FrameInfo& frame)
   s.non_finite = count_non_finite(c.position.span(), c.velocity.span());
   // With a NaN about, the bins cannot place the agents: report it alone.
   if (s.non_finite == 0) {
-    s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), options_.penetration_tolerance);
-    s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_bound, sim.contact_cell());
+    s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(),
+                                                 options_.penetration_tolerance);
+    s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_bound,
+                                  sim.contact_cell());
   }
   s.rss_bytes = resident_memory_bytes();
   return s;
@@ -61,11 +64,12 @@ SoakCheck SoakCheckStage::measure(const Simulation& sim, const FrameInfo& frame)
 std::string SoakCheckStage::violation(const SoakCheck& c) const {
   if (c.non_finite > 0) return fmt::format("{} agents with a non-finite position or velocity", c.non_finite);
   if (c.penetrations > 0)
-    return fmt::format("{} agents outside free space (discs into an obstacle by more than {:g} mm, or outside the walkable area)", c.penetrations,
-                       1000.0 * options_.penetration_tolerance);
+    return fmt::format(
+        "{} agents outside free space (discs into an obstacle by more than {:g} mm, or outside the walkable area)",
+        c.penetrations, 1000.0 * options_.penetration_tolerance);
   if (c.overlaps.pairs > 0)
-    return fmt::format("{} pairs overlap by more than the model's bound of {:g} cm (deepest {:.1f} cm)", c.overlaps.pairs,
-                       100.0 * options_.overlap_bound, 100.0 * c.overlaps.max_depth);
+    return fmt::format("{} pairs overlap by more than the model's bound of {:g} cm (deepest {:.1f} cm)",
+                       c.overlaps.pairs, 100.0 * options_.overlap_bound, 100.0 * c.overlaps.max_depth);
   return {};
 }
 
@@ -82,7 +86,8 @@ void SoakCheckStage::after_step(const Simulation& sim, const FrameInfo& frame) {
 }
 
 const SoakCheck* SoakCheckStage::warmed_up() const {
-  const auto warmup = static_cast<std::int64_t>(std::ceil(options_.warmup_fraction * static_cast<double>(options_.max_steps)));
+  const auto warmup =
+      static_cast<std::int64_t>(std::ceil(options_.warmup_fraction * static_cast<double>(options_.max_steps)));
   for (const SoakCheck& c : checks_)
     if (c.step >= warmup && &c != &checks_.back()) return &c;
   return nullptr;
@@ -96,9 +101,9 @@ double SoakCheckStage::rss_growth() const {
 
 std::string SoakCheckStage::failure() const {
   if (rss_growth() <= options_.max_rss_growth) return {};
-  return fmt::format("resident memory grew by {:.1f}% from step {} to step {} ({:.1f} -> {:.1f} MiB), more than {:g}%", 100.0 * rss_growth(),
-                     warmed_up()->step, checks_.back().step, mib(warmed_up()->rss_bytes), mib(checks_.back().rss_bytes),
-                     100.0 * options_.max_rss_growth);
+  return fmt::format("resident memory grew by {:.1f}% from step {} to step {} ({:.1f} -> {:.1f} MiB), more than {:g}%",
+                     100.0 * rss_growth(), warmed_up()->step, checks_.back().step, mib(warmed_up()->rss_bytes),
+                     mib(checks_.back().rss_bytes), 100.0 * options_.max_rss_growth);
 }
 
 void SoakCheckStage::finish(const Simulation& sim, nlohmann::json& stats) {
@@ -109,7 +114,9 @@ void SoakCheckStage::finish(const Simulation& sim, nlohmann::json& stats) {
     peak = std::max(peak, c.rss_bytes);
   }
   const SoakCheck* base = warmed_up();
-  auto rss_at = [](const SoakCheck* c) { return c != nullptr ? nlohmann::json(mib(c->rss_bytes)) : nlohmann::json(nullptr); };
+  auto rss_at = [](const SoakCheck* c) {
+    return c != nullptr ? nlohmann::json(mib(c->rss_bytes)) : nlohmann::json(nullptr);
+  };
   stats["soak"] = {{"checks", checks_.size()},
                    {"check_every_steps", options_.every},
                    {"steps", checks_.empty() ? 0 : checks_.back().step},

@@ -32,7 +32,7 @@ struct SoakOptions {
 
 struct SoakCheck {
   std::int64_t step = 0;
-  double time = 0;         // simulated s
+  double time = 0;          // simulated s
   double wall_seconds = 0;  // since the first check
   Index active = 0;
   Index non_finite = 0;

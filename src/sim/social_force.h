@@ -68,7 +68,8 @@ THRONG_HOST_DEVICE inline float sf_anisotropy_weight(glm::vec2 heading, glm::vec
 // / (1 + kappa g h / m): explicit friction at rate kappa g / m above 2 / h
 // would reverse the slip and grow; this one only damps it (exact for one
 // contact). h = 0: the paper's kappa.
-THRONG_HOST_DEVICE inline glm::vec2 sf_contact_force(glm::vec2 n, float overlap, float slip, const SocialForceParams& p, float h) {
+THRONG_HOST_DEVICE inline glm::vec2 sf_contact_force(glm::vec2 n, float overlap, float slip, const SocialForceParams& p,
+                                                     float h) {
   const float kappa = p.friction / (1.0f + p.friction * overlap * h / p.mass);
   return n * (p.body_stiffness * overlap) + perp_left(n) * (kappa * overlap * slip);
 }
@@ -76,8 +77,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sf_contact_force(glm::vec2 n, float overlap,
 // The force (N) of neighbour j on agent i: x = x_i - x_j, v_i and v_j their
 // velocities, R = r_i + r_j, `heading` the agent's unit walking direction
 // (zero when standing), h the substep (sf_contact_force).
-THRONG_HOST_DEVICE inline glm::vec2 sf_neighbour_force(glm::vec2 x, glm::vec2 vi, glm::vec2 vj, float R, glm::vec2 heading,
-                                                       const SocialForceParams& p, float h) {
+THRONG_HOST_DEVICE inline glm::vec2 sf_neighbour_force(glm::vec2 x, glm::vec2 vi, glm::vec2 vj, float R,
+                                                       glm::vec2 heading, const SocialForceParams& p, float h) {
   const float d = length_of(x);
   if (d <= 1e-6f) return glm::vec2(0.0f);  // coincident: the contact passes separate them
   const glm::vec2 n = x * (1.0f / d);
@@ -98,7 +99,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sf_neighbour_force(glm::vec2 x, glm::vec2 vi
 
 // The force (N) of the wall or circle point q on the agent at x_i with
 // velocity v and radius r, h the substep (sf_contact_force).
-THRONG_HOST_DEVICE inline glm::vec2 sf_wall_force(glm::vec2 xi, glm::vec2 v, float r, glm::vec2 q, const SocialForceParams& p, float h) {
+THRONG_HOST_DEVICE inline glm::vec2 sf_wall_force(glm::vec2 xi, glm::vec2 v, float r, glm::vec2 q,
+                                                  const SocialForceParams& p, float h) {
   const glm::vec2 x = xi - q;
   const float d = length_of(x);
   if (d <= 1e-6f) return glm::vec2(0.0f);  // centre on the wall: the move stage's projection decides the side
@@ -109,7 +111,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sf_wall_force(glm::vec2 xi, glm::vec2 v, flo
 }
 
 // The driving force m (v0 e0 - v) / tau (N).
-THRONG_HOST_DEVICE inline glm::vec2 sf_driving_force(glm::vec2 v, float pref_speed, glm::vec2 e0, const SocialForceParams& p) {
+THRONG_HOST_DEVICE inline glm::vec2 sf_driving_force(glm::vec2 v, float pref_speed, glm::vec2 e0,
+                                                     const SocialForceParams& p) {
   return (e0 * pref_speed - v) * (p.mass / p.relaxation_time);
 }
 

@@ -31,7 +31,8 @@ struct Probe {
   float half_width = 0.0f;
   float radius = 0.0f;  // the agent's; half_width - radius is the margin band on each side
 };
-THRONG_HOST_DEVICE inline Probe make_probe(glm::vec2 p, glm::vec2 v, float heading, float radius, const ModelParams& m) {
+THRONG_HOST_DEVICE inline Probe make_probe(glm::vec2 p, glm::vec2 v, float heading, float radius,
+                                           const ModelParams& m) {
   return {p, forward_of(v, heading), radius + m.pred_time * length_of(v), radius + m.probe_margin, radius};
 }
 
@@ -169,8 +170,8 @@ struct Threat {
   float reach = 0.0f;
 };
 
-THRONG_HOST_DEVICE inline Threat predict_threat(glm::vec2 p, glm::vec2 v, glm::vec2 forward, float observe_r, glm::vec2 q, glm::vec2 w,
-                                                float other_observe_r, float pred_time) {
+THRONG_HOST_DEVICE inline Threat predict_threat(glm::vec2 p, glm::vec2 v, glm::vec2 forward, float observe_r,
+                                                glm::vec2 q, glm::vec2 w, float other_observe_r, float pred_time) {
   Threat t;
   const glm::vec2 dp = q - p, dv = w - v;
   if (dot2(dp, forward) <= 0.0f) return t;
@@ -217,8 +218,8 @@ THRONG_HOST_DEVICE inline glm::vec2 avoidance_force(glm::vec2 forward, const Thr
 // (or once past the end of the leg) it seeks the goal, slowing over the
 // last pref_speed * relaxation_time metres.
 // Force = (desired velocity - velocity) / relaxation_time, at most max_force.
-THRONG_HOST_DEVICE inline glm::vec2 path_following_force(glm::vec2 p, glm::vec2 v, float pref_speed, glm::vec2 start, glm::vec2 goal,
-                                                         const ModelParams& m) {
+THRONG_HOST_DEVICE inline glm::vec2 path_following_force(glm::vec2 p, glm::vec2 v, float pref_speed, glm::vec2 start,
+                                                         glm::vec2 goal, const ModelParams& m) {
   const glm::vec2 to_goal = goal - p;
   const float dist = length_of(to_goal);
   const float lookahead = fmaxf(pref_speed * m.pred_time, m.lane_half_width);

@@ -81,7 +81,8 @@ THRONG_HOST_DEVICE inline glm::vec2 ttc_avoidance(glm::vec2 x, glm::vec2 v, floa
   const float s = sqrtf(discr);
   // tau below 1 ms counts as 1 ms: the force stays finite (and is clamped).
   const float tau = fmaxf((-b - s) / a, 1e-3f);
-  const float scale = -p.strength * expf(-tau / p.time_horizon) * (2.0f / tau + 1.0f / p.time_horizon) / (a * tau * tau);
+  const float scale =
+      -p.strength * expf(-tau / p.time_horizon) * (2.0f / tau + 1.0f / p.time_horizon) / (a * tau * tau);
   glm::vec2 f = (v - (x * a - v * b) * (1.0f / s)) * scale;
   if (p.side_bias > 0.0f) {
     // Keep right: the closer to dead centre (miss distance m of 0, of R),

@@ -18,18 +18,20 @@ namespace {
 void check_point(glm::vec2 p, float max_extent, const std::string& field) {
   if (!std::isfinite(p.x) || !std::isfinite(p.y)) throw Error("coordinate is not a finite number", at_field(field));
   if (std::fabs(p.x) > max_extent || std::fabs(p.y) > max_extent)
-    throw Error(fmt::format("coordinate ({}, {}) is beyond the limit of +-{} m", p.x, p.y, max_extent), at_field(field));
+    throw Error(fmt::format("coordinate ({}, {}) is beyond the limit of +-{} m", p.x, p.y, max_extent),
+                at_field(field));
 }
 
 void check_ring(const Ring& r, float max_extent, const std::string& field) {
-  if (r.size() < 3) throw Error(fmt::format("a polygon ring needs at least 3 vertices, got {}", r.size()), at_field(field));
+  if (r.size() < 3)
+    throw Error(fmt::format("a polygon ring needs at least 3 vertices, got {}", r.size()), at_field(field));
   for (std::size_t i = 0; i < r.size(); ++i) check_point(r[i], max_extent, fmt::format("{}[{}]", field, i));
   if (const auto bad = find_self_intersection(r)) {
     if (bad->first == bad->second)
       throw Error(fmt::format("polygon has a zero-length edge at vertex {}", bad->first), at_field(field));
-    throw Error(fmt::format("polygon is self-intersecting: edge {} (vertices {}-{}) crosses edge {} (vertices {}-{})", bad->first,
-                            bad->first, (bad->first + 1) % static_cast<std::int64_t>(r.size()), bad->second, bad->second,
-                            (bad->second + 1) % static_cast<std::int64_t>(r.size())),
+    throw Error(fmt::format("polygon is self-intersecting: edge {} (vertices {}-{}) crosses edge {} (vertices {}-{})",
+                            bad->first, bad->first, (bad->first + 1) % static_cast<std::int64_t>(r.size()), bad->second,
+                            bad->second, (bad->second + 1) % static_cast<std::int64_t>(r.size())),
                 at_field(field));
   }
   if (std::fabs(signed_area2(r)) < 1e-8) throw Error("polygon has zero area", at_field(field));
@@ -37,7 +39,8 @@ void check_ring(const Ring& r, float max_extent, const std::string& field) {
 
 void check_polygon(const Polygon& p, float max_extent, const std::string& field) {
   check_ring(p.outer, max_extent, field + ".polygon");
-  for (std::size_t h = 0; h < p.holes.size(); ++h) check_ring(p.holes[h], max_extent, fmt::format("{}.holes[{}]", field, h));
+  for (std::size_t h = 0; h < p.holes.size(); ++h)
+    check_ring(p.holes[h], max_extent, fmt::format("{}.holes[{}]", field, h));
   if (!polygon_is_simple(p)) throw Error("polygon rings cross one another", at_field(field));
   for (std::size_t h = 0; h < p.holes.size(); ++h)
     if (!point_in_ring(p.holes[h][0], p.outer))
@@ -52,7 +55,8 @@ void cells_of_segment(const Segment& s, float cell, Fn&& fn) {
   const float ymin = std::min(s.a.y, s.b.y) - eps, ymax = std::max(s.a.y, s.b.y) + eps;
   const std::int32_t r0 = cell_coord(ymin, cell), r1 = cell_coord(ymax, cell);
   for (std::int32_t row = r0; row <= r1; ++row) {
-    const float y0 = std::max(ymin, static_cast<float>(row) * cell), y1 = std::min(ymax, static_cast<float>(row + 1) * cell);
+    const float y0 = std::max(ymin, static_cast<float>(row) * cell),
+                y1 = std::min(ymax, static_cast<float>(row + 1) * cell);
     float xa, xb;
     if (std::fabs(s.b.y - s.a.y) < 1e-12f) {
       xa = std::min(s.a.x, s.b.x);
@@ -84,18 +88,21 @@ void cells_of_circle(const Circle& c, float cell, Fn&& fn) {
 }
 
 double cells_in_box(const Aabb& b, float cell) {
-  return (std::floor(b.max.x / cell) - std::floor(b.min.x / cell) + 1.0) * (std::floor(b.max.y / cell) - std::floor(b.min.y / cell) + 1.0);
+  return (std::floor(b.max.x / cell) - std::floor(b.min.x / cell) + 1.0) *
+         (std::floor(b.max.y / cell) - std::floor(b.min.y / cell) + 1.0);
 }
 
 // Obstacles scattered at random: circles and rotated rectangles whose
 // bounding circles keep `clearance` between them.
 void scatter(const ScatterSpec& s, const std::string& field, const ScenarioLimits& limits, std::vector<Polygon>& polys,
-             std::vector<std::string>& poly_fields, std::vector<Circle>& circles, std::vector<std::string>& circle_fields) {
+             std::vector<std::string>& poly_fields, std::vector<Circle>& circles,
+             std::vector<std::string>& circle_fields) {
   if (s.count < 0 || s.count > limits.max_obstacles)
     throw Error(fmt::format("count must be in [0, {}]", limits.max_obstacles), at_field(field + ".count"));
   if (!(s.min_size > 0) || !(s.max_size >= s.min_size) || !std::isfinite(s.max_size))
     throw Error("sizes must satisfy 0 < min_size <= max_size", at_field(field + ".size"));
-  if (!(s.clearance >= 0) || !std::isfinite(s.clearance)) throw Error("clearance must be >= 0", at_field(field + ".clearance"));
+  if (!(s.clearance >= 0) || !std::isfinite(s.clearance))
+    throw Error("clearance must be >= 0", at_field(field + ".clearance"));
   const glm::vec2 lo = s.region.min, hi = s.region.max;
   if (!(hi.x > lo.x && hi.y > lo.y)) throw Error("region must have max > min", at_field(field + ".region"));
   const float bound_r = s.max_size * 0.7072f;
@@ -109,7 +116,8 @@ void scatter(const ScatterSpec& s, const std::string& field, const ScenarioLimit
     const bool round = rng.uniform() < 0.5;
     const float angle = static_cast<float>(rng.uniform(0.0, 3.141592653589793));
     const float r = round ? size * 0.5f : size * 0.7072f;
-    const glm::vec2 c(static_cast<float>(rng.uniform(lo.x + r, hi.x - r)), static_cast<float>(rng.uniform(lo.y + r, hi.y - r)));
+    const glm::vec2 c(static_cast<float>(rng.uniform(lo.x + r, hi.x - r)),
+                      static_cast<float>(rng.uniform(lo.y + r, hi.y - r)));
     if (!(c.x - r >= lo.x && c.x + r <= hi.x && c.y - r >= lo.y && c.y + r <= hi.y)) continue;
     const std::int32_t cx = cell_coord(c.x, cell), cy = cell_coord(c.y, cell);
     bool ok = true;
@@ -134,14 +142,16 @@ void scatter(const ScatterSpec& s, const std::string& field, const ScenarioLimit
     ++made;
   }
   if (made < s.count)
-    throw Error(fmt::format("placed only {} of {} shapes: enlarge the region or lower count, size or clearance", made, s.count),
-                at_field(field));
+    throw Error(
+        fmt::format("placed only {} of {} shapes: enlarge the region or lower count, size or clearance", made, s.count),
+        at_field(field));
 }
 
 }  // namespace
 
 World World::build(const WorldSpec& spec, float cell_size, const ScenarioLimits& limits, Memory memory) {
-  if (!(cell_size > 0) || !std::isfinite(cell_size)) throw Error("cell size must be a positive number", at_field("model"));
+  if (!(cell_size > 0) || !std::isfinite(cell_size))
+    throw Error("cell size must be a positive number", at_field("model"));
   World w;
   w.cell_size_ = cell_size;
   std::int64_t vertices = 0;
@@ -167,14 +177,16 @@ World World::build(const WorldSpec& spec, float cell_size, const ScenarioLimits&
     }
   }
   for (std::size_t i = 0; i < spec.polygons.size(); ++i) {
-    const std::string field = i < spec.polygon_fields.size() ? spec.polygon_fields[i] : fmt::format("world.obstacles[{}]", i);
+    const std::string field =
+        i < spec.polygon_fields.size() ? spec.polygon_fields[i] : fmt::format("world.obstacles[{}]", i);
     count_vertices(spec.polygons[i], field);
     check_polygon(spec.polygons[i], limits.max_extent, field);
     w.polygons_.push_back(spec.polygons[i]);
     w.polygon_fields_.push_back(field);
   }
   for (std::size_t i = 0; i < spec.circles.size(); ++i) {
-    const std::string field = i < spec.circle_fields.size() ? spec.circle_fields[i] : fmt::format("world.circles[{}]", i);
+    const std::string field =
+        i < spec.circle_fields.size() ? spec.circle_fields[i] : fmt::format("world.circles[{}]", i);
     const Circle& c = spec.circles[i];
     check_point(c.center, limits.max_extent, field + ".center");
     if (!(c.radius > 0) || !(c.radius < limits.max_extent))
@@ -183,7 +195,8 @@ World World::build(const WorldSpec& spec, float cell_size, const ScenarioLimits&
     w.circle_fields_.push_back(field);
   }
   for (std::size_t i = 0; i < spec.scatters.size(); ++i) {
-    const std::string field = i < spec.scatter_fields.size() ? spec.scatter_fields[i] : fmt::format("world.scatter[{}]", i);
+    const std::string field =
+        i < spec.scatter_fields.size() ? spec.scatter_fields[i] : fmt::format("world.scatter[{}]", i);
     check_point(spec.scatters[i].region.min, limits.max_extent, field + ".region");
     check_point(spec.scatters[i].region.max, limits.max_extent, field + ".region");
     scatter(spec.scatters[i], field, limits, w.polygons_, w.polygon_fields_, w.circles_, w.circle_fields_);
@@ -224,12 +237,16 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
   // what the world contains rather than what it measures.
   constexpr double kLongWallCells = 1024;
   constexpr std::size_t kMaxLongWalls = 64;
-  auto cells_crossed = [cell](const Segment& s) { return (std::fabs(s.b.x - s.a.x) + std::fabs(s.b.y - s.a.y)) / cell + 1.0; };
+  auto cells_crossed = [cell](const Segment& s) {
+    return (std::fabs(s.b.x - s.a.x) + std::fabs(s.b.y - s.a.y)) / cell + 1.0;
+  };
   long_walls_.clear();
   for (std::size_t k = 0; k < segments_.size(); ++k)
     if (cells_crossed(segments_[k]) > kLongWallCells) long_walls_.push_back(static_cast<std::int32_t>(k));
-  std::stable_sort(long_walls_.begin(), long_walls_.end(),
-                   [&](std::int32_t a, std::int32_t b) { return cells_crossed(segments_[static_cast<std::size_t>(a)]) > cells_crossed(segments_[static_cast<std::size_t>(b)]); });
+  std::stable_sort(long_walls_.begin(), long_walls_.end(), [&](std::int32_t a, std::int32_t b) {
+    return cells_crossed(segments_[static_cast<std::size_t>(a)]) >
+           cells_crossed(segments_[static_cast<std::size_t>(b)]);
+  });
   if (long_walls_.size() > kMaxLongWalls) long_walls_.resize(kMaxLongWalls);
   std::sort(long_walls_.begin(), long_walls_.end());
   std::vector<bool> in_grid(segments_.size(), true);
@@ -243,10 +260,12 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
   for (const Circle& c : circles_) total += 9.0 * cells_in_box(sim::bounds(c), cell);
   for (const Polygon& p : polygons_) total += cells_in_box(sim::bounds(p), cell);
   if (total > static_cast<double>(limits.max_grid_items))
-    throw Error(fmt::format("obstacles would need about {:.0f} grid cells at cell size {} m (limit {}): use fewer or smaller obstacles "
-                            "or a larger model.max_speed (the cell is the model's query radius)",
-                            total, cell, limits.max_grid_items),
-                at_field("world.obstacles"));
+    throw Error(
+        fmt::format(
+            "obstacles would need about {:.0f} grid cells at cell size {} m (limit {}): use fewer or smaller obstacles "
+            "or a larger model.max_speed (the cell is the model's query radius)",
+            total, cell, limits.max_grid_items),
+        at_field("world.obstacles"));
 
   std::vector<std::pair<std::uint64_t, std::int32_t>> pairs;
   // Walls and circles go into every cell they touch and the ring of cells
@@ -261,7 +280,8 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
     if (in_grid[k]) cells_of_segment(segments_[k], cell, with_halo(static_cast<std::int32_t>(k)));
   segment_grid_ = StaticGrid(cell, std::move(pairs), memory);
   pairs.clear();
-  for (std::size_t k = 0; k < circles_.size(); ++k) cells_of_circle(circles_[k], cell, with_halo(static_cast<std::int32_t>(k)));
+  for (std::size_t k = 0; k < circles_.size(); ++k)
+    cells_of_circle(circles_[k], cell, with_halo(static_cast<std::int32_t>(k)));
   circle_grid_ = StaticGrid(cell, std::move(pairs), memory);
   pairs.clear();
   for (std::size_t k = 0; k < polygons_.size(); ++k) {
@@ -281,9 +301,9 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
 }
 
 WorldView World::view() const {
-  return {cell_size_,           has_walkable_,           walkable_outer_,           d_vertices_.span(),
-          d_rings_.span(),      d_polygons_.span(),      d_segments_.span(),        d_circles_.span(),
-          segment_grid_.view(), d_long_walls_.span(),    circle_grid_.view(),       polygon_grid_.view()};
+  return {cell_size_,           has_walkable_,        walkable_outer_,     d_vertices_.span(),
+          d_rings_.span(),      d_polygons_.span(),   d_segments_.span(),  d_circles_.span(),
+          segment_grid_.view(), d_long_walls_.span(), circle_grid_.view(), polygon_grid_.view()};
 }
 
 WorldView World::host_view() const {
@@ -306,8 +326,10 @@ bool World::in_free_space(glm::vec2 p) const { return sim::in_free_space(host_vi
 std::string World::what_blocks(glm::vec2 p) const {
   const WorldView v = host_view();
   if (v.has_walkable && !point_in_ring(p, walkable_.outer)) return "outside the walkable region world.walkable";
-  if (const std::int32_t k = polygon_containing(v, p); k >= 0) return "inside obstacle " + polygon_fields_[static_cast<std::size_t>(k)];
-  if (const std::int32_t k = circle_containing(v, p); k >= 0) return "inside obstacle " + circle_fields_[static_cast<std::size_t>(k)];
+  if (const std::int32_t k = polygon_containing(v, p); k >= 0)
+    return "inside obstacle " + polygon_fields_[static_cast<std::size_t>(k)];
+  if (const std::int32_t k = circle_containing(v, p); k >= 0)
+    return "inside obstacle " + circle_fields_[static_cast<std::size_t>(k)];
   return {};
 }
 
@@ -328,7 +350,8 @@ Reachability::Reachability(const World& world, Aabb extent, std::int32_t resolut
   const WorldView v = world.host_view();
   for (std::int64_t y = 0; y < ny_; ++y)
     for (std::int64_t x = 0; x < nx_; ++x) {
-      const glm::vec2 c = extent_.min + glm::vec2((static_cast<float>(x) + 0.5f) * h_, (static_cast<float>(y) + 0.5f) * h_);
+      const glm::vec2 c =
+          extent_.min + glm::vec2((static_cast<float>(x) + 0.5f) * h_, (static_cast<float>(y) + 0.5f) * h_);
       free[static_cast<std::size_t>(y * nx_ + x)] = in_free_space(v, c) ? 1 : 0;
     }
   std::int32_t next = 0;

@@ -80,7 +80,8 @@ THRONG_HOST_DEVICE inline std::int32_t circle_containing(const WorldView& w, glm
 // p is in free space: inside the walkable region (when there is one) and in
 // no obstacle.
 THRONG_HOST_DEVICE inline bool in_free_space(const WorldView& w, glm::vec2 p) {
-  if (w.has_walkable && !point_in_ring(p, w.vertices.data() + w.walkable_outer.begin, w.walkable_outer.count)) return false;
+  if (w.has_walkable && !point_in_ring(p, w.vertices.data() + w.walkable_outer.begin, w.walkable_outer.count))
+    return false;
   return polygon_containing(w, p) < 0 && circle_containing(w, p) < 0;
 }
 
@@ -98,7 +99,8 @@ THRONG_HOST_DEVICE inline ObstacleCell obstacle_cell(const WorldView& w, glm::ve
   c.cy = cell_coord(p.y, w.segment_grid.cell_size);
   const Index ws = w.segment_grid.find(c.cx, c.cy);
   if (ws >= 0) c.wall_start = w.segment_grid.start[ws], c.wall_count = w.segment_grid.count[ws];
-  const Index cs = w.circle_grid.find(cell_coord(p.x, w.circle_grid.cell_size), cell_coord(p.y, w.circle_grid.cell_size));
+  const Index cs =
+      w.circle_grid.find(cell_coord(p.x, w.circle_grid.cell_size), cell_coord(p.y, w.circle_grid.cell_size));
   if (cs >= 0) c.circle_start = w.circle_grid.start[cs], c.circle_count = w.circle_grid.count[cs];
   return c;
 }
@@ -124,7 +126,8 @@ THRONG_HOST_DEVICE inline void for_each_wall_near(const WorldView& w, glm::vec2 
 }
 
 template <class WallFn, class CircleFn>
-THRONG_HOST_DEVICE inline void for_each_obstacle(const WorldView& w, const ObstacleCell& c, WallFn&& wall, CircleFn&& circle) {
+THRONG_HOST_DEVICE inline void for_each_obstacle(const WorldView& w, const ObstacleCell& c, WallFn&& wall,
+                                                 CircleFn&& circle) {
   for (std::int32_t m = 0; m < c.wall_count; ++m) wall(w.segments[w.segment_grid.items[c.wall_start + m]]);
   if (w.long_walls.size() > 0) for_each_long_wall(w, c.cx, c.cy, wall);
   for (std::int32_t m = 0; m < c.circle_count; ++m) circle(w.circles[w.circle_grid.items[c.circle_start + m]]);
@@ -140,7 +143,9 @@ THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, const Obstacl
   return best;
 }
 // The same for the walls within one cell side of p.
-THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, glm::vec2 p, float far) { return wall_clearance(w, obstacle_cell(w, p), p, far); }
+THRONG_HOST_DEVICE inline float wall_clearance(const WorldView& w, glm::vec2 p, float far) {
+  return wall_clearance(w, obstacle_cell(w, p), p, far);
+}
 
 // A disc of radius r at p penetrates no obstacle by more than `tolerance`:
 // walls and circle boundaries at least r - tolerance away, centre in free space.
@@ -153,7 +158,8 @@ class World {
   World() = default;
   // Validates and indexes the geometry. Errors name the field path of the
   // offending shape ("world.obstacles[2]: polygon edges 3 and 7 cross").
-  static World build(const WorldSpec& spec, float cell_size, const ScenarioLimits& limits = {}, Memory memory = current_memory());
+  static World build(const WorldSpec& spec, float cell_size, const ScenarioLimits& limits = {},
+                     Memory memory = current_memory());
 
   WorldView view() const;       // in the memory the world was built for
   WorldView host_view() const;  // host mirror, for spawning and validation

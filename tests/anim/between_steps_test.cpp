@@ -55,8 +55,13 @@ constexpr float kStep = 0.1f;
 // A case's arrays in buffers, and the job over them.
 struct Arrays {
   explicit Arrays(const Case& c)
-      : p0(host(c.p0)), p1(host(c.p1)), out_p(static_cast<Index>(c.p0.size())), out_v(static_cast<Index>(c.p0.size())),
-        h0(host(c.h0)), h1(host(c.h1)), out_h(static_cast<Index>(c.p0.size())) {}
+      : p0(host(c.p0)),
+        p1(host(c.p1)),
+        out_p(static_cast<Index>(c.p0.size())),
+        out_v(static_cast<Index>(c.p0.size())),
+        h0(host(c.h0)),
+        h1(host(c.h1)),
+        out_h(static_cast<Index>(c.p0.size())) {}
   InterpolateAgentsJob job(float alpha) {
     InterpolateAgentsJob j;
     j.alpha = alpha;
@@ -93,7 +98,8 @@ TEST(InterpolateAgents, MatchesTheReferenceAtEveryFraction) {
   for (float alpha : {0.0f, 0.25f, 0.5f, 0.9f, 1.0f}) {
     const Out o = interpolate(c, alpha);
     for (std::size_t i = 0; i < c.p0.size(); ++i) {
-      const glm::dvec2 want = glm::dvec2(c.p0[i]) + static_cast<double>(alpha) * (glm::dvec2(c.p1[i]) - glm::dvec2(c.p0[i]));
+      const glm::dvec2 want =
+          glm::dvec2(c.p0[i]) + static_cast<double>(alpha) * (glm::dvec2(c.p1[i]) - glm::dvec2(c.p0[i]));
       EXPECT_NEAR(o.p[i].x, want.x, 1e-4) << i;
       EXPECT_NEAR(o.p[i].y, want.y, 1e-4) << i;
       const glm::dvec2 velocity = (glm::dvec2(c.p1[i]) - glm::dvec2(c.p0[i])) / static_cast<double>(kStep);

@@ -65,7 +65,8 @@ TEST(Blend1DController, PoseIsPerCharacterSynthesisAtItsSpeedAndPhase) {
       c.advance(kDt, params, events);
       c.evaluate(pose);
       ASSERT_EQ(pose.joint_count(), rig.joint_count());
-      EXPECT_LT(largest_distance(joint_positions(rig, pose), synthesised(*spaces().speeds, speed, c.phase())), 1e-4) << speed << " " << f;
+      EXPECT_LT(largest_distance(joint_positions(rig, pose), synthesised(*spaces().speeds, speed, c.phase())), 1e-4)
+          << speed << " " << f;
     }
   }
 }
@@ -187,7 +188,8 @@ TEST(Blend2DController, FullTurnAtTheTurningClipsSpeedIsThatClip) {
       c.advance(kDt, params, e);
       EXPECT_NEAR(c.turn_weight(), 1.0f, 1e-5f);
       c.evaluate(pose);
-      EXPECT_LT(largest_distance(joint_positions(rig, pose), synthesised(*turn, info.speed, c.phase())), 1e-4) << left << " " << f;
+      EXPECT_LT(largest_distance(joint_positions(rig, pose), synthesised(*turn, info.speed, c.phase())), 1e-4)
+          << left << " " << f;
     }
     EXPECT_NEAR(c.duration(), info.period, 1e-3 * info.period);
   }
@@ -203,7 +205,9 @@ TEST(Blend2DController, TurnWeightGrowsWithTurnAndFadesAwayFromTheTurningSpeed) 
     return Blend2DController(spaces().speeds, spaces().turn_left, spaces().turn_right, o).turn_weight();
   };
   EXPECT_NEAR(weight(info.speed, 0.5f * rate), 0.5f, 1e-5f);
-  EXPECT_NEAR(weight(info.speed, -0.5f * spaces().turn_right->clip_infos()[0].turn / spaces().turn_right->clip_infos()[0].period), 0.5f, 1e-5f);
+  EXPECT_NEAR(weight(info.speed,
+                     -0.5f * spaces().turn_right->clip_infos()[0].turn / spaces().turn_right->clip_infos()[0].period),
+              0.5f, 1e-5f);
   float previous = 1.0f;
   for (const float speed : {info.speed, info.speed + 0.1f, info.speed + 0.2f, info.speed + 0.4f}) {
     const float w = weight(speed, rate);
@@ -243,7 +247,8 @@ TEST(BlendControllers, PlayInStreamsUnchanged) {
   const std::int32_t s = pool.add(rig, 0, spec, std::make_unique<Blend1DController>(spaces().speeds));
   pool[s].parameters().set("speed", 1.4f);
   spec.name = "turn";
-  const std::int32_t t = pool.add(rig, 0, spec, std::make_unique<Blend2DController>(spaces().speeds, spaces().turn_left, spaces().turn_right));
+  const std::int32_t t = pool.add(
+      rig, 0, spec, std::make_unique<Blend2DController>(spaces().speeds, spaces().turn_left, spaces().turn_right));
   pool[t].parameters().set("speed", 1.2f);
   pool[t].parameters().set("turn", 0.4f);
   Blend1DController reference(spaces().speeds);

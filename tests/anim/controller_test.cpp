@@ -30,11 +30,12 @@ TEST(ClipPlayer, SamplesBetweenFramesBySlerp) {
     const int f = static_cast<int>(t / kDt);
     const double a = t / kDt - f;
     for (int j = 0; j < 6; ++j) {
-      const glm::dquat want = sine_slerp(glm::dquat(clip.clip->rotation(f, j)), glm::dquat(clip.clip->rotation(f + 1, j)), a);
+      const glm::dquat want =
+          sine_slerp(glm::dquat(clip.clip->rotation(f, j)), glm::dquat(clip.clip->rotation(f + 1, j)), a);
       EXPECT_LT(angle_deg(glm::dquat(p.local[static_cast<std::size_t>(j)]), want), 1e-3) << t << " " << j;
     }
-    const glm::vec3 r = glm::mix(clip.clip->root_positions[static_cast<std::size_t>(f)], clip.clip->root_positions[static_cast<std::size_t>(f + 1)],
-                                 static_cast<float>(a));
+    const glm::vec3 r = glm::mix(clip.clip->root_positions[static_cast<std::size_t>(f)],
+                                 clip.clip->root_positions[static_cast<std::size_t>(f + 1)], static_cast<float>(a));
     EXPECT_LT(glm::length(p.root - r), 1e-5f);
   }
 }
@@ -44,7 +45,8 @@ TEST(ClipPlayer, LoopWrapsFromLastFrameToFirstAndOneShotHolds) {
   Pose p;
   sample_clip(clip, 9.5 * kDt, p);  // half way from frame 9 to frame 0
   for (int j = 0; j < 4; ++j) {
-    const glm::dquat want = sine_slerp(glm::dquat(clip.clip->rotation(9, j)), glm::dquat(clip.clip->rotation(0, j)), 0.5);
+    const glm::dquat want =
+        sine_slerp(glm::dquat(clip.clip->rotation(9, j)), glm::dquat(clip.clip->rotation(0, j)), 0.5);
     EXPECT_LT(angle_deg(glm::dquat(p.local[static_cast<std::size_t>(j)]), want), 1e-3);
   }
   // Root carried on by the last frame's step, not jumping back.
@@ -150,7 +152,8 @@ TEST(Layers, OverrideAndAdditiveWithBoneMasks) {
       const glm::dquat ref(glm::angleAxis(0.3f, glm::vec3(0, 0, 1)));
       want = qb * sine_slerp(glm::dquat(1, 0, 0, 0), glm::inverse(ref) * ql, 0.8 * 0.5);
     }
-    EXPECT_LT(angle_deg(glm::dquat(got.local[static_cast<std::size_t>(j)]), want), 2e-3) << skel.names[static_cast<std::size_t>(j)];
+    EXPECT_LT(angle_deg(glm::dquat(got.local[static_cast<std::size_t>(j)]), want), 2e-3)
+        << skel.names[static_cast<std::size_t>(j)];
   }
   // A clone evolves independently and equally.
   auto copy = layered.clone();
@@ -223,7 +226,8 @@ TEST(StateMachine, ScriptedParametersGiveTheExpectedStatesAndEvents) {
   // Fades of 0.19 s take 6 frames; no transition fires while one runs, so
   // walk -> idle waits for the run -> walk fade; the one-shot wave (16
   // frames) hands back to idle on the frame it finishes.
-  const std::vector<std::pair<int, std::string>> want = {{10, "walk"}, {30, "run"}, {50, "walk"}, {56, "idle"}, {70, "wave"}, {86, "idle"}};
+  const std::vector<std::pair<int, std::string>> want = {{10, "walk"}, {30, "run"},  {50, "walk"},
+                                                         {56, "idle"}, {70, "wave"}, {86, "idle"}};
   EXPECT_EQ(entered, want);
   // wave_start exactly once, on entering; footsteps only while walk or run dominates.
   int waves = 0;
@@ -283,7 +287,8 @@ TEST(StateMachine, CrossFadeBlendsTheTwoStatesBySlerp) {
   sample_clip(wiggle_clip(5, 40, kDt, "idle"), 2 * kDt, idle);
   sample_clip(wiggle_clip(5, 30, kDt, "walk"), kDt, walk);
   for (int j = 0; j < 5; ++j) {
-    const glm::dquat want = sine_slerp(glm::dquat(idle.local[static_cast<std::size_t>(j)]), glm::dquat(walk.local[static_cast<std::size_t>(j)]), w);
+    const glm::dquat want = sine_slerp(glm::dquat(idle.local[static_cast<std::size_t>(j)]),
+                                       glm::dquat(walk.local[static_cast<std::size_t>(j)]), w);
     EXPECT_LT(angle_deg(glm::dquat(got.local[static_cast<std::size_t>(j)]), want), 2e-3);
   }
 }
@@ -300,12 +305,16 @@ TEST(StateMachine, BadDefinitionsNameTheirField) {
     return std::string("no error");
   };
   EXPECT_EQ(field([&] { sm.add_state("a", std::make_unique<ClipPlayer>(wiggle_clip(3, 4, kDt))); }), "states[1].name");
-  EXPECT_EQ(field([&] { sm.add_state("b", std::make_unique<ClipPlayer>(wiggle_clip(4, 4, kDt))); }), "states[1].controller");
+  EXPECT_EQ(field([&] { sm.add_state("b", std::make_unique<ClipPlayer>(wiggle_clip(4, 4, kDt))); }),
+            "states[1].controller");
   EXPECT_EQ(field([&] { sm.add_transition(0, 3, {}, 0.1f); }), "transitions[0].to");
   EXPECT_EQ(field([&] { sm.add_transition(0, 0, {}, 0.1f); }), "transitions[0].to");
   sm.add_state("b", std::make_unique<ClipPlayer>(wiggle_clip(3, 4, kDt)));
   EXPECT_EQ(field([&] { sm.add_transition(0, 1, {}, -1.0f); }), "transitions[0].fade");
-  EXPECT_EQ(field([&] { sm.add_transition(0, 1, {{"x", Compare::Less, std::nanf("")}}, 0.1f); }), "transitions[0].when[0]");
+  EXPECT_EQ(field([&] {
+              sm.add_transition(0, 1, {{"x", Compare::Less, std::nanf("")}}, 0.1f);
+            }),
+            "transitions[0].when[0]");
 }
 
 TEST(Parameters, SetGetAndRejectNonFinite) {

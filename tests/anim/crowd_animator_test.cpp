@@ -67,12 +67,15 @@ TEST(CrowdAnimator, MatchesThePerCharacterReference) {
     double worst_p = 0.0, worst_q = 0.0;
     for (Index i = 0; i < n; ++i) {
       auto& r = ref[static_cast<std::size_t>(i)];
-      motion::advance_locomotion(v, step, crowd.speeds[static_cast<std::size_t>(i)], 0.0f, 0.0f, r.scale, r.position, r.yaw, r.phase,
-                                 r.blend_speed);
-      motion::synthesise_pose(v, motion::character_frame(v, r.blend_speed, r.phase, r.position, r.yaw, r.scale), p.data(), q.data());
+      motion::advance_locomotion(v, step, crowd.speeds[static_cast<std::size_t>(i)], 0.0f, 0.0f, r.scale, r.position,
+                                 r.yaw, r.phase, r.blend_speed);
+      motion::synthesise_pose(v, motion::character_frame(v, r.blend_speed, r.phase, r.position, r.yaw, r.scale),
+                              p.data(), q.data());
       for (std::int32_t j = 0; j < J; ++j) {
-        worst_p = std::max(worst_p, static_cast<double>(glm::length(positions[static_cast<std::size_t>(i * J + j)] - p[static_cast<std::size_t>(j)])));
-        worst_q = std::max(worst_q, angle_deg(rotations[static_cast<std::size_t>(i * J + j)], q[static_cast<std::size_t>(j)]));
+        worst_p = std::max(worst_p, static_cast<double>(glm::length(positions[static_cast<std::size_t>(i * J + j)] -
+                                                                    p[static_cast<std::size_t>(j)])));
+        worst_q = std::max(worst_q,
+                           angle_deg(rotations[static_cast<std::size_t>(i * J + j)], q[static_cast<std::size_t>(j)]));
       }
     }
     EXPECT_LT(worst_p, 1e-5) << frame;
@@ -163,20 +166,25 @@ TEST(CrowdAnimator, MaskedJointsAreNotSynthesised) {
     if (bits < J) ++partly;
     const auto lm = locals_of(world_masked, J, c);
     const auto lf = locals_of(world_full, J, c);
-    const glm::quat* held = motion::held_rotations(v, motion::blend_point(v, motion::blend_coordinate(v, speeds[static_cast<std::size_t>(c)])));
+    const glm::quat* held = motion::held_rotations(
+        v, motion::blend_point(v, motion::blend_coordinate(v, speeds[static_cast<std::size_t>(c)])));
     // A leg whose foot LOD dropped is not planted (planted feet are a
     // detail of the finest level): its thigh and knee are the plain blend,
     // not full synthesis's IK, and are left out here.
     std::vector<std::uint8_t> ik_without_foot(static_cast<std::size_t>(J), 0);
     for (const motion::LegChain& leg : v.legs) {
-      const std::int32_t thigh = leg.joints[leg.count - 3], knee = leg.joints[leg.count - 2], ankle = leg.joints[leg.count - 1];
-      if (!joint_synthesised(masks.data() + c * W, ankle)) ik_without_foot[static_cast<std::size_t>(thigh)] = ik_without_foot[static_cast<std::size_t>(knee)] = 1;
+      const std::int32_t thigh = leg.joints[leg.count - 3], knee = leg.joints[leg.count - 2],
+                         ankle = leg.joints[leg.count - 1];
+      if (!joint_synthesised(masks.data() + c * W, ankle))
+        ik_without_foot[static_cast<std::size_t>(thigh)] = ik_without_foot[static_cast<std::size_t>(knee)] = 1;
     }
     for (std::int32_t j = 1; j < J; ++j) {
       const bool kept = joint_synthesised(masks.data() + c * W, j);
       if (kept && ik_without_foot[static_cast<std::size_t>(j)]) continue;
-      if (kept) worst_kept = std::max(worst_kept, angle_deg(lm[static_cast<std::size_t>(j)], lf[static_cast<std::size_t>(j)]));
-      else worst_held = std::max(worst_held, angle_deg(lm[static_cast<std::size_t>(j)], held[j]));
+      if (kept)
+        worst_kept = std::max(worst_kept, angle_deg(lm[static_cast<std::size_t>(j)], lf[static_cast<std::size_t>(j)]));
+      else
+        worst_held = std::max(worst_held, angle_deg(lm[static_cast<std::size_t>(j)], held[j]));
     }
   }
   EXPECT_GT(partly, n / 4);  // the camera sees most of the crowd small
@@ -197,8 +205,9 @@ TEST(CycleCache, AHitReadsWhatSynthesisGivesWithinTheReportedError) {
   cached.place(crowd.positions, crowd.yaws, crowd.scales, crowd.phases);
   cached.set_speeds(crowd.speeds);
   const QuantisationError reported = cached.cache()->quantisation_error(101, 96);
-  std::printf("cache error: max %.3f deg (x = %.3f, phase %.3f, joint %d), mean %.4f deg over %lld samples\n", reported.max_deg,
-              reported.worst_w, reported.worst_phase, reported.worst_joint, reported.mean_deg, static_cast<long long>(reported.samples));
+  std::printf("cache error: max %.3f deg (x = %.3f, phase %.3f, joint %d), mean %.4f deg over %lld samples\n",
+              reported.max_deg, reported.worst_w, reported.worst_phase, reported.worst_joint, reported.mean_deg,
+              static_cast<long long>(reported.samples));
   EXPECT_GT(reported.max_deg, 0.0);
   // Absolute caps, so a growing error cannot hide behind a growing estimate:
   // buckets 0.05 wide (half a bucket, 0.025, from the exact blend point) at
@@ -231,7 +240,8 @@ TEST(CycleCache, AHitReadsWhatSynthesisGivesWithinTheReportedError) {
       }
     }
   }
-  std::printf("measured on %lld characters: max %.3f deg, mean %.4f deg\n", static_cast<long long>(n), worst, sum / static_cast<double>(terms));
+  std::printf("measured on %lld characters: max %.3f deg, mean %.4f deg\n", static_cast<long long>(n), worst,
+              sum / static_cast<double>(terms));
   EXPECT_LE(worst, 1.1 * reported.max_deg + 1e-3);
   EXPECT_GT(terms, 0);
   EXPECT_LT(worst, 10.0);  // 8.3 deg measured
@@ -243,13 +253,15 @@ TEST(CycleCache, CountsCharactersAndEvictsFirstInFirstOut) {
   Crowd crowd = random_crowd(n, 15);
   CrowdAnimatorConfig config;
   config.lod = false;
-  config.cache_config.capacity_bytes = 3 * static_cast<std::size_t>(default_cache_frames(space())) * space().joint_count() * sizeof(glm::quat);
+  config.cache_config.capacity_bytes =
+      3 * static_cast<std::size_t>(default_cache_frames(space())) * space().joint_count() * sizeof(glm::quat);
   CrowdAnimator animator(space(), n, config);
   animator.place(crowd.positions, crowd.yaws, {}, crowd.phases);  // scale 1: one blend speed, one key
   ASSERT_EQ(animator.cache()->slot_count(), 3);
   Index lookups = 0;
   for (int frame = 0; frame < 6; ++frame) {
-    for (float& s : crowd.speeds) s = 0.5f + 0.7f * static_cast<float>(frame);  // one key per frame, a new one each time
+    for (float& s : crowd.speeds)
+      s = 0.5f + 0.7f * static_cast<float>(frame);  // one key per frame, a new one each time
     animator.set_speeds(crowd.speeds);
     const FrameStats& s = animator.animate({1.0f / 60.0f, nullptr, true});
     lookups += n;
@@ -322,10 +334,12 @@ TEST(CrowdAnimator, FootSkatingOfTheDefaultSetThroughTheBatch) {
       positions.emplace_back(3.0f * static_cast<float>(i), 0.0f, 0.0f);
       v.push_back(space().max_speed() * static_cast<float>(i + 1) / static_cast<float>(speeds));
     }
-    std::printf("%s\n%8s %9s %9s %9s\n", cache ? "with the cache (bucket 0.05):" : "synthesised:", "speed", "contacts", "mean_cm", "p95_cm");
+    std::printf("%s\n%8s %9s %9s %9s\n", cache ? "with the cache (bucket 0.05):" : "synthesised:", "speed", "contacts",
+                "mean_cm", "p95_cm");
     for (std::int32_t i = 0; i < speeds; ++i) {
       CrowdAnimator one(space(), 1, config);
-      one.place(std::span(positions).subspan(static_cast<std::size_t>(i), 1), std::span(yaws).subspan(static_cast<std::size_t>(i), 1));
+      one.place(std::span(positions).subspan(static_cast<std::size_t>(i), 1),
+                std::span(yaws).subspan(static_cast<std::size_t>(i), 1));
       one.set_speeds(std::span(v).subspan(static_cast<std::size_t>(i), 1));
       one.track({0});
       for (int f = 0; f < 480; ++f) one.animate({1.0f / 60.0f, nullptr, true});

@@ -37,7 +37,8 @@ Crowd grid_crowd(const std::vector<float>& speeds, std::uint64_t seed) {
   const auto side = static_cast<Index>(std::ceil(std::sqrt(static_cast<double>(speeds.size()))));
   Rng rng(seed);
   for (std::size_t i = 0; i < speeds.size(); ++i) {
-    c.positions.emplace_back(2.0f * static_cast<float>(static_cast<Index>(i) % side), 0.0f, 2.0f * static_cast<float>(static_cast<Index>(i) / side));
+    c.positions.emplace_back(2.0f * static_cast<float>(static_cast<Index>(i) % side), 0.0f,
+                             2.0f * static_cast<float>(static_cast<Index>(i) / side));
     c.yaws.push_back(static_cast<float>(rng.uniform(-3.14159, 3.14159)));
     c.speeds.push_back(speeds[i]);
   }
@@ -55,7 +56,8 @@ std::vector<glm::vec3> palette_joints(const LocomotionStreams& loco, Index a) {
   const Rig& rig = loco.rig();
   std::vector<glm::vec3> out;
   for (std::int32_t j = 0; j < loco.joint_count(); ++j)
-    out.push_back(transform_point(loco.palettes()[a * loco.joint_count() + j], rig.bind_positions[static_cast<std::size_t>(j)]));
+    out.push_back(
+        transform_point(loco.palettes()[a * loco.joint_count() + j], rig.bind_positions[static_cast<std::size_t>(j)]));
   return out;
 }
 
@@ -66,7 +68,8 @@ std::vector<glm::vec3> synthesised(const LocomotionStreams& loco, Index a, float
     v.quantum = quantum;
     v.quantum_buckets = motion::weight_bucket_count(quantum);
   }
-  const motion::CharacterFrame f = motion::character_frame(v, loco.speeds()[a], loco.phases()[a], loco.positions()[a], loco.yaws()[a], 1.0f);
+  const motion::CharacterFrame f =
+      motion::character_frame(v, loco.speeds()[a], loco.phases()[a], loco.positions()[a], loco.yaws()[a], 1.0f);
   std::vector<glm::vec3> p(static_cast<std::size_t>(v.joint_count));
   std::vector<glm::quat> q(p.size());
   motion::synthesise_pose(v, f, p.data(), q.data());
@@ -89,13 +92,15 @@ TEST(LocomotionStreams, StreamedAgentsShowSynthesisAtTheirBucketsBlendAndTheirPh
     EXPECT_EQ(s.streamed, n);
     EXPECT_EQ(s.exact, 0);
     double worst = 0.0;
-    for (Index a = 0; a < n; ++a) worst = std::max(worst, largest_distance(palette_joints(loco, a), synthesised(loco, a, 0.05f)));
+    for (Index a = 0; a < n; ++a)
+      worst = std::max(worst, largest_distance(palette_joints(loco, a), synthesised(loco, a, 0.05f)));
     ASSERT_LT(worst, 2e-4) << frame;  // metres: float FK through the palettes
   }
   // Streams in use: one per distinct bucket of the agents' speeds.
   std::set<std::int32_t> keys;
   const motion::BlendSpaceView v = loco.blend_space().view();
-  for (float s : c.speeds) keys.insert(cache_key(motion::blend_point(v, motion::blend_coordinate(v, s)), 0.05f, loco.bucket_count()));
+  for (float s : c.speeds)
+    keys.insert(cache_key(motion::blend_point(v, motion::blend_coordinate(v, s)), 0.05f, loco.bucket_count()));
   EXPECT_EQ(loco.last_frame().streams_in_use, static_cast<std::int32_t>(keys.size()));
   EXPECT_EQ(loco.last_frame().streams_running, static_cast<std::int32_t>(keys.size()));
   EXPECT_EQ(loco.last_frame().streams, loco.blend_space().segment_count() * loco.bucket_count());
@@ -247,10 +252,14 @@ TEST(LocomotionStreams, SharingErrorShrinksWithTheBucketWidthWithinTheDerivedBou
           const float w = std::clamp(0.01f * static_cast<float>(wi), h, 1.0f - h);
           const float phase = static_cast<float>(pi) / 48.0f;
           motion::BlendPoint a{seg, seg + 1, seg, w - h}, b{seg, seg + 1, seg, w + h};
-          motion::synthesise_pose(v, motion::character_frame_at(v, a, phase, glm::vec3(0.0f), 0.0f, 1.0f), p0.data(), q.data());
-          motion::synthesise_pose(v, motion::character_frame_at(v, b, phase, glm::vec3(0.0f), 0.0f, 1.0f), p1.data(), q.data());
+          motion::synthesise_pose(v, motion::character_frame_at(v, a, phase, glm::vec3(0.0f), 0.0f, 1.0f), p0.data(),
+                                  q.data());
+          motion::synthesise_pose(v, motion::character_frame_at(v, b, phase, glm::vec3(0.0f), 0.0f, 1.0f), p1.data(),
+                                  q.data());
           for (std::int32_t j = 0; j < J; ++j)
-            D = std::max(D, static_cast<double>(glm::length(p1[static_cast<std::size_t>(j)] - p0[static_cast<std::size_t>(j)])) / (2.0 * h));
+            D = std::max(
+                D, static_cast<double>(glm::length(p1[static_cast<std::size_t>(j)] - p0[static_cast<std::size_t>(j)])) /
+                       (2.0 * h));
         }
   }
   const Crowd c = grid_crowd(speed_sweep(401, 4.5f), 11);
@@ -270,9 +279,9 @@ TEST(LocomotionStreams, SharingErrorShrinksWithTheBucketWidthWithinTheDerivedBou
     const SharingError e = loco.sharing_error();
     EXPECT_EQ(e.agents, n);
     const double bound = 100.0 * D * width / 2.0;
-    std::cout << "[ figures  ] bucket width " << width << ": max " << e.max_cm << " cm, mean " << e.mean_cm << " cm, p95 " << e.p95_cm
-              << " cm, bound " << bound << " cm, streams in use " << loco.last_frame().streams_in_use << ", pose bytes "
-              << loco.last_frame().pose_bytes << "\n";
+    std::cout << "[ figures  ] bucket width " << width << ": max " << e.max_cm << " cm, mean " << e.mean_cm
+              << " cm, p95 " << e.p95_cm << " cm, bound " << bound << " cm, streams in use "
+              << loco.last_frame().streams_in_use << ", pose bytes " << loco.last_frame().pose_bytes << "\n";
     EXPECT_LE(e.max_cm, 1.05 * bound + 0.02) << width;
     EXPECT_LT(e.max_cm, previous_max) << width;
     EXPECT_LT(e.mean_cm, 0.75 * previous_mean) << width;  // about halves with the width
@@ -299,7 +308,8 @@ TEST(LocomotionStreams, StreamedFeetStayPlanted) {
   loco.animate(nullptr);
   loco.track(all);
   for (int f = 0; f < 8 * 30; ++f) {
-    for (Index a = 0; a < n; ++a) c.positions[static_cast<std::size_t>(a)].z += speeds[static_cast<std::size_t>(a)] * dt;
+    for (Index a = 0; a < n; ++a)
+      c.positions[static_cast<std::size_t>(a)].z += speeds[static_cast<std::size_t>(a)] * dt;
     loco.set_agents(c.positions, c.yaws, c.speeds);
     loco.animate(nullptr);
   }
@@ -311,16 +321,21 @@ TEST(LocomotionStreams, StreamedFeetStayPlanted) {
   const motion::BlendSpaceView v = space()->view();
   for (Index a = 0; a < n; ++a) {
     const float s = speeds[static_cast<std::size_t>(a)];
-    const std::int32_t key = cache_key(motion::blend_point(v, motion::blend_coordinate(v, s)), 0.05f, loco.bucket_count());
-    const double period = 1.0 / motion::cycle_rate(v, motion::blend_point(v, motion::blend_coordinate(v, loco.key_speed(key))), loco.key_speed(key));
+    const std::int32_t key =
+        cache_key(motion::blend_point(v, motion::blend_coordinate(v, s)), 0.05f, loco.bucket_count());
+    const double period =
+        1.0 / motion::cycle_rate(v, motion::blend_point(v, motion::blend_coordinate(v, loco.key_speed(key))),
+                                 loco.key_speed(key));
     allowance = std::max(allowance, 100.0 * std::abs(s - loco.key_speed(key)) * period);
-    const motion::FootSkatingReport exact = motion::locomotion_foot_skating(*space(), s, 8.0, motion::LocomotionStep{dt});
+    const motion::FootSkatingReport exact =
+        motion::locomotion_foot_skating(*space(), s, 8.0, motion::LocomotionStep{dt});
     worst_mean = std::max(worst_mean, exact.mean_cm);
     worst_max = std::max(worst_max, exact.max_cm);
   }
-  std::cout << "[ figures  ] streamed foot skating: mean " << streamed.mean_cm << " cm, p95 " << streamed.p95_cm << " cm, max "
-            << streamed.max_cm << " cm over " << streamed.contacts << " contacts; exact synthesis worst mean " << worst_mean
-            << " cm, worst max " << worst_max << " cm; allowance " << allowance << " cm\n";
+  std::cout << "[ figures  ] streamed foot skating: mean " << streamed.mean_cm << " cm, p95 " << streamed.p95_cm
+            << " cm, max " << streamed.max_cm << " cm over " << streamed.contacts
+            << " contacts; exact synthesis worst mean " << worst_mean << " cm, worst max " << worst_max
+            << " cm; allowance " << allowance << " cm\n";
   EXPECT_GT(streamed.contacts, 8 * n);
   EXPECT_LE(streamed.max_cm, worst_max + allowance);
   EXPECT_LE(streamed.mean_cm, 1.0);
@@ -341,7 +356,8 @@ TEST(LocomotionStreams, IdenticalResultsForOneTwoAndManyThreads) {
     Crowd moving = c;
     Index exact = 0;
     for (int f = 0; f < 12; ++f) {
-      for (Index a = 0; a < n; ++a) moving.speeds[static_cast<std::size_t>(a)] = speeds[static_cast<std::size_t>(a)] * (f < 6 ? 1.0f : 0.8f);
+      for (Index a = 0; a < n; ++a)
+        moving.speeds[static_cast<std::size_t>(a)] = speeds[static_cast<std::size_t>(a)] * (f < 6 ? 1.0f : 0.8f);
       loco.set_agents(moving.positions, moving.yaws, moving.speeds);
       exact += loco.animate(&camera).exact;
     }

@@ -80,7 +80,9 @@ TEST(BodyParts, PartitionDepthsAndAnchorsOfAHumanoid) {
       EXPECT_EQ(parts.part_of[static_cast<std::size_t>(j)], static_cast<std::uint8_t>(p));
     }
   for (int c : seen) EXPECT_EQ(c, 1);
-  const auto part_of = [&](const char* name) { return static_cast<BodyPart>(parts.part_of[static_cast<std::size_t>(s.find(name))]); };
+  const auto part_of = [&](const char* name) {
+    return static_cast<BodyPart>(parts.part_of[static_cast<std::size_t>(s.find(name))]);
+  };
   EXPECT_EQ(part_of("LeftArm"), BodyPart::LeftArm);
   EXPECT_EQ(part_of("LeftHandIndex1"), BodyPart::LeftArm);
   EXPECT_EQ(part_of("RightForeArm"), BodyPart::RightArm);
@@ -98,12 +100,14 @@ TEST(BodyParts, PartitionDepthsAndAnchorsOfAHumanoid) {
   EXPECT_EQ(parts.anchor(BodyPart::Torso).joint_b, s.find("Neck"));
   // Straight limbs in the rest pose: the radius is the longest chain from the centre joint.
   EXPECT_NEAR(parts.anchor(BodyPart::LeftArm).radius, 0.25f + 0.08f + 0.04f, 1e-5f);  // elbow -> fingertip
-  EXPECT_NEAR(parts.anchor(BodyPart::LeftLeg).radius, 0.42f + std::hypot(0.05f, 0.12f) + 0.05f, 1e-5f);  // knee -> toe tip
+  EXPECT_NEAR(parts.anchor(BodyPart::LeftLeg).radius, 0.42f + std::hypot(0.05f, 0.12f) + 0.05f,
+              1e-5f);  // knee -> toe tip
   // Mid-spine (0.225 above the hips) to the head's end site: 0.5 * (0.45 + 0.25) + 0.5 * 0.25.
   EXPECT_NEAR(parts.anchor(BodyPart::Torso).radius, 0.475f, 1e-5f);
   // Rest spheres stand on the ground: the knee is 0.42 + 0.05 above the sole... of the foot joint.
   EXPECT_NEAR(parts.rest_spheres[static_cast<std::size_t>(BodyPart::LeftLeg)].y, 0.42f + 0.05f, 1e-5f);
-  EXPECT_NEAR(bone_path_length(s, s.find("LeftHand"), s.find("RightHand")), 2 * (0.25f + 0.28f + 0.15f + std::hypot(0.05f, 0.15f)), 1e-5f);
+  EXPECT_NEAR(bone_path_length(s, s.find("LeftHand"), s.find("RightHand")),
+              2 * (0.25f + 0.28f + 0.15f + std::hypot(0.05f, 0.15f)), 1e-5f);
 }
 
 // The bound holds in every pose: brute force over random poses.
@@ -118,7 +122,8 @@ TEST(BodyParts, SpheresContainTheirPartInRandomPoses) {
   double tightest = 0;  // largest distance / radius seen
   for (int trial = 0; trial < 500; ++trial) {
     for (auto& q : local) q = random_rotation(rng);
-    motion::fk_pose(J, s.parents.data(), s.offsets.data(), local.data(), nullptr, glm::vec3(1, 2, 3), pos.data(), rot.data());
+    motion::fk_pose(J, s.parents.data(), s.offsets.data(), local.data(), nullptr, glm::vec3(1, 2, 3), pos.data(),
+                    rot.data());
     for (BodyPart p : kAllBodyParts) {
       const SphereAnchor& a = parts.anchor(p);
       const glm::vec3 c = anchor_centre(a, pos.data());
@@ -168,7 +173,8 @@ TEST(LodConfig, DefaultLevelsDropTheDeepestJointsFirst) {
     for (std::int32_t j : c.synthesised_joints(p, l)) out.push_back(s.names[static_cast<std::size_t>(j)]);
     return out;
   };
-  EXPECT_EQ(names(BodyPart::LeftArm, 0), (std::vector<std::string>{"LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1"}));
+  EXPECT_EQ(names(BodyPart::LeftArm, 0),
+            (std::vector<std::string>{"LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1"}));
   EXPECT_EQ(names(BodyPart::LeftArm, 1), (std::vector<std::string>{"LeftArm", "LeftForeArm"}));
   EXPECT_TRUE(names(BodyPart::LeftArm, 2).empty());
   EXPECT_EQ(names(BodyPart::Torso, 2), (std::vector<std::string>{"Hips"}));
@@ -245,7 +251,8 @@ std::vector<glm::vec4> world_spheres(const Crowd& crowd, const BodyParts& parts)
     glm::mat4 m = glm::translate(glm::mat4(1.0f), crowd.positions[i]);
     m = glm::rotate(m, crowd.headings[i], glm::vec3(0, 1, 0));
     m = glm::scale(m, glm::vec3(crowd.scales[i]));
-    for (const glm::vec4& t : parts.rest_spheres) out.emplace_back(glm::vec3(m * glm::vec4(glm::vec3(t), 1.0f)), t.w * crowd.scales[i]);
+    for (const glm::vec4& t : parts.rest_spheres)
+      out.emplace_back(glm::vec3(m * glm::vec4(glm::vec3(t), 1.0f)), t.w * crowd.scales[i]);
   }
   return out;
 }
@@ -256,9 +263,10 @@ struct LodOutput {
   std::vector<float> coverage;
 };
 
-LodOutput run_lod(const CameraView& view, const LodConfig& config, const std::vector<glm::vec4>* spheres, const Crowd* crowd,
-                  const BodyParts& parts) {
-  const Index n = spheres != nullptr ? static_cast<Index>(spheres->size()) / kBodyPartCount : static_cast<Index>(crowd->positions.size());
+LodOutput run_lod(const CameraView& view, const LodConfig& config, const std::vector<glm::vec4>* spheres,
+                  const Crowd* crowd, const BodyParts& parts) {
+  const Index n = spheres != nullptr ? static_cast<Index>(spheres->size()) / kBodyPartCount
+                                     : static_cast<Index>(crowd->positions.size());
   LodOutput out;
   out.levels.resize(static_cast<std::size_t>(n * kBodyPartCount));
   out.masks.resize(static_cast<std::size_t>(n * config.mask_words));
@@ -320,7 +328,8 @@ TEST(LodJob, MatchesPerCharacterDoublePrecisionReference) {
       for (std::int32_t j : config.synthesised_joints(part, got_level)) expected_joints.insert(j);
     }
     for (std::int32_t j = 0; j < s.joint_count(); ++j)
-      ASSERT_EQ(joint_synthesised(&got.masks[i], j), expected_joints.count(j) == 1) << "character " << i << " joint " << j;
+      ASSERT_EQ(joint_synthesised(&got.masks[i], j), expected_joints.count(j) == 1)
+          << "character " << i << " joint " << j;
   }
   EXPECT_LE(borderline, 2);
   for (int l = 0; l < config.level_count; ++l) EXPECT_GT(level_seen[static_cast<std::size_t>(l)], 0) << "level " << l;
@@ -398,7 +407,8 @@ TEST(LodJob, MoreLevelsAsACharacterWalksAway) {
     for (int p = 0; p < kBodyPartCount; ++p) {
       levels_seen.insert(o.levels[i * kBodyPartCount + static_cast<std::size_t>(p)]);
       if (i > 0) {
-        EXPECT_GE(o.levels[i * kBodyPartCount + static_cast<std::size_t>(p)], o.levels[(i - 1) * kBodyPartCount + static_cast<std::size_t>(p)]);
+        EXPECT_GE(o.levels[i * kBodyPartCount + static_cast<std::size_t>(p)],
+                  o.levels[(i - 1) * kBodyPartCount + static_cast<std::size_t>(p)]);
       }
     }
   }
@@ -446,7 +456,8 @@ TEST(LodHistogram, MatchesCountingByHand) {
   std::vector<Index> per_joint(static_cast<std::size_t>(s.joint_count()), 0);
   Index total = 0;
   for (std::size_t i = 0; i < crowd.positions.size(); ++i) {
-    for (int p = 0; p < kBodyPartCount; ++p) ++levels[static_cast<std::size_t>(p * config.level_count + o.levels[i * 5 + static_cast<std::size_t>(p)])];
+    for (int p = 0; p < kBodyPartCount; ++p)
+      ++levels[static_cast<std::size_t>(p * config.level_count + o.levels[i * 5 + static_cast<std::size_t>(p)])];
     int k = 0;
     for (std::int32_t j = 0; j < s.joint_count(); ++j)
       if (joint_synthesised(&o.masks[i], j)) {
@@ -477,8 +488,8 @@ TEST(LodSpheresJob, CentresFollowPosedJointsAndRadiiScale) {
   std::vector<float> scales;
   for (Index c = 0; c < n; ++c) {
     for (auto& q : local) q = random_rotation(rng);
-    motion::fk_pose(J, s.parents.data(), s.offsets.data(), local.data(), nullptr, glm::vec3(static_cast<float>(c), 1, 0),
-                    positions.data() + c * J, rotations.data() + c * J);
+    motion::fk_pose(J, s.parents.data(), s.offsets.data(), local.data(), nullptr,
+                    glm::vec3(static_cast<float>(c), 1, 0), positions.data() + c * J, rotations.data() + c * J);
     scales.push_back(1.0f + 0.01f * static_cast<float>(c));
   }
   std::vector<glm::vec4> spheres(static_cast<std::size_t>(n * kBodyPartCount));
@@ -494,7 +505,8 @@ TEST(LodSpheresJob, CentresFollowPosedJointsAndRadiiScale) {
     const glm::vec4 arm = spheres[static_cast<std::size_t>(c * 5 + 1)];
     EXPECT_EQ(glm::vec3(arm), positions[static_cast<std::size_t>(c * J + elbow)]);
     EXPECT_FLOAT_EQ(arm.w, parts.anchor(BodyPart::RightArm).radius * scales[static_cast<std::size_t>(c)]);
-    const glm::vec3 mid = 0.5f * (positions[static_cast<std::size_t>(c * J + hips)] + positions[static_cast<std::size_t>(c * J + neck)]);
+    const glm::vec3 mid =
+        0.5f * (positions[static_cast<std::size_t>(c * J + hips)] + positions[static_cast<std::size_t>(c * J + neck)]);
     EXPECT_LT(glm::length(glm::vec3(spheres[static_cast<std::size_t>(c * 5 + 2)]) - mid), 1e-5f);
   }
 }
@@ -536,10 +548,12 @@ TEST(MaskedPose, MaskedJointsAreNeverEvaluatedAndHoldTheParentFrame) {
   // The full mask is plain forward kinematics.
   const std::uint32_t all = (1u << J) - 1u;
   const MaskedPose full = synthesise_with_mask(
-      s, Span<const std::uint32_t>(&all, 1), [&](std::int32_t j) { return local[static_cast<std::size_t>(j)]; }, glm::vec3(2, 1, 0));
+      s, Span<const std::uint32_t>(&all, 1), [&](std::int32_t j) { return local[static_cast<std::size_t>(j)]; },
+      glm::vec3(2, 1, 0));
   std::vector<glm::vec3> fp(static_cast<std::size_t>(J));
   std::vector<glm::quat> fr(static_cast<std::size_t>(J));
-  motion::fk_pose(J, s.parents.data(), s.offsets.data(), local.data(), nullptr, glm::vec3(2, 1, 0), fp.data(), fr.data());
+  motion::fk_pose(J, s.parents.data(), s.offsets.data(), local.data(), nullptr, glm::vec3(2, 1, 0), fp.data(),
+                  fr.data());
   EXPECT_EQ(full.evaluated, J);
   for (std::size_t j = 0; j < fp.size(); ++j) {
     EXPECT_EQ(full.positions[j], fp[j]);

@@ -54,7 +54,8 @@ TEST(Slerp, RotationAngleIsAccurateNearZeroAndSignBlind) {
   const glm::quat b = a * glm::angleAxis(static_cast<float>(1e-4 * kPi / 180.0), glm::vec3(0, 1, 0));
   EXPECT_NEAR(rotation_angle_deg(a, b), 1e-4, 2e-5);
   EXPECT_NEAR(rotation_angle_deg(a, -a), 0.0, 1e-6);
-  EXPECT_NEAR(rotation_angle_deg(glm::quat(1, 0, 0, 0), glm::angleAxis(2.0f, glm::vec3(1, 0, 0))), 2.0 * 180.0 / kPi, 1e-3);
+  EXPECT_NEAR(rotation_angle_deg(glm::quat(1, 0, 0, 0), glm::angleAxis(2.0f, glm::vec3(1, 0, 0))), 2.0 * 180.0 / kPi,
+              1e-3);
 }
 
 CachedCycle random_cycle(std::mt19937& rng, std::int32_t frames, std::int32_t joints) {
@@ -93,11 +94,14 @@ TEST(SampleCycle, FramesAtTheirPhasesSlerpBetweenAndWrapAround) {
   std::vector<glm::quat> out(4);
   for (int f = 0; f < 10; ++f) {
     sample_cycle(c, static_cast<float>(f) / 10.0f, out.data());
-    for (int j = 0; j < 4; ++j) EXPECT_LT(rotation_angle_deg(out[static_cast<std::size_t>(j)], c.rotations[static_cast<std::size_t>(f * 4 + j)]), 1e-3);
+    for (int j = 0; j < 4; ++j)
+      EXPECT_LT(rotation_angle_deg(out[static_cast<std::size_t>(j)], c.rotations[static_cast<std::size_t>(f * 4 + j)]),
+                1e-3);
   }
   // Between frames 3 and 4, 30% of the way; between the last frame and frame 0.
-  for (const auto& [phase, f0, f1, t] : {std::tuple{0.33f, 3, 4, 0.3}, std::tuple{0.95f, 9, 0, 0.5}, std::tuple{1.33f, 3, 4, 0.3},
-                                         std::tuple{-0.67f, 3, 4, 0.3}, std::tuple{0.999999f, 9, 0, 0.99999}}) {
+  for (const auto& [phase, f0, f1, t] :
+       {std::tuple{0.33f, 3, 4, 0.3}, std::tuple{0.95f, 9, 0, 0.5}, std::tuple{1.33f, 3, 4, 0.3},
+        std::tuple{-0.67f, 3, 4, 0.3}, std::tuple{0.999999f, 9, 0, 0.99999}}) {
     sample_cycle(c, phase, out.data());
     for (int j = 0; j < 4; ++j) {
       const glm::dquat want = reference_slerp(glm::dquat(c.rotations[static_cast<std::size_t>(f0 * 4 + j)]),
@@ -304,7 +308,9 @@ TEST(MotionCache, CachedPoseIsWithinTheQuantisationErrorItReports) {
     const float w = u(rng), phase = u(rng);
     cache.sample(w, phase, synthetic_cycle, cached);
     sample_cycle(synthetic_cycle(w), phase, exact.data());
-    for (int j = 0; j < 6; ++j) worst = std::max(worst, rotation_angle_deg(cached[static_cast<std::size_t>(j)], exact[static_cast<std::size_t>(j)]));
+    for (int j = 0; j < 6; ++j)
+      worst =
+          std::max(worst, rotation_angle_deg(cached[static_cast<std::size_t>(j)], exact[static_cast<std::size_t>(j)]));
   }
   // ... and random (w, phase) stay within the grid's maximum (plus a margin for falling between grid points).
   EXPECT_LE(worst, 1.05 * e.max_deg);
@@ -316,8 +322,8 @@ TEST(MotionCache, CachedPoseIsWithinTheQuantisationErrorItReports) {
   const QuantisationError finer = measure_quantisation_error(config, synthetic_cycle, 201, 64);
   EXPECT_LT(finer.max_deg, 0.7 * e.max_deg);
   EXPECT_GT(finer.max_deg, 0.3 * e.max_deg);
-  std::printf("[ quantisation ] width 0.1: max %.3f deg, mean %.3f deg; width 0.05: max %.3f deg, mean %.3f deg\n", e.max_deg,
-              e.mean_deg, finer.max_deg, finer.mean_deg);
+  std::printf("[ quantisation ] width 0.1: max %.3f deg, mean %.3f deg; width 0.05: max %.3f deg, mean %.3f deg\n",
+              e.max_deg, e.mean_deg, finer.max_deg, finer.mean_deg);
 }
 
 TEST(MotionCache, OversizedCyclesAreServedButNotStored) {

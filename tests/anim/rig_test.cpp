@@ -23,7 +23,8 @@ namespace dj = motion::default_joint;
 
 std::set<std::string> names_of(const Rig& rig, const std::string& cluster) {
   std::set<std::string> out;
-  for (std::int32_t j : rig.clusters.joints_of(rig.clusters.find(cluster))) out.insert(rig.skeleton.names[static_cast<std::size_t>(j)]);
+  for (std::int32_t j : rig.clusters.joints_of(rig.clusters.find(cluster)))
+    out.insert(rig.skeleton.names[static_cast<std::size_t>(j)]);
   return out;
 }
 
@@ -31,8 +32,8 @@ TEST(Clusters, DefaultHumanoidSplitsIntoLowerUpperAndHead) {
   const Rig& rig = humanoid_rig();
   ASSERT_EQ(rig.clusters.count(), 3);
   EXPECT_EQ(rig.clusters.clusters[0].name, "lower");
-  EXPECT_EQ(names_of(rig, "lower"), (std::set<std::string>{"Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg",
-                                                           "RightFoot", "RightToeBase"}));
+  EXPECT_EQ(names_of(rig, "lower"), (std::set<std::string>{"Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase",
+                                                           "RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"}));
   EXPECT_EQ(names_of(rig, "head"), (std::set<std::string>{"Neck", "Head"}));
   EXPECT_EQ(names_of(rig, "upper").size(), 11u);  // spine x3, two clavicles, arms, forearms, hands
   EXPECT_EQ(rig.clusters.hook_joint[0], -1);
@@ -42,7 +43,8 @@ TEST(Clusters, DefaultHumanoidSplitsIntoLowerUpperAndHead) {
 
 TEST(Clusters, ExplicitRootsAndErrors) {
   const motion::Skeleton s = motion::default_skeleton();
-  const ClusterLayout l = make_cluster_layout(s, {{"body", {"Hips"}}, {"left_arm", {"LeftArm"}}, {"right_arm", {"RightArm"}}});
+  const ClusterLayout l =
+      make_cluster_layout(s, {{"body", {"Hips"}}, {"left_arm", {"LeftArm"}}, {"right_arm", {"RightArm"}}});
   EXPECT_EQ(l.joints_of(1), (std::vector<std::int32_t>{dj::LeftArm, dj::LeftForeArm, dj::LeftHand}));
   EXPECT_EQ(l.hook_joint[1], dj::LeftShoulder);
   auto field_of = [&](std::vector<ClusterDef> defs) {
@@ -54,7 +56,7 @@ TEST(Clusters, ExplicitRootsAndErrors) {
     return std::string("no error");
   };
   EXPECT_EQ(field_of({{"lower", {"Hips"}}, {"x", {"Nope"}}}), "clusters[1].roots[0]");
-  EXPECT_EQ(field_of({{"upper", {"Spine"}}}), "clusters");                    // root joint in no cluster
+  EXPECT_EQ(field_of({{"upper", {"Spine"}}}), "clusters");                       // root joint in no cluster
   EXPECT_EQ(field_of({{"a", {"Hips"}}, {"a", {"Spine"}}}), "clusters[1].name");  // name twice
   EXPECT_EQ(field_of({{"a", {"Hips"}}, {"b", {"Hips"}}}), "clusters[1].roots[0]");
   ClusterDef bad_hook{"b", {"Spine"}};
@@ -91,7 +93,8 @@ TEST(Mannequin, IsValidClosedAndCoversTheSkeleton) {
   // once in each direction (consistent winding).
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
   for (std::size_t t = 0; t < m.indices.size(); t += 3)
-    for (int k = 0; k < 3; ++k) ++edges[{m.indices[t + static_cast<std::size_t>(k)], m.indices[t + static_cast<std::size_t>((k + 1) % 3)]}];
+    for (int k = 0; k < 3; ++k)
+      ++edges[{m.indices[t + static_cast<std::size_t>(k)], m.indices[t + static_cast<std::size_t>((k + 1) % 3)]}];
   for (const auto& [e, n] : edges) {
     ASSERT_EQ(n, 1);
     ASSERT_EQ(edges.count({e.second, e.first}), 1u);
@@ -127,7 +130,9 @@ TEST(Mannequin, WeightsBlendSmoothlyAtJoints) {
   const glm::vec3 knee = rig.bind_positions[dj::LeftLeg];
   int shared = 0;
   for (std::size_t v = 0; v < m.positions.size(); ++v) {
-    if (glm::length(glm::vec2(m.positions[v].x - knee.x, m.positions[v].z - knee.z)) > 0.1f || std::abs(m.positions[v].y - knee.y) > 0.005f) continue;
+    if (glm::length(glm::vec2(m.positions[v].x - knee.x, m.positions[v].z - knee.z)) > 0.1f ||
+        std::abs(m.positions[v].y - knee.y) > 0.005f)
+      continue;
     float w_thigh = 0.0f, w_knee = 0.0f;
     for (int k = 0; k < 4; ++k) {
       if (m.joints[v][k] == dj::LeftUpLeg) w_thigh += m.weights[v][k];
@@ -157,7 +162,8 @@ TEST(Mannequin, OptionsAreValidated) {
 TEST(Skinning, RestPoseReproducesTheBindPose) {
   const Rig& rig = humanoid_rig();
   std::vector<Mat3x4> palette(rig.inverse_bind.size());
-  for (std::size_t j = 0; j < palette.size(); ++j) palette[j] = mat3x4_from(rig.bind_rotations[j], rig.bind_positions[j]) * rig.inverse_bind[j];
+  for (std::size_t j = 0; j < palette.size(); ++j)
+    palette[j] = mat3x4_from(rig.bind_rotations[j], rig.bind_positions[j]) * rig.inverse_bind[j];
   std::vector<glm::vec3> p(rig.mesh.positions.size()), n(p.size());
   skin_reference(rig.mesh, palette, p, n);
   for (std::size_t v = 0; v < p.size(); ++v) {
@@ -189,8 +195,10 @@ TEST(Skinning, KernelMatchesReferenceForManyCharactersOnAnyThreadCount) {
   const auto V = static_cast<std::size_t>(mesh.vertex_count());
   std::vector<glm::vec3> want(V * kChars);
   for (int c = 0; c < kChars; ++c)
-    skin_reference(mesh, std::span<const Mat3x4>(palettes).subspan(static_cast<std::size_t>(offsets[static_cast<std::size_t>(c)]), J),
-                   std::span<glm::vec3>(want).subspan(V * static_cast<std::size_t>(c), V), {});
+    skin_reference(
+        mesh,
+        std::span<const Mat3x4>(palettes).subspan(static_cast<std::size_t>(offsets[static_cast<std::size_t>(c)]), J),
+        std::span<glm::vec3>(want).subspan(V * static_cast<std::size_t>(c), V), {});
   std::vector<std::vector<glm::vec3>> results;
   for (int threads : {1, 2, 5}) {
     ScopedExecution exec(Backend::Cpu, threads);
@@ -225,7 +233,8 @@ TEST(Skinning, KernelMatchesReferenceForManyCharactersOnAnyThreadCount) {
 TEST(Rig, TooManyJointsIsAnError) {
   motion::Skeleton s;
   s.add_joint("root", -1, {0, 0, 0});
-  for (int j = 1; j <= kMaxRigJoints; ++j) s.add_joint(std::string(1, 'j').append(std::to_string(j)), j - 1, {0, 0.1f, 0});
+  for (int j = 1; j <= kMaxRigJoints; ++j)
+    s.add_joint(std::string(1, 'j').append(std::to_string(j)), j - 1, {0, 0.1f, 0});
   EXPECT_THROW(make_rig("long", s), Error);
 }
 

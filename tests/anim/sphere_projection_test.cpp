@@ -94,12 +94,14 @@ TEST(SphereProjection, AreaWithinTwoPercentOfRasterisedPixelCount) {
       for (double r : {0.25, 0.6})
         for (double range : {1.2, 3.0, 8.0, 20.0, 50.0}) {
           const glm::dvec3 c = centre_at_pixel(lens, spot.x * lens.width, spot.y * lens.height, range);
-          const ProjectedEllipse<double> e = project_sphere(c, r, lens.focal(), double(lens.width), double(lens.height));
+          const ProjectedEllipse<double> e =
+              project_sphere(c, r, lens.focal(), double(lens.width), double(lens.height));
           ASSERT_EQ(e.kind, SphereImage::Ellipse);
           if (!ellipse_inside_viewport(e, lens, 2.0) || e.area < 400.0) continue;
           const RasterStats s = rasterise(lens, c, r);
           const double rel = std::abs(e.area - s.count) / s.count;
-          EXPECT_LT(rel, 0.02) << "fov " << lens.fov_deg << " spot " << spot.x << "," << spot.y << " r " << r << " range " << range << " formula " << e.area << " raster " << s.count;
+          EXPECT_LT(rel, 0.02) << "fov " << lens.fov_deg << " spot " << spot.x << "," << spot.y << " r " << r
+                               << " range " << range << " formula " << e.area << " raster " << s.count;
           const int b = e.area < 2000 ? 0 : (e.area < 10000 ? 1 : 2);
           worst[b] = std::max(worst[b], rel);
           sum[b] += rel;
@@ -140,7 +142,8 @@ TEST(SphereProjection, SupersampledRasterConvergesToTheFormula) {
 TEST(SphereProjection, EllipseCentreAxesAndAngleMatchRasterMoments) {
   const Lens lens{70, 800, 600};
   int tested = 0;
-  for (const glm::dvec2& spot : {glm::dvec2(0.5, 0.5), glm::dvec2(0.8, 0.25), glm::dvec2(0.2, 0.8), glm::dvec2(0.85, 0.85)})
+  for (const glm::dvec2& spot :
+       {glm::dvec2(0.5, 0.5), glm::dvec2(0.8, 0.25), glm::dvec2(0.2, 0.8), glm::dvec2(0.85, 0.85)})
     for (double range : {3.0, 12.0}) {
       const double r = 0.08 * range;
       const glm::dvec3 c = centre_at_pixel(lens, spot.x * lens.width, spot.y * lens.height, range);
@@ -166,7 +169,8 @@ TEST(SphereProjection, EllipseCentreAxesAndAngleMatchRasterMoments) {
 TEST(SphereProjection, OutlineRaysAreTangentToTheSphere) {
   const Lens lens{60, 1000, 1000};
   const double f = lens.focal();
-  for (const glm::dvec3 c : {glm::dvec3(0.3, -0.2, -4.0), glm::dvec3(2.5, 1.7, -3.0), glm::dvec3(0, 0, -9), glm::dvec3(-7, 4, -5)})
+  for (const glm::dvec3 c :
+       {glm::dvec3(0.3, -0.2, -4.0), glm::dvec3(2.5, 1.7, -3.0), glm::dvec3(0, 0, -9), glm::dvec3(-7, 4, -5)})
     for (double r : {0.2, 1.0, 2.5}) {
       const auto e = project_sphere(c, r, f, 1000.0, 1000.0);
       ASSERT_EQ(e.kind, SphereImage::Ellipse);
@@ -229,10 +233,10 @@ TEST(SphereProjection, CoverageClampsToScreenAndCullsOutsideTheFrustum) {
   cam.fov_y = 1.0f;
   const CameraView v = make_camera_view(cam);
   const float screen = 640.0f * 480.0f;
-  EXPECT_EQ(sphere_pixel_coverage({0, 0, -0.2f}, 1.0f, v, true), screen);   // inside
-  EXPECT_EQ(sphere_pixel_coverage({0.5f, 0, 0.2f}, 1.0f, v, true), screen); // crossing the camera plane
-  EXPECT_EQ(sphere_pixel_coverage({0, 0, 5.0f}, 1.0f, v, true), 0.0f);      // behind
-  EXPECT_EQ(sphere_pixel_coverage({0, 0, -1.05f}, 1.0f, v, true), screen);  // huge ellipse, clamped
+  EXPECT_EQ(sphere_pixel_coverage({0, 0, -0.2f}, 1.0f, v, true), screen);    // inside
+  EXPECT_EQ(sphere_pixel_coverage({0.5f, 0, 0.2f}, 1.0f, v, true), screen);  // crossing the camera plane
+  EXPECT_EQ(sphere_pixel_coverage({0, 0, 5.0f}, 1.0f, v, true), 0.0f);       // behind
+  EXPECT_EQ(sphere_pixel_coverage({0, 0, -1.05f}, 1.0f, v, true), screen);   // huge ellipse, clamped
   const float a = sphere_pixel_coverage({0, 0, -20.0f}, 0.5f, v, true);
   EXPECT_FLOAT_EQ(a, sphere_ellipse_area(glm::vec3(0, 0, -20.0f), 0.5f, v.focal_px));
   // Far to the right of the view: visible only without culling.

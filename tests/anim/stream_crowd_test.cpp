@@ -73,7 +73,9 @@ AgentPose expected_pose(const StreamCrowd& crowd, Index agent) {
     const Pose to = source_pose(crowd, rig, ref.source, ref.offset);
     glm::dquat q(to.local[j]);
     glm::dvec3 root(to.root);
-    const double alpha = ref.blend_frames > 0.0f ? std::clamp((crowd.frame() - ref.t0) / static_cast<double>(ref.blend_frames), 0.0, 1.0) : 1.0;
+    const double alpha = ref.blend_frames > 0.0f
+                             ? std::clamp((crowd.frame() - ref.t0) / static_cast<double>(ref.blend_frames), 0.0, 1.0)
+                             : 1.0;
     if (alpha < 1.0) {
       const Pose from = source_pose(crowd, rig, ref.from_source, ref.from_offset);
       q = sine_slerp(glm::dquat(from.local[j]), q, alpha);
@@ -92,7 +94,8 @@ double max_palette_error(const StreamCrowd& crowd, const std::vector<Mat3x4>& pa
                                      w.yaws[static_cast<std::size_t>(agent)]);
   const Index base = crowd.palette_offsets()[agent];
   double e = 0.0;
-  for (std::size_t j = 0; j < ref.size(); ++j) e = std::max(e, palette_error(palettes[static_cast<std::size_t>(base) + j], ref[j]));
+  for (std::size_t j = 0; j < ref.size(); ++j)
+    e = std::max(e, palette_error(palettes[static_cast<std::size_t>(base) + j], ref[j]));
   return e;
 }
 
@@ -107,9 +110,12 @@ struct MixedCrowd {
     const int Jh = crowd.rig(human).joint_count(), Jf = crowd.rig(fingered).joint_count();
     auto& pool = crowd.streams();
     walk = pool.add(crowd.rig(human), human, spec_of("walk", 64), std::make_unique<ClipPlayer>(default_clip("walk")));
-    wave = pool.add(crowd.rig(human), human, spec_of("wave", 32), std::make_unique<ClipPlayer>(wiggle_clip(Jh, 45, kDt)));
-    f_walk = pool.add(crowd.rig(fingered), fingered, spec_of("f_walk", 64), std::make_unique<ClipPlayer>(wiggle_clip(Jf, 50, kDt)));
-    f_idle = pool.add(crowd.rig(fingered), fingered, spec_of("f_idle", 16), std::make_unique<ClipPlayer>(wiggle_clip(Jf, 70, kDt, "idle"), 0.5f));
+    wave =
+        pool.add(crowd.rig(human), human, spec_of("wave", 32), std::make_unique<ClipPlayer>(wiggle_clip(Jh, 45, kDt)));
+    f_walk = pool.add(crowd.rig(fingered), fingered, spec_of("f_walk", 64),
+                      std::make_unique<ClipPlayer>(wiggle_clip(Jf, 50, kDt)));
+    f_idle = pool.add(crowd.rig(fingered), fingered, spec_of("f_idle", 16),
+                      std::make_unique<ClipPlayer>(wiggle_clip(Jf, 70, kDt, "idle"), 0.5f));
     crowd.add_agents(human, 60);
     crowd.add_agents(fingered, 40);
     crowd.assign_random(0, 60, {{{walk}, {walk, wave}, {walk, wave}}, true}, 11);
@@ -124,7 +130,8 @@ TEST(StreamCrowd, MixedSkeletonsAnimateAndPoseMemoryIsTheSumOfStreams) {
   std::size_t want = 0;
   for (std::int32_t s = 0; s < crowd.streams().size(); ++s) {
     const AnimStream& st = crowd.streams()[s];
-    want += static_cast<std::size_t>(st.history()) * (static_cast<std::size_t>(crowd.rig(st.rig()).joint_count()) * 64u + 12u);
+    want += static_cast<std::size_t>(st.history()) *
+            (static_cast<std::size_t>(crowd.rig(st.rig()).joint_count()) * 64u + 12u);
   }
   EXPECT_EQ(crowd.memory().stream_poses, want);
   EXPECT_EQ(want, 64u * (22 * 64 + 12) + 32u * (22 * 64 + 12) + 64u * (28 * 64 + 12) + 16u * (28 * 64 + 12));
@@ -164,7 +171,8 @@ TEST(StreamCrowd, AgentsNeverReadAHistorySlotThatWasNotWritten) {
   StreamCrowd crowd({kFps, 3});
   const int h = crowd.add_rig(humanoid_rig());
   const int J = crowd.rig(h).joint_count();
-  const auto a = crowd.streams().add(crowd.rig(h), h, spec_of("a", 64, 3.0f), std::make_unique<ClipPlayer>(wiggle_clip(J, 40, kDt)));
+  const auto a = crowd.streams().add(crowd.rig(h), h, spec_of("a", 64, 3.0f),
+                                     std::make_unique<ClipPlayer>(wiggle_clip(J, 40, kDt)));
   StreamSpec later = spec_of("b", 48, 2.0f);
   later.running = false;
   const auto b = crowd.streams().add(crowd.rig(h), h, later, std::make_unique<ClipPlayer>(wiggle_clip(J, 30, kDt)));
@@ -243,7 +251,8 @@ TEST(StreamCrowd, EventsReachEachAgentDelayedByItsOffset) {
   const int h = crowd.add_rig(humanoid_rig());
   const int J = crowd.rig(h).joint_count();
   EventNames& names = crowd.event_names();
-  const auto left = names.intern("footstep_left"), right = names.intern("footstep_right"), wave_start = names.intern("wave_start");
+  const auto left = names.intern("footstep_left"), right = names.intern("footstep_right"),
+             wave_start = names.intern("wave_start");
   AnimClip walk = wiggle_clip(J, 30, kDt, "walk");  // 1 s loop
   walk.events = {{0.25f, left}, {0.75f, right}};
   AnimClip wave = wiggle_clip(J, 21, kDt, "wave");
@@ -261,8 +270,8 @@ TEST(StreamCrowd, EventsReachEachAgentDelayedByItsOffset) {
   crowd.assign(0, 3, 0, stream, 0);
   crowd.assign(0, 3, 1, stream, 0);
   crowd.assign(0, 3, 2, stream, 0);
-  crowd.assign(1, 1, 0, stream, 5);   // agent 1's legs lag 5 frames
-  crowd.assign(2, 1, 0, stream, 12);  // agent 2's legs 12
+  crowd.assign(1, 1, 0, stream, 5);                         // agent 1's legs lag 5 frames
+  crowd.assign(2, 1, 0, stream, 12);                        // agent 2's legs 12
   crowd.set_event_filter(0, (1u << left) | (1u << right));  // footsteps from the legs,
   crowd.set_event_filter(1, 1u << wave_start);              // waves from the upper body,
   crowd.set_event_filter(2, 0u);                            // nothing from the head
@@ -280,7 +289,9 @@ TEST(StreamCrowd, EventsReachEachAgentDelayedByItsOffset) {
   }
   // The stream: steps while walking, one wave_start.
   ASSERT_GE(at_stream.size(), 5u);
-  EXPECT_EQ(std::count_if(at_stream.begin(), at_stream.end(), [&](const auto& e) { return (e.second >> wave_start) & 1u; }), 1);
+  EXPECT_EQ(
+      std::count_if(at_stream.begin(), at_stream.end(), [&](const auto& e) { return (e.second >> wave_start) & 1u; }),
+      1);
   // Agent 0 (offset 0) gets exactly the stream's events on the same frames.
   EXPECT_EQ(got[0], at_stream);
   // Agents 1 and 2 get footsteps (from their legs) 5 and 12 frames later and
@@ -332,10 +343,13 @@ TEST(StreamCrowd, BoneOverridesReplaceRotationsAndAimLookAt) {
   const Rig& rig = crowd.rig(0);
   AgentPose p = expected_pose(crowd, a);
   p.local[dj::LeftForeArm] = glm::dquat(rot.rotation);
-  const auto ref = reference_palette(rig, p.local, p.root, glm::dvec3(w.positions[static_cast<std::size_t>(a)]), w.yaws[static_cast<std::size_t>(a)]);
+  const auto ref = reference_palette(rig, p.local, p.root, glm::dvec3(w.positions[static_cast<std::size_t>(a)]),
+                                     w.yaws[static_cast<std::size_t>(a)]);
   const Index base_a = crowd.palette_offsets()[a];
-  for (std::size_t j = 0; j < ref.size(); ++j) EXPECT_LT(palette_error(over[static_cast<std::size_t>(base_a) + j], ref[j]), 2e-4) << j;
-  EXPECT_GT(palette_error(plain[static_cast<std::size_t>(base_a) + dj::LeftHand], ref[dj::LeftHand]), 1e-2);  // it did change
+  for (std::size_t j = 0; j < ref.size(); ++j)
+    EXPECT_LT(palette_error(over[static_cast<std::size_t>(base_a) + j], ref[j]), 2e-4) << j;
+  EXPECT_GT(palette_error(plain[static_cast<std::size_t>(base_a) + dj::LeftHand], ref[dj::LeftHand]),
+            1e-2);  // it did change
 
   // Agent b: the head's forward axis points at the target; its parents did not move.
   const Index base_b = crowd.palette_offsets()[b];
@@ -354,15 +368,19 @@ TEST(StreamCrowd, BoneOverridesReplaceRotationsAndAimLookAt) {
   look.max_angle = 0.1f;
   crowd.set_override(b, look);
   crowd.resolve(w.positions, w.yaws, over);
-  const glm::vec3 f0 = glm::normalize(transform_vector(plain[static_cast<std::size_t>(base_b) + dj::Head], glm::vec3(0, 0, 1)));
-  const glm::vec3 f1 = glm::normalize(transform_vector(over[static_cast<std::size_t>(base_b) + dj::Head], glm::vec3(0, 0, 1)));
+  const glm::vec3 f0 =
+      glm::normalize(transform_vector(plain[static_cast<std::size_t>(base_b) + dj::Head], glm::vec3(0, 0, 1)));
+  const glm::vec3 f1 =
+      glm::normalize(transform_vector(over[static_cast<std::size_t>(base_b) + dj::Head], glm::vec3(0, 0, 1)));
   EXPECT_NEAR(std::acos(std::min(1.0f, glm::dot(f0, f1))), 0.1f, 2e-3f);
   // Cleared: back to the history.
   crowd.clear_overrides(a);
   crowd.clear_override(b, dj::Head);
   crowd.resolve(w.positions, w.yaws, over);
-  EXPECT_EQ(over[static_cast<std::size_t>(base_b) + dj::Head].r0, plain[static_cast<std::size_t>(base_b) + dj::Head].r0);
-  EXPECT_EQ(over[static_cast<std::size_t>(base_a) + dj::LeftHand].r1, plain[static_cast<std::size_t>(base_a) + dj::LeftHand].r1);
+  EXPECT_EQ(over[static_cast<std::size_t>(base_b) + dj::Head].r0,
+            plain[static_cast<std::size_t>(base_b) + dj::Head].r0);
+  EXPECT_EQ(over[static_cast<std::size_t>(base_a) + dj::LeftHand].r1,
+            plain[static_cast<std::size_t>(base_a) + dj::LeftHand].r1);
   BoneOverride bad;
   bad.joint = 40;
   EXPECT_THROW(crowd.set_override(a, bad), Error);
@@ -379,8 +397,10 @@ TEST(StreamCrowd, HookTransformsOnTheFastAndTheBlendingPath) {
   defs[2].hook_rotation = glm::angleAxis(-0.4f, glm::vec3(1.0f, 0.0f, 0.0f));
   const int h = crowd.add_rig(make_rig("tilted", motion::default_skeleton(), defs));
   const int J = crowd.rig(h).joint_count();
-  const auto a = crowd.streams().add(crowd.rig(h), h, spec_of("a", 16), std::make_unique<ClipPlayer>(wiggle_clip(J, 40, kDt)));
-  const auto b = crowd.streams().add(crowd.rig(h), h, spec_of("b", 16), std::make_unique<ClipPlayer>(default_clip("run_slow")));
+  const auto a =
+      crowd.streams().add(crowd.rig(h), h, spec_of("a", 16), std::make_unique<ClipPlayer>(wiggle_clip(J, 40, kDt)));
+  const auto b =
+      crowd.streams().add(crowd.rig(h), h, spec_of("b", 16), std::make_unique<ClipPlayer>(default_clip("run_slow")));
   crowd.add_agents(h, 40);
   crowd.assign_random(0, 40, {{{a, b}, {a, b}, {a, b}}, false}, 4);
   const World w(crowd.agent_count());
@@ -409,7 +429,9 @@ TEST(StreamCrowd, MannequinsAtRestPoseSkinToTheirBindPose) {
     const Rig& rig = crowd.rig(crowd.agent_rig(a));
     const auto J = static_cast<std::size_t>(rig.joint_count());
     std::vector<glm::vec3> p(rig.mesh.positions.size()), n(p.size());
-    skin_reference(rig.mesh, std::span<const Mat3x4>(palettes).subspan(static_cast<std::size_t>(crowd.palette_offsets()[a]), J), p, n);
+    skin_reference(rig.mesh,
+                   std::span<const Mat3x4>(palettes).subspan(static_cast<std::size_t>(crowd.palette_offsets()[a]), J),
+                   p, n);
     for (std::size_t v = 0; v < p.size(); ++v) {
       ASSERT_LT(glm::length(p[v] - rig.mesh.positions[v]), 1e-5f) << a << " " << v;
       ASSERT_LT(glm::length(n[v] - rig.mesh.normals[v]), 1e-5f) << a << " " << v;
@@ -426,7 +448,8 @@ TEST(StreamCrowd, CulledClusterCollapsesOntoItsHook) {
   crowd.resolve({}, {}, palettes);
   const Rig& rig = crowd.rig(0);
   const Index base = crowd.palette_offsets()[2];
-  const glm::vec3 hook = transform_point(palettes[static_cast<std::size_t>(base) + dj::Spine2], rig.bind_positions[dj::Spine2]);
+  const glm::vec3 hook =
+      transform_point(palettes[static_cast<std::size_t>(base) + dj::Spine2], rig.bind_positions[dj::Spine2]);
   for (int j : {static_cast<int>(dj::Neck), static_cast<int>(dj::Head)})
     for (const glm::vec3& v : {glm::vec3(0.0f), glm::vec3(1.0f, 2.0f, 3.0f)})
       EXPECT_LT(glm::length(transform_point(palettes[static_cast<std::size_t>(base + j)], v) - hook), 1e-6f);
@@ -443,12 +466,13 @@ TEST(StreamCrowd, UniqueAnimationsPlayPerAgentAndHandBack) {
   crowd.uniques().set_capacity(rig, m.human, 2);
   AnimClip bow = wiggle_clip(rig.joint_count(), 31, kDt, "bow");  // one second, one-shot
   bow.loop = false;
-  const auto anim = crowd.uniques().add_animation({"bow", m.human, std::make_unique<ClipPlayer>(bow), RootMotion::InPlace});
+  const auto anim =
+      crowd.uniques().add_animation({"bow", m.human, std::make_unique<ClipPlayer>(bow), RootMotion::InPlace});
   std::vector<Mat3x4> palettes(static_cast<std::size_t>(crowd.palette_size()));
   for (int f = 0; f < 10; ++f) crowd.step();
   // Agent 1 bows with its whole body (one instance for its three clusters), then walks.
   for (int c = 0; c < 3; ++c) crowd.transition_to_unique(1, c, anim, 0.2f, m.walk, 0.3f);
-  crowd.transition_to_unique(2, 1, anim, 0.2f);  // agent 2 bows with its upper body and stays
+  crowd.transition_to_unique(2, 1, anim, 0.2f);                       // agent 2 bows with its upper body and stays
   EXPECT_THROW(crowd.transition_to_unique(4, 1, anim, 0.2f), Error);  // capacity 2
   crowd.step();
   EXPECT_EQ(crowd.uniques().active_count(), 2);
@@ -490,19 +514,21 @@ TEST(StreamCrowd, RetargetSetsTransitionsOffsetsAndRestLikeTheOneByOneCalls) {
   const World w(crowd.agent_count());
   const Rig& rig = crowd.rig(m.human);
   crowd.uniques().set_capacity(rig, m.human, 1);
-  const auto anim = crowd.uniques().add_animation({"bow", m.human, std::make_unique<ClipPlayer>(wiggle_clip(rig.joint_count(), 31, kDt, "bow")),
-                                                   RootMotion::InPlace});
+  const auto anim = crowd.uniques().add_animation(
+      {"bow", m.human, std::make_unique<ClipPlayer>(wiggle_clip(rig.joint_count(), 31, kDt, "bow")),
+       RootMotion::InPlace});
   for (int f = 0; f < 70; ++f) crowd.step();
   crowd.transition_to_unique(5, 2, anim, 0.0f);
   crowd.step();
   const Index n = crowd.agent_count();
-  std::vector<std::int32_t> sources(static_cast<std::size_t>(n), -5), offsets(static_cast<std::size_t>(n), 0);  // < -1: left alone
+  std::vector<std::int32_t> sources(static_cast<std::size_t>(n), -5),
+      offsets(static_cast<std::size_t>(n), 0);  // < -1: left alone
   std::vector<std::vector<ClusterRef>> before;
   for (Index a = 0; a < n; ++a) before.push_back(crowd.clusters_of(a));
   sources[0] = m.wave;  // another stream: blended in
   offsets[0] = 7;
-  sources[1] = m.walk;  // clusters already on walk take the offset, the others blend in
-  offsets[1] = 1000;    // clamped to the history
+  sources[1] = m.walk;     // clusters already on walk take the offset, the others blend in
+  offsets[1] = 1000;       // clamped to the history
   sources[2] = kNoSource;  // rest pose at once
   sources[3] = m.f_walk;   // another rig's stream: ignored
   sources[4] = 99;         // no such stream: ignored
@@ -527,7 +553,8 @@ TEST(StreamCrowd, RetargetSetsTransitionsOffsetsAndRestLikeTheOneByOneCalls) {
         EXPECT_EQ(after[c].from_source, old[c].from_source) << a << " " << c;
         continue;
       }
-      const std::int32_t want_offset = s < 0 ? 0 : std::min(offsets[static_cast<std::size_t>(a)], crowd.streams()[s].history() - 1);
+      const std::int32_t want_offset =
+          s < 0 ? 0 : std::min(offsets[static_cast<std::size_t>(a)], crowd.streams()[s].history() - 1);
       EXPECT_EQ(after[c].source, s) << a << " " << c;
       EXPECT_EQ(after[c].offset, want_offset) << a << " " << c;
       if (old[c].source == s) {

@@ -87,7 +87,8 @@ TEST(StreamHistory, RingHoldsTheLastMPosesNewestFirst) {
     const SourceView v = s.view();
     const Pose head = s.pose_at(0);
     const auto ref = reference_palette(rig, to_double(head.local), glm::dvec3(head.root), glm::dvec3(0.0), 0.0);
-    for (int j = 0; j < rig.joint_count(); ++j) ASSERT_LT(palette_error(v.skinning[v.head * rig.joint_count() + j], ref[static_cast<std::size_t>(j)]), 1e-5);
+    for (int j = 0; j < rig.joint_count(); ++j)
+      ASSERT_LT(palette_error(v.skinning[v.head * rig.joint_count() + j], ref[static_cast<std::size_t>(j)]), 1e-5);
   }
   EXPECT_EQ(s.head(), 19 % 8);
 }
@@ -105,10 +106,14 @@ TEST(StreamHistory, PoseMemoryIsTheSumOfStreamSizesWithoutPadding) {
     spec.name = std::string(1, 's').append(std::to_string(i));
     spec.history = streams[i].second;
     const int J = streams[i].first->joint_count();
-    pool.add(*streams[i].first, streams[i].first == &human ? 0 : 1, spec, std::make_unique<ClipPlayer>(wiggle_clip(J, 10, kDt)));
-    want += static_cast<std::size_t>(streams[i].second) * (static_cast<std::size_t>(J) * (sizeof(glm::quat) + sizeof(Mat3x4)) + sizeof(glm::vec3));
-    padded += static_cast<std::size_t>(streams[i].second) * (28u * (sizeof(glm::quat) + sizeof(Mat3x4)) + sizeof(glm::vec3));
-    EXPECT_EQ(pool[static_cast<std::int32_t>(i)].pose_bytes(), static_cast<std::size_t>(streams[i].second) * (J * 64u + 12u));
+    pool.add(*streams[i].first, streams[i].first == &human ? 0 : 1, spec,
+             std::make_unique<ClipPlayer>(wiggle_clip(J, 10, kDt)));
+    want += static_cast<std::size_t>(streams[i].second) *
+            (static_cast<std::size_t>(J) * (sizeof(glm::quat) + sizeof(Mat3x4)) + sizeof(glm::vec3));
+    padded +=
+        static_cast<std::size_t>(streams[i].second) * (28u * (sizeof(glm::quat) + sizeof(Mat3x4)) + sizeof(glm::vec3));
+    EXPECT_EQ(pool[static_cast<std::int32_t>(i)].pose_bytes(),
+              static_cast<std::size_t>(streams[i].second) * (J * 64u + 12u));
   }
   EXPECT_EQ(pool.pose_bytes(), want);
   EXPECT_LT(pool.pose_bytes(), padded);
@@ -223,9 +228,12 @@ TEST(UniquePool, InstancesAreAllocatedPerRigUpToCapacity) {
   pool.set_capacity(human, 0, 2);
   pool.set_capacity(fingered, 1, 1);
   EXPECT_EQ(pool.pose_bytes(), 2u * (22u * 64u + 12u) + 1u * (28u * 64u + 12u));
-  const std::int32_t wave = pool.add_animation({"wave", 0, std::make_unique<ClipPlayer>(counting_clip(22, 50)), RootMotion::Keep});
-  const std::int32_t bow = pool.add_animation({"bow", 1, std::make_unique<ClipPlayer>(wiggle_clip(28, 50, kDt)), RootMotion::Keep});
-  EXPECT_THROW(pool.add_animation({"bad", 1, std::make_unique<ClipPlayer>(wiggle_clip(22, 5, kDt)), RootMotion::Keep}), Error);
+  const std::int32_t wave =
+      pool.add_animation({"wave", 0, std::make_unique<ClipPlayer>(counting_clip(22, 50)), RootMotion::Keep});
+  const std::int32_t bow =
+      pool.add_animation({"bow", 1, std::make_unique<ClipPlayer>(wiggle_clip(28, 50, kDt)), RootMotion::Keep});
+  EXPECT_THROW(pool.add_animation({"bad", 1, std::make_unique<ClipPlayer>(wiggle_clip(22, 5, kDt)), RootMotion::Keep}),
+               Error);
   const std::int32_t a = pool.acquire(wave);
   pool.step(0);
   pool.step(1);

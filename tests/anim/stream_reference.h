@@ -35,13 +35,15 @@ inline glm::dquat sine_slerp(glm::dquat q0, glm::dquat q1, double t) {
   return q0 * (std::sin((1.0 - t) * w) / s) + q1 * (std::sin(t * w) / s);
 }
 
-inline glm::dmat4 rigid(const glm::dquat& q, const glm::dvec3& t) { return glm::translate(glm::dmat4(1.0), t) * glm::mat4_cast(q); }
+inline glm::dmat4 rigid(const glm::dquat& q, const glm::dvec3& t) {
+  return glm::translate(glm::dmat4(1.0), t) * glm::mat4_cast(q);
+}
 
 // Model matrices of every joint: M_j = M_parent * H * T(offset_j) * R(local_j),
 // H the hook of j's cluster when j's parent is in another cluster; the root
 // at T(world) R(yaw) T(root) R(local_0).
-inline std::vector<glm::dmat4> reference_model(const Rig& rig, const std::vector<glm::dquat>& local, glm::dvec3 root, glm::dvec3 world_pos,
-                                               double yaw) {
+inline std::vector<glm::dmat4> reference_model(const Rig& rig, const std::vector<glm::dquat>& local, glm::dvec3 root,
+                                               glm::dvec3 world_pos, double yaw) {
   const auto& s = rig.skeleton;
   const std::size_t J = s.parents.size();
   std::vector<glm::dmat4> M(J);
@@ -75,8 +77,8 @@ inline std::vector<glm::dmat4> reference_bind(const Rig& rig) {
   return B;
 }
 
-inline std::vector<glm::dmat4> reference_palette(const Rig& rig, const std::vector<glm::dquat>& local, glm::dvec3 root, glm::dvec3 world_pos,
-                                                 double yaw) {
+inline std::vector<glm::dmat4> reference_palette(const Rig& rig, const std::vector<glm::dquat>& local, glm::dvec3 root,
+                                                 glm::dvec3 world_pos, double yaw) {
   std::vector<glm::dmat4> M = reference_model(rig, local, root, world_pos, yaw);
   const std::vector<glm::dmat4> B = reference_bind(rig);
   for (std::size_t j = 0; j < M.size(); ++j) M[j] = M[j] * glm::inverse(B[j]);
@@ -92,7 +94,9 @@ inline double palette_error(const Mat3x4& m, const glm::dmat4& ref) {
   return e;
 }
 
-inline std::vector<glm::dquat> to_double(const std::vector<glm::quat>& q) { return std::vector<glm::dquat>(q.begin(), q.end()); }
+inline std::vector<glm::dquat> to_double(const std::vector<glm::quat>& q) {
+  return std::vector<glm::dquat>(q.begin(), q.end());
+}
 
 // The default humanoid rig and its "walk" clip (one stride at 60 fps).
 inline const Rig& humanoid_rig() {
@@ -105,7 +109,8 @@ inline AnimClip default_clip(const std::string& name, bool loop = true) {
     if (spec.name == name) {
       AnimClip c;
       c.name = name;
-      c.clip = std::make_shared<motion::Clip>(motion::LocomotionGenerator(motion::default_skeleton(), spec).make_clip());
+      c.clip =
+          std::make_shared<motion::Clip>(motion::LocomotionGenerator(motion::default_skeleton(), spec).make_clip());
       c.loop = loop;
       return c;
     }
@@ -120,7 +125,8 @@ inline motion::Skeleton fingered_skeleton() {
   for (const char* hand : {"LeftHand", "RightHand"}) {
     const float x = hand[0] == 'L' ? 1.0f : -1.0f;
     int parent = s.find(hand);
-    for (int k = 0; k < 3; ++k) parent = s.add_joint(std::string(hand) + "Finger" + std::to_string(k), parent, glm::vec3(0.05f * x, 0.0f, 0.0f));
+    for (int k = 0; k < 3; ++k)
+      parent = s.add_joint(std::string(hand) + "Finger" + std::to_string(k), parent, glm::vec3(0.05f * x, 0.0f, 0.0f));
   }
   return s;
 }
@@ -128,7 +134,8 @@ inline motion::Skeleton fingered_skeleton() {
 // A random-looking but deterministic rotation per (joint, frame).
 inline glm::quat wiggle(int joint, int frame, float amount = 0.4f) {
   const float a = amount * std::sin(0.37f * static_cast<float>(frame) + 1.3f * static_cast<float>(joint));
-  const glm::vec3 axis = glm::normalize(glm::vec3(std::sin(static_cast<float>(joint)), 1.0f, std::cos(2.0f * static_cast<float>(joint))));
+  const glm::vec3 axis =
+      glm::normalize(glm::vec3(std::sin(static_cast<float>(joint)), 1.0f, std::cos(2.0f * static_cast<float>(joint))));
   return glm::angleAxis(a, axis);
 }
 

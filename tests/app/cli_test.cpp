@@ -59,9 +59,11 @@ TEST(Cli, BadArgumentsGiveOneLineErrorAndNonZeroExit) {
     const char* args;
     const char* names;
   };
-  for (const Case& c : {Case{"frobnicate", "unknown command 'frobnicate'"}, Case{"--backend gpu info", "--backend: gpu not in {auto,cpu,cuda}"},
-                        Case{"--threads -3 info", "--threads: must be at least 0, got -3"},
-                        Case{"bench --no-such-flag", "not expected: --no-such-flag"}, Case{"", "A subcommand is required"}}) {
+  for (const Case& c :
+       {Case{"frobnicate", "unknown command 'frobnicate'"},
+        Case{"--backend gpu info", "--backend: gpu not in {auto,cpu,cuda}"},
+        Case{"--threads -3 info", "--threads: must be at least 0, got -3"},
+        Case{"bench --no-such-flag", "not expected: --no-such-flag"}, Case{"", "A subcommand is required"}}) {
     const auto r = run(c.args);
     EXPECT_NE(r.code, 0) << c.args;
     EXPECT_EQ(r.code, 2) << "'" << c.args << "' printed:\n" << r.out;
@@ -229,7 +231,8 @@ TEST(Cli, GlobalOptionsBeforeOrAfterTheCommand) {
 
 TEST(Cli, RunWithThreadsAfterTheScenario) {
   const auto dir = fresh_dir("throng_cli_run_threads_after");
-  const Streams r = run_split("run circle --threads 1 --agents 100 --seconds 5 --backend cpu --quiet --no-trajectories --out " + dir.string());
+  const Streams r = run_split(
+      "run circle --threads 1 --agents 100 --seconds 5 --backend cpu --quiet --no-trajectories --out " + dir.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("circle: 100 agents, 50 steps (5.0 s simulated)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(", cpu x1\n"), std::string::npos) << r.out;
@@ -251,14 +254,20 @@ TEST(Cli, UnknownCommandSuggestsTheClosest) {
   Streams r = run_split("rnu");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.out, "");
-  EXPECT_EQ(r.err.rfind("throng: error: unknown command 'rnu' (did you mean 'run'?); the commands are run, animate, bench, info, ", 0), 0u)
+  EXPECT_EQ(
+      r.err.rfind(
+          "throng: error: unknown command 'rnu' (did you mean 'run'?); the commands are run, animate, bench, info, ",
+          0),
+      0u)
       << r.err;
-  for (const char* name : {"convert", "export-default", "match", "view", "version"}) EXPECT_NE(r.err.find(name), std::string::npos) << r.err;
+  for (const char* name : {"convert", "export-default", "match", "view", "version"})
+    EXPECT_NE(r.err.find(name), std::string::npos) << r.err;
   EXPECT_EQ(lines(r.err), 1u) << r.err;
   // An option's value is not taken for the command.
   r = run_split("--threads 2 inf");
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err.rfind("throng: error: unknown command 'inf' (did you mean 'info'?); the commands are ", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.rfind("throng: error: unknown command 'inf' (did you mean 'info'?); the commands are ", 0), 0u)
+      << r.err;
   // Nothing close: no suggestion.
   r = run_split("bogus");
   EXPECT_EQ(r.code, 2);
@@ -305,8 +314,8 @@ TEST(Cli, RangeErrorsNameTheFlagInPlainNumbers) {
 }
 
 TEST(Cli, RenderOptionsNeedRender) {
-  for (const char* option : {"--render-mode joints", "--width 320", "--height 200", "--fps 12", "--render-speed 2", "--render-seconds 1",
-                             "--camera orbit", "--camera-period 10"}) {
+  for (const char* option : {"--render-mode joints", "--width 320", "--height 200", "--fps 12", "--render-speed 2",
+                             "--render-seconds 1", "--camera orbit", "--camera-period 10"}) {
     const std::string flag = std::string(option).substr(0, std::string(option).find(' '));
     const Streams r = run_split(std::string("run circle --seconds 1 --quiet ") + option);
     EXPECT_EQ(r.code, 1) << option;
@@ -335,7 +344,8 @@ TEST(Cli, LodThresholdErrorsNameTheFlag) {
     const char* message;
   };
   const Case cases[] = {
-      {"--lod-thresholds 30,1000", "--lod-thresholds: thresholds must decrease (finest level first, e.g. 1000,30), got 1000 after 30"},
+      {"--lod-thresholds 30,1000",
+       "--lod-thresholds: thresholds must decrease (finest level first, e.g. 1000,30), got 1000 after 30"},
       {"--lod-thresholds 1000,0", "--lod-thresholds: thresholds must be positive square pixels, got 0"},
       {sixteen, "--lod-thresholds: at most 15 thresholds, got 16"},
   };
@@ -354,17 +364,22 @@ TEST(Cli, LodThresholdErrorsNameTheFlag) {
 TEST(Cli, TrajectoryFormatErrorsNameTheFlagOrTheKey) {
   Streams r = run_split("run circle --agents 5 --steps 1 --quiet --trajectory-format parquet");
   EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(r.err, "throng: error: --trajectory-format: unknown trajectory format 'parquet': expected csv, pedpy or sqlite\n");
+  EXPECT_EQ(r.err,
+            "throng: error: --trajectory-format: unknown trajectory format 'parquet': expected csv, pedpy or sqlite\n");
   r = run_split("run circle --agents 5 --steps 1 --quiet --trajectory-format PedPy");
-  EXPECT_EQ(r.err, "throng: error: --trajectory-format: unknown trajectory format 'PedPy': expected csv, pedpy or sqlite (did you mean 'pedpy'?)\n");
+  EXPECT_EQ(r.err,
+            "throng: error: --trajectory-format: unknown trajectory format 'PedPy': expected csv, pedpy or sqlite (did "
+            "you mean 'pedpy'?)\n");
   const std::filesystem::path yaml = std::filesystem::temp_directory_path() / "throng_cli_bad_format.yaml";
-  std::ofstream(yaml) << "groups:\n  - count: 2\n    spawn: {rect: {min: [0, 0], max: [2, 2]}}\n    goal: {point: [5, 1]}\n"
-                         "outputs:\n  trajectories: {format: hdf5}\n";
+  std::ofstream(yaml)
+      << "groups:\n  - count: 2\n    spawn: {rect: {min: [0, 0], max: [2, 2]}}\n    goal: {point: [5, 1]}\n"
+         "outputs:\n  trajectories: {format: hdf5}\n";
   r = run_split("run " + yaml.string() + " --quiet");
   EXPECT_EQ(r.code, 1);
   // The last line (the backend's note comes first: the scenario is read after it).
-  EXPECT_TRUE(r.err.ends_with("\nthrong: error: " + yaml.string() +
-                              ":6:26: outputs.trajectories.format: unknown trajectory format 'hdf5': expected csv, pedpy or sqlite\n"))
+  EXPECT_TRUE(r.err.ends_with(
+      "\nthrong: error: " + yaml.string() +
+      ":6:26: outputs.trajectories.format: unknown trajectory format 'hdf5': expected csv, pedpy or sqlite\n"))
       << r.err;
   std::filesystem::remove(yaml);
 }
@@ -375,11 +390,13 @@ TEST(Cli, ConvertChoosesTheWriterByExtension) {
   const std::string in = (dir / "walk.bvh").string();
   Streams r = run_split("convert " + in + " " + (dir / "out.gltf").string());
   EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(r.err, "throng: error: " + (dir / "out.gltf").string() + ": unknown output extension '.gltf' (supported: .bvh)\n");
+  EXPECT_EQ(r.err,
+            "throng: error: " + (dir / "out.gltf").string() + ": unknown output extension '.gltf' (supported: .bvh)\n");
   EXPECT_FALSE(std::filesystem::exists(dir / "out.gltf"));
   r = run_split("convert " + in + " " + (dir / "out").string());
   EXPECT_EQ(r.code, 1);
-  EXPECT_EQ(r.err, "throng: error: " + (dir / "out").string() + ": no extension to choose the output format by (supported: .bvh)\n");
+  EXPECT_EQ(r.err, "throng: error: " + (dir / "out").string() +
+                       ": no extension to choose the output format by (supported: .bvh)\n");
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
   // The extension in any case.
   r = run_split("--log-level warn convert " + in + " " + (dir / "out.BVH").string());

@@ -94,7 +94,8 @@ void drop_machine_figures(nlohmann::json& j) {
   for (auto it = j.begin(); it != j.end();) {
     const std::string& k = it.key();
     const bool timing = k == "kernels" || k == "frame_ms" || k == "wall_seconds" || k == "threads" || k == "backend" ||
-                        k == "timings" || k == "characters_per_second" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0);
+                        k == "timings" || k == "characters_per_second" ||
+                        (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0);
     if (timing) {
       it = j.erase(it);
     } else {
@@ -210,8 +211,8 @@ TEST_F(RecordedRun, RunsExportsAndAnimationsMatchTheRecording) {
 
   // Joint positions of every exported agent.
   const fs::path glb = dir_ / "crowd.glb";
-  ASSERT_EQ(run_throng({"export-crowd", "plaza", "--agents", "12", "--seconds", "4", "--fps", "24", "--seed", "7", "--out",
-                        glb.string()},
+  ASSERT_EQ(run_throng({"export-crowd", "plaza", "--agents", "12", "--seconds", "4", "--fps", "24", "--seed", "7",
+                        "--out", glb.string()},
                        dir_ / "export.log"),
             0)
       << slurp(dir_ / "export.log");
@@ -228,7 +229,8 @@ TEST_F(RecordedRun, RunsExportsAndAnimationsMatchTheRecording) {
   const fs::path recording = fs::path(THRONG_SOURCE_DIR) / "tests" / "data" / "recorded_run.txt";
   if (const char* to = std::getenv("THRONG_RECORD_RUN"); to != nullptr && *to != '\0') {
     std::ofstream f(to);
-    f << "# tests/app/recorded_run_test.cpp: item, FNV-1a 64 digest. Record anew only for an intended change of behaviour.\n";
+    f << "# tests/app/recorded_run_test.cpp: item, FNV-1a 64 digest. Record anew only for an intended change of "
+         "behaviour.\n";
     for (const auto& [item, digest] : now) f << item << ' ' << digest << '\n';
     GTEST_SKIP() << "recorded " << now.size() << " items to " << to << " with " << exe();
   }

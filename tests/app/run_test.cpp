@@ -129,7 +129,8 @@ std::map<long, int> read_trajectories(const fs::path& csv, long agents) {
 }
 
 TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
-  const Outcome o = run({"--threads", "2", "run", "circle", "--agents", "50", "--steps", "120", "--every", "10", "--out", dir_.string(), "--quiet"});
+  const Outcome o = run({"--threads", "2", "run", "circle", "--agents", "50", "--steps", "120", "--every", "10",
+                         "--out", dir_.string(), "--quiet"});
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_NE(o.out.find("circle: 50 agents, 120 steps"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("priority model, double_buffer"), std::string::npos) << o.out;
@@ -143,7 +144,8 @@ TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
   EXPECT_EQ(rows, want);
 
   const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "stats.json"));
-  for (const char* section : {"run", "timings", "crowd", "stuck_agents", "density_histogram", "fundamental_diagram", "trajectories", "scenario"})
+  for (const char* section : {"run", "timings", "crowd", "stuck_agents", "density_histogram", "fundamental_diagram",
+                              "trajectories", "scenario"})
     EXPECT_TRUE(stats.contains(section)) << section;
   EXPECT_EQ(stats["run"]["steps"], 120);
   EXPECT_EQ(stats["run"]["agents"], 50);
@@ -194,7 +196,9 @@ TEST_F(RunCommand, TheDefaultDemoRunsTheCircleToTheEnd) {
   double fps = 0, speed = 0;
   const auto announced = o.out.find("throng run: rendering video (");
   ASSERT_NE(announced, std::string::npos) << o.out;
-  ASSERT_EQ(std::sscanf(o.out.c_str() + announced, "throng run: rendering video (%31[^,], %dx%d, %lf fps, %lfx speed)", mode, &width, &height, &fps, &speed), 5)
+  ASSERT_EQ(std::sscanf(o.out.c_str() + announced, "throng run: rendering video (%31[^,], %dx%d, %lf fps, %lfx speed)",
+                        mode, &width, &height, &fps, &speed),
+            5)
       << o.out;
   // "DIR/crowd.mp4 (N frames, 640x360 at 24 fps)" in the summary.
   long said = -1;
@@ -234,7 +238,8 @@ TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) 
   const std::string agents = sanitized() ? "120" : "400";
   const auto run_with = [&](const std::string& threads) {
     const fs::path out = dir_ / ("threads_" + threads);
-    const Outcome o = run({"--threads", threads, "run", "circle", "--agents", agents, "--seconds", "12", "--no-trajectories", "--out", out.string()});
+    const Outcome o = run({"--threads", threads, "run", "circle", "--agents", agents, "--seconds", "12",
+                           "--no-trajectories", "--out", out.string()});
     EXPECT_EQ(o.code, 0) << o.out;
     EXPECT_NE(o.out.find("foot skating: mean"), std::string::npos) << o.out;
     return nlohmann::json::parse(slurp(out / "stats.json"));
@@ -260,7 +265,8 @@ TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) 
   EXPECT_TRUE(one["timings"]["stages"].contains("anim.locomotion"));
 
   // Every joint synthesised (no LOD): the feet that skate are all measured.
-  const Outcome full = run({"run", "circle", "--agents", agents, "--seconds", "12", "--no-lod", "--no-trajectories", "--out", (dir_ / "full").string()});
+  const Outcome full = run({"run", "circle", "--agents", agents, "--seconds", "12", "--no-lod", "--no-trajectories",
+                            "--out", (dir_ / "full").string()});
   ASSERT_EQ(full.code, 0) << full.out;
   const nlohmann::json all = nlohmann::json::parse(slurp(dir_ / "full" / "stats.json"))["locomotion"];
   EXPECT_EQ(all["joints_synthesised_per_character"].get<double>(), all["joints"].get<double>());
@@ -284,13 +290,14 @@ TEST_F(RunCommand, NoAnimateSkipsTheLocomotionStage) {
 }
 
 TEST_F(RunCommand, CheckEveryWritesASoakReportAndSection) {
-  const Outcome o = run({"run", "corridor", "--agents", "50", "--steps", "30", "--check-every", "10", "--no-animate", "--no-trajectories",
-                         "--quiet", "--out", dir_.string()});
+  const Outcome o = run({"run", "corridor", "--agents", "50", "--steps", "30", "--check-every", "10", "--no-animate",
+                         "--no-trajectories", "--quiet", "--out", dir_.string()});
   ASSERT_EQ(o.code, 0) << o.out;
   EXPECT_NE(o.out.find("soak checks: 4, every 10 steps"), std::string::npos) << o.out;
   std::ifstream report(dir_ / "soak.jsonl");
   int lines = 0;
-  for (std::string line; std::getline(report, line); ++lines) EXPECT_EQ(nlohmann::json::parse(line)["step"], 10 * lines);
+  for (std::string line; std::getline(report, line); ++lines)
+    EXPECT_EQ(nlohmann::json::parse(line)["step"], 10 * lines);
   EXPECT_EQ(lines, 4);  // steps 0, 10, 20, 30
   const nlohmann::json soak = nlohmann::json::parse(slurp(dir_ / "stats.json"))["soak"];
   EXPECT_TRUE(soak["passed"]) << soak.dump();
@@ -300,7 +307,8 @@ TEST_F(RunCommand, CheckEveryWritesASoakReportAndSection) {
 
 TEST_F(RunCommand, ABadScenarioFileIsOneLineWithItsPosition) {
   const fs::path bad = dir_ / "bad.yaml";
-  std::ofstream(bad) << "name: bad\ngroups:\n  - count: ten\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: [9, 9]\n";
+  std::ofstream(bad)
+      << "name: bad\ngroups:\n  - count: ten\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: [9, 9]\n";
   const Outcome o = run({"--backend", "cpu", "run", bad.string(), "--out", dir_.string()});
   EXPECT_EQ(o.code, 1);
   EXPECT_EQ(o.out, "throng: error: " + bad.string() + ":3:12: groups[0].count: expected a number, got 'ten'\n");
@@ -310,7 +318,8 @@ TEST_F(RunCommand, ABadScenarioFileIsOneLineWithItsPosition) {
                             "  - count: 5\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: [9, 9]\n";
   const Outcome g = run({"--backend", "cpu", "run", blocked.string(), "--out", dir_.string()});
   EXPECT_EQ(g.code, 1);
-  EXPECT_NE(g.out.find(blocked.string() + ":7:11: groups[0].goal: goal (9, 9) of agent 0 lies inside obstacle world.obstacles[0]"),
+  EXPECT_NE(g.out.find(blocked.string() +
+                       ":7:11: groups[0].goal: goal (9, 9) of agent 0 lies inside obstacle world.obstacles[0]"),
             std::string::npos)
       << g.out;
 }
@@ -318,7 +327,10 @@ TEST_F(RunCommand, ABadScenarioFileIsOneLineWithItsPosition) {
 TEST_F(RunCommand, UnknownNamesAndBadOptionsAreErrors) {
   Outcome o = run({"run", "circel"});
   EXPECT_EQ(o.code, 1);
-  EXPECT_NE(o.out.find("no built-in scenario 'circel' (built-ins: bottleneck, circle, corridor, crossing, maze, plaza)"), std::string::npos) << o.out;
+  EXPECT_NE(
+      o.out.find("no built-in scenario 'circel' (built-ins: bottleneck, circle, corridor, crossing, maze, plaza)"),
+      std::string::npos)
+      << o.out;
   o = run({"run", dir_.string()});  // a folder is not a scenario
   EXPECT_EQ(o.code, 1) << o.out;
   EXPECT_NE(o.out.find(dir_.string() + ": is a folder, not a scenario file"), std::string::npos) << o.out;
@@ -343,7 +355,8 @@ TEST_F(RunCommand, UnknownNamesAndBadOptionsAreErrors) {
 TEST_F(RunCommand, InterruptLeavesCompleteFiles) {
   const fs::path log = dir_ / "log.txt";
   const fs::path out = dir_ / "out";
-  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--out", out.string(), "--quiet"}, log);
+  const pid_t pid = start(
+      {"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--out", out.string(), "--quiet"}, log);
   // Wait for a few frames to be written.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline) {
@@ -374,8 +387,8 @@ TEST_F(RunCommand, InterruptLeavesCompleteFiles) {
 TEST_F(RunCommand, InterruptLeavesAReadableSqliteDatabaseOfCompleteFrames) {
   const fs::path log = dir_ / "log.txt";
   const fs::path out = dir_ / "out";
-  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--trajectory-format", "sqlite", "--no-animate",
-                           "--out", out.string(), "--quiet"},
+  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--trajectory-format",
+                           "sqlite", "--no-animate", "--out", out.string(), "--quiet"},
                           log);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline) {
@@ -424,15 +437,17 @@ TEST_F(RunCommand, CtrlCToTheProcessGroupDuringAVideoRunKeepsEveryFile) {
 #else
   const fs::path log = dir_ / "log.txt";
   const fs::path out = dir_ / "out";
-  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "200", "--render", "video", "--width", "160", "--height", "90",
-                           "--out", out.string(), "--quiet"},
+  const pid_t pid = start({"--threads", "1", "run", "circle", "--agents", "200", "--render", "video", "--width", "160",
+                           "--height", "90", "--out", out.string(), "--quiet"},
                           log);
   // Wait until the encoder has written part of the file (under its
   // temporary name until the video is finished).
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (std::chrono::steady_clock::now() < deadline) {
     std::error_code ec;
-    if (fs::file_size(out / "crowd.mp4.partial", ec) > 0 && !ec && fs::file_size(out / "trajectories.csv.partial", ec) > 200 * 40 * 3 && !ec) break;
+    if (fs::file_size(out / "crowd.mp4.partial", ec) > 0 && !ec &&
+        fs::file_size(out / "trajectories.csv.partial", ec) > 200 * 40 * 3 && !ec)
+      break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ASSERT_EQ(kill(-pid, SIGINT), 0);  // the group, as a terminal does
@@ -459,7 +474,9 @@ TEST_F(RunCommand, CtrlCToTheProcessGroupDuringAVideoRunKeepsEveryFile) {
 TEST_F(RunCommand, CtrlCDuringSetUpEndsItWithStatsAndStatus130) {
   const fs::path log = dir_ / "log.txt";
   const fs::path out = dir_ / "out";
-  const pid_t pid = start({"run", "plaza", "--agents", "500000", "--steps", "100000", "--no-animate", "--out", out.string(), "--quiet"}, log);
+  const pid_t pid = start(
+      {"run", "plaza", "--agents", "500000", "--steps", "100000", "--no-animate", "--out", out.string(), "--quiet"},
+      log);
   // The start line comes before set-up; signal as soon as it is there.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline && slurp(log).find("up to 100000 steps") == std::string::npos)
@@ -497,7 +514,8 @@ TEST_F(RunCommand, AHugeNearlyEmptyWorldSetsUpQuickly) {
                           "    goal: {point: [10, 0]}\n";
   const fs::path log = dir_ / "log.txt";
   const auto t0 = std::chrono::steady_clock::now();
-  const pid_t pid = start({"run", scene.string(), "--seconds", "30", "--no-animate", "--out", (dir_ / "out").string(), "--quiet"}, log);
+  const pid_t pid = start(
+      {"run", scene.string(), "--seconds", "30", "--no-animate", "--out", (dir_ / "out").string(), "--quiet"}, log);
   int status = 0;
   while (waitpid(pid, &status, WNOHANG) == 0 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(120))
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -518,16 +536,21 @@ TEST_F(RunCommand, RequestsBeyondTheMemoryBudgetAreRefusedUpFront) {
   const auto t0 = std::chrono::steady_clock::now();
   Outcome o = run({"--max-memory", "1G", "animate", "--characters", "10000000", "--out", dir_.string()});
   EXPECT_EQ(o.code, 1) << o.out;
-  EXPECT_NE(o.out.find("--characters: about 7.15 GiB for 10000000 characters exceeds the memory budget of 1 GiB (--max-memory)"),
-            std::string::npos)
+  EXPECT_NE(
+      o.out.find(
+          "--characters: about 7.15 GiB for 10000000 characters exceeds the memory budget of 1 GiB (--max-memory)"),
+      std::string::npos)
       << o.out;
   o = run({"run", "plaza", "--agents", "2000000", "--max-memory", "500M", "--out", dir_.string()});
   EXPECT_EQ(o.code, 1) << o.out;
-  EXPECT_NE(o.out.find("--agents: about 1.19 GiB for 2000000 agents exceeds the memory budget of 500 MiB"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("--agents: about 1.19 GiB for 2000000 agents exceeds the memory budget of 500 MiB"),
+            std::string::npos)
+      << o.out;
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(60)) << "the refusal came after the work";
   o = run({"run", "circle", "--max-memory", "lots"});
   EXPECT_EQ(o.code, 1) << o.out;
-  EXPECT_NE(o.out.find("--max-memory: expected a size such as 512M, 8G or 1.5GiB, got 'lots'"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("--max-memory: expected a size such as 512M, 8G or 1.5GiB, got 'lots'"), std::string::npos)
+      << o.out;
 }
 
 // A disk that fills up mid-run (every file capped at 300 KB): the run fails
@@ -541,14 +564,18 @@ TEST_F(RunCommand, AFullDiskLeavesNoUnmarkedPartialFile) {
 #endif
   const fs::path log = dir_ / "log.txt";
   const fs::path out = dir_ / "out";
-  std::vector<std::string> args = {"--threads", "1", "run", "circle", "--agents", "400", "--every", "1", "--out", out.string(), "--quiet"};
+  std::vector<std::string> args = {"--threads", "1", "run",   "circle",     "--agents", "400",
+                                   "--every",   "1", "--out", out.string(), "--quiet"};
   args.insert(args.end(), render.begin(), render.end());
   const Outcome o = finish(start(args, log, 300 * 1024), log);
   EXPECT_EQ(o.code, 1) << o.out;
   EXPECT_NE(o.out.find("File too large"), std::string::npos) << o.out;
-  EXPECT_NE(o.out.find("trajectories.csv is incomplete: kept as " + (out / "trajectories.csv.partial").string()), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("trajectories.csv is incomplete: kept as " + (out / "trajectories.csv.partial").string()),
+            std::string::npos)
+      << o.out;
   EXPECT_TRUE(fs::exists(out / "trajectories.csv.partial"));
-  for (const char* whole : {"trajectories.csv", "crowd.mp4", "stats.json"}) EXPECT_FALSE(fs::exists(out / whole)) << whole;
+  for (const char* whole : {"trajectories.csv", "crowd.mp4", "stats.json"})
+    EXPECT_FALSE(fs::exists(out / whole)) << whole;
   for (const fs::directory_entry& e : fs::directory_iterator(out)) {
     const std::string name = e.path().filename().string();
     const bool marked = name.size() > 8 && name.substr(name.size() - 8) == ".partial";
@@ -565,8 +592,8 @@ TEST_F(RunCommand, RenderedCharactersAreLargeEnoughToSee) {
   GTEST_SKIP() << "this build has no renderer";
 #else
   const fs::path out = dir_ / "out";
-  const Outcome o = run({"--threads", "2", "run", "circle", "--agents", "300", "--seconds", "3", "--render", "frames", "--width", "320",
-                         "--height", "180", "--no-trajectories", "--out", out.string()});
+  const Outcome o = run({"--threads", "2", "run", "circle", "--agents", "300", "--seconds", "3", "--render", "frames",
+                         "--width", "320", "--height", "180", "--no-trajectories", "--out", out.string()});
   ASSERT_EQ(o.code, 0) << o.out;
   const nlohmann::json stats = nlohmann::json::parse(slurp(out / "stats.json"));
   EXPECT_GT(stats["render"]["frames"].get<long>(), 10);

@@ -28,7 +28,8 @@ Camera test_camera() {
 
 // The OpenGL route: clip = P V p, NDC = clip / w, viewport transform with v down.
 glm::dvec2 pixel_via_matrices(const Camera& c, glm::vec3 p) {
-  const glm::dvec4 clip = glm::dmat4(projection_matrix(c)) * glm::dmat4(view_matrix(c)) * glm::dvec4(glm::dvec3(p), 1.0);
+  const glm::dvec4 clip =
+      glm::dmat4(projection_matrix(c)) * glm::dmat4(view_matrix(c)) * glm::dvec4(glm::dvec3(p), 1.0);
   const glm::dvec3 ndc = glm::dvec3(clip) / clip.w;
   return {(ndc.x + 1.0) * 0.5 * c.width, (1.0 - ndc.y) * 0.5 * c.height};
 }

@@ -40,7 +40,9 @@ TEST(MemoryBudget, DefaultIsMostOfPhysicalMemoryAndAChecksNamesTheFigure) {
   } catch (const Error& e) {
     EXPECT_EQ(e.location().field, "--agents");
     const std::string m = e.message();
-    EXPECT_NE(m.find("about 3 GiB for 1000 agents exceeds the memory budget of 1 GiB (--max-memory)"), std::string::npos) << m;
+    EXPECT_NE(m.find("about 3 GiB for 1000 agents exceeds the memory budget of 1 GiB (--max-memory)"),
+              std::string::npos)
+        << m;
   }
   set_memory_budget(0);
   EXPECT_EQ(format_bytes(1536), "1.5 KiB");

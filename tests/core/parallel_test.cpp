@@ -34,7 +34,8 @@ TEST(ParallelFor, VisitsEveryIndexExactlyOnce) {
   for (int t : thread_counts()) {
     ScopedExecution exec(Backend::Cpu, t);
     std::vector<std::atomic<int>> hits(100003);
-    parallel_for("test.visit", static_cast<Index>(hits.size()), [&](Index i) { hits[static_cast<std::size_t>(i)]++; }, 7);
+    parallel_for(
+        "test.visit", static_cast<Index>(hits.size()), [&](Index i) { hits[static_cast<std::size_t>(i)]++; }, 7);
     for (auto& h : hits) ASSERT_EQ(h.load(), 1) << "threads=" << t;
   }
 }
@@ -48,9 +49,10 @@ TEST(ParallelFor, EmptyAndNegativeRangesDoNothing) {
 
 TEST(ParallelFor, ExceptionsPropagate) {
   ScopedExecution exec(Backend::Cpu, 2);
-  EXPECT_THROW(parallel_for("test.throw", 100000, [](Index i) {
-    if (i == 77777) throw Error("boom");
-  }),
+  EXPECT_THROW(parallel_for("test.throw", 100000,
+                            [](Index i) {
+                              if (i == 77777) throw Error("boom");
+                            }),
                Error);
 }
 

@@ -37,7 +37,10 @@ TEST(Reduce, CustomCombineMaxWithIndex) {
   for (int t : {1, 2, 4}) {
     ScopedExecution exec(Backend::Cpu, t);
     const ArgMax m = parallel_reduce(
-        "test.argmax", s.size(), ArgMax{-1e300, -1}, [s](Index i) { return ArgMax{s[i], i}; },
+        "test.argmax", s.size(), ArgMax{-1e300, -1},
+        [s](Index i) {
+          return ArgMax{s[i], i};
+        },
         [](ArgMax a, ArgMax b) { return b.value > a.value || (b.value == a.value && b.index < a.index) ? b : a; });
     const auto it = std::max_element(v.begin(), v.end());
     EXPECT_EQ(m.index, it - v.begin());

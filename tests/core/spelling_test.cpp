@@ -20,7 +20,8 @@ TEST(Spelling, EditDistanceOfKnownPairs) {
   // Optimal string alignment edits no substring twice: "ca" -> "abc" is 3,
   // where unrestricted Damerau-Levenshtein would say 2.
   EXPECT_EQ(edit_distance("ca", "abc"), 3u);
-  for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{{"agents", "agnets"}, {"spawn", "spwan"}, {"x", "xyz"}})
+  for (const auto& [a, b] :
+       std::vector<std::pair<std::string, std::string>>{{"agents", "agnets"}, {"spawn", "spwan"}, {"x", "xyz"}})
     EXPECT_EQ(edit_distance(a, b), edit_distance(b, a)) << a << " " << b;
 }
 

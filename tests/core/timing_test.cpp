@@ -30,7 +30,8 @@ TEST(Timing, ParallelForRecordsByDescription) {
   auto& t = KernelTimings::global();
   t.reset();
   for (int i = 0; i < 4; ++i)
-    parallel_for("test.sleepy", 2, [](Index) { std::this_thread::sleep_for(std::chrono::milliseconds(2)); }, 1);
+    parallel_for(
+        "test.sleepy", 2, [](Index) { std::this_thread::sleep_for(std::chrono::milliseconds(2)); }, 1);
   const auto s = t.stats();
   ASSERT_EQ(s.size(), 1u);
   EXPECT_EQ(s[0].name, "test.sleepy");

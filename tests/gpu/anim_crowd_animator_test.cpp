@@ -87,8 +87,10 @@ TEST(CudaCrowdAnimator, FramesMatchCpu) {
   for (Index c = 0; c < kN; ++c) {
     if (borderline[static_cast<std::size_t>(c)]) continue;
     for (std::size_t w = 0; w < W; ++w)
-      ASSERT_EQ(gpu.masks[static_cast<std::size_t>(c) * W + w], cpu.masks[static_cast<std::size_t>(c) * W + w]) << "character " << c;
-    ASSERT_EQ(gpu.evaluated[static_cast<std::size_t>(c)], cpu.evaluated[static_cast<std::size_t>(c)]) << "character " << c;
+      ASSERT_EQ(gpu.masks[static_cast<std::size_t>(c) * W + w], cpu.masks[static_cast<std::size_t>(c) * W + w])
+          << "character " << c;
+    ASSERT_EQ(gpu.evaluated[static_cast<std::size_t>(c)], cpu.evaluated[static_cast<std::size_t>(c)])
+        << "character " << c;
   }
   if (level_diff.empty()) {
     EXPECT_TRUE(gpu_test::bitwise_equal(gpu.stats, cpu.stats)) << "joints synthesised, from cache, cycles stored";

@@ -53,7 +53,8 @@ TEST(CudaLocomotionStreams, FramesMatchCpu) {
     for (int frame = 0; frame < 8; ++frame) {
       if (frame == 4) loco.set_agents(positions, yaws, faster);
       const LocomotionStreamsStats& s = loco.animate(&camera);
-      r.stats.insert(r.stats.end(), {s.streamed, s.exact, s.retargeted, Index{s.streams_in_use}, Index{s.streams_running}, Index{s.streams_started}});
+      r.stats.insert(r.stats.end(), {s.streamed, s.exact, s.retargeted, Index{s.streams_in_use},
+                                     Index{s.streams_running}, Index{s.streams_started}});
     }
     r.palettes = gpu_test::download(loco.palettes(), m);
     r.exact = gpu_test::download(loco.exact(), m);
@@ -75,7 +76,8 @@ TEST(CudaLocomotionStreams, FramesMatchCpu) {
   const std::vector<std::size_t> exact_diff = gpu_test::differing(gpu.exact, cpu.exact);
   EXPECT_LE(exact_diff.size(), 2u) << "agents exact on one side only";
   if (exact_diff.empty()) {
-    EXPECT_TRUE(gpu_test::bitwise_equal(gpu.stats, cpu.stats)) << "streamed, exact, retargeted, streams in use/running/started";
+    EXPECT_TRUE(gpu_test::bitwise_equal(gpu.stats, cpu.stats))
+        << "streamed, exact, retargeted, streams in use/running/started";
     EXPECT_EQ(gpu.sharing_agents, cpu.sharing_agents);
   }
   const std::int32_t J = default_blend_spaces().speeds->joint_count();
@@ -95,7 +97,8 @@ TEST(CudaLocomotionStreams, FramesMatchCpu) {
   // kinematics of ~20 joints (SLERP, leg IK for exact agents), times the
   // inverse bind: a chain of ~100 FMA-able operations; 1e-5 relative plus
   // 2e-4 absolute (about 25 ulps at 70 m).
-  EXPECT_TRUE(gpu_test::near(gpu.palettes, cpu.palettes, {1e-5, 2e-4, 12 * static_cast<std::size_t>(J) * left_out})) << "palettes";
+  EXPECT_TRUE(gpu_test::near(gpu.palettes, cpu.palettes, {1e-5, 2e-4, 12 * static_cast<std::size_t>(J) * left_out}))
+      << "palettes";
   // The sharing error is a maximum over joints of distances in cm of
   // streamed against exact synthesis, both computed on the side's backend.
   if (gpu_test::tolerant())

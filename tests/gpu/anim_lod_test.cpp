@@ -50,7 +50,8 @@ TEST(CudaLod, SpheresLevelsAndHistogramMatchCpu) {
     headings.push_back(6.2831853f * u(rng) - 3.1415927f);
     scales.push_back(0.85f + 0.3f * u(rng));
     for (std::int32_t j = 0; j < J; ++j)
-      joints.push_back(roots.back() + glm::vec3(jitter(rng), 1.8f * static_cast<float>(j) / static_cast<float>(J), jitter(rng)));
+      joints.push_back(roots.back() +
+                       glm::vec3(jitter(rng), 1.8f * static_cast<float>(j) / static_cast<float>(J), jitter(rng)));
   }
   const CameraView view = make_camera_view(street_camera());
   const auto run = [&](Memory m) {

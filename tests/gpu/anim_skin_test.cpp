@@ -25,7 +25,8 @@ TEST(CudaSkin, PositionsAndNormalsMatchCpu) {
     positions.emplace_back(0.4f * u(rng), 0.9f + 0.9f * u(rng), 0.3f * u(rng));
     normals.push_back(glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.0f, 0.0f, 0.01f)));
     joints.emplace_back(joint(rng), joint(rng), joint(rng), joint(rng));
-    glm::vec4 w(w01(rng), w01(rng), v % 3 == 0 ? 0.0f : w01(rng), v % 2 == 0 ? 0.0f : w01(rng));  // some unused influences
+    glm::vec4 w(w01(rng), w01(rng), v % 3 == 0 ? 0.0f : w01(rng),
+                v % 2 == 0 ? 0.0f : w01(rng));  // some unused influences
     weights.push_back(w / (w.x + w.y + w.z + w.w));
   }
   // Palettes: rotations (unit quaternions) with translations of characters

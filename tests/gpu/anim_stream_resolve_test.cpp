@@ -55,12 +55,14 @@ TEST(CudaStreamCrowd, StepRetargetAndResolveMatchCpu) {
     AnimClip walk_clip = default_clip("walk");
     walk_clip.events = {{0.1f, left}, {0.4f, right}};  // within the stride (about 1 s)
     StreamPool& pool = crowd.streams();
-    const std::int32_t walk = pool.add(crowd.rig(human), human, spec_of("walk", 64), std::make_unique<ClipPlayer>(walk_clip));
-    const std::int32_t wave = pool.add(crowd.rig(human), human, spec_of("wave", 32), std::make_unique<ClipPlayer>(wiggle_clip(Jh, 45, kDt)));
-    const std::int32_t f_walk =
-        pool.add(crowd.rig(fingered), fingered, spec_of("f_walk", 64), std::make_unique<ClipPlayer>(wiggle_clip(Jf, 50, kDt)));
-    const std::int32_t f_idle =
-        pool.add(crowd.rig(fingered), fingered, spec_of("f_idle", 16), std::make_unique<ClipPlayer>(wiggle_clip(Jf, 70, kDt, "idle"), 0.5f));
+    const std::int32_t walk =
+        pool.add(crowd.rig(human), human, spec_of("walk", 64), std::make_unique<ClipPlayer>(walk_clip));
+    const std::int32_t wave =
+        pool.add(crowd.rig(human), human, spec_of("wave", 32), std::make_unique<ClipPlayer>(wiggle_clip(Jh, 45, kDt)));
+    const std::int32_t f_walk = pool.add(crowd.rig(fingered), fingered, spec_of("f_walk", 64),
+                                         std::make_unique<ClipPlayer>(wiggle_clip(Jf, 50, kDt)));
+    const std::int32_t f_idle = pool.add(crowd.rig(fingered), fingered, spec_of("f_idle", 16),
+                                         std::make_unique<ClipPlayer>(wiggle_clip(Jf, 70, kDt, "idle"), 0.5f));
     crowd.add_agents(human, kHumans);
     crowd.add_agents(fingered, kFingered);
     crowd.assign_random(0, kHumans, {{{walk}, {walk, wave}, {walk, wave}}, true}, 11);
@@ -85,7 +87,8 @@ TEST(CudaStreamCrowd, StepRetargetAndResolveMatchCpu) {
         std::vector<std::int32_t> sources, offsets;
         for (Index a = 0; a < kAgents; ++a) {
           const bool h = a < kHumans;
-          sources.push_back(a % 11 == 0 ? kNoSource : (a % 13 == 0 ? 99 : (a % 3 == 0 ? (h ? wave : f_idle) : (h ? walk : f_walk))));
+          sources.push_back(
+              a % 11 == 0 ? kNoSource : (a % 13 == 0 ? 99 : (a % 3 == 0 ? (h ? wave : f_idle) : (h ? walk : f_walk))));
           offsets.push_back(static_cast<std::int32_t>((a * 7) % 40));
         }
         const Buffer<std::int32_t> bs = gpu_test::upload(sources, m), bo = gpu_test::upload(offsets, m);

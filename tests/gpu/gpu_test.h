@@ -57,7 +57,9 @@ struct Side {
   Memory memory = Memory::Host;
 };
 inline Side cpu_side() { return {Backend::Cpu, Memory::Host}; }
-inline Side device_side() { return device_side_on_cpu() ? Side{Backend::Cpu, Memory::Host} : Side{Backend::Cuda, Memory::Device}; }
+inline Side device_side() {
+  return device_side_on_cpu() ? Side{Backend::Cpu, Memory::Host} : Side{Backend::Cuda, Memory::Device};
+}
 
 // True when the device side is CUDA, so floating-point comparisons may use
 // their tolerance; false when both sides are the CPU: exact.
@@ -103,7 +105,8 @@ template <class T>
 template <class T>
 ::testing::AssertionResult bitwise_equal(const std::vector<T>& device, const std::vector<T>& cpu) {
   static_assert(std::is_trivially_copyable_v<T>);
-  if (device.size() != cpu.size()) return ::testing::AssertionFailure() << "sizes differ: " << device.size() << " vs " << cpu.size();
+  if (device.size() != cpu.size())
+    return ::testing::AssertionFailure() << "sizes differ: " << device.size() << " vs " << cpu.size();
   return detail::bitwise_equal_impl(device.data(), cpu.data(), device.size());
 }
 
@@ -123,7 +126,8 @@ struct Tolerance {
 template <class T>
 ::testing::AssertionResult near(const std::vector<T>& device, const std::vector<T>& cpu, Tolerance tol) {
   static_assert(std::is_trivially_copyable_v<T> && sizeof(T) % sizeof(float) == 0, "compares floats");
-  if (device.size() != cpu.size()) return ::testing::AssertionFailure() << "sizes differ: " << device.size() << " vs " << cpu.size();
+  if (device.size() != cpu.size())
+    return ::testing::AssertionFailure() << "sizes differ: " << device.size() << " vs " << cpu.size();
   if (!tolerant()) return detail::bitwise_equal_impl(device.data(), cpu.data(), device.size());
   const std::size_t n = device.size() * (sizeof(T) / sizeof(float));
   std::vector<float> a(n), b(n);
@@ -147,15 +151,17 @@ template <class T>
   }
   if (bad <= tol.outliers) return ::testing::AssertionSuccess();
   const std::size_t per = sizeof(T) / sizeof(float);
-  return ::testing::AssertionFailure() << bad << " of " << n << " floats beyond abs " << tol.abs << " + rel " << tol.rel << " (" << tol.outliers
-                                       << " allowed); worst: element " << worst / per << " float " << worst % per << ": device "
-                                       << a[worst] << " cpu " << b[worst];
+  return ::testing::AssertionFailure() << bad << " of " << n << " floats beyond abs " << tol.abs << " + rel " << tol.rel
+                                       << " (" << tol.outliers << " allowed); worst: element " << worst / per
+                                       << " float " << worst % per << ": device " << a[worst] << " cpu " << b[worst];
 }
 
 // Angles in radians compared modulo 2 pi (a wrapped angle one rounding from
 // the seam may come out as -pi on one side and just under pi on the other).
-inline ::testing::AssertionResult near_angle(const std::vector<float>& device, const std::vector<float>& cpu, double abs) {
-  if (device.size() != cpu.size()) return ::testing::AssertionFailure() << "sizes differ: " << device.size() << " vs " << cpu.size();
+inline ::testing::AssertionResult near_angle(const std::vector<float>& device, const std::vector<float>& cpu,
+                                             double abs) {
+  if (device.size() != cpu.size())
+    return ::testing::AssertionFailure() << "sizes differ: " << device.size() << " vs " << cpu.size();
   if (!tolerant()) return detail::bitwise_equal_impl(device.data(), cpu.data(), device.size());
   constexpr double kTwoPi = 6.283185307179586;
   std::size_t bad = 0, first = 0;
@@ -166,8 +172,8 @@ inline ::testing::AssertionResult near_angle(const std::vector<float>& device, c
     if (bad++ == 0) first = i;
   }
   if (bad == 0) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << bad << " angles differ by more than " << abs << " rad, first [" << first << "]: device " << device[first]
-                                       << " cpu " << cpu[first];
+  return ::testing::AssertionFailure() << bad << " angles differ by more than " << abs << " rad, first [" << first
+                                       << "]: device " << device[first] << " cpu " << cpu[first];
 }
 
 // Of two equal-length arrays, the indices where they differ (bitwise).
@@ -183,8 +189,8 @@ std::vector<std::size_t> differing(const std::vector<T>& a, const std::vector<T>
 
 // First statement of every test: skips with the reason when the device side
 // would need a GPU and none is usable.
-#define THRONG_REQUIRE_GPU()                                                                            \
-  do {                                                                                                  \
-    if (!::throng::gpu_test::device_side_on_cpu() && !::throng::cuda_usable())                          \
-      GTEST_SKIP() << "no usable GPU: " << ::throng::cuda_status();                                     \
+#define THRONG_REQUIRE_GPU()                                                   \
+  do {                                                                         \
+    if (!::throng::gpu_test::device_side_on_cpu() && !::throng::cuda_usable()) \
+      GTEST_SKIP() << "no usable GPU: " << ::throng::cuda_status();            \
   } while (0)

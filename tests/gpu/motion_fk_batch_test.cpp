@@ -19,7 +19,8 @@ TEST(CudaBatchFk, MatchesCpu) {
   const Skeleton skeleton = testing::random_skeleton(rng, kJoints);
   const Clip clip = testing::random_clip(skeleton, kFrames, rng, false);
   std::vector<std::int32_t> frames;
-  for (Index c = 0; c < kCharacters; ++c) frames.push_back(static_cast<std::int32_t>(rng() % (kFrames + 6)) - 3);  // some out of range
+  for (Index c = 0; c < kCharacters; ++c)
+    frames.push_back(static_cast<std::int32_t>(rng() % (kFrames + 6)) - 3);  // some out of range
   struct Out {
     std::vector<glm::vec3> p;
     std::vector<glm::quat> q;

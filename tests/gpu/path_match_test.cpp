@@ -49,7 +49,7 @@ Grid random_grid(std::uint32_t seed) {
       heading += bend;
     }
     g.curve_state.push_back(c % 5 == 0 ? static_cast<std::int32_t>(c % 4) : -1);  // some curves require a state
-    g.curve_speed.push_back(c % 3 == 0 ? 0.0f : speed(rng));                       // some any speed
+    g.curve_speed.push_back(c % 3 == 0 ? 0.0f : speed(rng));                      // some any speed
   }
   return g;
 }
@@ -62,7 +62,8 @@ TEST(CudaMatchGrid, CostsAndBestMotionsMatchCpu) {
     std::vector<std::int32_t> best, best_of_cpu_grid;
   };
   std::vector<float> cpu_cost;  // the CPU's grid, given to both sides' BestMotionJob
-  const auto best_of = [&](const Buffer<float>& cost, Memory m, std::vector<std::int32_t>& best, std::vector<float>& best_cost) {
+  const auto best_of = [&](const Buffer<float>& cost, Memory m, std::vector<std::int32_t>& best,
+                           std::vector<float>& best_cost) {
     Buffer<std::int32_t> b(kCurves, m);
     Buffer<float> bc(kCurves, m);
     BestMotionJob job;
@@ -78,7 +79,8 @@ TEST(CudaMatchGrid, CostsAndBestMotionsMatchCpu) {
     Buffer<glm::vec2> mp = gpu_test::upload(g.motion_points, m), cp = gpu_test::upload(g.curve_points, m),
                       ct = gpu_test::upload(g.curve_tangents, m);
     Buffer<std::int32_t> ms = gpu_test::upload(g.motion_state, m), cs = gpu_test::upload(g.curve_state, m);
-    Buffer<float> mv = gpu_test::upload(g.motion_speed, m), cv = gpu_test::upload(g.curve_speed, m), cost(kCurves * kMotions, m);
+    Buffer<float> mv = gpu_test::upload(g.motion_speed, m), cv = gpu_test::upload(g.curve_speed, m),
+                  cost(kCurves * kMotions, m);
     MatchGridJob job;
     job.k = kK;
     job.motions = kMotions;
@@ -113,7 +115,8 @@ TEST(CudaMatchGrid, CostsAndBestMotionsMatchCpu) {
   EXPECT_TRUE(gpu_test::near(gpu.cost, cpu.cost, {1e-5, 1e-5})) << "costs";
   // The arg-min over a row only compares: on the same grid, bitwise.
   EXPECT_TRUE(gpu_test::bitwise_equal(gpu.best_of_cpu_grid, cpu.best_of_cpu_grid)) << "best motion on the CPU's grid";
-  EXPECT_TRUE(gpu_test::bitwise_equal(gpu.best_cost_of_cpu_grid, cpu.best_cost_of_cpu_grid)) << "best cost on the CPU's grid";
+  EXPECT_TRUE(gpu_test::bitwise_equal(gpu.best_cost_of_cpu_grid, cpu.best_cost_of_cpu_grid))
+      << "best cost on the CPU's grid";
   // On each side's own grid the best costs agree within the grid's
   // tolerance; the chosen motion may differ only where two motions' costs
   // are within that tolerance of each other.
@@ -122,7 +125,8 @@ TEST(CudaMatchGrid, CostsAndBestMotionsMatchCpu) {
     const auto i = static_cast<std::size_t>(c);
     if (gpu.best[i] == cpu.best[i]) continue;
     const float other = cpu.cost[i * kMotions + static_cast<std::size_t>(gpu.best[i])];
-    EXPECT_NEAR(other, cpu.best_cost[i], 2e-5 * cpu.best_cost[i] + 2e-5) << "curve " << c << " chose a motion that is not a near tie";
+    EXPECT_NEAR(other, cpu.best_cost[i], 2e-5 * cpu.best_cost[i] + 2e-5)
+        << "curve " << c << " chose a motion that is not a near tie";
   }
 }
 

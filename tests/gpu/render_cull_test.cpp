@@ -43,7 +43,8 @@ TEST(CudaCull, CullAndPackMatchCpu) {
   TPoseCrowd c;
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> x(-70.0f, 70.0f), yaw(-3.14f, 3.14f), scale(0.8f, 1.25f);
-  for (int i = 0; i < 1500; ++i) c.add({x(rng), 0.0f, x(rng) - 30.0f}, yaw(rng), static_cast<std::uint8_t>(i % 3), scale(rng));
+  for (int i = 0; i < 1500; ++i)
+    c.add({x(rng), 0.0f, x(rng) - 30.0f}, yaw(rng), static_cast<std::uint8_t>(i % 3), scale(rng));
   const Index n = c.count();
   const JointRig joint_rig = make_joint_rig(c.skeleton);
   const SkinRig skin = make_skin_rig(anim::make_rig("humanoid", c.skeleton));
@@ -73,7 +74,8 @@ TEST(CudaCull, CullAndPackMatchCpu) {
     Buffer<glm::quat> rotations = gpu_test::upload(c.rotations, m);
     Buffer<float> scales = gpu_test::upload(c.scales, m);
     Buffer<std::uint8_t> levels = gpu_test::upload(c.levels, m);
-    Buffer<anim::Mat3x4> b_palettes = gpu_test::upload(palettes, m), inverse_bind = gpu_test::upload(skin.inverse_bind, m);
+    Buffer<anim::Mat3x4> b_palettes = gpu_test::upload(palettes, m),
+                         inverse_bind = gpu_test::upload(skin.inverse_bind, m);
     Buffer<Index> b_offsets = gpu_test::upload(offsets, m);
     Buffer<std::int32_t> b_rigs = gpu_test::upload(rigs, m);
     Buffer<RigPoint> points = gpu_test::upload(joint_rig.points, m);
@@ -170,7 +172,8 @@ TEST(CudaCull, CullAndPackMatchCpu) {
   EXPECT_TRUE(gpu_test::near(gpu.points, cpu.points, {1e-6, 2e-5})) << "packed points";
   // Palettes from joint frames: T R S times the inverse bind (a 3x4
   // product, ~30 FMA-able operations); copies and tags: bitwise.
-  EXPECT_TRUE(gpu_test::near(gpu.palettes_from_joints, cpu.palettes_from_joints, {1e-6, 2e-5})) << "palettes from joint frames";
+  EXPECT_TRUE(gpu_test::near(gpu.palettes_from_joints, cpu.palettes_from_joints, {1e-6, 2e-5}))
+      << "palettes from joint frames";
   EXPECT_TRUE(gpu_test::bitwise_equal(gpu.palettes_copied, cpu.palettes_copied)) << "copied palettes";
   EXPECT_TRUE(gpu_test::bitwise_equal(gpu.tags_from_joints, cpu.tags_from_joints)) << "tags";
   EXPECT_TRUE(gpu_test::bitwise_equal(gpu.tags_copied, cpu.tags_copied)) << "tags of copied palettes";

@@ -45,7 +45,8 @@ TEST(CudaMetrics, MatchCpu) {
   const Aabb area{{17.0f, 8.0f}, {20.0f, 12.0f}};
   const auto run = [&](Memory m) {
     const World world = World::build(spec.world, spec.model.query_radius(), {}, m);
-    const Buffer<glm::vec2> bp = gpu_test::upload(positions, m), bv = gpu_test::upload(velocities, m), bg = gpu_test::upload(goals, m);
+    const Buffer<glm::vec2> bp = gpu_test::upload(positions, m), bv = gpu_test::upload(velocities, m),
+                            bg = gpu_test::upload(goals, m);
     const Buffer<float> br = gpu_test::upload(radii, m);
     const Buffer<std::uint8_t> bf = gpu_test::upload(flags, m);
     Result out;
@@ -72,7 +73,7 @@ TEST(CudaMetrics, MatchCpu) {
   EXPECT_LE(std::abs(gpu.overlaps.touching - cpu.overlaps.touching), slack);
   EXPECT_LE(std::abs(gpu.overlaps.pairs - cpu.overlaps.pairs), slack);
   EXPECT_LE(std::abs(gpu.penetrations - cpu.penetrations), slack);
-  EXPECT_EQ(gpu.area.agents, cpu.area.agents);  // inside a rectangle: comparisons only
+  EXPECT_EQ(gpu.area.agents, cpu.area.agents);        // inside a rectangle: comparisons only
   EXPECT_EQ(gpu.density.agents, cpu.density.agents);  // counts per cell times 1/cell^2: one multiply, no add
   // Depths and separations: one distance and two subtractions: a rounding
   // or two of values below a metre.
@@ -82,7 +83,8 @@ TEST(CudaMetrics, MatchCpu) {
   // Mean speeds: |v| per agent (FMA-able), summed in double in a fixed
   // order on both: 1e-6 relative per term, so 1e-6 relative in the mean.
   EXPECT_NEAR(gpu.area.mean_speed, cpu.area.mean_speed, tol * (1.0 + std::abs(cpu.area.mean_speed)));
-  EXPECT_NEAR(gpu.area.mean_speed_magnitude, cpu.area.mean_speed_magnitude, tol * (1.0 + cpu.area.mean_speed_magnitude));
+  EXPECT_NEAR(gpu.area.mean_speed_magnitude, cpu.area.mean_speed_magnitude,
+              tol * (1.0 + cpu.area.mean_speed_magnitude));
   EXPECT_NEAR(gpu.speed, cpu.speed, tol * (1.0 + cpu.speed));
   if (!gpu_test::tolerant()) {
     EXPECT_EQ(gpu.overlaps.max_depth, cpu.overlaps.max_depth);

@@ -26,7 +26,8 @@ State run_steps(const ScenarioSpec& spec, SchedulerKind scheduler, NeighbourSear
   Simulation sim(spec, options);  // world, crowd and scratch in current_memory()
   sim.set_scheduler(scheduler);
   sim.run(steps);
-  return {sim.positions(), sim.velocities(), sim.headings(), sim.arrival_times(), sim.flags(), sim.active_count(), sim.arrived_count()};
+  return {sim.positions(), sim.velocities(),   sim.headings(),     sim.arrival_times(),
+          sim.flags(),     sim.active_count(), sim.arrived_count()};
 }
 
 struct Case {
@@ -38,8 +39,8 @@ struct Case {
 };
 
 void expect_one_step_matches(const Case& c) {
-  SCOPED_TRACE(std::string(c.scenario) + ", " + to_string(c.scheduler) + (c.neighbours == NeighbourSearch::AllPairs ? ", all pairs" : "") +
-               ", " + to_string(c.model));
+  SCOPED_TRACE(std::string(c.scenario) + ", " + to_string(c.scheduler) +
+               (c.neighbours == NeighbourSearch::AllPairs ? ", all pairs" : "") + ", " + to_string(c.model));
   ScenarioSpec spec = test::builtin(c.scenario, c.agents);
   spec.model.kind = c.model;
   const auto run = [&](Memory) { return run_steps(spec, c.scheduler, c.neighbours, 1); };
@@ -75,21 +76,22 @@ void expect_one_step_matches(const Case& c) {
 
 TEST(CudaSimulation, OneStepMatchesCpu) {
   THRONG_REQUIRE_GPU();
-  for (const Case& c : {Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins},
-                        Case{"crossing", 1000, SchedulerKind::FourColour, NeighbourSearch::Bins},
-                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins},
-                        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins},
-                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs},
-                        // The collision-free speed model: sums of exponentials over neighbours (expf
-                        // differs by an ulp or two between the backends), the same bounds.
-                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
-                        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
-                        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs, ModelKind::CollisionFreeSpeed},
-                        // The time-to-collision model: sums of exponentials and square roots, likewise.
-                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::Ttc},
-                        // The social force model: the same sums, over ten substeps.
-                        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::SocialForce},
-                        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::SocialForce}})
+  for (const Case& c :
+       {Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins},
+        Case{"crossing", 1000, SchedulerKind::FourColour, NeighbourSearch::Bins},
+        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins},
+        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins},
+        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs},
+        // The collision-free speed model: sums of exponentials over neighbours (expf
+        // differs by an ulp or two between the backends), the same bounds.
+        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
+        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::CollisionFreeSpeed},
+        Case{"bottleneck", 600, SchedulerKind::DoubleBuffer, NeighbourSearch::AllPairs, ModelKind::CollisionFreeSpeed},
+        // The time-to-collision model: sums of exponentials and square roots, likewise.
+        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::Ttc},
+        // The social force model: the same sums, over ten substeps.
+        Case{"crossing", 1000, SchedulerKind::DoubleBuffer, NeighbourSearch::Bins, ModelKind::SocialForce},
+        Case{"bottleneck", 600, SchedulerKind::FourColour, NeighbourSearch::Bins, ModelKind::SocialForce}})
     expect_one_step_matches(c);
 }
 

@@ -30,8 +30,8 @@ using testing::Result;
 using testing::run;
 using testing::throng_exe;
 
-#define REQUIRE_EXE_AND_SHARED(exe, dir)                                                       \
-  const fs::path exe = throng_exe();                                                           \
+#define REQUIRE_EXE_AND_SHARED(exe, dir) \
+  const fs::path exe = throng_exe();     \
   THRONG_NEED_SHARED_BVH(dir)
 
 // Header facts read without the reader.
@@ -117,7 +117,8 @@ TEST(BvhCli, ConvertRoundTripsAndNormalises) {
   const auto mb = motion::forward_kinematics(b.skeleton, b.clip);
   ASSERT_EQ(ma.positions.size(), mb.positions.size());
   double worst = 0;
-  for (std::size_t i = 0; i < ma.positions.size(); ++i) worst = std::max(worst, static_cast<double>(glm::length(ma.positions[i] - mb.positions[i])));
+  for (std::size_t i = 0; i < ma.positions.size(); ++i)
+    worst = std::max(worst, static_cast<double>(glm::length(ma.positions[i] - mb.positions[i])));
   EXPECT_LT(worst, 1e-4);
 }
 

@@ -79,11 +79,14 @@ struct RefJoint {
   glm::dvec3 offset;
   std::string channels;  // one letter pair per channel: "Zr Xp ..."
 };
-const std::vector<RefJoint> kJoints = {
-    {"Pelvis", -1, {1, 2, 3}, "Zr Xp Yr Yp Xr Zp"}, {"NoChannels", 0, {0, 10, 0}, ""},
-    {"OneRot", 1, {0, 5, 10}, "Xr"},                {"NoChannelsLine", 0, {-5, 0, 0}, ""},
-    {"TwoRot", 3, {-4, 0, 2.5}, "Yr Zr"},           {"PosOnly", 4, {0, -7, 0}, "Zp Xp Yp"},
-    {"SixChan", 5, {0, -6, 0}, "Xr Yp Zr Xp Yr Zp"}, {"PartialPos", 4, {1, 1, 1}, "Yp Zr Yr Xr"}};
+const std::vector<RefJoint> kJoints = {{"Pelvis", -1, {1, 2, 3}, "Zr Xp Yr Yp Xr Zp"},
+                                       {"NoChannels", 0, {0, 10, 0}, ""},
+                                       {"OneRot", 1, {0, 5, 10}, "Xr"},
+                                       {"NoChannelsLine", 0, {-5, 0, 0}, ""},
+                                       {"TwoRot", 3, {-4, 0, 2.5}, "Yr Zr"},
+                                       {"PosOnly", 4, {0, -7, 0}, "Zp Xp Yp"},
+                                       {"SixChan", 5, {0, -6, 0}, "Xr Yp Zr Xp Yr Zp"},
+                                       {"PartialPos", 4, {1, 1, 1}, "Yp Zr Yr Xr"}};
 constexpr int kChannels = 22;
 
 std::vector<std::string> split(const std::string& s) {
@@ -230,20 +233,36 @@ TEST(BvhReader, UnitsOptionScalesEverything) {
   for (std::size_t j = 0; j < kJoints.size(); ++j)
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(in.skeleton.offsets[j][i], cm.skeleton.offsets[j][i] * 2.54f, 1e-6);
   for (int f = 0; f < 3; ++f)
-    for (int i = 0; i < 3; ++i) EXPECT_NEAR(in.clip.root_positions[static_cast<std::size_t>(f)][i], cm.clip.root_positions[static_cast<std::size_t>(f)][i] * 2.54f, 1e-5);
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(in.clip.root_positions[static_cast<std::size_t>(f)][i],
+                  cm.clip.root_positions[static_cast<std::size_t>(f)][i] * 2.54f, 1e-5);
 }
 
 // A small human in a given unit: legs 0.85 m, so detection has a real answer.
 std::string human(double units_per_metre) {
   auto v = [&](double metres) { return std::to_string(metres * units_per_metre); };
-  return "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
-         "JOINT LeftUpLeg\n{\nOFFSET " + v(0.1) + " 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
-         "JOINT LeftLeg\n{\nOFFSET 0 -" + v(0.43) + " 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
-         "JOINT LeftFoot\n{\nOFFSET 0 -" + v(0.42) + " 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
-         "End Site\n{\nOFFSET 0 0 " + v(0.15) + "\n}\n}\n}\n}\n"
-         "JOINT Spine\n{\nOFFSET 0 " + v(0.1) + " 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
-         "End Site\n{\nOFFSET 0 " + v(0.5) + " 0\n}\n}\n}\n"
-         "MOTION\nFrames: 1\nFrame Time: 0.0333333\n0 " + v(0.95) + " 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n";
+  return "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+         "Yrotation\n"
+         "JOINT LeftUpLeg\n{\nOFFSET " +
+         v(0.1) +
+         " 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+         "JOINT LeftLeg\n{\nOFFSET 0 -" +
+         v(0.43) +
+         " 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+         "JOINT LeftFoot\n{\nOFFSET 0 -" +
+         v(0.42) +
+         " 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+         "End Site\n{\nOFFSET 0 0 " +
+         v(0.15) +
+         "\n}\n}\n}\n}\n"
+         "JOINT Spine\n{\nOFFSET 0 " +
+         v(0.1) +
+         " 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+         "End Site\n{\nOFFSET 0 " +
+         v(0.5) +
+         " 0\n}\n}\n}\n"
+         "MOTION\nFrames: 1\nFrame Time: 0.0333333\n0 " +
+         v(0.95) + " 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n";
 }
 
 TEST(BvhReader, DetectsUnitsFromLegLength) {
@@ -269,7 +288,8 @@ TEST(BvhReader, ZeroFramesAndSkeletonOnly) {
 }
 
 // Parses `text` and checks the Error's line and that its text contains `needle`.
-void expect_error(const std::string& text, int line, const std::string& needle, const BvhReadOptions& options = in_cm()) {
+void expect_error(const std::string& text, int line, const std::string& needle,
+                  const BvhReadOptions& options = in_cm()) {
   try {
     parse_bvh(text, "bad.bvh", options);
     ADD_FAILURE() << "no error; expected line " << line << ": " << needle;
@@ -288,26 +308,26 @@ std::string replace(std::string s, const std::string& from, const std::string& t
 }
 
 const char* kSmall =
-    "HIERARCHY\n"                       // 1
-    "ROOT Hips\n"                       // 2
-    "{\n"                               // 3
-    "  OFFSET 0 0 0\n"                  // 4
+    "HIERARCHY\n"                                                                 // 1
+    "ROOT Hips\n"                                                                 // 2
+    "{\n"                                                                         // 3
+    "  OFFSET 0 0 0\n"                                                            // 4
     "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"  // 5
-    "  JOINT Leg\n"                     // 6
-    "  {\n"                             // 7
-    "    OFFSET 0 -40 0\n"              // 8
-    "    CHANNELS 3 Zrotation Xrotation Yrotation\n"  // 9
-    "    End Site\n"                    // 10
-    "    {\n"                           // 11
-    "      OFFSET 0 -40 0\n"            // 12
-    "    }\n"                           // 13
-    "  }\n"                             // 14
-    "}\n"                               // 15
-    "MOTION\n"                          // 16
-    "Frames: 2\n"                       // 17
-    "Frame Time: 0.0333333\n"           // 18
-    "1 90 2 0 0 0 10 20 30\n"           // 19
-    "1 91 2 0 0 0 11 21 31\n";          // 20
+    "  JOINT Leg\n"                                                               // 6
+    "  {\n"                                                                       // 7
+    "    OFFSET 0 -40 0\n"                                                        // 8
+    "    CHANNELS 3 Zrotation Xrotation Yrotation\n"                              // 9
+    "    End Site\n"                                                              // 10
+    "    {\n"                                                                     // 11
+    "      OFFSET 0 -40 0\n"                                                      // 12
+    "    }\n"                                                                     // 13
+    "  }\n"                                                                       // 14
+    "}\n"                                                                         // 15
+    "MOTION\n"                                                                    // 16
+    "Frames: 2\n"                                                                 // 17
+    "Frame Time: 0.0333333\n"                                                     // 18
+    "1 90 2 0 0 0 10 20 30\n"                                                     // 19
+    "1 91 2 0 0 0 11 21 31\n";                                                    // 20
 
 TEST(BvhReader, SmallFileParses) {
   const BvhFile b = parse_bvh(kSmall, "small.bvh", in_cm());
@@ -321,8 +341,10 @@ TEST(BvhReader, ErrorsNameLineAndWhatWasExpected) {
   expect_error(replace(s, "HIERARCHY", "HIERARCHX"), 1, "expected 'HIERARCHY', found 'HIERARCHX'");
   expect_error(replace(s, "ROOT Hips", "ROOT"), 2, "expected a joint name");
   expect_error(replace(s, "1 91 2 0 0 0 11 21 31", "1 91 2 0 0 0 11 21"), 20, "frame row 2 has 8 values, expected 9");
-  expect_error(replace(s, "1 91 2 0 0 0 11 21 31", "1 91 2 0 0 0 11 21 31 4"), 20, "frame row 2 has 10 values, expected 9");
-  expect_error(replace(s, "1 90 2 0 0 0 10", "1 90 2 0 0 0 1O"), 19, "expected a number (frame row 1 value 7), found '1O'");
+  expect_error(replace(s, "1 91 2 0 0 0 11 21 31", "1 91 2 0 0 0 11 21 31 4"), 20,
+               "frame row 2 has 10 values, expected 9");
+  expect_error(replace(s, "1 90 2 0 0 0 10", "1 90 2 0 0 0 1O"), 19,
+               "expected a number (frame row 1 value 7), found '1O'");
   expect_error(replace(s, "1 90 2 0 0 0 10", "1 90 2 0 0 0 nan"), 19, "not a finite number: 'nan'");
   expect_error(replace(s, "1 90 2 0 0 0 10", "1 90 2 0 0 0 -inf"), 19, "not a finite number");
   expect_error(replace(s, "1 90 2 0 0 0 10", "1 90 2 0 0 0 1e999"), 19, "out of range");
@@ -338,7 +360,8 @@ TEST(BvhReader, ErrorsNameLineAndWhatWasExpected) {
   expect_error(replace(s, "Frames: 2", "Frames: 2000000"), 17, "exceeds the limit of 1000000");
   expect_error(replace(s, "Frames: 2", "Frames: 900000"), 17, "bytes follow (truncated file?)");
   expect_error(replace(s, "Frame Time: 0.0333333", "Frame Time: 0"), 18, "frame time must be positive");
-  expect_error(replace(s, "Frame Time: 0.0333333", "Frame Time: 0.03 x"), 18, "expected the end of the 'Frame Time' line, found 'x'");
+  expect_error(replace(s, "Frame Time: 0.0333333", "Frame Time: 0.03 x"), 18,
+               "expected the end of the 'Frame Time' line, found 'x'");
   expect_error(replace(s, "Frame Time", "FrameTime"), 18, "expected 'Frame', found 'FrameTime:'");
   expect_error(replace(s, "CHANNELS 3 Zrotation Xrotation Yrotation", "CHANNELS 3 Zrotation Xrotation Wrotation"), 9,
                "expected a channel name (Xposition ... Zrotation), found 'Wrotation'");
@@ -346,16 +369,19 @@ TEST(BvhReader, ErrorsNameLineAndWhatWasExpected) {
                "channel 'Zrotation' listed twice");
   expect_error(replace(s, "CHANNELS 3 Zrotation", "CHANNELS 7 Zrotation"), 9, "channel count must be 0 to 6");
   expect_error(replace(s, "    End Site", "    End Zone"), 10, "expected 'Site' after 'End', found 'Zone'");
-  expect_error(replace(s, "  }\n}\nMOTION", "  }\nMOTION"), 15, "expected 'JOINT', 'End Site' or '}' in joint 'Hips' opened at line 2, found 'MOTION'");
+  expect_error(replace(s, "  }\n}\nMOTION", "  }\nMOTION"), 15,
+               "expected 'JOINT', 'End Site' or '}' in joint 'Hips' opened at line 2, found 'MOTION'");
   expect_error(replace(s, "MOTION", "MOTON"), 16, "expected 'MOTION', found 'MOTON'");
   expect_error(replace(s, "MOTION", "ROOT Again"), 16, "a second ROOT hierarchy is not supported");
-  expect_error(replace(s, "    OFFSET 0 -40 0", "    OFFSET 0 -40"), 9, "expected a number (OFFSET z), found 'CHANNELS'");
+  expect_error(replace(s, "    OFFSET 0 -40 0", "    OFFSET 0 -40"), 9,
+               "expected a number (OFFSET z), found 'CHANNELS'");
   expect_error(replace(s, "    OFFSET 0 -40 0", "    OFFSET 0 -40 inf"), 8, "OFFSET z is not a finite number");
   expect_error(s.substr(0, s.find("  }\n}\nMOTION")), 14, "file ends inside joint 'Leg' opened at line 6");
   expect_error(s.substr(0, s.find("Frame Time")), 18, "expected 'Frame', found end of file");
   expect_error(std::string(kSmall).substr(0, 0), 1, "expected 'HIERARCHY', found end of file");
   expect_error(replace(s, "Hips", std::string(300, 'a')), 2, "longer than 256 characters");
-  expect_error(std::string("HIERARCHY\nROOT \x01\x02\xff\n{\n\x80\x81 0 0 0\n"), 4, "expected 'OFFSET', found '\\x80\\x81'");
+  expect_error(std::string("HIERARCHY\nROOT \x01\x02\xff\n{\n\x80\x81 0 0 0\n"), 4,
+               "expected 'OFFSET', found '\\x80\\x81'");
 }
 
 TEST(BvhReader, ResourceLimitsAreCheckedBeforeAllocating) {

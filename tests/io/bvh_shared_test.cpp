@@ -25,7 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 std::vector<fs::path> shared_files(const fs::path& dir) {
   std::vector<fs::path> out;
   for (const auto& e : fs::directory_iterator(dir))
@@ -121,35 +120,69 @@ TEST(BvhShared, RolesOfEveryFile) {
     const BvhFile b = read_bvh(path.string());
     const motion::Skeleton& s = b.skeleton;
     std::printf("%s:", path.filename().c_str());
-    for (std::size_t r = 0; r < motion::kRoleCount; ++r) std::printf(" %s=%s", motion::to_string(static_cast<Role>(r)), role_name(s, static_cast<Role>(r)).c_str());
+    for (std::size_t r = 0; r < motion::kRoleCount; ++r)
+      std::printf(" %s=%s", motion::to_string(static_cast<Role>(r)), role_name(s, static_cast<Role>(r)).c_str());
     std::printf(" | spine:");
     for (std::int32_t j : s.spine_chain) std::printf(" %s", s.names[static_cast<std::size_t>(j)].c_str());
     std::printf("\n");
     std::vector<std::pair<Role, std::string>> want;
     std::vector<std::string> spine;
     if (is_mb(path)) {
-      want = {{Role::Hips, "Hips"},          {Role::Neck, "Neck"},           {Role::Head, "Head"},
-              {Role::LeftShoulder, "LeftArm"}, {Role::RightShoulder, "RightArm"}, {Role::LeftElbow, "LeftForeArm"},
-              {Role::RightElbow, "RightForeArm"}, {Role::LeftWrist, "LeftHand"}, {Role::RightWrist, "RightHand"},
-              {Role::LeftThigh, "LeftUpLeg"}, {Role::RightThigh, "RightUpLeg"}, {Role::LeftKnee, "LeftLeg"},
-              {Role::RightKnee, "RightLeg"}, {Role::LeftAnkle, "LeftFoot"}, {Role::RightAnkle, "RightFoot"},
-              {Role::LeftToe, "LeftToeBase"}, {Role::RightToe, "RightToeBase"}};
+      want = {{Role::Hips, "Hips"},
+              {Role::Neck, "Neck"},
+              {Role::Head, "Head"},
+              {Role::LeftShoulder, "LeftArm"},
+              {Role::RightShoulder, "RightArm"},
+              {Role::LeftElbow, "LeftForeArm"},
+              {Role::RightElbow, "RightForeArm"},
+              {Role::LeftWrist, "LeftHand"},
+              {Role::RightWrist, "RightHand"},
+              {Role::LeftThigh, "LeftUpLeg"},
+              {Role::RightThigh, "RightUpLeg"},
+              {Role::LeftKnee, "LeftLeg"},
+              {Role::RightKnee, "RightLeg"},
+              {Role::LeftAnkle, "LeftFoot"},
+              {Role::RightAnkle, "RightFoot"},
+              {Role::LeftToe, "LeftToeBase"},
+              {Role::RightToe, "RightToeBase"}};
       spine = {"LowerBack", "Spine", "Spine1"};
     } else if (is_daz(path)) {
-      want = {{Role::Hips, "hip"},          {Role::Neck, "neck"},         {Role::Head, "head"},
-              {Role::LeftShoulder, "lShldr"}, {Role::RightShoulder, "rShldr"}, {Role::LeftElbow, "lForeArm"},
-              {Role::RightElbow, "rForeArm"}, {Role::LeftWrist, "lHand"},   {Role::RightWrist, "rHand"},
-              {Role::LeftThigh, "lThigh"},  {Role::RightThigh, "rThigh"},  {Role::LeftKnee, "lShin"},
-              {Role::RightKnee, "rShin"},   {Role::LeftAnkle, "lFoot"},   {Role::RightAnkle, "rFoot"},
-              {Role::LeftToe, "-"},         {Role::RightToe, "-"}};  // the DAZ feet end in an End Site
+      want = {{Role::Hips, "hip"},
+              {Role::Neck, "neck"},
+              {Role::Head, "head"},
+              {Role::LeftShoulder, "lShldr"},
+              {Role::RightShoulder, "rShldr"},
+              {Role::LeftElbow, "lForeArm"},
+              {Role::RightElbow, "rForeArm"},
+              {Role::LeftWrist, "lHand"},
+              {Role::RightWrist, "rHand"},
+              {Role::LeftThigh, "lThigh"},
+              {Role::RightThigh, "rThigh"},
+              {Role::LeftKnee, "lShin"},
+              {Role::RightKnee, "rShin"},
+              {Role::LeftAnkle, "lFoot"},
+              {Role::RightAnkle, "rFoot"},
+              {Role::LeftToe, "-"},
+              {Role::RightToe, "-"}};  // the DAZ feet end in an End Site
       spine = {"abdomen", "chest"};
     } else if (is_max(path)) {
-      want = {{Role::Hips, "Hips"},              {Role::Neck, "lowerneck"},            {Role::Head, "Head"},
-              {Role::LeftShoulder, "LeftShoulder"}, {Role::RightShoulder, "RightShoulder"}, {Role::LeftElbow, "LeftElbow"},
-              {Role::RightElbow, "RightElbow"},   {Role::LeftWrist, "LeftWrist"},       {Role::RightWrist, "RightWrist"},
-              {Role::LeftThigh, "LeftHip"},       {Role::RightThigh, "RightHip"},        {Role::LeftKnee, "LeftKnee"},
-              {Role::RightKnee, "RightKnee"},     {Role::LeftAnkle, "LeftAnkle"},        {Role::RightAnkle, "RightAnkle"},
-              {Role::LeftToe, "LeftToe"},         {Role::RightToe, "RightToe"}};
+      want = {{Role::Hips, "Hips"},
+              {Role::Neck, "lowerneck"},
+              {Role::Head, "Head"},
+              {Role::LeftShoulder, "LeftShoulder"},
+              {Role::RightShoulder, "RightShoulder"},
+              {Role::LeftElbow, "LeftElbow"},
+              {Role::RightElbow, "RightElbow"},
+              {Role::LeftWrist, "LeftWrist"},
+              {Role::RightWrist, "RightWrist"},
+              {Role::LeftThigh, "LeftHip"},
+              {Role::RightThigh, "RightHip"},
+              {Role::LeftKnee, "LeftKnee"},
+              {Role::RightKnee, "RightKnee"},
+              {Role::LeftAnkle, "LeftAnkle"},
+              {Role::RightAnkle, "RightAnkle"},
+              {Role::LeftToe, "LeftToe"},
+              {Role::RightToe, "RightToe"}};
       spine = {"lowerback", "Chest", "Chest2"};
     } else {
       ADD_FAILURE() << "unknown naming scheme; add its expected roles here";
@@ -173,7 +206,8 @@ double max_joint_distance(const BvhFile& a, const BvhFile& b) {
 
 TEST(BvhShared, RoundTripWithinATenthOfAMillimetre) {
   THRONG_NEED_SHARED_BVH(dir);
-  const motion::LengthUnit units[] = {motion::LengthUnit::Centimetre, motion::LengthUnit::Metre, motion::LengthUnit::Inch};
+  const motion::LengthUnit units[] = {motion::LengthUnit::Centimetre, motion::LengthUnit::Metre,
+                                      motion::LengthUnit::Inch};
   std::size_t k = 0;
   for (const auto& path : shared_files(*dir)) {
     SCOPED_TRACE(path.filename().string());
@@ -193,8 +227,8 @@ TEST(BvhShared, RoundTripWithinATenthOfAMillimetre) {
       EXPECT_EQ(again.skeleton.parents, original.skeleton.parents);
       EXPECT_EQ(again.frame_time, original.frame_time);
       const double d = max_joint_distance(original, again);
-      std::printf("%s as %s in %s: max joint distance %.3g m over %d frames\n", path.filename().c_str(), motion::to_string(order),
-                  motion::to_string(w.unit), d, original.clip.frame_count);
+      std::printf("%s as %s in %s: max joint distance %.3g m over %d frames\n", path.filename().c_str(),
+                  motion::to_string(order), motion::to_string(w.unit), d, original.clip.frame_count);
       EXPECT_LT(d, 1e-4) << motion::to_string(order);
     }
     ++k;

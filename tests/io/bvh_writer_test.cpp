@@ -19,7 +19,8 @@ using motion::EulerOrder;
 using motion::LengthUnit;
 
 // Largest distance between the same joint (matched by name) in two clips.
-double max_joint_distance(const motion::Skeleton& sa, const motion::Clip& ca, const motion::Skeleton& sb, const motion::Clip& cb) {
+double max_joint_distance(const motion::Skeleton& sa, const motion::Clip& ca, const motion::Skeleton& sb,
+                          const motion::Clip& cb) {
   const motion::ModelSpaceClip a = motion::forward_kinematics(sa, ca);
   const motion::ModelSpaceClip b = motion::forward_kinematics(sb, cb);
   EXPECT_EQ(a.frame_count, b.frame_count);
@@ -49,7 +50,8 @@ TEST(BvhWriter, RoundTripEveryOrderAndUnit) {
     const motion::Skeleton s = motion::testing::random_skeleton(rng, 18);
     const motion::Clip c = motion::testing::random_clip(s, 30, rng, translations);
     for (EulerOrder order : motion::kAllEulerOrders)
-      for (LengthUnit unit : {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf}) {
+      for (LengthUnit unit :
+           {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf}) {
         const BvhFile b = round_trip(s, c, order, unit);
         ASSERT_EQ(b.skeleton.joint_count(), s.joint_count());
         EXPECT_EQ(b.skeleton.names, s.names);  // depth-first skeleton: same indices
@@ -61,9 +63,11 @@ TEST(BvhWriter, RoundTripEveryOrderAndUnit) {
           EXPECT_EQ(b.channels[static_cast<std::size_t>(j)].size(), (translations && j % 4 == 3) ? 6u : 3u) << j;
         }
         const double d = max_joint_distance(s, c, b.skeleton, b.clip);
-        EXPECT_LT(d, 1e-5) << motion::to_string(order) << " " << motion::to_string(unit) << " translations " << translations;
+        EXPECT_LT(d, 1e-5) << motion::to_string(order) << " " << motion::to_string(unit) << " translations "
+                           << translations;
         for (std::size_t i = 0; i < c.rotations.size(); ++i) {
-          const float diff = std::min(glm::length(c.rotations[i] - b.clip.rotations[i]), glm::length(c.rotations[i] + b.clip.rotations[i]));
+          const float diff = std::min(glm::length(c.rotations[i] - b.clip.rotations[i]),
+                                      glm::length(c.rotations[i] + b.clip.rotations[i]));
           ASSERT_LT(diff, 2e-6f) << i;
         }
       }
@@ -98,8 +102,10 @@ TEST(BvhWriter, HeaderAndFrameTime) {
   w.unit = LengthUnit::Centimetre;
   w.order = EulerOrder::ZYX;
   std::string text = write_bvh_string(s, c, w);
-  EXPECT_NE(text.find("ROOT Hips\n{\n\tOFFSET 0 0 0\n\tCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n"),
-            std::string::npos)
+  EXPECT_NE(
+      text.find(
+          "ROOT Hips\n{\n\tOFFSET 0 0 0\n\tCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n"),
+      std::string::npos)
       << text;
   EXPECT_NE(text.find("\tJOINT Bad_name__\n"), std::string::npos) << text;
   EXPECT_NE(text.find("\t\tJOINT joint_2\n"), std::string::npos) << text;

@@ -72,7 +72,8 @@ TEST(CrowdGltf, JointsReadBackWithinAMillimetreOfTheAnimator) {
   EXPECT_FALSE(fs::exists(path.string() + ".partial"));
   const double size = static_cast<double>(fs::file_size(path));
   const double estimate = CrowdTake::estimate_bytes(take.rig(), n, frames);
-  std::printf("  %lld agents x %d frames: %.0f bytes (estimate %.0f)\n", static_cast<long long>(n), frames, size, estimate);
+  std::printf("  %lld agents x %d frames: %.0f bytes (estimate %.0f)\n", static_cast<long long>(n), frames, size,
+              estimate);
   EXPECT_NEAR(estimate, size, 0.05 * size);
 
   const CrowdGlb glb(path.string());
@@ -90,8 +91,11 @@ TEST(CrowdGltf, JointsReadBackWithinAMillimetreOfTheAnimator) {
       glb.joint_frames(a, f, p, q, s);
       for (std::int32_t j = 0; j < J; ++j) {
         const std::size_t k = static_cast<std::size_t>(a * J + j);
-        worst_mm = std::max(worst_mm, 1000.0 * static_cast<double>(glm::length(p[static_cast<std::size_t>(j)] - world.positions[f][k])));
-        worst_deg = std::max(worst_deg, anim::rotation_angle_deg(q[static_cast<std::size_t>(j)], world.rotations[f][k]));
+        worst_mm =
+            std::max(worst_mm,
+                     1000.0 * static_cast<double>(glm::length(p[static_cast<std::size_t>(j)] - world.positions[f][k])));
+        worst_deg =
+            std::max(worst_deg, anim::rotation_angle_deg(q[static_cast<std::size_t>(j)], world.rotations[f][k]));
         EXPECT_FLOAT_EQ(s[static_cast<std::size_t>(j)], world.scales[static_cast<std::size_t>(a)]);
       }
     }
@@ -122,7 +126,10 @@ TEST(CrowdGltf, MeshSkinnedFromTheFileMatchesThrongsSkinning) {
   std::vector<float> s;
   auto skin = [&](const anim::SkinnedMesh& m, const std::vector<anim::Mat3x4>& palette, std::int32_t v) {
     glm::vec3 out(0.0f);
-    for (int i = 0; i < 4; ++i) out += m.weights[static_cast<std::size_t>(v)][i] * anim::transform_point(palette[m.joints[static_cast<std::size_t>(v)][i]], m.positions[static_cast<std::size_t>(v)]);
+    for (int i = 0; i < 4; ++i)
+      out += m.weights[static_cast<std::size_t>(v)][i] *
+             anim::transform_point(palette[m.joints[static_cast<std::size_t>(v)][i]],
+                                   m.positions[static_cast<std::size_t>(v)]);
     return out;
   };
   double worst_mm = 0.0;
@@ -137,9 +144,11 @@ TEST(CrowdGltf, MeshSkinnedFromTheFileMatchesThrongsSkinning) {
       from_throng[J_] = frame_of(world.rotations[f][k], world.positions[f][k], scale) * rig.inverse_bind[J_];
     }
     for (std::int32_t v = 0; v < mesh.vertex_count(); ++v)
-      worst_mm = std::max(worst_mm, 1000.0 * static_cast<double>(glm::length(skin(mesh, from_file, v) - skin(rig.mesh, from_throng, v))));
+      worst_mm = std::max(worst_mm, 1000.0 * static_cast<double>(glm::length(skin(mesh, from_file, v) -
+                                                                             skin(rig.mesh, from_throng, v))));
   }
-  std::printf("  worst skinned vertex %.4f mm over %lld agents x %d vertices\n", worst_mm, static_cast<long long>(n), mesh.vertex_count());
+  std::printf("  worst skinned vertex %.4f mm over %lld agents x %d vertices\n", worst_mm, static_cast<long long>(n),
+              mesh.vertex_count());
   EXPECT_LT(worst_mm, 1.0);
   fs::remove(path);
 }

@@ -46,15 +46,17 @@ TEST(LocomotionOnSharedFiles, WalkAndJogOfOneSubjectFormABlendSpace) {
   // Same subject, same skeleton: the jog's clip plays on the walk's skeleton.
   ASSERT_EQ(s->walk.skeleton.joint_count(), s->jog.skeleton.joint_count());
   for (std::size_t j = 0; j < s->walk.skeleton.offsets.size(); ++j)
-    EXPECT_LT(glm::length(s->walk.skeleton.offsets[j] - s->jog.skeleton.offsets[j]), 1e-4f) << s->walk.skeleton.names[j];
+    EXPECT_LT(glm::length(s->walk.skeleton.offsets[j] - s->jog.skeleton.offsets[j]), 1e-4f)
+        << s->walk.skeleton.names[j];
   const motion::BlendSpace1D& space = *s->space;
   ASSERT_EQ(space.clip_count(), 2);
-  std::printf("%-12s %6s %8s %8s %8s %10s %8s %8s %8s %8s\n", "clip", "frames", "speed", "stride", "period", "straight", "L up", "R down",
-              "R up", "cleanup");
+  std::printf("%-12s %6s %8s %8s %8s %10s %8s %8s %8s %8s\n", "clip", "frames", "speed", "stride", "period", "straight",
+              "L up", "R down", "R up", "cleanup");
   for (const motion::LocomotionClip& c : space.clips())
-    std::printf("%-12s %6d %8.3f %8.3f %8.3f %9.2fd %8.3f %8.3f %8.3f %7.1fcm\n", c.name.c_str(), c.frame_count(), c.speed, c.stride_m,
-                c.period_s, c.turn_removed_rad * 57.29578, c.event(motion::FootEvent::LeftUp), c.event(motion::FootEvent::RightDown),
-                c.event(motion::FootEvent::RightUp), 100.0 * c.contact_cleanup_m);
+    std::printf("%-12s %6d %8.3f %8.3f %8.3f %9.2fd %8.3f %8.3f %8.3f %7.1fcm\n", c.name.c_str(), c.frame_count(),
+                c.speed, c.stride_m, c.period_s, c.turn_removed_rad * 57.29578, c.event(motion::FootEvent::LeftUp),
+                c.event(motion::FootEvent::RightDown), c.event(motion::FootEvent::RightUp),
+                100.0 * c.contact_cleanup_m);
   const motion::LocomotionClip& walk = space.clips()[0];
   const motion::LocomotionClip& jog = space.clips()[1];
   EXPECT_EQ(walk.name, "walk_16_15");

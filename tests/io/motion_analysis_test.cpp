@@ -40,11 +40,13 @@ TEST(DefaultMotionsBvh, ExportReadsBackWithTheSameMotionAndCycle) {
     EXPECT_EQ(back.unit, motion::LengthUnit::Centimetre) << m.spec.name;  // detected from the leg length
     ASSERT_EQ(back.clip.frame_count, m.clip.frame_count);
     for (std::size_t r = 0; r < motion::kRoleCount; ++r)
-      EXPECT_EQ(back.skeleton.roles[r], skeleton.roles[r]) << m.spec.name << " " << motion::to_string(static_cast<motion::Role>(r));
+      EXPECT_EQ(back.skeleton.roles[r], skeleton.roles[r])
+          << m.spec.name << " " << motion::to_string(static_cast<motion::Role>(r));
     const motion::ModelSpaceClip a = motion::forward_kinematics(skeleton, m.clip);
     const motion::ModelSpaceClip b = motion::forward_kinematics(back.skeleton, back.clip);
     float worst = 0.0f;
-    for (std::size_t i = 0; i < a.positions.size(); ++i) worst = std::max(worst, glm::length(a.positions[i] - b.positions[i]));
+    for (std::size_t i = 0; i < a.positions.size(); ++i)
+      worst = std::max(worst, glm::length(a.positions[i] - b.positions[i]));
     EXPECT_LT(worst, 1e-4f) << m.spec.name;  // 0.1 mm
     if (m.spec.gait == motion::biomech::Gait::Stand) continue;
     const motion::CycleReport before = motion::analyze_cycle(skeleton, m.clip);
@@ -65,15 +67,15 @@ struct Expect {
 
 // Walks at 80-140 steps/min and 0.5-2 m/s; the jog at 140-190 and 2-3.5.
 constexpr Expect kLocomotion[] = {
-    {"cmu_02_01_walk_mb.bvh", 80, 140, 0.5, 2.0},      {"cmu_05_01_walk_daz.bvh", 80, 140, 0.5, 2.0},
-    {"cmu_07_03_walk_daz.bvh", 80, 140, 0.5, 2.0},     {"cmu_08_08_walk_fast_daz.bvh", 80, 140, 0.5, 2.0},
-    {"cmu_16_15_walk_daz.bvh", 80, 140, 0.5, 2.0},     {"cmu_16_36_run_jog_daz.bvh", 140, 190, 2.0, 3.5},
+    {"cmu_02_01_walk_mb.bvh", 80, 140, 0.5, 2.0},  {"cmu_05_01_walk_daz.bvh", 80, 140, 0.5, 2.0},
+    {"cmu_07_03_walk_daz.bvh", 80, 140, 0.5, 2.0}, {"cmu_08_08_walk_fast_daz.bvh", 80, 140, 0.5, 2.0},
+    {"cmu_16_15_walk_daz.bvh", 80, 140, 0.5, 2.0}, {"cmu_16_36_run_jog_daz.bvh", 140, 190, 2.0, 3.5},
 };
 
 TEST(CycleOnSharedFiles, WalksAndJogHavePlausibleCycles) {
   THRONG_NEED_SHARED_BVH(dir);
-  std::printf("%-30s %6s %7s %6s %9s %7s %7s %9s %9s %8s\n", "file", "frames", "period", "steps", "cadence", "stride", "speed",
-              "skate_cm", "p95_cm", "contacts");
+  std::printf("%-30s %6s %7s %6s %9s %7s %7s %9s %9s %8s\n", "file", "frames", "period", "steps", "cadence", "stride",
+              "speed", "skate_cm", "p95_cm", "contacts");
   for (const Expect& e : kLocomotion) {
     const fs::path path = *dir / e.file;
     if (!fs::exists(path)) {
@@ -112,8 +114,8 @@ TEST(CycleOnSharedFiles, WalksAndJogHavePlausibleCycles) {
     EXPECT_LE(again.pose_rms_m, r.pose_rms_m + 0.002) << e.file;
 
     const motion::FootSkatingReport skate = motion::measure_foot_skating(f.skeleton, f.clip, o.contacts);
-    std::printf("%-30s %6d %6.3fs %6d %9.1f %6.2fm %5.2fm/s %9.2f %9.2f %8d\n", e.file, f.clip.frame_count, r.period_s, r.steps,
-                r.cadence, r.stride_length, r.mean_speed, skate.mean_cm, skate.p95_cm, skate.contacts);
+    std::printf("%-30s %6d %6.3fs %6d %9.1f %6.2fm %5.2fm/s %9.2f %9.2f %8d\n", e.file, f.clip.frame_count, r.period_s,
+                r.steps, r.cadence, r.stride_length, r.mean_speed, skate.mean_cm, skate.p95_cm, skate.contacts);
     EXPECT_GE(skate.contacts, 2) << e.file;  // at least the cycle's own steps
   }
 }

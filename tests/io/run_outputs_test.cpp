@@ -80,7 +80,8 @@ TEST_F(TrajectoryFormats, PedpyTextReadsBackAsTheCsvPositions) {
   EXPECT_EQ(*f.framerate, 2.0);  // 1 / (0.1 s * 5)
   EXPECT_EQ(f.unit, "m");
   const Positions csv = read_csv(path(TrajectoryFormat::Csv));
-  ASSERT_EQ(f.rows.size(), 5u * static_cast<std::size_t>(kAgents));  // steps 0, 5, .., 20; the last step (23) is off the frame rate
+  ASSERT_EQ(f.rows.size(),
+            5u * static_cast<std::size_t>(kAgents));  // steps 0, 5, .., 20; the last step (23) is off the frame rate
   std::map<std::int64_t, int> per_frame;
   for (const auto& [id, frame, x, y] : f.rows) {
     EXPECT_GE(id, 1);
@@ -114,7 +115,8 @@ TEST(TrajectoryFormat, NamesAreCheckedOnceForYamlAndCli) {
     FAIL() << "accepted sqlite3";
   } catch (const Error& e) {
     EXPECT_EQ(e.location().field, "--trajectory-format");
-    EXPECT_EQ(e.message(), "unknown trajectory format 'sqlite3': expected csv, pedpy or sqlite (did you mean 'sqlite'?)");
+    EXPECT_EQ(e.message(),
+              "unknown trajectory format 'sqlite3': expected csv, pedpy or sqlite (did you mean 'sqlite'?)");
   }
   EXPECT_EQ(trajectory_file_name(TrajectoryFormat::Pedpy), "trajectories.txt");
   EXPECT_EQ(trajectory_file_name(TrajectoryFormat::Sqlite), "trajectories.sqlite");

@@ -43,7 +43,8 @@ std::vector<Expectation> expectations() {
     if (row.empty() || row[0] == '#') continue;
     std::vector<std::string> cols;
     std::size_t start = 0;
-    for (std::size_t tab; (tab = row.find('\t', start)) != std::string::npos; start = tab + 1) cols.push_back(row.substr(start, tab - start));
+    for (std::size_t tab; (tab = row.find('\t', start)) != std::string::npos; start = tab + 1)
+      cols.push_back(row.substr(start, tab - start));
     cols.push_back(row.substr(start));
     EXPECT_EQ(cols.size(), 5u) << row;
     if (cols.size() == 5) out.push_back({cols[0], cols[3], cols[4], std::stoi(cols[1]), std::stoi(cols[2])});
@@ -67,7 +68,8 @@ TEST(ScenarioBadCorpus, EveryFileGivesOneClearErrorAtItsKey) {
       EXPECT_EQ(e.location().line, c.line) << what;
       EXPECT_EQ(e.location().column, c.column) << what;
       EXPECT_EQ(e.location().field, c.field) << what;
-      EXPECT_NE(what.find(path + ":" + std::to_string(c.line) + ":" + std::to_string(c.column)), std::string::npos) << what;
+      EXPECT_NE(what.find(path + ":" + std::to_string(c.line) + ":" + std::to_string(c.column)), std::string::npos)
+          << what;
       EXPECT_NE(what.find(c.text), std::string::npos) << "\n  got:    " << what << "\n  wanted: " << c.text;
       EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
     }
@@ -278,11 +280,13 @@ groups:
 
 TEST(ScenarioYaml, TrajectoryOutputsLongAndShortForms) {
   const std::string head = "groups:\n  - count: 1\n    spawn: {points: [[0, 0]]}\n    goal: {point: [5, 0]}\n";
-  const LoadedScenario map_form = parse_scenario(head + "outputs:\n  trajectories: {format: sqlite, every: 7}\n", "t.yaml");
+  const LoadedScenario map_form =
+      parse_scenario(head + "outputs:\n  trajectories: {format: sqlite, every: 7}\n", "t.yaml");
   EXPECT_EQ(map_form.trajectory_format, TrajectoryFormat::Sqlite);
   EXPECT_EQ(map_form.spec.outputs.every, 7);
   EXPECT_TRUE(map_form.spec.outputs.trajectories);
-  const LoadedScenario format_only = parse_scenario(head + "outputs:\n  every: 3\n  trajectories:\n    format: pedpy\n", "t.yaml");
+  const LoadedScenario format_only =
+      parse_scenario(head + "outputs:\n  every: 3\n  trajectories:\n    format: pedpy\n", "t.yaml");
   EXPECT_EQ(format_only.trajectory_format, TrajectoryFormat::Pedpy);
   EXPECT_EQ(format_only.spec.outputs.every, 3);  // the stride where it always was
   const LoadedScenario short_form = parse_scenario(head + "outputs: {every: 3, trajectories: true}\n", "t.yaml");
@@ -297,7 +301,8 @@ TEST(ScenarioYaml, TrajectoryOutputsLongAndShortForms) {
   } catch (const Error& e) {
     EXPECT_EQ(e.location().field, "outputs.trajectories.format");
     EXPECT_EQ(e.location().line, 6);
-    EXPECT_NE(e.message().find("unknown trajectory format 'hdf5': expected csv, pedpy or sqlite"), std::string::npos) << e.message();
+    EXPECT_NE(e.message().find("unknown trajectory format 'hdf5': expected csv, pedpy or sqlite"), std::string::npos)
+        << e.message();
   }
   try {
     parse_scenario(head + "outputs:\n  trajectories: {fromat: csv}\n", "t.yaml");
@@ -333,12 +338,12 @@ TEST(ScenarioYaml, MeasurementAreasAndLines) {
 
   // Only lines: the areas stay to the default (the stage's 10 m square).
   const sim::MeasurementSpec lines_only =
-      parse_scenario(std::string(kOneGroup) + "measurement: {lines: [{from: [0, 0], to: [0, 1]}]}\n", "l.yaml").spec.measurement;
+      parse_scenario(std::string(kOneGroup) + "measurement: {lines: [{from: [0, 0], to: [0, 1]}]}\n", "l.yaml")
+          .spec.measurement;
   EXPECT_TRUE(lines_only.areas.empty());
   EXPECT_EQ(lines_only.lines.size(), 1u);
   EXPECT_FLOAT_EQ(lines_only.voronoi_cutoff, 2.0f);
 }
-
 
 // Parsing the one-group scenario with `model` fails with a message naming
 // the model that owns the misplaced parameter.
@@ -363,8 +368,8 @@ TEST(ScenarioYaml, TtcModelKeys) {
 )";
   const sim::ModelParams m = parse_scenario(text, "ttc.yaml").spec.model;
   EXPECT_EQ(m.kind, sim::ModelKind::Ttc);
-  const std::vector<std::pair<float, float>> read = {{m.ttc.strength, 2.0f},         {m.ttc.time_horizon, 4.0f},
-                                                     {m.ttc.relaxation_time, 0.6f},  {m.ttc.sensing_radius, 5.0f},
+  const std::vector<std::pair<float, float>> read = {{m.ttc.strength, 2.0f},          {m.ttc.time_horizon, 4.0f},
+                                                     {m.ttc.relaxation_time, 0.6f},   {m.ttc.sensing_radius, 5.0f},
                                                      {m.ttc.max_acceleration, 15.0f}, {m.ttc.side_bias, 0.25f},
                                                      {m.query_radius(), 5.0f}};
   for (const auto& [got, want] : read) EXPECT_FLOAT_EQ(got, want);
@@ -390,8 +395,8 @@ TEST(ScenarioYaml, SocialForceModelKeys) {
   const sim::ModelParams m = parse_scenario(text, "sf.yaml").spec.model;
   EXPECT_EQ(m.kind, sim::ModelKind::SocialForce);
   const std::vector<std::pair<float, float>> read = {
-      {m.sf.mass, 70.0f},          {m.sf.relaxation_time, 0.4f}, {m.sf.strength, 1500.0f},    {m.sf.range, 0.1f},
-      {m.sf.body_stiffness, 1e5f}, {m.sf.friction, 2e5f},        {m.sf.anisotropy, 0.3f},     {m.sf.sensing_radius, 3.0f},
+      {m.sf.mass, 70.0f},          {m.sf.relaxation_time, 0.4f}, {m.sf.strength, 1500.0f}, {m.sf.range, 0.1f},
+      {m.sf.body_stiffness, 1e5f}, {m.sf.friction, 2e5f},        {m.sf.anisotropy, 0.3f},  {m.sf.sensing_radius, 3.0f},
       {m.sf.max_substep, 0.02f},   {m.sf.side_bias, 1.0f},       {m.query_radius(), 3.0f}};
   for (const auto& [got, want] : read) EXPECT_FLOAT_EQ(got, want);
   // A parameter of another model names its owner, either way round.
@@ -403,7 +408,8 @@ TEST(ScenarioYaml, MeasurementListsAreBounded) {
   for (const char* list : {"areas", "lines"}) {
     std::string text = std::string(kOneGroup) + "measurement:\n  " + list + ":\n";
     for (int i = 0; i < 1001; ++i)
-      text += std::string(list) == "areas" ? "    - {rect: {min: [0, 0], max: [1, 1]}}\n" : "    - {from: [0, 0], to: [1, 1]}\n";
+      text += std::string(list) == "areas" ? "    - {rect: {min: [0, 0], max: [1, 1]}}\n"
+                                           : "    - {from: [0, 0], to: [1, 1]}\n";
     try {
       parse_scenario(text, "many.yaml");
       ADD_FAILURE() << list << ": no error";
@@ -417,7 +423,8 @@ TEST(ScenarioYaml, MeasurementListsAreBounded) {
 
 TEST(ScenarioYaml, CameraLookingStraightDownHasNorthUp) {
   const LoadedScenario l = parse_scenario(
-      "groups: [{count: 1, spawn: {rect: {min: [0, 0], max: [1, 1]}}, goal: [5, 5]}]\ncamera: {position: [3, 4, 50], target: [3, 4, 0]}\n",
+      "groups: [{count: 1, spawn: {rect: {min: [0, 0], max: [1, 1]}}, goal: [5, 5]}]\ncamera: {position: [3, 4, 50], "
+      "target: [3, 4, 0]}\n",
       "down.yaml");
   ASSERT_TRUE(l.spec.camera);
   l.spec.camera->validate();
@@ -430,8 +437,10 @@ TEST(BuiltinScenarios, AreTheExamplesFiles) {
     if (entry.path().extension() == ".yaml") files.insert(entry.path().stem().string());
   const std::vector<std::string> names = builtin_scenario_names();
   EXPECT_EQ(std::set<std::string>(names.begin(), names.end()), files);
-  for (const char* required : {"circle", "crossing", "corridor", "bottleneck", "plaza"}) EXPECT_TRUE(files.count(required)) << required;
-  for (const std::string& n : names) EXPECT_EQ(*builtin_scenario_text(n), slurp(kRoot / "examples" / (n + ".yaml"))) << n;
+  for (const char* required : {"circle", "crossing", "corridor", "bottleneck", "plaza"})
+    EXPECT_TRUE(files.count(required)) << required;
+  for (const std::string& n : names)
+    EXPECT_EQ(*builtin_scenario_text(n), slurp(kRoot / "examples" / (n + ".yaml"))) << n;
 }
 
 TEST(BuiltinScenarios, EachReadsBuildsAndRuns) {
@@ -451,10 +460,12 @@ TEST(BuiltinScenarios, EachReadsBuildsAndRuns) {
     EXPECT_EQ(sim->steps_done(), 3);
     const std::vector<glm::vec2> now = sim->positions();
     ASSERT_EQ(now.size(), start.size());
-    EXPECT_TRUE(std::all_of(now.begin(), now.end(), [](glm::vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }));
+    EXPECT_TRUE(
+        std::all_of(now.begin(), now.end(), [](glm::vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }));
     EXPECT_NE(now, start);
     const sim::CrowdState& c = sim->crowd();
-    EXPECT_EQ(sim::count_obstacle_penetrations(sim->world(), c.position.span(), c.radius.span(), c.flags.span(), 1e-3f), 0);
+    EXPECT_EQ(sim::count_obstacle_penetrations(sim->world(), c.position.span(), c.radius.span(), c.flags.span(), 1e-3f),
+              0);
     // A file path reads the same scenario.
     const LoadedScenario from_file = load_scenario((kRoot / "examples" / (n + ".yaml")).string());
     EXPECT_EQ(from_file.spec.total_agents(), load_scenario(n).spec.total_agents());

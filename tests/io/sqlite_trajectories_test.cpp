@@ -20,7 +20,9 @@ using namespace throng::io::testing;
 // sqlite3 helpers for the checks below.
 struct Db {
   sqlite3* db = nullptr;
-  explicit Db(const std::string& path) { EXPECT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK); }
+  explicit Db(const std::string& path) {
+    EXPECT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  }
   ~Db() { sqlite3_close(db); }
   // Each row of a query as text columns.
   std::vector<std::vector<std::string>> query(const std::string& sql) const {

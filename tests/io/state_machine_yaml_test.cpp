@@ -52,22 +52,29 @@ TEST(StateMachineYaml, DefaultMachineHasTheRequiredStates) {
 
 TEST(StateMachineYaml, ErrorsCarryFileLineAndColumn) {
   const std::string head = "clips:\n  walk: {default: walk}\nstates:\n";
-  EXPECT_NE(error_of(head + "  w:\n    segments: [{clip: walk, start: 0}]\n    colour: red\n").find("m.yaml:6:5"), std::string::npos);
+  EXPECT_NE(error_of(head + "  w:\n    segments: [{clip: walk, start: 0}]\n    colour: red\n").find("m.yaml:6:5"),
+            std::string::npos);
   EXPECT_NE(error_of(head + "  w:\n    segments: [{clip: jog}]\n").find("m.yaml:5:16"), std::string::npos);
   EXPECT_NE(error_of(head + "  w:\n    segments: [{clip: walk, start: -3}]\n").find("m.yaml:5:36"), std::string::npos);
   EXPECT_NE(error_of("clips:\n  walk: {default: walk}\nstates: [1, 2\n").find("m.yaml:"), std::string::npos);
-  EXPECT_NE(error_of("clips:\n  a: {gait: walk, speed: 9}\nstates:\n  w:\n    segments: [{clip: a}]\n").find("m.yaml:2:"), std::string::npos);
-  EXPECT_NE(error_of("clips:\n  a: {default: moonwalk}\nstates:\n  w:\n    segments: [{clip: a}]\n").find("moonwalk"), std::string::npos);
-  EXPECT_NE(error_of(head + "  w:\n    segments: [{clip: walk}]\nedges:\n  - [w, nowhere]\n").find("m.yaml:7:5"), std::string::npos);
+  EXPECT_NE(
+      error_of("clips:\n  a: {gait: walk, speed: 9}\nstates:\n  w:\n    segments: [{clip: a}]\n").find("m.yaml:2:"),
+      std::string::npos);
+  EXPECT_NE(error_of("clips:\n  a: {default: moonwalk}\nstates:\n  w:\n    segments: [{clip: a}]\n").find("moonwalk"),
+            std::string::npos);
+  EXPECT_NE(error_of(head + "  w:\n    segments: [{clip: walk}]\nedges:\n  - [w, nowhere]\n").find("m.yaml:7:5"),
+            std::string::npos);
   EXPECT_NE(error_of(head + "  w:\n    segments: [{clip: walk, frames: 30}]\n").find("m.yaml:5:"), std::string::npos);
-  EXPECT_NE(error_of("points_per_segment: 1.5\n" + head + "  w:\n    segments: [{clip: walk}]\n").find("m.yaml:1:21"), std::string::npos);
+  EXPECT_NE(error_of("points_per_segment: 1.5\n" + head + "  w:\n    segments: [{clip: walk}]\n").find("m.yaml:1:21"),
+            std::string::npos);
   EXPECT_EQ(error_of(head + "  w:\n    segments: [{clip: walk}]\n"), "");
 }
 
 TEST(PathsYaml, ReadsPathsAndRejectsBadOnes) {
   const PathsFile f = parse_paths(
       "radius: 0.3\nworld:\n  bounds: [[0, 0], [20, 10]]\n  circles: [{center: [5, 5], radius: 1}]\n"
-      "paths:\n  - {name: a, points: [[1, 1], [4, 1]], speed: 1.35, marks: [{from: 0.5, to: 1.5, state: run_forward}]}\n"
+      "paths:\n  - {name: a, points: [[1, 1], [4, 1]], speed: 1.35, marks: [{from: 0.5, to: 1.5, state: "
+      "run_forward}]}\n"
       "  - {from: [1, 1], to: [19, 9]}\n",
       "p.yaml");
   EXPECT_FLOAT_EQ(f.radius, 0.3f);
@@ -87,7 +94,8 @@ TEST(PathsYaml, ReadsPathsAndRejectsBadOnes) {
   EXPECT_NE(error("paths:\n  - {points: [[1, 1]]}\n").find("p.yaml:2:14"), std::string::npos);
   EXPECT_NE(error("paths:\n  - {from: [1, 1], to: [2, 2]}\n").find("needs a 'world'"), std::string::npos);
   EXPECT_NE(error("paths:\n  - {points: [[1, .nan], [2, 2]]}\n").find("p.yaml:2:"), std::string::npos);
-  EXPECT_NE(error("paths:\n  - {points: [[1, 1], [2, 2]], marks: [{from: 2, to: 1, state: x}]}\n").find("p.yaml:2:"), std::string::npos);
+  EXPECT_NE(error("paths:\n  - {points: [[1, 1], [2, 2]], marks: [{from: 2, to: 1, state: x}]}\n").find("p.yaml:2:"),
+            std::string::npos);
   EXPECT_NE(error("speed: 3\npaths: []\n").find("unknown key 'speed'"), std::string::npos);
 }
 

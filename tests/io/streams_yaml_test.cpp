@@ -105,33 +105,43 @@ TEST(StreamsYaml, ErrorsNameLineAndColumn) {
   const std::vector<Case> cases = {
       {rig + "streams:\n  - name: s\n    rig: h\n    histroy: 8\n", "t.yaml:6:5", "unknown key 'histroy'"},
       {clip + "streams:\n  - {name: s, rig: h, controller: {clip: nope}}\n", "t.yaml:6:42", "no clip named 'nope'"},
-      {clip + "streams:\n  - {name: s, rig: h, history: -3, controller: {clip: w}}\n", "t.yaml:6:32", "must be in [1, 65536], got -3"},
+      {clip + "streams:\n  - {name: s, rig: h, history: -3, controller: {clip: w}}\n", "t.yaml:6:32",
+       "must be in [1, 65536], got -3"},
       {clip + "streams:\n  - {name: s, rig: h, history: 64, time_to_dilate: 1, controller: {clip: w}}\n", "t.yaml:6:5",
        "time_to_dilate: must be at least"},
-      {clip + "streams:\n  - name: s\n    rig: h\n    controller:\n      state_machine:\n        states: [{name: a, controller: {clip: w}}]\n"
+      {clip + "streams:\n  - name: s\n    rig: h\n    controller:\n      state_machine:\n        states: [{name: a, "
+              "controller: {clip: w}}]\n"
               "        transitions: [{from: a, to: b}]\n",
        "t.yaml:11:37", "no state named 'b'"},
-      {clip + "streams:\n  - name: s\n    rig: h\n    controller:\n      state_machine:\n        states: [{name: a, controller: {clip: w}}, "
+      {clip + "streams:\n  - name: s\n    rig: h\n    controller:\n      state_machine:\n        states: [{name: a, "
+              "controller: {clip: w}}, "
               "{name: b, controller: {clip: w}}]\n        transitions: [{from: a, to: b, when: 'speed >> 2'}]\n",
        "t.yaml:11:46", "expected a number after the comparison"},
       {"rigs: [{name: h, skeleton: robot}]\n", "t.yaml:1:28", "the only built-in skeleton is 'default'"},
       {"rigs: [{name: h, bvh: /no/such/file.bvh}]\n", "t.yaml:1:23", "cannot read '/no/such/file.bvh'"},
       {"rigs: [{name: h, skeleton: default}\n", "t.yaml:", "end of sequence flow"},
       {rig + "clips:\n  - {name: w, rig: h, default: sprint}\n", "t.yaml:4:32", "no default motion 'sprint'"},
-      {rig + "clips:\n  - {name: w, rig: h, default: walk, events: [{name: e, time: 9}]}\n", "t.yaml:4:63", "must be in [0, "},
-      {rig + "clips:\n  - {name: w, rig: h, default: walk}\nstreams:\n  - {name: s, rig: h, controller: {layered: {base: {clip: w}, "
+      {rig + "clips:\n  - {name: w, rig: h, default: walk, events: [{name: e, time: 9}]}\n", "t.yaml:4:63",
+       "must be in [0, "},
+      {rig + "clips:\n  - {name: w, rig: h, default: walk}\nstreams:\n  - {name: s, rig: h, controller: {layered: "
+             "{base: {clip: w}, "
              "layers: [{controller: {clip: w}, mask: [Tail]}]}}}\n",
        "t.yaml:6:102", "no joint named 'Tail'"},
       {"rigs: [{name: h, skeleton: default, clusters: [{name: up, roots: [Spine]}]}]\n", "t.yaml:1:8",
        "must be a root of some cluster"},
       {rig + "unique:\n  - {name: u, rig: h, controller: {clip: w}}\n", "t.yaml:4:20", "has no unique_capacity"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, nope]}}}\n", "t.yaml:6:57", "no clip named 'nope'"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, w]}}}\n", "t.yaml:6:53", "have the same speed"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: mine}}}\n", "t.yaml:6:53", "the only built-in blend space"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: default, speed: -1}}}\n", "t.yaml:6:69", "must be in [0, 100], got -1"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {clips: [w]}}}\n", "t.yaml:6:45", "missing required key 'turn_left'"},
-      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {space: default, turn_left: w, turn_right: w}}}\n", "t.yaml:",
-       "must turn"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, nope]}}}\n", "t.yaml:6:57",
+       "no clip named 'nope'"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {clips: [w, w]}}}\n", "t.yaml:6:53",
+       "have the same speed"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: mine}}}\n", "t.yaml:6:53",
+       "the only built-in blend space"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend1d: {space: default, speed: -1}}}\n", "t.yaml:6:69",
+       "must be in [0, 100], got -1"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {clips: [w]}}}\n", "t.yaml:6:45",
+       "missing required key 'turn_left'"},
+      {clip + "streams:\n  - {name: s, rig: h, controller: {blend2d: {space: default, turn_left: w, turn_right: w}}}\n",
+       "t.yaml:", "must turn"},
   };
   // Each position is the first character of the offending value (or of the
   // mapping that lacks or contradicts something).
@@ -142,7 +152,8 @@ TEST(StreamsYaml, ErrorsNameLineAndColumn) {
   }
   StreamsYamlOptions small;
   small.limits.max_pose_bytes = 10000;
-  EXPECT_NE(error_of(clip + "streams:\n  - {name: s, rig: h, history: 64, controller: {clip: w}}\n", small).find("pose memory would exceed"),
+  EXPECT_NE(error_of(clip + "streams:\n  - {name: s, rig: h, history: 64, controller: {clip: w}}\n", small)
+                .find("pose memory would exceed"),
             std::string::npos);
   StreamsYamlOptions no_files;
   no_files.allow_files = false;
@@ -158,7 +169,9 @@ TEST(StreamsYaml, MixedCrowdWithARealCmuSkeleton) {
   const std::string yaml = "frame_rate: 30\nrigs:\n  - {name: human, skeleton: default}\n  - {name: cmu, bvh: '" + bvh +
                            "'}\nclips:\n  - {name: walk, rig: human, default: walk, footsteps: true}\n"
                            "  - {name: idle, rig: human, default: idle}\n"
-                           "  - {name: cmu_walk, rig: cmu, bvh: '" + bvh + "', frames: [10, 130], footsteps: true}\n"
+                           "  - {name: cmu_walk, rig: cmu, bvh: '" +
+                           bvh +
+                           "', frames: [10, 130], footsteps: true}\n"
                            "streams:\n  - {name: h_walk, rig: human, history: 64, controller: {clip: walk}}\n"
                            "  - {name: h_idle, rig: human, history: 32, controller: {clip: idle}}\n"
                            "  - {name: c_walk, rig: cmu, history: 64, controller: {clip: cmu_walk}}\n"
@@ -174,7 +187,8 @@ TEST(StreamsYaml, MixedCrowdWithARealCmuSkeleton) {
   crowd->add_agents(1, 500);
   crowd->assign_random(0, 500, {{{0, 1}, {0, 1}, {0}}, true}, 1);
   crowd->assign_random(500, 500, {{{2, 3}, {2, 3}, {2, 3}}, true}, 2);
-  const std::size_t want = 64u * (22u * 64u + 12u) + 32u * (22u * 64u + 12u) + 64u * (31u * 64u + 12u) + 48u * (31u * 64u + 12u);
+  const std::size_t want =
+      64u * (22u * 64u + 12u) + 32u * (22u * 64u + 12u) + 64u * (31u * 64u + 12u) + 48u * (31u * 64u + 12u);
   EXPECT_EQ(crowd->memory().stream_poses, want);
   EXPECT_EQ(crowd->palette_size(), 500 * 22 + 500 * 31);
 
@@ -204,9 +218,11 @@ TEST(StreamsYaml, MixedCrowdWithARealCmuSkeleton) {
       local[j] = glm::dquat(p.local[j]);
       if (j == 0) root = glm::dvec3(p.root);
     }
-    const auto want_palette = reference_palette(cmu, local, root, glm::dvec3(pos[static_cast<std::size_t>(a)]), yaw[static_cast<std::size_t>(a)]);
+    const auto want_palette = reference_palette(cmu, local, root, glm::dvec3(pos[static_cast<std::size_t>(a)]),
+                                                yaw[static_cast<std::size_t>(a)]);
     const Index base = crowd->palette_offsets()[a];
-    for (std::size_t j = 0; j < 31; ++j) ASSERT_LT(palette_error(palettes[static_cast<std::size_t>(base) + j], want_palette[j]), 3e-4) << a << " " << j;
+    for (std::size_t j = 0; j < 31; ++j)
+      ASSERT_LT(palette_error(palettes[static_cast<std::size_t>(base) + j], want_palette[j]), 3e-4) << a << " " << j;
   }
 }
 

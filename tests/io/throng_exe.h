@@ -24,7 +24,8 @@ struct Result {
 };
 // Runs `throng --backend cpu --log-level warn ARGS`; stdout (and stderr unless told not to).
 inline Result run(const std::filesystem::path& exe, const std::string& args, bool with_stderr = true) {
-  const std::string cmd = exe.string() + " --backend cpu --log-level warn " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
+  const std::string cmd =
+      exe.string() + " --backend cpu --log-level warn " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return {-1, "popen failed"};
   std::string out;

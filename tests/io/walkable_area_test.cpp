@@ -47,7 +47,8 @@ TEST(WalkableArea, AWallAcrossTheRoomGivesAMultiPolygon) {
   EXPECT_EQ(to_wkt(area), "MULTIPOLYGON (((0 0, 4 0, 4 10, 0 10, 0 0)), ((6 0, 10 0, 10 10, 6 10, 6 0)))");
   const nlohmann::json g = to_geojson(area)["features"][0]["geometry"];
   EXPECT_EQ(g["type"], "MultiPolygon");
-  EXPECT_EQ(g["coordinates"], nlohmann::json::parse("[[[[0,0],[4,0],[4,10],[0,10],[0,0]]], [[[6,0],[10,0],[10,10],[6,10],[6,0]]]]"));
+  EXPECT_EQ(g["coordinates"],
+            nlohmann::json::parse("[[[[0,0],[4,0],[4,10],[0,10],[0,0]]], [[[6,0],[10,0],[10,10],[6,10],[6,0]]]]"));
 }
 
 TEST(WalkableArea, OverlappingObstaclesBecomeOneHole) {
@@ -62,7 +63,8 @@ TEST(WalkableArea, AWorldWithoutBoundaryUsesItsBoundingBoxGrownBy2m) {
   EXPECT_EQ(to_wkt(walkable_area(world)), "POLYGON ((-2 -2, 3 -2, 3 3, -2 3, -2 -2), (0 0, 0 1, 1 1, 1 0, 0 0))");
   sim::Aabb extent;
   extent.add(glm::vec2(-5, 0.5f));
-  EXPECT_EQ(to_wkt(walkable_area(world, extent)), "POLYGON ((-7 -2, 3 -2, 3 3, -7 3, -7 -2), (0 0, 0 1, 1 1, 1 0, 0 0))");
+  EXPECT_EQ(to_wkt(walkable_area(world, extent)),
+            "POLYGON ((-7 -2, 3 -2, 3 3, -7 3, -7 -2), (0 0, 0 1, 1 1, 1 0, 0 0))");
 }
 
 TEST(WalkableArea, GeometryFilesAreWrittenWhole) {

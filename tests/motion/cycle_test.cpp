@@ -41,9 +41,9 @@ struct Synthetic {
   std::int32_t period = 37;
   std::int32_t frames = 160;
   double fps = 30.0;
-  double speed = 1.1;      // m/s
-  double turn_rate = 0.0;  // rad/s
-  double yaw0 = 0.0;       // constant heading of the whole clip
+  double speed = 1.1;         // m/s
+  double turn_rate = 0.0;     // rad/s
+  double yaw0 = 0.0;          // constant heading of the whole clip
   double spine_drift = 0.0;   // rad per frame (not periodic)
   double height_drift = 0.0;  // m per frame
 };
@@ -59,9 +59,11 @@ Clip synthetic_clip(const Skeleton& s, const Synthetic& c) {
     const double psi = c.yaw0 + c.turn_rate * t;
     glm::dvec3 path = std::abs(c.turn_rate) < 1e-12
                           ? glm::dvec3(0.0, 0.0, c.speed * t)
-                          : glm::dvec3(c.speed / c.turn_rate * (1 - std::cos(c.turn_rate * t)), 0.0, c.speed / c.turn_rate * std::sin(c.turn_rate * t));
+                          : glm::dvec3(c.speed / c.turn_rate * (1 - std::cos(c.turn_rate * t)), 0.0,
+                                       c.speed / c.turn_rate * std::sin(c.turn_rate * t));
     path = glm::angleAxis(c.yaw0, glm::dvec3(0, 1, 0)) * path;
-    clip.root_positions[static_cast<std::size_t>(f)] = glm::vec3(path + glm::dvec3(0.0, 0.95 + 0.02 * std::sin(2 * ph) + c.height_drift * f, 0.0));
+    clip.root_positions[static_cast<std::size_t>(f)] =
+        glm::vec3(path + glm::dvec3(0.0, 0.95 + 0.02 * std::sin(2 * ph) + c.height_drift * f, 0.0));
     clip.rotation(f, 0) = glm::quat(glm::angleAxis(psi + 0.06 * std::sin(ph), glm::dvec3(0, 1, 0)));
     clip.rotation(f, 1) = glm::quat(glm::angleAxis(0.1 * std::sin(ph + 2.0) + c.spine_drift * f, glm::dvec3(0, 1, 0)));
     for (int side = 0; side < 2; ++side) {
@@ -201,7 +203,8 @@ Tracks make_tracks(std::int32_t frames, Place place) {
   for (std::int32_t f = 0; f < frames; ++f)
     for (int foot = 0; foot < 2; ++foot)
       for (int point = 0; point < 2; ++point) {
-        const std::int32_t j = point == 0 ? t.feet.ankle[static_cast<std::size_t>(foot)] : t.feet.toe[static_cast<std::size_t>(foot)];
+        const std::int32_t j =
+            point == 0 ? t.feet.ankle[static_cast<std::size_t>(foot)] : t.feet.toe[static_cast<std::size_t>(foot)];
         m.positions[static_cast<std::size_t>(f * m.joint_count + j)] = place(f, foot, point);
       }
   return t;
@@ -244,10 +247,13 @@ TEST(FootSkating, MeasuresTheSlideOfThePinnedPoint) {
   const Tracks t = make_tracks(60, [](std::int32_t f, int foot, int point) {
     const float base = point == 0 ? 0.08f : 0.03f;
     const bool down = f >= 10 && f < 40;
-    if (foot == 0 && !down) return glm::vec3(0.0f, base + 0.3f, f < 10 ? travel(f, -5, -2.0f, 8, 0.0f) : travel(f, 41, 0.029f, 55, 2.0f));
+    if (foot == 0 && !down)
+      return glm::vec3(0.0f, base + 0.3f, f < 10 ? travel(f, -5, -2.0f, 8, 0.0f) : travel(f, 41, 0.029f, 55, 2.0f));
     if (!down) return glm::vec3(1.0f, base + 0.3f, point == 0 ? 0.35f : 0.5f);  // lifted straight up
     if (foot == 0) return glm::vec3(0.0f, base, 0.001f * static_cast<float>(f - 10));
-    return point == 1 ? glm::vec3(1.0f, base, 0.5f) : glm::vec3(1.0f, base + 0.001f * static_cast<float>(f - 10), 0.35f + 0.0005f * static_cast<float>(f - 10));
+    return point == 1 ? glm::vec3(1.0f, base, 0.5f)
+                      : glm::vec3(1.0f, base + 0.001f * static_cast<float>(f - 10),
+                                  0.35f + 0.0005f * static_cast<float>(f - 10));
   });
   ContactOptions o;
   o.smoothing_s = 0.0;
@@ -284,8 +290,11 @@ TEST(MakeCyclic, LeavesAnExactLoopAloneAndClosesADriftingOne) {
   const Clip loop = make_cyclic(exact, 20, 20 + c.period);
   ASSERT_EQ(loop.frame_count, c.period);
   for (std::int32_t f = 0; f < loop.frame_count; ++f) {
-    EXPECT_LT(glm::length(loop.root_positions[static_cast<std::size_t>(f)] - exact.root_positions[static_cast<std::size_t>(20 + f)]), 1e-6f);
-    for (std::int32_t j = 0; j < s.joint_count(); ++j) EXPECT_GT(std::abs(glm::dot(loop.rotation(f, j), exact.rotation(20 + f, j))), 1.0f - 1e-6f);
+    EXPECT_LT(glm::length(loop.root_positions[static_cast<std::size_t>(f)] -
+                          exact.root_positions[static_cast<std::size_t>(20 + f)]),
+              1e-6f);
+    for (std::int32_t j = 0; j < s.joint_count(); ++j)
+      EXPECT_GT(std::abs(glm::dot(loop.rotation(f, j), exact.rotation(20 + f, j))), 1.0f - 1e-6f);
   }
 
   // Spine rotation and root height drift: the period is still found (the
@@ -310,7 +319,8 @@ TEST(MakeCyclic, LeavesAnExactLoopAloneAndClosesADriftingOne) {
   const float dy_wrap = std::abs(closed.root_positions[0].y - closed.root_positions[static_cast<std::size_t>(n - 1)].y);
   float dy_max = 0.0f;
   for (std::int32_t f = 0; f + 1 < n; ++f)
-    dy_max = std::max(dy_max, std::abs(closed.root_positions[static_cast<std::size_t>(f + 1)].y - closed.root_positions[static_cast<std::size_t>(f)].y));
+    dy_max = std::max(dy_max, std::abs(closed.root_positions[static_cast<std::size_t>(f + 1)].y -
+                                       closed.root_positions[static_cast<std::size_t>(f)].y));
   EXPECT_LE(dy_wrap, dy_max * 1.01f);
   // Repeating the closed loop gives a clip whose period is the loop.
   const CycleReport again = analyze_cycle(s, repeat_cycle(closed, 4), wide_options());
@@ -331,10 +341,13 @@ TEST(RepeatCycle, ContinuesTheRootInTheHeadingFrame) {
     ASSERT_EQ(repeated.frame_count, direct.frame_count);
     for (std::int32_t f = 0; f < direct.frame_count; ++f) {
       // The loop step is estimated from its neighbours: ~mm after 3 strides.
-      EXPECT_LT(glm::length(repeated.root_positions[static_cast<std::size_t>(f)] - direct.root_positions[static_cast<std::size_t>(f)]), 0.005f)
+      EXPECT_LT(glm::length(repeated.root_positions[static_cast<std::size_t>(f)] -
+                            direct.root_positions[static_cast<std::size_t>(f)]),
+                0.005f)
           << name << " frame " << f;
       for (std::int32_t j = 0; j < sk.joint_count(); ++j)
-        ASSERT_GT(std::abs(glm::dot(repeated.rotation(f, j), direct.rotation(f, j))), 1.0f - 2e-4f) << name << " frame " << f;
+        ASSERT_GT(std::abs(glm::dot(repeated.rotation(f, j), direct.rotation(f, j))), 1.0f - 2e-4f)
+            << name << " frame " << f;
     }
     // A single stride is recognised as a loop and analysed as one.
     const CycleReport r = analyze_cycle(sk, gen.make_clip());

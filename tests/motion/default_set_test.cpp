@@ -78,7 +78,8 @@ TEST(DefaultSkeleton, NameHeuristicsAgreeWithTheRolesWeSet) {
   guessed.roles.fill(-1);
   guessed.spine_chain.clear();
   assign_roles(guessed);
-  for (std::size_t r = 0; r < kRoleCount; ++r) EXPECT_EQ(guessed.roles[r], ours.roles[r]) << to_string(static_cast<Role>(r));
+  for (std::size_t r = 0; r < kRoleCount; ++r)
+    EXPECT_EQ(guessed.roles[r], ours.roles[r]) << to_string(static_cast<Role>(r));
   EXPECT_EQ(guessed.spine_chain, ours.spine_chain);
 }
 
@@ -191,7 +192,8 @@ TEST_P(LocomotionClip, MatchesBiomechanicsByTwoMethods) {
     prev = d;
   }
   ASSERT_GE(crossings.size(), 5u);
-  const double steps_per_s = (static_cast<double>(crossings.size()) - 1.0) / ((crossings.back() - crossings.front()) / spec.fps);
+  const double steps_per_s =
+      (static_cast<double>(crossings.size()) - 1.0) / ((crossings.back() - crossings.front()) / spec.fps);
   EXPECT_NEAR(steps_per_s * 60.0 / t.cadence, 1.0, 0.01);
   const glm::vec3 a = clip.root_positions[0], b = clip.root_positions[static_cast<std::size_t>(2 * N)];
   const double chord = std::hypot(b.x - a.x, b.z - a.z);
@@ -203,7 +205,8 @@ TEST_P(LocomotionClip, MatchesBiomechanicsByTwoMethods) {
   const ContactReport& c = r.contacts;
   std::int32_t none = 0, both = 0;
   for (std::int32_t f = 0; f < clip.frame_count; ++f) {
-    const bool l = c.feet[0].in_contact[static_cast<std::size_t>(f)], rr = c.feet[1].in_contact[static_cast<std::size_t>(f)];
+    const bool l = c.feet[0].in_contact[static_cast<std::size_t>(f)],
+               rr = c.feet[1].in_contact[static_cast<std::size_t>(f)];
     none += !l && !rr;
     both += l && rr;
   }
@@ -259,7 +262,8 @@ TEST_P(LocomotionClip, FeetStayPlantedAndBonesKeepTheirLength) {
     for (std::int32_t j = 1; j < sk.joint_count(); ++j) {
       const auto p = static_cast<std::size_t>(sk.parents[static_cast<std::size_t>(j)]);
       const float len = glm::length(m.position(f, j) - m.position(f, static_cast<std::int32_t>(p)));
-      ASSERT_NEAR(len, glm::length(sk.offsets[static_cast<std::size_t>(j)]), 1e-4f) << sk.names[static_cast<std::size_t>(j)] << " frame " << f;
+      ASSERT_NEAR(len, glm::length(sk.offsets[static_cast<std::size_t>(j)]), 1e-4f)
+          << sk.names[static_cast<std::size_t>(j)] << " frame " << f;
     }
   // Swing clearance: the toe tip clears the ground (its rest height is 2 cm)
   // in the middle of each swing, and never goes more than 1 mm below it.
@@ -267,7 +271,8 @@ TEST_P(LocomotionClip, FeetStayPlantedAndBonesKeepTheirLength) {
   for (std::int32_t f = 0; f < clip.frame_count; ++f) {
     for (int side = 0; side < 2; ++side) {
       const std::int32_t toe = side == 0 ? dj::LeftToeBase : dj::RightToeBase;
-      const glm::vec3 tip = m.position(f, toe) + m.rotations[static_cast<std::size_t>(f) * sk.joint_count() + toe] * sk.end_sites[static_cast<std::size_t>(toe)];
+      const glm::vec3 tip = m.position(f, toe) + m.rotations[static_cast<std::size_t>(f) * sk.joint_count() + toe] *
+                                                     sk.end_sites[static_cast<std::size_t>(toe)];
       EXPECT_GT(tip.y, 0.019f);
       double u = static_cast<double>(f) / N - (side == 0 ? 0.0 : 0.5);
       u -= std::floor(u);
@@ -294,8 +299,12 @@ TEST_P(LocomotionClip, ArmsAndThoraxCounterRotate) {
     wrist_l.push_back((unturn * (m.position(f, dj::LeftHand) - root)).z);
     knee_l.push_back((unturn * (m.position(f, dj::LeftLeg) - root)).z);
     knee_r.push_back((unturn * (m.position(f, dj::RightLeg) - root)).z);
-    pelvis_yaw.push_back(std::remainder(heading_of(m.rotations[static_cast<std::size_t>(f) * sk.joint_count() + dj::Hips]) - psi, 2 * std::numbers::pi));
-    thorax_yaw.push_back(std::remainder(heading_of(m.rotations[static_cast<std::size_t>(f) * sk.joint_count() + dj::Spine2]) - psi, 2 * std::numbers::pi));
+    pelvis_yaw.push_back(
+        std::remainder(heading_of(m.rotations[static_cast<std::size_t>(f) * sk.joint_count() + dj::Hips]) - psi,
+                       2 * std::numbers::pi));
+    thorax_yaw.push_back(
+        std::remainder(heading_of(m.rotations[static_cast<std::size_t>(f) * sk.joint_count() + dj::Spine2]) - psi,
+                       2 * std::numbers::pi));
   }
   EXPECT_GT(correlation(wrist_l, knee_r), 0.7);   // the left arm swings with the right leg
   EXPECT_LT(correlation(wrist_l, knee_l), -0.7);  // and against the left leg

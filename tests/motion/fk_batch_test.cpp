@@ -37,7 +37,8 @@ Batch make_batch(int characters) {
   Batch b;
   b.skeleton = testing::random_skeleton(rng, 20);
   b.clip = testing::random_clip(b.skeleton, 30, rng, false);
-  for (int c = 0; c < characters; ++c) b.frames.push_back(static_cast<std::int32_t>(rng() % 34) - 2);  // some out of range
+  for (int c = 0; c < characters; ++c)
+    b.frames.push_back(static_cast<std::int32_t>(rng() % 34) - 2);  // some out of range
   b.positions.resize(static_cast<std::size_t>(characters * 20));
   b.rotations.resize(b.positions.size());
   return b;

@@ -28,7 +28,8 @@ const std::vector<double>& positive_halves() {
     std::vector<double> out;
     for (std::uint32_t h = 0; h <= 0x7bffu; ++h) {
       const std::uint32_t e = h >> 10, m = h & 0x3ffu;
-      out.push_back(e == 0 ? std::ldexp(static_cast<double>(m), -24) : std::ldexp(1.0 + m / 1024.0, static_cast<int>(e) - 15));
+      out.push_back(e == 0 ? std::ldexp(static_cast<double>(m), -24)
+                           : std::ldexp(1.0 + m / 1024.0, static_cast<int>(e) - 15));
     }
     return out;
   }();
@@ -79,12 +80,12 @@ TEST(Half, SpecialValues) {
   EXPECT_EQ(float_to_half(std::numeric_limits<float>::infinity()), 0x7c00u);
   EXPECT_EQ(float_to_half(-std::numeric_limits<float>::infinity()), 0xfc00u);
   EXPECT_TRUE(is_nan_half(float_to_half(std::numeric_limits<float>::quiet_NaN())));
-  EXPECT_EQ(float_to_half(std::ldexp(1.0f, -24)), 0x0001u);       // smallest subnormal
-  EXPECT_EQ(float_to_half(std::ldexp(1.0f, -25)), 0x0000u);       // tie -> even (zero)
-  EXPECT_EQ(float_to_half(std::ldexp(1.5f, -25)), 0x0001u);       // above the tie
-  EXPECT_EQ(float_to_half(std::ldexp(3.0f, -25)), 0x0002u);       // 1.5 ulp tie -> even (2)
-  EXPECT_EQ(float_to_half(std::ldexp(1.0f, -14)), 0x0400u);       // smallest normal
-  EXPECT_EQ(float_to_half(1.0f + std::ldexp(1.0f, -11)), 0x3c00u);  // tie -> even (1.0)
+  EXPECT_EQ(float_to_half(std::ldexp(1.0f, -24)), 0x0001u);             // smallest subnormal
+  EXPECT_EQ(float_to_half(std::ldexp(1.0f, -25)), 0x0000u);             // tie -> even (zero)
+  EXPECT_EQ(float_to_half(std::ldexp(1.5f, -25)), 0x0001u);             // above the tie
+  EXPECT_EQ(float_to_half(std::ldexp(3.0f, -25)), 0x0002u);             // 1.5 ulp tie -> even (2)
+  EXPECT_EQ(float_to_half(std::ldexp(1.0f, -14)), 0x0400u);             // smallest normal
+  EXPECT_EQ(float_to_half(1.0f + std::ldexp(1.0f, -11)), 0x3c00u);      // tie -> even (1.0)
   EXPECT_EQ(float_to_half(1.0f + 3 * std::ldexp(1.0f, -11)), 0x3c02u);  // tie -> even (up)
   EXPECT_EQ(half_to_float(0x3555u), 0.333251953125f);
 }

@@ -39,7 +39,8 @@ TEST(LocomotionSlerp, SlerpShortestMatchesTheExponentialMapAndKeepsEndsExact) {
     glm::quat b = glm::normalize(glm::quat(g(rng), g(rng), g(rng), g(rng)));
     if (i % 2 == 0) b = -b;  // the other hemisphere: must still take the short way
     const float t = u(rng);
-    ASSERT_LT(angle_deg(glm::dquat(slerp_shortest(a, b, t)), reference_slerp(glm::dquat(a), glm::dquat(b), t)), 2e-3) << i;
+    ASSERT_LT(angle_deg(glm::dquat(slerp_shortest(a, b, t)), reference_slerp(glm::dquat(a), glm::dquat(b), t)), 2e-3)
+        << i;
   }
   const glm::quat a(0.5f, 0.5f, 0.5f, 0.5f), b(0.0f, 1.0f, 0.0f, 0.0f);
   EXPECT_EQ(slerp_shortest(a, b, 0.0f), a);
@@ -60,7 +61,8 @@ TEST(LocomotionSlerp, NeighbouringFramesInterpolateAsSlerpDoes) {
         const glm::quat a = c.cycle.rotation(i, j), b = c.cycle.rotation((i + 1) % F, j);
         widest = std::max(widest, angle_deg(glm::dquat(a), glm::dquat(b)));
         for (float t : {0.1f, 0.25f, 0.5f, 0.8f})
-          worst = std::max(worst, angle_deg(glm::dquat(interpolate_frames(a, b, t)), reference_slerp(glm::dquat(a), glm::dquat(b), t)));
+          worst = std::max(worst, angle_deg(glm::dquat(interpolate_frames(a, b, t)),
+                                            reference_slerp(glm::dquat(a), glm::dquat(b), t)));
       }
   }
   std::printf("neighbouring frames up to %.2f deg apart; normalised lerp within %.2e deg of SLERP\n", widest, worst);
@@ -78,7 +80,8 @@ TEST(LocomotionSlerp, BlendedRotationIsTheReferenceSlerpOfBothClipsSamples) {
     const BlendPoint p = blend_point(v, x);
     const ClipPhases ph = warp_phase(v.sync[p.segment].group[0], p.w, u(rng));
     const auto j = static_cast<std::int32_t>(u(rng) * static_cast<float>(v.joint_count - 1));
-    const glm::dquat want = reference_slerp(glm::dquat(clip_rotation(v, p.a, ph.a, j)), glm::dquat(clip_rotation(v, p.b, ph.b, j)), p.w);
+    const glm::dquat want =
+        reference_slerp(glm::dquat(clip_rotation(v, p.a, ph.a, j)), glm::dquat(clip_rotation(v, p.b, ph.b, j)), p.w);
     worst = std::max(worst, angle_deg(glm::dquat(blended_rotation(v, p, ph, j)), want));
   }
   EXPECT_LT(worst, 2e-3);
@@ -142,19 +145,22 @@ TEST(LocomotionBlend, EndsOfTheBlendReproduceTheInputClips) {
       const CharacterFrame f = character_frame_at(v, p, phase, glm::vec3(0.0f), 0.0f, 1.0f);
       const std::int32_t src = (i + c.source_start_frame) % F;
       for (std::int32_t j = 1; j < J; ++j)
-        worst_rotation = std::max(worst_rotation, angle_deg(glm::dquat(joint_rotation(v, f, j)), glm::dquat(input->rotation(src, j))));
+        worst_rotation = std::max(worst_rotation,
+                                  angle_deg(glm::dquat(joint_rotation(v, f, j)), glm::dquat(input->rotation(src, j))));
       synthesise_pose(v, f, pos.data(), rot.data());
       // Joints relative to the root, in the root's heading frame.
       const double ours = heading_of(rot[0]), theirs = heading_of(fk.rotations[static_cast<std::size_t>(src * J)]);
       for (std::int32_t j = 0; j < J; ++j) {
-        const glm::dvec3 a = glm::angleAxis(-ours, glm::dvec3(0, 1, 0)) * glm::dvec3(pos[static_cast<std::size_t>(j)] - pos[0]);
-        const glm::dvec3 b = glm::angleAxis(-theirs, glm::dvec3(0, 1, 0)) * glm::dvec3(fk.position(src, j) - fk.position(src, 0));
+        const glm::dvec3 a =
+            glm::angleAxis(-ours, glm::dvec3(0, 1, 0)) * glm::dvec3(pos[static_cast<std::size_t>(j)] - pos[0]);
+        const glm::dvec3 b =
+            glm::angleAxis(-theirs, glm::dvec3(0, 1, 0)) * glm::dvec3(fk.position(src, j) - fk.position(src, 0));
         worst_position = std::max(worst_position, glm::length(a - b));
       }
       EXPECT_NEAR(pos[0].y, input->root_positions[static_cast<std::size_t>(src)].y, 1e-5) << c.name << " frame " << i;
     }
-    EXPECT_LT(worst_rotation, 0.02) << c.name;   // degrees: 1e-4 of a frame's motion
-    EXPECT_LT(worst_position, 2e-4) << c.name;   // metres
+    EXPECT_LT(worst_rotation, 0.02) << c.name;  // degrees: 1e-4 of a frame's motion
+    EXPECT_LT(worst_position, 2e-4) << c.name;  // metres
   }
 }
 
@@ -170,10 +176,11 @@ TEST(LocomotionBlend, RootDisplacementIsTheLerpOfTheClipsDisplacements) {
   for (int i = 0; i < 500; ++i) {
     const BlendPoint p = blend_point(v, u(rng) * static_cast<float>(v.clip_count - 1));
     const float phase0 = u(rng), phase1 = phase0 + 0.05f * u(rng);
-    const auto root_travel = [&](float phase) {  // root in the world of a character whose path point advances L_w per cycle
-      const ClipPhases ph = warp_phase(v.sync[p.segment].group[0], p.w, phase);
-      return blended_root_offset(v, p, phase, ph).position + glm::vec3(0.0f, 0.0f, blended_stride(v, p) * phase);
-    };
+    const auto root_travel =
+        [&](float phase) {  // root in the world of a character whose path point advances L_w per cycle
+          const ClipPhases ph = warp_phase(v.sync[p.segment].group[0], p.w, phase);
+          return blended_root_offset(v, p, phase, ph).position + glm::vec3(0.0f, 0.0f, blended_stride(v, p) * phase);
+        };
     const auto clip_travel = [&](std::int32_t clip, float phase) {  // a clip's root in its own world
       return clip_root_offset(v, clip, phase) + glm::vec3(0.0f, 0.0f, v.clips[clip].stride * phase);
     };
@@ -273,7 +280,7 @@ TEST(LocomotionRootMotion, ConstantTurnStaysOnItsCircle) {
 TEST(LocomotionRootMotion, CurvatureKeepsTheCircleWhateverTheSpeed) {
   const BlendSpaceView v = default_space().view();
   LocomotionStep step;
-  glm::vec3 p(10.0f, 0.0f, 0.0f);  // on a circle of radius 10 round the origin
+  glm::vec3 p(10.0f, 0.0f, 0.0f);                // on a circle of radius 10 round the origin
   float yaw = kPi, phase = 0.0f, shown = -1.0f;  // facing -Z: left turns go round the origin
   double worst = 0.0;
   for (int i = 0; i < 1200; ++i) {

@@ -71,12 +71,14 @@ TEST(MotionTexture, HalfTexelsAreRoundedFloatTexels) {
   const MotionTexture f16 = make_motion_texture(d.skeleton, d.clip, TexelFormat::Float16);
   ASSERT_EQ(f16.texels_f16.size(), f32.texels_f32.size());
   EXPECT_EQ(f16.bytes() * 2, f32.bytes());
-  for (std::size_t i = 0; i < f32.texels_f32.size(); ++i) ASSERT_EQ(f16.texels_f16[i], float_to_half(f32.texels_f32[i]));
+  for (std::size_t i = 0; i < f32.texels_f32.size(); ++i)
+    ASSERT_EQ(f16.texels_f16[i], float_to_half(f32.texels_f32[i]));
 }
 
 double max_position_error(const ModelSpaceClip& a, const ModelSpaceClip& b) {
   double worst = 0;
-  for (std::size_t i = 0; i < a.positions.size(); ++i) worst = std::max(worst, static_cast<double>(glm::length(a.positions[i] - b.positions[i])));
+  for (std::size_t i = 0; i < a.positions.size(); ++i)
+    worst = std::max(worst, static_cast<double>(glm::length(a.positions[i] - b.positions[i])));
   return worst;
 }
 
@@ -88,7 +90,8 @@ TEST(MotionTexture, Float32FkEqualsClipFk) {
     ASSERT_EQ(tex.positions.size(), ref.positions.size());
     // Only the renormalisation of already unit quaternions differs.
     EXPECT_LT(max_position_error(ref, tex), 1e-5);
-    for (std::size_t i = 0; i < ref.rotations.size(); ++i) ASSERT_LT(glm::length(ref.rotations[i] - tex.rotations[i]), 1e-5f);
+    for (std::size_t i = 0; i < ref.rotations.size(); ++i)
+      ASSERT_LT(glm::length(ref.rotations[i] - tex.rotations[i]), 1e-5f);
   }
 }
 

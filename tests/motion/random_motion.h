@@ -48,7 +48,8 @@ inline Clip random_clip(const Skeleton& s, int frames, std::mt19937& rng, bool a
   Clip c;
   c.resize(frames, s.joint_count());
   c.frame_time = 1.0f / 120.0f;
-  if (animate_translations) c.translations.resize(static_cast<std::size_t>(frames) * static_cast<std::size_t>(s.joint_count()));
+  if (animate_translations)
+    c.translations.resize(static_cast<std::size_t>(frames) * static_cast<std::size_t>(s.joint_count()));
   int k = 0;
   for (int f = 0; f < frames; ++f) {
     c.root_positions[static_cast<std::size_t>(f)] = glm::vec3(pos(rng), 1.0f + 0.1f * pos(rng), pos(rng));
@@ -65,7 +66,8 @@ inline Clip random_clip(const Skeleton& s, int frames, std::mt19937& rng, bool a
       c.rotation(f, j) = q;
       if (animate_translations) {
         const glm::vec3 rest = s.offsets[static_cast<std::size_t>(j)];
-        c.translations[static_cast<std::size_t>(f) * static_cast<std::size_t>(s.joint_count()) + static_cast<std::size_t>(j)] =
+        c.translations[static_cast<std::size_t>(f) * static_cast<std::size_t>(s.joint_count()) +
+                       static_cast<std::size_t>(j)] =
             (j % 4 == 3) ? rest + 0.1f * glm::vec3(g(rng), g(rng), g(rng)) : rest;
       }
     }

@@ -8,7 +8,8 @@ namespace throng::motion {
 namespace {
 
 TEST(Units, NamesAndFactors) {
-  for (LengthUnit u : {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf})
+  for (LengthUnit u :
+       {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf})
     EXPECT_EQ(parse_length_unit(to_string(u)), u);
   EXPECT_EQ(parse_length_unit("Inches"), LengthUnit::Inch);
   EXPECT_FALSE(parse_length_unit("furlong").has_value());
@@ -29,7 +30,8 @@ Skeleton figure(double scale, bool named_legs) {
 
 TEST(Units, GuessFromLegsOrExtent) {
   for (bool legs : {true, false})
-    for (LengthUnit u : {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf}) {
+    for (LengthUnit u :
+         {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch, LengthUnit::CmuAsf}) {
       const UnitGuess g = guess_length_unit(figure(1.0 / metres_per_unit(u), legs));
       EXPECT_EQ(g.unit, u) << to_string(u) << " legs " << legs;
       EXPECT_EQ(g.from_legs, legs);

@@ -75,9 +75,9 @@ TEST(MotionGraph, ChildrenInheritTheirGroupsEdges) {
   auto s = [&](const char* n) { return m.state_index(n); };
   EXPECT_TRUE(m.allowed(s("walk_forward"), s("walk_right")));  // F -> locomotion
   EXPECT_TRUE(m.allowed(s("run_forward"), s("walk_left")));
-  EXPECT_TRUE(m.allowed(s("walk_left"), s("run_forward")));    // L -> F
+  EXPECT_TRUE(m.allowed(s("walk_left"), s("run_forward")));  // L -> F
   EXPECT_TRUE(m.allowed(s("walk_left"), s("walk_left")));
-  EXPECT_FALSE(m.allowed(s("walk_left"), s("walk_right")));    // no L -> R
+  EXPECT_FALSE(m.allowed(s("walk_left"), s("walk_right")));  // no L -> R
   EXPECT_FALSE(m.allowed(s("idle"), s("run_forward")));
   EXPECT_TRUE(m.allowed(s("walk_forward"), s("idle")));
   // Transition costs: finite exactly where allowed; a segment flows into its
@@ -134,7 +134,8 @@ Reference exhaustive(const MotionGraph& m, const CurveSet& cs, double speed_weig
       double sum = 0;
       for (std::int32_t i = 0; i < cs.k; ++i) {
         const glm::dvec2 q(seg.trajectory[static_cast<std::size_t>(i)]);
-        const glm::dvec2 placed(p[0].x + std::cos(th) * q.x - std::sin(th) * q.y, p[0].y + std::sin(th) * q.x + std::cos(th) * q.y);
+        const glm::dvec2 placed(p[0].x + std::cos(th) * q.x - std::sin(th) * q.y,
+                                p[0].y + std::sin(th) * q.x + std::cos(th) * q.y);
         sum += glm::length(glm::dvec2(p[i]) - placed);
       }
       const double v = cs.speed[static_cast<std::size_t>(c)];
@@ -204,7 +205,8 @@ TEST(MatchGrid, AMotionsOwnTrajectoryMatchesItself) {
     std::vector<glm::vec2> pts;
     for (glm::vec2 q : seg.trajectory) pts.push_back(glm::vec2(3, -2) + glm::vec2(-q.y, q.x));  // +90 degrees
     pts.push_back(glm::vec2(3, -2) + glm::vec2(-seg.end_point.y, seg.end_point.x));
-    pts.push_back(pts.back() + 0.2f * (pts.back() - pts[pts.size() - 2]) / sim::length_of(pts.back() - pts[pts.size() - 2]));
+    pts.push_back(pts.back() +
+                  0.2f * (pts.back() - pts[pts.size() - 2]) / sim::length_of(pts.back() - pts[pts.size() - 2]));
     ResampleOptions o;
     o.spacing = m.spacing();
     o.max_knot_spacing = 0.1f;
@@ -214,7 +216,9 @@ TEST(MatchGrid, AMotionsOwnTrajectoryMatchesItself) {
     MatchGrid grid(m, cs);
     grid.match();
     const std::int32_t chosen = m.locomotion_segments()[static_cast<std::size_t>(grid.best()[0])];
-    const float own = grid.cost()[static_cast<std::size_t>(std::find(m.locomotion_segments().begin(), m.locomotion_segments().end(), id) - m.locomotion_segments().begin())];
+    const float own = grid.cost()[static_cast<std::size_t>(
+        std::find(m.locomotion_segments().begin(), m.locomotion_segments().end(), id) -
+        m.locomotion_segments().begin())];
     EXPECT_LT(own / static_cast<float>(m.k()), 0.01f) << seg.name;  // within 1 cm per point
     // Walking and running straight are the same curve: the same group is enough.
     EXPECT_EQ(m.states()[static_cast<std::size_t>(m.segments()[static_cast<std::size_t>(chosen)].state)].group,
@@ -233,7 +237,8 @@ TEST(MatchGrid, MarkedStretchesOnlyAcceptTheirState) {
   for (std::int32_t c = 0; c < cs.curve_count(); ++c) {
     if (cs.required_state[static_cast<std::size_t>(c)] < 0) continue;
     ++marked;
-    const std::int32_t seg = m.locomotion_segments()[static_cast<std::size_t>(grid.best()[static_cast<std::size_t>(c)])];
+    const std::int32_t seg =
+        m.locomotion_segments()[static_cast<std::size_t>(grid.best()[static_cast<std::size_t>(c)])];
     EXPECT_EQ(m.segments()[static_cast<std::size_t>(seg)].state, m.state_index("run_forward"));
   }
   EXPECT_GE(marked, 2);
@@ -267,7 +272,8 @@ TEST(Sequences, DpIsLegalOptimalAndBeatsRepairedGreedy) {
     }
     // Every consecutive pair is an edge of the machine.
     for (std::size_t c = 1; c < dp[p].segments.size(); ++c)
-      EXPECT_TRUE(m.allowed(m.segments()[static_cast<std::size_t>(dp[p].segments[c - 1])].state, m.segments()[static_cast<std::size_t>(dp[p].segments[c])].state));
+      EXPECT_TRUE(m.allowed(m.segments()[static_cast<std::size_t>(dp[p].segments[c - 1])].state,
+                            m.segments()[static_cast<std::size_t>(dp[p].segments[c])].state));
   }
   EXPECT_GT(greedy_illegal, 0) << "these S-bends should trip the greedy choice";
 }
@@ -309,21 +315,25 @@ TEST(Sequences, DpEqualsBruteForceOnShortPaths) {
     const std::vector<float> cost = grid.cost();
     auto start_cost = [&](std::int32_t seg) {
       double best = INFINITY;
-      for (std::int32_t a : m.states()[static_cast<std::size_t>(m.start_state())].segments) best = std::min(best, static_cast<double>(m.transition_cost(a, seg)));
+      for (std::int32_t a : m.states()[static_cast<std::size_t>(m.start_state())].segments)
+        best = std::min(best, static_cast<double>(m.transition_cost(a, seg)));
       return best;
     };
     auto end_cost = [&](std::int32_t seg) {
       double best = INFINITY;
-      for (std::int32_t b : m.states()[static_cast<std::size_t>(m.end_state())].segments) best = std::min(best, static_cast<double>(m.transition_cost(seg, b)));
+      for (std::int32_t b : m.states()[static_cast<std::size_t>(m.end_state())].segments)
+        best = std::min(best, static_cast<double>(m.transition_cost(seg, b)));
       return best;
     };
     double optimum = INFINITY;
     for (std::int32_t a = 0; a < M; ++a)
       for (std::int32_t b = 0; b < M; ++b)
         for (std::int32_t c = 0; c < M; ++c) {
-          const std::int32_t sa = loco[static_cast<std::size_t>(a)], sb = loco[static_cast<std::size_t>(b)], sc = loco[static_cast<std::size_t>(c)];
-          const double total = start_cost(sa) + cost[static_cast<std::size_t>(a)] + m.transition_cost(sa, sb) + cost[static_cast<std::size_t>(M + b)] +
-                               m.transition_cost(sb, sc) + cost[static_cast<std::size_t>(2 * M + c)] + end_cost(sc);
+          const std::int32_t sa = loco[static_cast<std::size_t>(a)], sb = loco[static_cast<std::size_t>(b)],
+                             sc = loco[static_cast<std::size_t>(c)];
+          const double total = start_cost(sa) + cost[static_cast<std::size_t>(a)] + m.transition_cost(sa, sb) +
+                               cost[static_cast<std::size_t>(M + b)] + m.transition_cost(sb, sc) +
+                               cost[static_cast<std::size_t>(2 * M + c)] + end_cost(sc);
           optimum = std::min(optimum, total);
         }
     const auto dp = dp_sequences(m, cs, cost);
@@ -344,7 +354,8 @@ TEST(Playback, FollowsThePathAndReportsDeviation) {
   const Playback pb = play(m, ps[0], dp[0]);
   // Frames: every segment's duration at the machine's fps.
   double total = 0;
-  total += m.segments()[static_cast<std::size_t>(dp[0].start_segment)].duration + m.segments()[static_cast<std::size_t>(dp[0].end_segment)].duration;
+  total += m.segments()[static_cast<std::size_t>(dp[0].start_segment)].duration +
+           m.segments()[static_cast<std::size_t>(dp[0].end_segment)].duration;
   for (std::int32_t s : dp[0].segments) total += m.segments()[static_cast<std::size_t>(s)].duration;
   EXPECT_EQ(pb.clip.frame_count, static_cast<std::int32_t>(std::floor(total * m.spec().fps)) + 1);
   EXPECT_GT(pb.matched_frames, 0);
@@ -355,13 +366,15 @@ TEST(Playback, FollowsThePathAndReportsDeviation) {
   EXPECT_LT(pb.deviation_max, 0.5);
   EXPECT_GE(pb.deviation_max, pb.deviation_mean);
   // Continuous: no frame-to-frame jump of the root beyond a running step.
-  for (std::size_t f = 1; f < pb.root_ground.size(); ++f) EXPECT_LT(sim::length_of(pb.root_ground[f] - pb.root_ground[f - 1]), 0.12f) << f;
+  for (std::size_t f = 1; f < pb.root_ground.size(); ++f)
+    EXPECT_LT(sim::length_of(pb.root_ground[f] - pb.root_ground[f - 1]), 0.12f) << f;
   // Starts standing at the first point.
   EXPECT_LT(sim::length_of(pb.root_ground[0] - ps[0].points[0]), 0.1f);
   // The character faces along the path where it walks: yaw = heading + pi/2.
   const std::int32_t f = pb.first_matched_frame + pb.matched_frames / 2;
   const glm::vec3 facing = pb.clip.rotation(f, 0) * glm::vec3(0, 0, 1);
-  const glm::vec2 dir = sim::normalize_or(pb.root_ground[static_cast<std::size_t>(f) + 5] - pb.root_ground[static_cast<std::size_t>(f) - 5], {1, 0});
+  const glm::vec2 dir = sim::normalize_or(
+      pb.root_ground[static_cast<std::size_t>(f) + 5] - pb.root_ground[static_cast<std::size_t>(f) - 5], {1, 0});
   const glm::vec2 face_map = sim::normalize_or(glm::vec2(facing.x, -facing.z), {0, 0});
   EXPECT_GT(sim::dot2(dir, face_map), 0.85f);
 }

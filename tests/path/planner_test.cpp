@@ -80,7 +80,8 @@ Raster raster(const Shapes& s, float h, float threshold, const std::vector<float
   std::vector<std::int32_t> parent(static_cast<std::size_t>(nx * ny));
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](std::int32_t a) {
-    while (parent[static_cast<std::size_t>(a)] != a) a = parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
+    while (parent[static_cast<std::size_t>(a)] != a)
+      a = parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
     return a;
   };
   auto ok = [&](int x, int y) { return clearance[static_cast<std::size_t>(y * nx + x)] >= threshold; };
@@ -105,7 +106,8 @@ TEST(Planner, PathExistsExactlyWithinAFreeComponent) {
     const int nx = 400, ny = 300;
     std::vector<float> clearance(static_cast<std::size_t>(nx * ny));
     for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x) clearance[static_cast<std::size_t>(y * nx + x)] = testing::true_clearance({(x + 0.5f) * h, (y + 0.5f) * h}, s);
+      for (int x = 0; x < nx; ++x)
+        clearance[static_cast<std::size_t>(y * nx + x)] = testing::true_clearance({(x + 0.5f) * h, (y + 0.5f) * h}, s);
     const Raster strict = raster(s, h, radius + h, clearance, nx, ny);
     const Raster loose = raster(s, h, radius - h, clearance, nx, ny);
     std::vector<glm::vec2> starts;
@@ -169,7 +171,7 @@ TEST(Planner, BlockedEndsAreReportedNotPlanned) {
   const Planner planner = planner_for(s, 0.3f);
   EXPECT_EQ(planner.plan({{-5, 5}, {20, 15}}).status, PlanStatus::StartBlocked);
   EXPECT_EQ(planner.plan({{0.1f, 15}, {20, 15}}).status, PlanStatus::StartBlocked);  // too close to the wall
-  EXPECT_EQ(planner.plan({{20, 15}, {5.5f, 7}}).status, PlanStatus::GoalBlocked);   // inside the L wall
+  EXPECT_EQ(planner.plan({{20, 15}, {5.5f, 7}}).status, PlanStatus::GoalBlocked);    // inside the L wall
   PlanOptions bad;
   bad.radius = -1;
   EXPECT_THROW(bad.validate(), Error);

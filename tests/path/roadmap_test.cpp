@@ -15,7 +15,9 @@ namespace {
 
 using testing::Shapes;
 
-FreeSpace space_of(const Shapes& s, FreeSpaceOptions o = {}) { return FreeSpace::build(&s.walkable, s.polygons, s.circles, o); }
+FreeSpace space_of(const Shapes& s, FreeSpaceOptions o = {}) {
+  return FreeSpace::build(&s.walkable, s.polygons, s.circles, o);
+}
 
 // A walkable region 2000 km across with one small obstacle: containment and
 // clear segments answer as brute force over the boundary does, and the
@@ -38,10 +40,13 @@ TEST(FreeSpace, AHugeNearlyEmptyWorldAnswersLikeBruteForce) {
       if (segment_segment_distance(a, b, e.a, e.b) < r) return false;
     return true;
   };
-  const glm::vec2 points[] = {{-10, 0}, {0.5f, 0}, {0.5f, 6}, {5e5f, -3e5f}, {1.5e6f, 0}, {-9.99e5f, 9.99e5f}, {2, 4.9f}};
+  const glm::vec2 points[] = {{-10, 0},    {0.5f, 0},           {0.5f, 6}, {5e5f, -3e5f},
+                              {1.5e6f, 0}, {-9.99e5f, 9.99e5f}, {2, 4.9f}};
   for (const glm::vec2 p : points) EXPECT_EQ(fs.contains(p), brute_contains(p)) << p.x << ", " << p.y;
   for (const glm::vec2 a : points)
-    for (const glm::vec2 b : points) EXPECT_EQ(fs.segment_clear(a, b, 0.3f), brute_clear(a, b, 0.3f)) << a.x << "," << a.y << " -> " << b.x << "," << b.y;
+    for (const glm::vec2 b : points)
+      EXPECT_EQ(fs.segment_clear(a, b, 0.3f), brute_clear(a, b, 0.3f))
+          << a.x << "," << a.y << " -> " << b.x << "," << b.y;
   RoadmapOptions ro;
   ro.radius = 0.25f;
   const Roadmap map = build_roadmap(fs, ro);
@@ -69,7 +74,7 @@ TEST(FreeSpace, UnionOfOverlappingObstaclesAndContainment) {
   s.walkable.outer = sim::rect_ring({0, 0}, {10, 10});
   s.polygons.push_back({sim::rect_ring({2, 2}, {5, 5}), {}});
   s.polygons.push_back({sim::rect_ring({4, 4}, {7, 7}), {}});  // overlaps the first
-  s.circles.push_back({{7, 7}, 1.0f});                          // overlaps the second
+  s.circles.push_back({{7, 7}, 1.0f});                         // overlaps the second
   const FreeSpace fs = space_of(s);
   ASSERT_EQ(fs.components().size(), 1u);
   EXPECT_EQ(fs.components()[0].holes.size(), 1u);  // one merged obstacle
@@ -146,12 +151,14 @@ TEST(Roadmap, EveryEdgeKeepsTheRadiusAgainstBruteForce) {
         const RoadmapEdge& e = map.edges[static_cast<std::size_t>(k)];
         for (std::int32_t node : {e.a, e.b}) {
           bool listed = false;
-          for (std::int32_t j = map.adjacency_begin[static_cast<std::size_t>(node)]; j < map.adjacency_begin[static_cast<std::size_t>(node) + 1]; ++j)
+          for (std::int32_t j = map.adjacency_begin[static_cast<std::size_t>(node)];
+               j < map.adjacency_begin[static_cast<std::size_t>(node) + 1]; ++j)
             listed |= map.adjacency[static_cast<std::size_t>(j)] == k;
           EXPECT_TRUE(listed);
         }
         EXPECT_LT(sim::length_of(map.nodes[static_cast<std::size_t>(e.a)] - map.edge_point(k, 0)), 1e-3f);
-        EXPECT_LT(sim::length_of(map.nodes[static_cast<std::size_t>(e.b)] - map.edge_point(k, e.point_count - 1)), 1e-3f);
+        EXPECT_LT(sim::length_of(map.nodes[static_cast<std::size_t>(e.b)] - map.edge_point(k, e.point_count - 1)),
+                  1e-3f);
       }
     }
   }

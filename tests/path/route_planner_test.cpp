@@ -72,7 +72,8 @@ float exact_segment_clearance(glm::vec2 a, glm::vec2 b, const Shapes& s) {
   if (testing::true_clearance(a, s) <= 0) return 0.0f;
   float best = INFINITY;
   for_each_edge(s, [&](glm::vec2 c, glm::vec2 d) { best = std::min(best, segment_segment(a, b, c, d)); });
-  for (const sim::Circle& c : s.circles) best = std::max(0.0f, std::min(best, point_segment(c.center, a, b) - c.radius));
+  for (const sim::Circle& c : s.circles)
+    best = std::max(0.0f, std::min(best, point_segment(c.center, a, b) - c.radius));
   return best;
 }
 
@@ -82,7 +83,8 @@ float visibility_shortest(glm::vec2 a, glm::vec2 b, const Shapes& s, float radiu
   const float off = radius + 0.02f;
   std::vector<glm::vec2> nodes = {a, b};
   auto add_ring = [&](glm::vec2 centre, float r, int count) {
-    const float grow = 1.0f / std::cos(3.14159265f / static_cast<float>(count));  // the polygon circumscribes the circle
+    const float grow =
+        1.0f / std::cos(3.14159265f / static_cast<float>(count));  // the polygon circumscribes the circle
     for (int k = 0; k < count; ++k) {
       const float t = 2.0f * 3.14159265f * static_cast<float>(k) / static_cast<float>(count);
       const glm::vec2 p = centre + (r * grow) * glm::vec2(std::cos(t), std::sin(t));
@@ -114,7 +116,8 @@ float visibility_shortest(glm::vec2 a, glm::vec2 b, const Shapes& s, float radiu
 // ---- tests ---------------------------------------------------------------------
 
 // Random free (start, goal) pairs with room for the disc at both ends.
-void random_queries(const Shapes& s, float radius, std::uint64_t seed, int count, std::vector<glm::vec2>& starts, std::vector<glm::vec2>& goals) {
+void random_queries(const Shapes& s, float radius, std::uint64_t seed, int count, std::vector<glm::vec2>& starts,
+                    std::vector<glm::vec2>& goals) {
   Rng rng(seed);
   auto free_point = [&] {
     for (;;) {
@@ -154,7 +157,8 @@ TEST(RoutePlanner, RoutesAreCollisionFreeAndNearTheVisibilityGraphShortestPath) 
       route.insert(route.end(), routes[k].begin(), routes[k].end());
       route.push_back(goals[k]);
       for (std::size_t i = 1; i < route.size(); ++i)
-        EXPECT_GE(exact_segment_clearance(route[i - 1], route[i], s), radius - 2e-3f) << "seed " << seed << " query " << k << " piece " << i;
+        EXPECT_GE(exact_segment_clearance(route[i - 1], route[i], s), radius - 2e-3f)
+            << "seed " << seed << " query " << k << " piece " << i;
       const float length = polyline_length(route);
       EXPECT_GE(length, ref * 0.98f);  // the reference is shortest up to its corner discretisation
       EXPECT_LE(length, ref * 2.0f) << "seed " << seed << " query " << k;
@@ -164,8 +168,9 @@ TEST(RoutePlanner, RoutesAreCollisionFreeAndNearTheVisibilityGraphShortestPath) 
       routed += routes[k].empty() ? 0 : 1;
     }
   }
-  std::printf("  %d queries compared (%d routed around obstacles): route / visibility-graph length mean %.3f, max %.3f\n", compared,
-              routed, ratio_sum / compared, ratio_max);
+  std::printf(
+      "  %d queries compared (%d routed around obstacles): route / visibility-graph length mean %.3f, max %.3f\n",
+      compared, routed, ratio_sum / compared, ratio_max);
   EXPECT_GE(compared, 48);
   EXPECT_GE(routed, 16);
   EXPECT_LE(ratio_sum / compared, 1.1);

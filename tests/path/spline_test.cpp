@@ -39,7 +39,8 @@ TEST(Spline, InterpolatesKnotsAndIsC1) {
       EXPECT_LT(sim::length_of(left - right), 1e-4f * std::max(1.0f, sim::length_of(left)));
       // And numerically, from finite differences in the knot parameter.
       const float hl = s.knot_params()[static_cast<std::size_t>(i) + 1] - s.knot_params()[static_cast<std::size_t>(i)];
-      const float hr = s.knot_params()[static_cast<std::size_t>(i) + 2] - s.knot_params()[static_cast<std::size_t>(i) + 1];
+      const float hr =
+          s.knot_params()[static_cast<std::size_t>(i) + 2] - s.knot_params()[static_cast<std::size_t>(i) + 1];
       const float e = 1e-3f;
       const glm::vec2 dl = (s.position(i, 1.0f) - s.position(i, 1.0f - e)) / (e * hl);
       const glm::vec2 dr = (s.position(i + 1, e) - s.position(i + 1, 0.0f)) / (e * hr);
@@ -76,7 +77,8 @@ TEST(Resample, SpacingWithinOnePercent) {
       for (std::size_t i = 1; i < r.points.size(); ++i) {
         const double d = sim::length_of(r.points[i] - r.points[i - 1]);
         worst = std::max(worst, std::fabs(d - spacing) / spacing);
-        EXPECT_GE(r.arc[i] - r.arc[i - 1], spacing * 0.99f);  // an arc is never shorter than its chord (the table's arc is approximate)
+        EXPECT_GE(r.arc[i] - r.arc[i - 1],
+                  spacing * 0.99f);  // an arc is never shorter than its chord (the table's arc is approximate)
       }
       EXPECT_LT(worst, 0.01) << "spacing " << spacing << " seed " << seed;
       for (glm::vec2 t : r.tangents) EXPECT_NEAR(sim::length_of(t), 1.0f, 1e-4f);
@@ -110,7 +112,8 @@ TEST(Resample, MarksCarryAFixedState) {
   const std::vector<glm::vec2> pts = {{0, 0}, {10, 0}, {10, 10}};
   ResampleOptions o;
   o.spacing = 0.1f;
-  const std::vector<PathMark> marks = {{2.0f, 4.0f, "run_forward"}, {15.0f, 16.0f, "walk_left"}, {17.0f, 18.0f, "run_forward"}};
+  const std::vector<PathMark> marks = {
+      {2.0f, 4.0f, "run_forward"}, {15.0f, 16.0f, "walk_left"}, {17.0f, 18.0f, "run_forward"}};
   const ResampledPath r = resample_path(pts, o, marks);
   ASSERT_EQ(r.mark_states.size(), 2u);
   EXPECT_EQ(r.mark_states[0], "run_forward");

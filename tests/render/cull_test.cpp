@@ -77,7 +77,8 @@ TEST(Cull, KeepsEveryCharacterWithAPointInViewAndDropsThoseFarOutside) {
     bool any_point_in_view = false;
     for (int j = 0; j < rig.joint_count; ++j) {
       const glm::vec3 px = world_to_pixel(view, c.positions[static_cast<std::size_t>(i * rig.joint_count + j)]);
-      any_point_in_view |= px.z > cam.near_plane && px.z < cam.far_plane && px.x >= 0 && px.x < 640 && px.y >= 0 && px.y < 360;
+      any_point_in_view |=
+          px.z > cam.near_plane && px.z < cam.far_plane && px.x >= 0 && px.x < 640 && px.y >= 0 && px.y < 360;
     }
     const glm::vec3 root = c.positions[static_cast<std::size_t>(i * rig.joint_count)];
     bool far_outside = false;
@@ -189,7 +190,8 @@ TEST(Pack, PerPartLevelsColourEachPoint) {
   job.out_points = out;
   job.run();
   for (std::int32_t k = 0; k < rig.point_count(); ++k)
-    EXPECT_EQ(static_cast<int>(out[static_cast<std::size_t>(k)].w) & 15, 1 + rig.points[static_cast<std::size_t>(k)].part);
+    EXPECT_EQ(static_cast<int>(out[static_cast<std::size_t>(k)].w) & 15,
+              1 + rig.points[static_cast<std::size_t>(k)].part);
   job.lod_levels = Span<const std::uint8_t>(levels.data(), 3);
   EXPECT_THROW(job.run(), Error);
 }
@@ -210,7 +212,8 @@ TEST(PalettePack, JointFramesTimesInverseBindGiveEachCharactersTransformAndThrea
   TPoseCrowd c;
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> x(-30.0f, 30.0f), yaw(-3.14f, 3.14f), scale(0.8f, 1.25f);
-  for (int i = 0; i < 300; ++i) c.add({x(rng), 0.0f, x(rng) - 30.0f}, yaw(rng), static_cast<std::uint8_t>(i % 3), scale(rng));
+  for (int i = 0; i < 300; ++i)
+    c.add({x(rng), 0.0f, x(rng) - 30.0f}, yaw(rng), static_cast<std::uint8_t>(i % 3), scale(rng));
   const SkinRig skin = make_skin_rig(anim::make_rig("humanoid", c.skeleton));
   const Index n = c.count();
   const std::int32_t J = skin.joint_count;
@@ -253,12 +256,14 @@ TEST(PalettePack, JointFramesTimesInverseBindGiveEachCharactersTransformAndThrea
       for (Index i = 0; i < n; ++i) {
         if (f[static_cast<std::size_t>(g * n + i)] == 0u) continue;
         EXPECT_EQ(tags[static_cast<std::size_t>(slot)].x, static_cast<std::uint32_t>(i));
-        EXPECT_EQ(tags[static_cast<std::size_t>(slot)].y, 0x11111u * c.levels[static_cast<std::size_t>(i)]);  // one level, every part
+        EXPECT_EQ(tags[static_cast<std::size_t>(slot)].y,
+                  0x11111u * c.levels[static_cast<std::size_t>(i)]);  // one level, every part
         for (std::int32_t j = 0; j < J; ++j) {
           const anim::Mat3x4& got = out[static_cast<std::size_t>(slot * J + j)];
           const anim::Mat3x4& w = want[static_cast<std::size_t>(i * J + j)];
           for (int r = 0; r < 3; ++r)
-            ASSERT_LT(glm::length((&got.r0)[r] - (&w.r0)[r]), 2e-5f * (1.0f + glm::length((&w.r0)[r]))) << i << " " << j;
+            ASSERT_LT(glm::length((&got.r0)[r] - (&w.r0)[r]), 2e-5f * (1.0f + glm::length((&w.r0)[r])))
+                << i << " " << j;
         }
         ++slot;
       }
@@ -310,8 +315,8 @@ TEST(Cull, PalettesPlaceCharactersAsTheirJointFramesDoAndPickTheirRigsGroup) {
   for (Index i = 0; i < n && broken.size() < 3; ++i)
     if (from_frames.to_vector()[static_cast<std::size_t>(i)] != 0u) broken.push_back(i);  // visible, fine
   ASSERT_EQ(broken.size(), 3u);
-  rigs[static_cast<std::size_t>(broken[0])] = 2;                         // no such rig
-  offsets[static_cast<std::size_t>(broken[1])] = n * J - J + 1;            // palette runs past the end
+  rigs[static_cast<std::size_t>(broken[0])] = 2;                 // no such rig
+  offsets[static_cast<std::size_t>(broken[1])] = n * J - J + 1;  // palette runs past the end
   offsets[static_cast<std::size_t>(broken[2])] = -1;
   streamed.run();
   const std::vector<std::uint32_t> a = from_frames.to_vector(), b = from_palettes.to_vector();

@@ -13,7 +13,8 @@ Image gradient(std::int32_t w, std::int32_t h, std::uint8_t alpha) {
   Image im(w, h);
   for (std::int32_t y = 0; y < h; ++y)
     for (std::int32_t x = 0; x < w; ++x) {
-      std::uint8_t* p = im.rgba.data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 4;
+      std::uint8_t* p = im.rgba.data() +
+                        (static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 4;
       p[0] = static_cast<std::uint8_t>(x * 255 / (w - 1));
       p[1] = static_cast<std::uint8_t>(y * 255 / (h - 1));
       p[2] = static_cast<std::uint8_t>((x * 7 + y * 13) & 255);
@@ -22,7 +23,9 @@ Image gradient(std::int32_t w, std::int32_t h, std::uint8_t alpha) {
   return im;
 }
 
-std::string temp_path(const std::string& name) { return (std::filesystem::temp_directory_path() / ("throng_image_test_" + name)).string(); }
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("throng_image_test_" + name)).string();
+}
 
 TEST(Png, OpaqueRoundTripIsExact) {
   const Image a = gradient(37, 21, 255);

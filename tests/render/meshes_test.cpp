@@ -28,7 +28,8 @@ TEST(UnitSphere, IsAClosedOutwardFacingUnitSphere) {
     EXPECT_GT(v, 0.0) << slices << "x" << stacks;
     EXPECT_LT(v, 4.18879);
     for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-      const glm::vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]], c = m.positions[m.indices[t + 2]];
+      const glm::vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]],
+                      c = m.positions[m.indices[t + 2]];
       EXPECT_GT(glm::dot(glm::cross(b - a, c - a), a + b + c), 0.0f);
     }
     EXPECT_EQ(m.triangle_count(), 2 * slices * (stacks - 1));
@@ -39,7 +40,7 @@ TEST(UnitSphere, IsAClosedOutwardFacingUnitSphere) {
 
 TEST(ExtrudeObstacles, WallsFaceAwayFromTheSolidAndCapsCoverIt) {
   sim::Polygon square;
-  square.outer = {{0.0f, 0.0f}, {4.0f, 0.0f}, {4.0f, 4.0f}, {0.0f, 4.0f}};   // counter-clockwise
+  square.outer = {{0.0f, 0.0f}, {4.0f, 0.0f}, {4.0f, 4.0f}, {0.0f, 4.0f}};    // counter-clockwise
   square.holes = {{{1.0f, 1.0f}, {1.0f, 3.0f}, {3.0f, 3.0f}, {3.0f, 1.0f}}};  // clockwise
   std::vector<sim::Polygon> polygons = {square};
   std::vector<sim::Circle> circles = {{{10.0f, 0.0f}, 1.0f}};
@@ -56,12 +57,14 @@ TEST(ExtrudeObstacles, WallsFaceAwayFromTheSolidAndCapsCoverIt) {
     return in_square || glm::length(p - glm::vec2(10.0f, 0.0f)) < 1.0f;
   };
   for (std::size_t q = 0; q < m.walls.positions.size(); q += 4) {
-    const glm::vec2 mid = 0.5f * (ground_from_world(m.walls.positions[q]) + ground_from_world(m.walls.positions[q + 1]));
+    const glm::vec2 mid =
+        0.5f * (ground_from_world(m.walls.positions[q]) + ground_from_world(m.walls.positions[q + 1]));
     const glm::vec2 n = ground_from_world(m.walls.normals[q]);
     EXPECT_NEAR(glm::length(n), 1.0f, 1e-5f);
     EXPECT_FALSE(solid(mid + 0.05f * n)) << "wall " << q / 4;
     EXPECT_TRUE(solid(mid - 0.05f * n)) << "wall " << q / 4;
-    for (std::size_t k = 0; k < 4; ++k) EXPECT_TRUE(m.walls.positions[q + k].y == 0.0f || m.walls.positions[q + k].y == 2.0f);
+    for (std::size_t k = 0; k < 4; ++k)
+      EXPECT_TRUE(m.walls.positions[q + k].y == 0.0f || m.walls.positions[q + k].y == 2.0f);
   }
   // Caps: fans at the top; by the even-odd rule their coverage of a point
   // is odd exactly where the obstacle is solid.
@@ -73,7 +76,7 @@ TEST(ExtrudeObstacles, WallsFaceAwayFromTheSolidAndCapsCoverIt) {
       const glm::vec2 a = ground_from_world(m.cap_triangles[t]), b = ground_from_world(m.cap_triangles[t + 1]),
                       c = ground_from_world(m.cap_triangles[t + 2]);
       const float d1 = sim::cross2(b - a, p - a), d2 = sim::cross2(c - b, p - b), d3 = sim::cross2(a - c, p - c);
-      const bool has_neg = d1 < 0 || d2 < 0 || d3 < 0, has_pos = d1 > 0 || d2 > 0 || d3 > 0;
+      const bool has_neg = d1 < 0 || d2 < 0 || d3<0, has_pos = d1> 0 || d2 > 0 || d3 > 0;
       if (!(has_neg && has_pos)) ++count;
     }
     return count % 2 == 1;

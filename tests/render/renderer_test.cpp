@@ -54,8 +54,8 @@ class RendererTest : public ::testing::Test {
     return c;
   }
   static TPoseCrowd crowd() { return test_crowd(); }
-  static Image draw(Renderer& r, const Camera& cam, const CharacterPoses& poses, const RenderOptions& o = {}, RenderStats* stats = nullptr,
-                    std::int32_t samples = 4) {
+  static Image draw(Renderer& r, const Camera& cam, const CharacterPoses& poses, const RenderOptions& o = {},
+                    RenderStats* stats = nullptr, std::int32_t samples = 4) {
     OffscreenTarget target(cam.width, cam.height, samples);
     target.bind();
     const RenderStats s = r.render(cam, poses, o);
@@ -101,7 +101,9 @@ TEST_F(RendererTest, AgentsShowWhereTheyStandAndNowhereElse) {
     // the dominant channel ordering.
     const std::uint8_t* p = with.pixel(x, y);
     const glm::vec3 expect = lod_level_colour(k);
-    const auto order = [](float red, float green, float blue) { return (red > green) * 4 + (green > blue) * 2 + (red > blue); };
+    const auto order = [](float red, float green, float blue) {
+      return (red > green) * 4 + (green > blue) * 2 + (red > blue);
+    };
     EXPECT_EQ(order(p[0], p[1], p[2]), order(expect.r, expect.g, expect.b)) << "level " << k;
   }
 
@@ -160,7 +162,8 @@ TEST_F(RendererTest, EveryTierDrawsTheCharacters) {
       EXPECT_EQ(stats.lines, tier == 2 ? 3 : 0);
       const ImageDifference d = compare_images(im, empty, 20);
       // Three people of about a hundred pixels each at this distance; lines fewer.
-      EXPECT_GT(d.fraction_differing * im.width * im.height, tier == 2 ? 30.0 : 150.0) << to_string(mode) << " tier " << tier;
+      EXPECT_GT(d.fraction_differing * im.width * im.height, tier == 2 ? 30.0 : 150.0)
+          << to_string(mode) << " tier " << tier;
     }
   }
 }
@@ -189,9 +192,9 @@ TEST_F(RendererTest, ObstacleTopsFollowTheEvenOddRule) {
   };
   EXPECT_TRUE(differs({-4.0f, 2.0f}, 1.0f));  // solid rim, top
   EXPECT_TRUE(differs({4.0f, 2.0f}, 1.0f));
-  EXPECT_TRUE(differs({7.0f, 2.0f}, 1.0f));   // the disc's top
-  EXPECT_FALSE(differs({0.0f, 2.0f}, 0.0f));  // the ground seen through the hole
-  EXPECT_FALSE(differs({-8.0f, 2.0f}, 0.0f)); // outside
+  EXPECT_TRUE(differs({7.0f, 2.0f}, 1.0f));    // the disc's top
+  EXPECT_FALSE(differs({0.0f, 2.0f}, 0.0f));   // the ground seen through the hole
+  EXPECT_FALSE(differs({-8.0f, 2.0f}, 0.0f));  // outside
   RenderOptions hidden;
   hidden.obstacles = false;
   EXPECT_EQ(compare_images(draw(r, cam, none.poses(), hidden), empty).max_abs, 0);
@@ -281,10 +284,13 @@ TEST_F(RendererTest, SkinnedAgentsShowWhereTheyStandAndNowhereElse) {
     EXPECT_GT(colour_distance(with, x, y, without.pixel(x, y)), 40) << "character " << k;
     const std::uint8_t* p = with.pixel(x, y);
     const glm::vec3 expect = lod_level_colour(k);
-    const auto order = [](float red, float green, float blue) { return (red > green) * 4 + (green > blue) * 2 + (red > blue); };
+    const auto order = [](float red, float green, float blue) {
+      return (red > green) * 4 + (green > blue) * 2 + (red > blue);
+    };
     EXPECT_EQ(order(p[0], p[1], p[2]), order(expect.r, expect.g, expect.b)) << "level " << k;
     // Its skinned vertices' box (palette T(at) R(yaw)).
-    anim::Mat3x4 m = anim::mat3x4_from(glm::angleAxis(c.yaws[static_cast<std::size_t>(k)], glm::vec3(0, 1, 0)), c.places[static_cast<std::size_t>(k)]);
+    anim::Mat3x4 m = anim::mat3x4_from(glm::angleAxis(c.yaws[static_cast<std::size_t>(k)], glm::vec3(0, 1, 0)),
+                                       c.places[static_cast<std::size_t>(k)]);
     const std::vector<anim::Mat3x4> palette(static_cast<std::size_t>(J), m);
     std::vector<glm::vec3> skinned_vertices(static_cast<std::size_t>(rig.mesh.vertex_count()));
     anim::skin_reference(rig.mesh, palette, skinned_vertices, {});
@@ -300,7 +306,8 @@ TEST_F(RendererTest, SkinnedAgentsShowWhereTheyStandAndNowhereElse) {
   for (std::int32_t y = 0; y < cam.height; ++y)
     for (std::int32_t x = 0; x < cam.width; ++x) {
       bool near = false;
-      for (const auto& b : boxes) near = near || (x > b[0] - margin && x < b[2] + margin && y > b[1] - margin && y < b[3] + margin);
+      for (const auto& b : boxes)
+        near = near || (x > b[0] - margin && x < b[2] + margin && y > b[1] - margin && y < b[3] + margin);
       if (near) continue;
       ++checked;
       if (colour_distance(with, x, y, without.pixel(x, y)) > 2) ++differing;
@@ -332,7 +339,8 @@ TEST_F(RendererTest, SkinnedPartsTakeTheirOwnLevelsAndClothesOtherwise) {
   const Image im = draw(r, cam, poses, skinned);
   const CameraView view = make_camera_view(cam);
   const auto colour_at = [&](std::int32_t joint_a, std::int32_t joint_b) {
-    const glm::vec3 mid = 0.5f * (c.positions[static_cast<std::size_t>(joint_a)] + c.positions[static_cast<std::size_t>(joint_b)]);
+    const glm::vec3 mid =
+        0.5f * (c.positions[static_cast<std::size_t>(joint_a)] + c.positions[static_cast<std::size_t>(joint_b)]);
     const glm::vec3 px = world_to_pixel(view, mid);
     const std::uint8_t* p = im.pixel(static_cast<std::int32_t>(px.x), static_cast<std::int32_t>(px.y));
     return glm::vec3(p[0], p[1], p[2]) / 255.0f;
@@ -357,13 +365,15 @@ TEST_F(RendererTest, SkinnedPartsTakeTheirOwnLevelsAndClothesOtherwise) {
   skinned.lod_colours = false;
   const Image dressed = draw(r, cam, poses, skinned);
   const auto pixel_at = [&](std::int32_t joint_a, std::int32_t joint_b, float t) {
-    const glm::vec3 at = glm::mix(c.positions[static_cast<std::size_t>(joint_a)], c.positions[static_cast<std::size_t>(joint_b)], t);
+    const glm::vec3 at =
+        glm::mix(c.positions[static_cast<std::size_t>(joint_a)], c.positions[static_cast<std::size_t>(joint_b)], t);
     const glm::vec3 px = world_to_pixel(view, at);
     return dressed.pixel(static_cast<std::int32_t>(px.x), static_cast<std::int32_t>(px.y));
   };
   const std::uint8_t* chest = pixel_at(dj::Spine, dj::Spine1, 0.5f);
   const auto x = [&](std::int32_t a, std::int32_t b, float t) {
-    const glm::vec3 px = world_to_pixel(view, glm::mix(c.positions[static_cast<std::size_t>(a)], c.positions[static_cast<std::size_t>(b)], t));
+    const glm::vec3 px = world_to_pixel(
+        view, glm::mix(c.positions[static_cast<std::size_t>(a)], c.positions[static_cast<std::size_t>(b)], t));
     return std::array<std::int32_t, 2>{static_cast<std::int32_t>(px.x), static_cast<std::int32_t>(px.y)};
   };
   const auto thigh = x(dj::LeftUpLeg, dj::LeftLeg, 0.5f);
@@ -394,7 +404,8 @@ TEST_F(RendererTest, GpuSkinningMatchesTheCpuReference) {
   const anim::Rig rig = anim::make_rig("humanoid", space.skeleton());
   Renderer r(make_crowd_rigs(space.skeleton()));
   const std::int32_t J = rig.joint_count();
-  const auto compare = [&](const SkinCapture& got, const std::vector<anim::Mat3x4>& palettes, const anim::SkinnedMesh& mesh, Index characters) {
+  const auto compare = [&](const SkinCapture& got, const std::vector<anim::Mat3x4>& palettes,
+                           const anim::SkinnedMesh& mesh, Index characters) {
     ASSERT_EQ(got.vertices, mesh.vertex_count());
     ASSERT_EQ(got.positions.size(), static_cast<std::size_t>(characters * mesh.vertex_count()));
     std::vector<Index> offsets;
@@ -420,14 +431,16 @@ TEST_F(RendererTest, GpuSkinningMatchesTheCpuReference) {
     EXPECT_LT(worst_n, 1e-4f);
   };
   // Palettes from the joint frames: T(p) R(q) S(s) * inverse bind, computed here.
-  const std::vector<glm::vec3> p(crowd.joint_positions().begin(), crowd.joint_positions().end());  // host memory in tests
+  const std::vector<glm::vec3> p(crowd.joint_positions().begin(),
+                                 crowd.joint_positions().end());  // host memory in tests
   const std::vector<glm::quat> q(crowd.joint_rotations().begin(), crowd.joint_rotations().end());
   std::vector<anim::Mat3x4> palettes;
   for (Index c = 0; c < n; ++c)
     for (std::int32_t j = 0; j < J; ++j) {
       const std::size_t k = static_cast<std::size_t>(c * J + j);
       anim::Mat3x4 world = anim::mat3x4_from(q[k], p[k]);
-      for (glm::vec4* row : {&world.r0, &world.r1, &world.r2}) *row = glm::vec4(glm::vec3(*row) * scales[static_cast<std::size_t>(c)], row->w);
+      for (glm::vec4* row : {&world.r0, &world.r1, &world.r2})
+        *row = glm::vec4(glm::vec3(*row) * scales[static_cast<std::size_t>(c)], row->w);
       palettes.push_back(world * rig.inverse_bind[static_cast<std::size_t>(j)]);
     }
   const CharacterPoses frames = poses_of(crowd);
@@ -441,7 +454,7 @@ TEST_F(RendererTest, GpuSkinningMatchesTheCpuReference) {
   const std::vector<motion::DefaultMotion> motions = motion::make_default_motions(space.skeleton());
   anim::AnimClip walk{"walk", std::make_shared<motion::Clip>(motions[1].clip), true, {}};
   const std::int32_t stream = streams.streams().add(streams.rig(human), human, {.name = "walk", .history = 16},
-                                                     std::make_unique<anim::ClipPlayer>(walk));
+                                                    std::make_unique<anim::ClipPlayer>(walk));
   const Index agents = 5;
   streams.add_agents(human, agents);
   streams.assign_random(0, agents, {{{stream}, {stream}, {stream}}, true}, 3);
@@ -450,7 +463,8 @@ TEST_F(RendererTest, GpuSkinningMatchesTheCpuReference) {
   const std::vector<glm::vec3> positions(at.begin(), at.begin() + agents);
   const std::vector<float> agent_yaws(yaws.begin(), yaws.begin() + agents);
   streams.resolve(positions, agent_yaws, resolved.span());
-  compare(r.capture_skinned(poses_of(streams, resolved.span()), DrawTier::Fine), resolved.to_vector(), rig.mesh, agents);
+  compare(r.capture_skinned(poses_of(streams, resolved.span()), DrawTier::Fine), resolved.to_vector(), rig.mesh,
+          agents);
 }
 
 // A crowd exported to glTF and read back (io/crowd_gltf.h) draws like the
@@ -513,13 +527,14 @@ TEST_F(RendererTest, ACrowdReadBackFromItsGltfDrawsLikeThrongsOwn) {
   std::int64_t both = 0, either = 0;
   for (std::int32_t y = 0; y < cam.height; ++y)
     for (std::int32_t x = 0; x < cam.width; ++x) {
-      const bool a = colour_distance(own, x, y, empty.pixel(x, y)) > 24, b = colour_distance(exported, x, y, empty.pixel(x, y)) > 24;
+      const bool a = colour_distance(own, x, y, empty.pixel(x, y)) > 24,
+                 b = colour_distance(exported, x, y, empty.pixel(x, y)) > 24;
       both += a && b;
       either += a || b;
     }
   const double overlap = either > 0 ? static_cast<double>(both) / static_cast<double>(either) : 0.0;
-  std::printf("  silhouettes: %lld pixels in both, %lld in either: overlap %.4f\n", static_cast<long long>(both), static_cast<long long>(either),
-              overlap);
+  std::printf("  silhouettes: %lld pixels in both, %lld in either: overlap %.4f\n", static_cast<long long>(both),
+              static_cast<long long>(either), overlap);
   EXPECT_GT(either, 1000);  // eight characters, 12 to 16 m away
   EXPECT_GT(overlap, 0.97);
 }
@@ -568,8 +583,12 @@ Image golden_scene(RenderMode mode) {
   return target.read();
 }
 
-TEST_F(RendererTest, GoldenImage) { expect_golden(golden_scene(RenderMode::Joints), "tests/data/render_golden_joints.png"); }
-TEST_F(RendererTest, GoldenImageSkinned) { expect_golden(golden_scene(RenderMode::Skinned), "tests/data/render_golden_skinned.png"); }
+TEST_F(RendererTest, GoldenImage) {
+  expect_golden(golden_scene(RenderMode::Joints), "tests/data/render_golden_joints.png");
+}
+TEST_F(RendererTest, GoldenImageSkinned) {
+  expect_golden(golden_scene(RenderMode::Skinned), "tests/data/render_golden_skinned.png");
+}
 
 }  // namespace
 }  // namespace throng::render

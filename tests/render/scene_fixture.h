@@ -30,8 +30,8 @@ struct TPoseCrowd {
     std::vector<glm::quat> local(static_cast<std::size_t>(J), glm::quat(1, 0, 0, 0));
     std::vector<glm::vec3> p(static_cast<std::size_t>(J));
     std::vector<glm::quat> q(static_cast<std::size_t>(J));
-    motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), local.data(), nullptr, skeleton.offsets[0], p.data(),
-                    q.data());
+    motion::fk_pose(J, skeleton.parents.data(), skeleton.offsets.data(), local.data(), nullptr, skeleton.offsets[0],
+                    p.data(), q.data());
     const glm::quat turn = glm::angleAxis(yaw, glm::vec3(0, 1, 0));
     for (std::int32_t j = 0; j < J; ++j) {
       positions.push_back(at + turn * (scale * p[static_cast<std::size_t>(j)]));

@@ -27,7 +27,9 @@ TEST(JointRig, OneBonePerJointAndEndSite) {
   for (std::int32_t j = 0; j < J; ++j)
     EXPECT_EQ(std::count_if(rig.bones.begin(), rig.bones.end(), [&](const RigBone& b) { return b.to == j; }), 1) << j;
   // Limbs are thinner than the trunk; the arms are coloured as arms.
-  const auto bone_to = [&](std::int32_t j) { return *std::find_if(rig.bones.begin(), rig.bones.end(), [&](const RigBone& b) { return b.to == j; }); };
+  const auto bone_to = [&](std::int32_t j) {
+    return *std::find_if(rig.bones.begin(), rig.bones.end(), [&](const RigBone& b) { return b.to == j; });
+  };
   EXPECT_LT(bone_to(motion::default_joint::LeftForeArm).radius, bone_to(motion::default_joint::Spine1).radius);
   EXPECT_EQ(rig.points[motion::default_joint::LeftForeArm].part, static_cast<std::uint8_t>(anim::BodyPart::LeftArm));
   EXPECT_EQ(rig.points[motion::default_joint::RightLeg].part, static_cast<std::uint8_t>(anim::BodyPart::RightLeg));
@@ -42,7 +44,8 @@ TEST(JointRig, BoundingRadiusHoldsEveryPoseOfTheMotionSet) {
     for (std::int32_t f = 0; f < ms.frame_count; f += 3) {
       const glm::vec3 root = ms.position(f, 0);
       for (const RigPoint& p : rig.points) {
-        const std::size_t k = static_cast<std::size_t>(f) * static_cast<std::size_t>(ms.joint_count) + static_cast<std::size_t>(p.joint);
+        const std::size_t k =
+            static_cast<std::size_t>(f) * static_cast<std::size_t>(ms.joint_count) + static_cast<std::size_t>(p.joint);
         const glm::vec3 at = ms.positions[k] + ms.rotations[k] * p.offset;
         widest = std::max(widest, glm::length(at - root));
       }
@@ -64,14 +67,16 @@ TEST(SkinRig, TiersOfTheMannequinShareItsJoints) {
   // Far: a line per bone and end site, both ends on the same joint.
   const anim::SkinnedMesh& lines = skin.meshes[2];
   std::int32_t end_sites = 0;
-  for (std::int32_t j = 0; j < s.joint_count(); ++j) end_sites += s.has_end_site[static_cast<std::size_t>(j)] != 0 ? 1 : 0;
+  for (std::int32_t j = 0; j < s.joint_count(); ++j)
+    end_sites += s.has_end_site[static_cast<std::size_t>(j)] != 0 ? 1 : 0;
   EXPECT_EQ(lines.indices.size(), 2u * static_cast<std::size_t>(s.joint_count() - 1 + end_sites));
   for (std::size_t i = 0; i < lines.indices.size(); i += 2)
     EXPECT_EQ(lines.joints[lines.indices[i]].x, lines.joints[lines.indices[i + 1]].x);
   // Styles: hands and head are skin, shins are trousers, the chest a shirt.
   const auto style_of = [&](std::int32_t joint, const std::array<std::vector<std::uint8_t>, kDrawTiers>& table) {
     for (std::int32_t v = 0; v < skin.meshes[0].vertex_count(); ++v)
-      if (skin.meshes[0].joints[static_cast<std::size_t>(v)].x == joint && skin.meshes[0].weights[static_cast<std::size_t>(v)].x > 0.99f)
+      if (skin.meshes[0].joints[static_cast<std::size_t>(v)].x == joint &&
+          skin.meshes[0].weights[static_cast<std::size_t>(v)].x > 0.99f)
         return static_cast<int>(table[0][static_cast<std::size_t>(v)]);
     return -1;
   };
@@ -92,7 +97,8 @@ TEST(SkinRig, BoundingRadiusHoldsEverySkinnedVertexOfTheMotionSet) {
   for (const motion::DefaultMotion& m : motion::make_default_motions(s)) {
     for (std::int32_t f = 0; f < m.clip.frame_count; f += 5) {
       anim::Pose pose(s.joint_count());
-      for (std::int32_t j = 0; j < s.joint_count(); ++j) pose.local[static_cast<std::size_t>(j)] = m.clip.rotation(f, j);
+      for (std::int32_t j = 0; j < s.joint_count(); ++j)
+        pose.local[static_cast<std::size_t>(j)] = m.clip.rotation(f, j);
       pose.root = m.clip.root_positions[static_cast<std::size_t>(f)];
       kinematics.palette(pose, palette.data());
       const glm::vec3 root = anim::transform_point(palette[0], skin.bind_positions[0]);

@@ -18,8 +18,8 @@
 namespace throng::testing {
 
 struct VideoProbe {
-  std::string codec;       // e.g. "h264"; empty when ffprobe found no video stream
-  std::string pix_fmt;     // e.g. "yuv420p"
+  std::string codec;    // e.g. "h264"; empty when ffprobe found no video stream
+  std::string pix_fmt;  // e.g. "yuv420p"
   int width = 0;
   int height = 0;
   long frames = -1;        // frames decoded (nb_read_frames); -1 when unknown
@@ -31,9 +31,10 @@ inline std::ostream& operator<<(std::ostream& os, const VideoProbe& p) { return 
 
 // Runs `ffprobe -count_frames` (it decodes every frame) on `path`.
 inline VideoProbe probe_video(const std::string& path) {
-  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                          "stream=codec_name,pix_fmt,width,height,nb_read_frames:format=duration -of json '" +
-                          path + "' 2>&1";
+  const std::string cmd =
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+      "stream=codec_name,pix_fmt,width,height,nb_read_frames:format=duration -of json '" +
+      path + "' 2>&1";
   VideoProbe p;
   {
     std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
@@ -77,7 +78,8 @@ inline std::vector<std::uint8_t> decode_frame_rgb(const std::string& path, long 
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
   std::array<std::uint8_t, 65536> buf;
   std::size_t n;
-  while (pipe && (n = fread(buf.data(), 1, buf.size(), pipe.get())) > 0) rgb.insert(rgb.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+  while (pipe && (n = fread(buf.data(), 1, buf.size(), pipe.get())) > 0)
+    rgb.insert(rgb.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
   return rgb;
 }
 

@@ -37,7 +37,8 @@ std::string temp_dir(const std::string& name) {
 
 Image solid(std::int32_t w, std::int32_t h, std::uint8_t shade) {
   Image im(w, h);
-  for (std::size_t i = 0; i < im.rgba.size(); ++i) im.rgba[i] = (i % 4 == 3) ? 255 : static_cast<std::uint8_t>(shade + i % 7);
+  for (std::size_t i = 0; i < im.rgba.size(); ++i)
+    im.rgba[i] = (i % 4 == 3) ? 255 : static_cast<std::uint8_t>(shade + i % 7);
   return im;
 }
 
@@ -210,7 +211,8 @@ TEST_F(VideoTest, RecorderWritesNumberedPngFrames) {
 // first).
 TEST_F(VideoTest, ThrongRunRendersTheCircleAsAVideo) {
   const std::string dir = temp_dir("run");
-  const std::string cmd = std::string(THRONG_EXE) + " --threads 2 run circle --agents 1000 --seconds 2 --render video --width 160 --height 90 " +
+  const std::string cmd = std::string(THRONG_EXE) +
+                          " --threads 2 run circle --agents 1000 --seconds 2 --render video --width 160 --height 90 " +
                           "--fps 12 --camera orbit --no-trajectories --quiet --out '" + dir + "' 2>&1";
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
   std::string out;
@@ -280,8 +282,10 @@ TEST(ThrongRunCamera, FollowKeepsTheCrowdInTheMiddleOfTheFrame) {
   const auto frames = [&](const std::string& camera, const std::string& lod) {
     const std::string out_dir = dir + "/" + camera + "_" + lod;
     std::string out;
-    const int code = run_throng("--backend cpu --threads 2 run '" + scenario + "' --seconds 2 --render frames --width 160 --height 90 --fps 2 "
-                                "--no-trajectories --quiet --lod-colours --camera " + camera + " --lod-thresholds " +
+    const int code = run_throng("--backend cpu --threads 2 run '" + scenario +
+                                    "' --seconds 2 --render frames --width 160 --height 90 --fps 2 "
+                                    "--no-trajectories --quiet --lod-colours --camera " +
+                                    camera + " --lod-thresholds " +
                                     (lod == "fine" ? "0.002,0.001" : "100000000,10000000") + " --out '" + out_dir + "'",
                                 out);
     EXPECT_EQ(code, 0) << out;

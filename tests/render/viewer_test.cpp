@@ -31,7 +31,8 @@ class VirtualDisplay {
     int fds[2];
     if (pipe(fds) != 0) return;
     const std::string fd = std::to_string(fds[1]);
-    std::vector<std::string> args = {"Xvfb", "-displayfd", fd, "-screen", "0", "1024x768x24", "-nolisten", "tcp", "-noreset"};
+    std::vector<std::string> args = {"Xvfb",        "-displayfd", fd,    "-screen", "0",
+                                     "1024x768x24", "-nolisten",  "tcp", "-noreset"};
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -78,7 +79,8 @@ class VirtualDisplay {
 std::size_t distinct_colours(const Image& im) {
   std::set<std::uint32_t> colours;
   for (std::size_t i = 0; i < im.rgba.size(); i += 4)
-    colours.insert(static_cast<std::uint32_t>(im.rgba[i]) << 16 | static_cast<std::uint32_t>(im.rgba[i + 1]) << 8 | im.rgba[i + 2]);
+    colours.insert(static_cast<std::uint32_t>(im.rgba[i]) << 16 | static_cast<std::uint32_t>(im.rgba[i + 1]) << 8 |
+                   im.rgba[i + 2]);
   return colours.size();
 }
 
@@ -105,9 +107,10 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
   const std::string shot = (std::filesystem::temp_directory_path() / "throng_viewer_test.png").string();
   std::filesystem::remove(shot);
   std::string out;
-  const int code = run("DISPLAY=" + x.display() + " " + THRONG_EXE +
-                           " --threads 2 view bottleneck --agents 150 --bins --frames 12 --width 480 --height 270 --screenshot " + shot,
-                       out);
+  const int code = run(
+      "DISPLAY=" + x.display() + " " + THRONG_EXE +
+          " --threads 2 view bottleneck --agents 150 --bins --frames 12 --width 480 --height 270 --screenshot " + shot,
+      out);
   ASSERT_EQ(code, 0) << out;
   EXPECT_NE(out.find("12 frames"), std::string::npos) << out;
   ASSERT_TRUE(std::filesystem::exists(shot)) << out;
@@ -127,8 +130,10 @@ TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_headless";
   std::filesystem::remove_all(dir);
   std::string out;
-  const std::string frames = std::string(THRONG_EXE) + " --threads 2 view corridor --agents 120 --headless --render frames --frames 3 --width 160 --height 90 "
-                             "--camera flyover --out ";
+  const std::string frames =
+      std::string(THRONG_EXE) +
+      " --threads 2 view corridor --agents 120 --headless --render frames --frames 3 --width 160 --height 90 "
+      "--camera flyover --out ";
   ASSERT_EQ(run(frames + dir.string() + " --lod-colours", out), 0) << out;
   EXPECT_NE(out.find("3 frames"), std::string::npos) << out;
   out.clear();
@@ -148,7 +153,9 @@ TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   }
   const std::string shot = (dir / "formation.png").string();
   const std::string clothes_shot = (dir / "formation_clothes.png").string();
-  const std::string formation = std::string(THRONG_EXE) + " view formation --layout grid --agents 50 --headless --frames 2 --width 160 --height 90 ";
+  const std::string formation =
+      std::string(THRONG_EXE) +
+      " view formation --layout grid --agents 50 --headless --frames 2 --width 160 --height 90 ";
   out.clear();
   ASSERT_EQ(run(formation + "--lod-colours --screenshot " + shot, out), 0) << out;
   out.clear();
@@ -160,7 +167,9 @@ TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   // 50 characters framed whole: about 6% of the picture is theirs.
   EXPECT_GT(character_pixels(im, read_png(clothes_shot)), im.width * im.height / 40);
   out.clear();
-  EXPECT_EQ(run(std::string(THRONG_EXE) + " view corridor --layout grid --headless --frames 2 --screenshot " + shot, out), 1) << out;
+  EXPECT_EQ(
+      run(std::string(THRONG_EXE) + " view corridor --layout grid --headless --frames 2 --screenshot " + shot, out), 1)
+      << out;
   EXPECT_NE(out.find("--layout"), std::string::npos) << out;
   std::filesystem::remove_all(dir);
 }

@@ -28,8 +28,18 @@ struct DoorRun {
 DoorRun empty_room(float width, std::int64_t agents) {
   const float lo = 5.0f - 0.5f * width, hi = 5.0f + 0.5f * width;
   ScenarioSpec s = test::collision_free_spec("door", 0.05f, 400.0f,
-                                             {{0, 0}, {10, 0}, {10, lo}, {10.4f, lo}, {10.4f, -10}, {30, -10},
-                                              {30, 20}, {10.4f, 20}, {10.4f, hi}, {10, hi}, {10, 10}, {0, 10}});
+                                             {{0, 0},
+                                              {10, 0},
+                                              {10, lo},
+                                              {10.4f, lo},
+                                              {10.4f, -10},
+                                              {30, -10},
+                                              {30, 20},
+                                              {10.4f, 20},
+                                              {10.4f, hi},
+                                              {10, hi},
+                                              {10, 10},
+                                              {0, 10}});
   GroupSpec g;
   g.count = agents;
   g.radius = 0.2f;
@@ -58,13 +68,15 @@ DoorRun empty_room(float width, std::int64_t agents) {
     const std::vector<std::uint8_t> is = sim.flags();
     for (std::size_t i = 0; i < after.size(); ++i) {
       double f = 0;
-      if ((was[i] & kAgentActive) != 0 && (is[i] & kAgentActive) != 0 && step_crossing(before[i], after[i], a, b, &f) != 0)
+      if ((was[i] & kAgentActive) != 0 && (is[i] & kAgentActive) != 0 &&
+          step_crossing(before[i], after[i], a, b, &f) != 0)
         times.push_back(t0 + f * s.dt);
     }
     before = after;
     was = is;
     const CrowdState& c = sim.crowd();
-    r.deepest = std::max(r.deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
+    r.deepest =
+        std::max(r.deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
   }
   std::sort(times.begin(), times.end());
   r.left = sim.arrived_count();
@@ -73,14 +85,16 @@ DoorRun empty_room(float width, std::int64_t agents) {
 }
 
 TEST(Bottleneck, CollisionFreeSpeedEmptiesARoomThroughDoorsOfEveryWidth) {
-  const std::vector<float> widths = test::sanitized() ? std::vector<float>{0.8f, 1.6f} : std::vector<float>{0.5f, 0.8f, 1.2f, 1.6f, 2.4f};
+  const std::vector<float> widths =
+      test::sanitized() ? std::vector<float>{0.8f, 1.6f} : std::vector<float>{0.5f, 0.8f, 1.2f, 1.6f, 2.4f};
   const std::int64_t agents = test::sanitized() ? 60 : 150;
   double previous = 0;
   for (float w : widths) {
     SCOPED_TRACE(w);
     const DoorRun r = empty_room(w, agents);
-    std::printf("  door %.1f m: %lld of %lld out, flow %.2f P/s (%.2f P/(m s)), deepest overlap %.3f m\n", w, static_cast<long long>(r.left),
-                static_cast<long long>(r.agents), r.flow.flow, r.flow.specific_flow, r.deepest);
+    std::printf("  door %.1f m: %lld of %lld out, flow %.2f P/s (%.2f P/(m s)), deepest overlap %.3f m\n", w,
+                static_cast<long long>(r.left), static_cast<long long>(r.agents), r.flow.flow, r.flow.specific_flow,
+                r.deepest);
     EXPECT_EQ(r.left, r.agents);
     EXPECT_EQ(r.flow.crossings, r.agents);  // each crosses the door line once
     EXPECT_LE(r.deepest, 0.05f);

@@ -109,8 +109,8 @@ struct Outcome {
   Index agents = 0, arrived = 0, active_end = 0;
   std::int64_t steps = 0;
   double seconds = 0;
-  Index non_finite = 0;             // agent-steps with a non-finite position
-  Index max_penetrations = 0;       // most agents in an obstacle at one step
+  Index non_finite = 0;                // agent-steps with a non-finite position
+  Index max_penetrations = 0;          // most agents in an obstacle at one step
   std::int64_t penetration_steps = 0;  // steps with any
   float max_overlap_depth = 0.0f;
   Index max_deep_pairs = 0;
@@ -139,7 +139,8 @@ std::vector<double> remaining(const Simulation& sim, const std::vector<glm::vec2
   const auto p = sim.positions();
   const auto f = sim.flags();
   std::vector<double> d(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i) d[i] = (f[i] & kAgentArrived) != 0 ? 0.0 : static_cast<double>(length_of(goals[i] - p[i]));
+  for (std::size_t i = 0; i < p.size(); ++i)
+    d[i] = (f[i] & kAgentArrived) != 0 ? 0.0 : static_cast<double>(length_of(goals[i] - p[i]));
   return d;
 }
 
@@ -182,10 +183,12 @@ Outcome run_builtin(const std::string& name, std::int64_t agents) {
     sim->step();
     ++r.steps;
     for (const glm::vec2 p : sim->positions()) r.non_finite += std::isfinite(p.x) && std::isfinite(p.y) ? 0 : 1;
-    const Index pen = count_obstacle_penetrations(sim->world(), c.position.span(), c.radius.span(), c.flags.span(), kPenetrationTolerance);
+    const Index pen = count_obstacle_penetrations(sim->world(), c.position.span(), c.radius.span(), c.flags.span(),
+                                                  kPenetrationTolerance);
     r.max_penetrations = std::max(r.max_penetrations, pen);
     r.penetration_steps += pen > 0 ? 1 : 0;
-    const OverlapStats o = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), kOverlapTolerance, sim->contact_cell());
+    const OverlapStats o =
+        measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), kOverlapTolerance, sim->contact_cell());
     r.max_overlap_depth = std::max(r.max_overlap_depth, o.max_depth);
     r.max_deep_pairs = std::max(r.max_deep_pairs, o.pairs);
     stuck.update(*sim);
@@ -201,7 +204,8 @@ Outcome run_builtin(const std::string& name, std::int64_t agents) {
   const auto group = c.group.to_vector();
   const auto flags = sim->flags();
   for (std::size_t i = 0; i < flags.size(); ++i) {
-    const bool left = (flags[i] & kAgentArrived) != 0 && l.spec.groups[static_cast<std::size_t>(group[i])].arrival == ArrivalBehaviour::Despawn;
+    const bool left = (flags[i] & kAgentArrived) != 0 &&
+                      l.spec.groups[static_cast<std::size_t>(group[i])].arrival == ArrivalBehaviour::Despawn;
     r.expected_active += left ? 0 : 1;
   }
   r.stuck = stuck.stats();
@@ -224,16 +228,21 @@ TEST_P(BuiltinOutcome, RunsToItsEndWithProgressArrivalsAndNoCollisions) {
   const std::int64_t n = size.agents;
   const Outcome r = run_builtin(name, n);
   std::printf(
-      "  %s, %lld agents: %lld steps (%.0f s), arrived %lld, active at the end %lld; mean distance to goal %.1f -> %.1f m, "
-      "progress %.3f over %.0f s, advancing %.3f, moved %.1f m; deepest overlap %.4f m, deep pairs at most %lld; penetrations at most %lld\n",
-      name.c_str(), static_cast<long long>(r.agents), static_cast<long long>(r.steps), r.seconds, static_cast<long long>(r.arrived),
-      static_cast<long long>(r.active_end), r.start_distance, r.end_distance, r.progress, r.progress_seconds, r.advancing, r.moved,
-      static_cast<double>(r.max_overlap_depth), static_cast<long long>(r.max_deep_pairs), static_cast<long long>(r.max_penetrations));
+      "  %s, %lld agents: %lld steps (%.0f s), arrived %lld, active at the end %lld; mean distance to goal %.1f -> "
+      "%.1f m, "
+      "progress %.3f over %.0f s, advancing %.3f, moved %.1f m; deepest overlap %.4f m, deep pairs at most %lld; "
+      "penetrations at most %lld\n",
+      name.c_str(), static_cast<long long>(r.agents), static_cast<long long>(r.steps), r.seconds,
+      static_cast<long long>(r.arrived), static_cast<long long>(r.active_end), r.start_distance, r.end_distance,
+      r.progress, r.progress_seconds, r.advancing, r.moved, static_cast<double>(r.max_overlap_depth),
+      static_cast<long long>(r.max_deep_pairs), static_cast<long long>(r.max_penetrations));
   std::string stuck_where;
   for (const StuckExample& x : r.stuck.examples)
-    stuck_where += fmt::format(" agent {} at {:.1f} s at ({:.2f}, {:.2f});", x.agent, x.time, x.position.x, x.position.y);
-  std::printf("  %s stuck agents: %lld (at most %lld at once, first at %.1f s)%s\n", name.c_str(), static_cast<long long>(r.stuck.agents),
-              static_cast<long long>(r.stuck.max_at_once), r.stuck.first_time, stuck_where.c_str());
+    stuck_where +=
+        fmt::format(" agent {} at {:.1f} s at ({:.2f}, {:.2f});", x.agent, x.time, x.position.x, x.position.y);
+  std::printf("  %s stuck agents: %lld (at most %lld at once, first at %.1f s)%s\n", name.c_str(),
+              static_cast<long long>(r.stuck.agents), static_cast<long long>(r.stuck.max_at_once), r.stuck.first_time,
+              stuck_where.c_str());
   EXPECT_EQ(r.agents, std::min<std::int64_t>(n, io::load_builtin_scenario(name).spec.total_agents()));
   EXPECT_GT(r.steps, 0);
   EXPECT_EQ(r.non_finite, 0);

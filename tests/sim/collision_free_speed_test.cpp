@@ -28,14 +28,15 @@ TEST(CollisionFreeSpeed, SpeedKeepsTheTimeGapWithinZeroAndTheFreeSpeed) {
 
 TEST(CollisionFreeSpeed, GapCountsOnlyNeighboursInFrontInsideTheBodyCorridor) {
   const glm::vec2 east(1.0f, 0.0f);
-  EXPECT_NEAR(cfs_gap_ahead({0, 0}, 0.2f, east, {1.0f, 0.0f}, 0.2f), 0.6f, kEps);            // dead ahead
+  EXPECT_NEAR(cfs_gap_ahead({0, 0}, 0.2f, east, {1.0f, 0.0f}, 0.2f), 0.6f, kEps);  // dead ahead
   EXPECT_NEAR(cfs_gap_ahead({0, 0}, 0.2f, east, {1.0f, 0.39f}, 0.2f), std::hypot(1.0f, 0.39f) - 0.4f, kEps);  // grazing
-  EXPECT_TRUE(std::isinf(cfs_gap_ahead({0, 0}, 0.2f, east, {1.0f, 0.41f}, 0.2f)));           // passes beside
-  EXPECT_TRUE(std::isinf(cfs_gap_ahead({0, 0}, 0.2f, east, {-1.0f, 0.0f}, 0.2f)));           // behind
+  EXPECT_TRUE(std::isinf(cfs_gap_ahead({0, 0}, 0.2f, east, {1.0f, 0.41f}, 0.2f)));  // passes beside
+  EXPECT_TRUE(std::isinf(cfs_gap_ahead({0, 0}, 0.2f, east, {-1.0f, 0.0f}, 0.2f)));  // behind
 }
 
 TEST(CollisionFreeSpeed, RepulsionIsTheStrengthAtContactAndDecaysOverItsRange) {
-  const CfsAgent me{{0.0f, 0.0f}, {0.0f, 0.0f}, 0.2f, {0.0f, 1.0f}};  // walking north: no anticipation of a neighbour east
+  const CfsAgent me{
+      {0.0f, 0.0f}, {0.0f, 0.0f}, 0.2f, {0.0f, 1.0f}};  // walking north: no anticipation of a neighbour east
   const glm::vec2 at_contact = cfs_neighbour_push(me, {0.4f, 0.0f}, {0.0f, 0.0f}, 0.2f, false, kParams);
   EXPECT_NEAR(at_contact.x, -kParams.neighbour_strength, 1e-4f);
   EXPECT_NEAR(at_contact.y, 0.0f, kEps);

@@ -78,7 +78,8 @@ CounterflowRun counterflow(ModelKind model, std::int64_t per_side) {
   CounterflowRun r;
   r.agents = sim.agent_count();
   while (sim.steps_done() < 200) sim.step();
-  r.lane_order_20s = lane_order(sim.positions(), sim.crowd().goal.to_vector(), sim.flags(), {1.0f, 0.0f}, 0.3f, 5.0f).order;
+  r.lane_order_20s =
+      lane_order(sim.positions(), sim.crowd().goal.to_vector(), sim.flags(), {1.0f, 0.0f}, 0.3f, 5.0f).order;
   while (!sim.all_arrived() && sim.time() < 300.0) sim.step();
   const std::vector<float> arrival = sim.arrival_times();
   for (std::size_t i = 0; i < arrival.size(); ++i) {
@@ -92,12 +93,14 @@ CounterflowRun counterflow(ModelKind model, std::int64_t per_side) {
 
 TEST(Counterflow, StreamsInAFourMetreCorridorPassEachOther) {
   const std::int64_t per_side = test::sanitized() ? 100 : 200;
-  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce}) {
+  for (const ModelKind model :
+       {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce}) {
     SCOPED_TRACE(to_string(model));
     const CounterflowRun r = counterflow(model, per_side);
-    std::printf("  %s, 2 x %lld: lane order after 20 s %.2f, arrived %lld of %lld within 300 s, mean progress speed %.2f m/s\n",
-                to_string(model), static_cast<long long>(per_side), r.lane_order_20s, static_cast<long long>(r.arrived),
-                static_cast<long long>(r.agents), r.progress_speed);
+    std::printf(
+        "  %s, 2 x %lld: lane order after 20 s %.2f, arrived %lld of %lld within 300 s, mean progress speed %.2f m/s\n",
+        to_string(model), static_cast<long long>(per_side), r.lane_order_20s, static_cast<long long>(r.arrived),
+        static_cast<long long>(r.agents), r.progress_speed);
     // Lanes form under every model (the order is far above a mixed crowd's).
     // The collision-free speed, time-to-collision and social force models
     // get everyone through; the priority model leaves a few swirling against

@@ -58,21 +58,24 @@ inline double route_length(const Walker& w) {
 // is the aim) and no pair may overlap by more than `deepest_allowed` (1 cm
 // is the aim) at any step.
 inline void expect_encounter_resolves(ModelKind model, const std::string& what, const std::vector<Walker>& walkers,
-                                      const WorldSpec& world = {}, double slowest = 1.5, float deepest_allowed = 0.01f) {
+                                      const WorldSpec& world = {}, double slowest = 1.5,
+                                      float deepest_allowed = 0.01f) {
   SCOPED_TRACE(what);
   Simulation sim(encounter(walkers, world, model));
   float deepest = 0.0f;
   while (!sim.all_arrived() && sim.time() < 120.0) {
     sim.step();
     const CrowdState& c = sim.crowd();
-    deepest = std::max(deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
+    deepest =
+        std::max(deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
   }
   ASSERT_TRUE(sim.all_arrived()) << "after " << sim.time() << " s";
   const std::vector<float> times = sim.arrival_times();
   double worst = 0;
-  for (std::size_t i = 0; i < walkers.size(); ++i) worst = std::max(worst, times[i] / ((route_length(walkers[i]) - 0.3) / 1.3));
-  std::printf("  %s, %s: slowest arrival %.2fx the unhindered time, deepest overlap %.4f m\n", to_string(model), what.c_str(), worst,
-              deepest);
+  for (std::size_t i = 0; i < walkers.size(); ++i)
+    worst = std::max(worst, times[i] / ((route_length(walkers[i]) - 0.3) / 1.3));
+  std::printf("  %s, %s: slowest arrival %.2fx the unhindered time, deepest overlap %.4f m\n", to_string(model),
+              what.c_str(), worst, deepest);
   EXPECT_LE(worst, slowest);
   EXPECT_LE(deepest, deepest_allowed);
 }

@@ -68,7 +68,8 @@ TEST(FrameLoop, MetricsOfALongRunKeepBoundedSeriesAndExactMeans) {
   EXPECT_EQ(stats["crowd"]["series_stride"].get<std::int64_t>(), 4);
   double sum = 0;
   for (const double v : reference.speeds) sum += v;
-  EXPECT_NEAR(stats["crowd"]["mean_speed_mps"]["over_samples"].get<double>(), sum / static_cast<double>(reference.speeds.size()), 1e-9);
+  EXPECT_NEAR(stats["crowd"]["mean_speed_mps"]["over_samples"].get<double>(),
+              sum / static_cast<double>(reference.speeds.size()), 1e-9);
   const nlohmann::json& series = stats["measurement"]["areas"][0]["samples"];
   EXPECT_LE(series.size(), kMaxSeriesSamples + 1);
   EXPECT_GE(series.size(), kMaxSeriesSamples / 2);
@@ -95,7 +96,8 @@ TEST(FrameLoop, StagesRunAfterEachStepInOrder) {
   const RunResult r = loop.run(control);
   EXPECT_EQ(r.steps, 3);
   EXPECT_FALSE(r.interrupted);
-  EXPECT_EQ(log, (std::vector<std::string>{"a start 0", "b start 0", "a 1", "b 1", "a 2", "b 2", "a 3 last", "b 3 last"}));
+  EXPECT_EQ(log,
+            (std::vector<std::string>{"a start 0", "b start 0", "a 1", "b 1", "a 2", "b 2", "a 3 last", "b 3 last"}));
   EXPECT_EQ(progress_calls, 4);
   nlohmann::json stats;
   loop.finish(stats);
@@ -103,7 +105,8 @@ TEST(FrameLoop, StagesRunAfterEachStepInOrder) {
   EXPECT_EQ(stats["run"]["steps"], 3);
   EXPECT_EQ(stats["run"]["agents"], 20);
   EXPECT_TRUE(stats["timings"]["stages"].contains("a"));
-  for (const char* stage : {"sim.bin", "sim.sense", "sim.steer", "sim.move"}) EXPECT_TRUE(stats["timings"]["stages"].contains(stage)) << stage;
+  for (const char* stage : {"sim.bin", "sim.sense", "sim.steer", "sim.move"})
+    EXPECT_TRUE(stats["timings"]["stages"].contains(stage)) << stage;
 }
 
 TEST(FrameLoop, StopsWhenEveryoneHasArrived) {
@@ -150,7 +153,8 @@ TEST(FrameLoop, MetricsStageWritesItsSections) {
   EXPECT_EQ(metrics.samples().size(), 7u);  // frames 0, 10, ..., 50 and the last (55)
   nlohmann::json stats;
   loop.finish(stats);
-  for (const char* section : {"crowd", "density_histogram", "fundamental_diagram", "run", "timings"}) EXPECT_TRUE(stats.contains(section)) << section;
+  for (const char* section : {"crowd", "density_histogram", "fundamental_diagram", "run", "timings"})
+    EXPECT_TRUE(stats.contains(section)) << section;
   EXPECT_EQ(stats["crowd"]["agents"], 100);
   EXPECT_EQ(stats["crowd"]["obstacle_penetrations"]["max"], 0);
   std::int64_t agent_samples = 0;
@@ -184,7 +188,8 @@ TEST(FrameLoop, MetricsStageMeasuresAreasAndEveryStepsLineCrossings) {
   FrameLoop loop(sim);
   MetricsOptions options;
   options.sample_every = 10;
-  const std::vector<MeasurementLine> lines{{"north_south", {0.37f, -30.0f}, {0.37f, 30.0f}}, {"west_east", {-30.0f, -0.53f}, {30.0f, -0.53f}}};
+  const std::vector<MeasurementLine> lines{{"north_south", {0.37f, -30.0f}, {0.37f, 30.0f}},
+                                           {"west_east", {-30.0f, -0.53f}, {30.0f, -0.53f}}};
   options.measurement.lines = lines;
   Aabb centre, east;
   centre.add({-3, -3});
@@ -227,8 +232,8 @@ TEST(FrameLoop, MetricsStageMeasuresAreasAndEveryStepsLineCrossings) {
   EXPECT_EQ(m["areas"][1]["name"], "east");
   EXPECT_EQ(m["areas"][0]["samples"].size(), metrics.samples().size());
   EXPECT_DOUBLE_EQ(m["areas"][0]["area_m2"].get<double>(), 36.0);
-  for (const char* key : {"agents", "density", "voronoi_density", "speed", "voronoi_speed", "speed_magnitude", "voronoi_speed_magnitude", "flow",
-                          "voronoi_flow"}) {
+  for (const char* key : {"agents", "density", "voronoi_density", "speed", "voronoi_speed", "speed_magnitude",
+                          "voronoi_speed_magnitude", "flow", "voronoi_flow"}) {
     EXPECT_TRUE(m["areas"][0]["mean"].contains(key)) << key;
     EXPECT_TRUE(m["areas"][0]["samples"][0].contains(key)) << key;
   }
@@ -242,8 +247,10 @@ TEST(FrameLoop, MetricsStageMeasuresAreasAndEveryStepsLineCrossings) {
   const std::vector<double>& t = metrics.line_times()[0].positive;
   ASSERT_GE(t.size(), 2u);
   EXPECT_EQ(line["positive"]["crossings"], t.size());
-  EXPECT_DOUBLE_EQ(line["positive"]["flow_per_s"].get<double>(), static_cast<double>(t.size() - 1) / (t.back() - t.front()));
-  EXPECT_DOUBLE_EQ(line["positive"]["specific_flow_per_m_s"].get<double>(), line["positive"]["flow_per_s"].get<double>() / 60.0);
+  EXPECT_DOUBLE_EQ(line["positive"]["flow_per_s"].get<double>(),
+                   static_cast<double>(t.size() - 1) / (t.back() - t.front()));
+  EXPECT_DOUBLE_EQ(line["positive"]["specific_flow_per_m_s"].get<double>(),
+                   line["positive"]["flow_per_s"].get<double>() / 60.0);
   EXPECT_EQ(line["positive"]["nt"].size(), t.size());
   EXPECT_EQ(line["positive"]["nt"].back()[1], t.size());
   // The fundamental diagram is the first area's, with its Voronoi values.

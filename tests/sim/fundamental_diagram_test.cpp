@@ -87,7 +87,8 @@ Point measure(double rho) {
   g.arrival = ArrivalBehaviour::Stop;
   s.groups = {g};
   Simulation sim(s);
-  return sample_10_to_70_s(sim, {{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 10.0f}}, rho, false);
+  return sample_10_to_70_s(sim, {{static_cast<float>(X - 5.0), 0.0f}, {static_cast<float>(X + 5.0), 10.0f}}, rho,
+                           false);
 }
 
 TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
@@ -108,7 +109,8 @@ TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
   const double rms = std::sqrt(squares / static_cast<double>(points.size()));
   std::printf("  RMS deviation from Weidmann: %.3f m/s over %zu densities\n", rms, points.size());
   EXPECT_LE(rms, 0.15);
-  for (std::size_t i = 1; i < points.size(); ++i) EXPECT_LT(points[i].speed, points[i - 1].speed) << "speed must fall with density";
+  for (std::size_t i = 1; i < points.size(); ++i)
+    EXPECT_LT(points[i].speed, points[i - 1].speed) << "speed must fall with density";
   for (const Point& p : points) {
     if (p.density < 4.5) {
       EXPECT_GT(p.speed, 0.05) << "stopped at " << p.density << " /m2";
@@ -117,7 +119,8 @@ TEST(FundamentalDiagram, CollisionFreeSpeedFollowsWeidmann) {
   if (const char* path = std::getenv("THRONG_FD_CSV")) {
     std::ofstream out(path);
     out << "target,density,speed,weidmann\n";
-    for (const Point& p : points) out << p.target << ',' << p.density << ',' << p.speed << ',' << weidmann(p.density) << '\n';
+    for (const Point& p : points)
+      out << p.target << ',' << p.density << ',' << p.speed << ',' << weidmann(p.density) << '\n';
   }
 }
 

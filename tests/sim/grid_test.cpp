@@ -118,7 +118,8 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
     // The cached form visits the same items in the same order.
     std::vector<std::int32_t> a, b;
     for_each_in_3x3(v, p[i], [&](std::int32_t j) { a.push_back(j); });
-    for_each_in_cells(v, cells_3x3(v, cell_coord(p[i].x, side), cell_coord(p[i].y, side)), [&](std::int32_t j) { b.push_back(j); });
+    for_each_in_cells(v, cells_3x3(v, cell_coord(p[i].x, side), cell_coord(p[i].y, side)),
+                      [&](std::int32_t j) { b.push_back(j); });
     EXPECT_EQ(a, b);
   }
 }
@@ -156,7 +157,8 @@ TEST(Bins, WallHaloFindsEveryWallWithinOneCellOfAPoint) {
 // 6.25 million cells).
 TEST(Bins, MemoryFollowsAgentsAndOccupiedAreaNotTheExtent) {
   std::vector<glm::vec2> p;
-  for (int k = 0; k < 100; ++k) p.push_back({static_cast<float>(k % 10) * 1000.0f, static_cast<float>(k / 10) * 1000.0f});
+  for (int k = 0; k < 100; ++k)
+    p.push_back({static_cast<float>(k % 10) * 1000.0f, static_cast<float>(k / 10) * 1000.0f});
   const std::vector<std::uint8_t> flags(p.size(), kAgentActive);
   AgentGrid g(4.0f);
   g.rebuild(p, flags);

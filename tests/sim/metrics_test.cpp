@@ -188,7 +188,8 @@ TEST(MetricsVoronoi, SquareLatticeDensityIsOneOverSpacingSquared) {
     area.add({-2.3f * a, -1.1f * a});
     area.add({2.9f * a, 3.4f * a});
     const double size = (static_cast<double>(area.max.x) - area.min.x) * (static_cast<double>(area.max.y) - area.min.y);
-    const VoronoiSample s = measure_area_voronoi(p, v, goal, flags, area, 1.0f);  // corners at a/sqrt(2) < 1: cut by no disc
+    const VoronoiSample s =
+        measure_area_voronoi(p, v, goal, flags, area, 1.0f);  // corners at a/sqrt(2) < 1: cut by no disc
     // Exact up to the rounding of the lattice's float coordinates.
     EXPECT_NEAR(s.density * a * a, 1.0, 1e-6);
     EXPECT_NEAR(s.speed, 1.2, 1e-6);
@@ -297,7 +298,8 @@ TEST(MetricsVoronoi, SameResultOnOneAndFourThreads) {
 
 // Agents at at(i, t), stepped by hand every dt: every step's crossings.
 std::vector<LineCrossing> walk_crossings(std::size_t n, const std::function<glm::vec2(std::size_t, double)>& at,
-                                         const std::vector<std::uint8_t>& flags, const std::vector<Segment>& lines, double dt, int steps) {
+                                         const std::vector<std::uint8_t>& flags, const std::vector<Segment>& lines,
+                                         double dt, int steps) {
   Aabb bounds;
   for (const Segment& s : lines) bounds.add(s.a), bounds.add(s.b);
   std::vector<LineCrossing> all;
@@ -305,7 +307,8 @@ std::vector<LineCrossing> walk_crossings(std::size_t n, const std::function<glm:
   for (std::size_t i = 0; i < n; ++i) before[i] = at(i, 0.0);
   for (int k = 1; k <= steps; ++k) {
     for (std::size_t i = 0; i < n; ++i) after[i] = at(i, k * dt);
-    const std::vector<LineCrossing> step = line_crossings(before, flags, after, flags, lines, bounds, (k - 1) * dt, k * dt);
+    const std::vector<LineCrossing> step =
+        line_crossings(before, flags, after, flags, lines, bounds, (k - 1) * dt, k * dt);
     all.insert(all.end(), step.begin(), step.end());
     before = after;
   }
@@ -318,8 +321,9 @@ TEST(MetricsLines, CrossingsOfStraightWalkersAtKnownTimes) {
   struct Walker {
     float v, t_cross, y;  // speed along x (negative: towards -x), time at x = 0, y
   };
-  const std::vector<Walker> w{{1.0f, 1.25f, 0.0f}, {1.3f, 2.0f, 1.0f}, {0.8f, 3.05f, -2.0f}, {1.1f, 4.5f, 4.0f},
-                              {-1.2f, 2.7f, 0.5f}, {1.0f, 2.0f, 6.0f} /* beside the line */, {1.0f, 1.5f, 0.0f} /* inactive */};
+  const std::vector<Walker> w{{1.0f, 1.25f, 0.0f}, {1.3f, 2.0f, 1.0f},  {0.8f, 3.05f, -2.0f},
+                              {1.1f, 4.5f, 4.0f},  {-1.2f, 2.7f, 0.5f}, {1.0f, 2.0f, 6.0f} /* beside the line */,
+                              {1.0f, 1.5f, 0.0f} /* inactive */};
   std::vector<std::uint8_t> flags(w.size(), kAgentActive);
   flags[6] = 0;
   const std::vector<Segment> lines{{{0, 5}, {0, -5}}};

@@ -40,7 +40,8 @@ MazeRun run_maze(PlanningKind planning, std::int64_t agents) {
     ++r.steps;
     // Every step: an agent pushed into a wall for one step is caught.
     const CrowdState& c = sim->crowd();
-    const Index penetrations = count_obstacle_penetrations(sim->world(), c.position.span(), c.radius.span(), c.flags.span(), 1e-3f);
+    const Index penetrations =
+        count_obstacle_penetrations(sim->world(), c.position.span(), c.radius.span(), c.flags.span(), 1e-3f);
     r.max_penetrations = std::max(r.max_penetrations, penetrations);
     r.penetration_steps += penetrations > 0 ? 1 : 0;
   }
@@ -52,8 +53,9 @@ MazeRun run_maze(PlanningKind planning, std::int64_t agents) {
 TEST(PlannedRoutes, EveryAgentCrossesTheMazeOnPlannedRoutesFewWithout) {
   const std::int64_t n = test::sanitized() ? 60 : 100;  // as shipped; fewer under the sanitizers
   const MazeRun planned = run_maze(PlanningKind::Roadmap, n);
-  std::printf("  maze, %lld agents, planning roadmap: %lld routed, %lld arrived after %.0f s\n", static_cast<long long>(n),
-              static_cast<long long>(planned.routed), static_cast<long long>(planned.arrived), planned.seconds);
+  std::printf("  maze, %lld agents, planning roadmap: %lld routed, %lld arrived after %.0f s\n",
+              static_cast<long long>(n), static_cast<long long>(planned.routed),
+              static_cast<long long>(planned.arrived), planned.seconds);
   EXPECT_EQ(planned.agents, n);
   EXPECT_GE(planned.routed, n * 9 / 10);  // the first wall blocks nearly every straight line
   EXPECT_GE(planned.arrived * 100, n * 95);
@@ -64,7 +66,8 @@ TEST(PlannedRoutes, EveryAgentCrossesTheMazeOnPlannedRoutesFewWithout) {
               static_cast<long long>(straight.arrived), straight.seconds);
   EXPECT_EQ(straight.routed, 0);
   EXPECT_LT(straight.arrived, n / 2);
-  EXPECT_EQ(straight.max_penetrations, 0) << "in " << straight.penetration_steps << " of " << straight.steps << " steps";
+  EXPECT_EQ(straight.max_penetrations, 0)
+      << "in " << straight.penetration_steps << " of " << straight.steps << " steps";
 }
 
 }  // namespace

@@ -39,9 +39,9 @@ struct RunRecord {
   float max_overlap_depth = 0.0f;
   Index max_deep_pairs = 0;
   Index max_penetrations = 0;
-  Index deep_pair_samples = 0;  // sum over samples (steps) of the pairs deeper than the tolerance
-  Index touching_samples = 0;   // sum over samples of the pairs in contact (collisions)
-  Index samples = 0;            // the start and every step
+  Index deep_pair_samples = 0;         // sum over samples (steps) of the pairs deeper than the tolerance
+  Index touching_samples = 0;          // sum over samples of the pairs in contact (collisions)
+  Index samples = 0;                   // the start and every step
   std::int64_t penetration_steps = 0;  // samples with any agent in an obstacle
 };
 
@@ -52,13 +52,15 @@ RunRecord run_to_arrival(const ScenarioSpec& spec, SchedulerKind scheduler, std:
   RunRecord r;
   auto sample = [&] {
     const CrowdState& c = sim.crowd();
-    const OverlapStats o = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), kOverlapTolerance, sim.contact_cell());
+    const OverlapStats o =
+        measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), kOverlapTolerance, sim.contact_cell());
     r.max_overlap_depth = std::max(r.max_overlap_depth, o.max_depth);
     r.max_deep_pairs = std::max(r.max_deep_pairs, o.pairs);
     r.deep_pair_samples += o.pairs;
     r.touching_samples += o.touching;
     ++r.samples;
-    const Index penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), kPenetrationTolerance);
+    const Index penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(),
+                                                           c.flags.span(), kPenetrationTolerance);
     r.max_penetrations = std::max(r.max_penetrations, penetrations);
     r.penetration_steps += penetrations > 0 ? 1 : 0;
   };
@@ -73,7 +75,9 @@ RunRecord run_to_arrival(const ScenarioSpec& spec, SchedulerKind scheduler, std:
   return r;
 }
 
-double mean(const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }
+double mean(const std::vector<float>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
 
 // Two-sample Kolmogorov-Smirnov statistic: the largest gap between the
 // empirical distributions.
@@ -86,7 +90,8 @@ double ks_statistic(std::vector<float> a, std::vector<float> b) {
     const float x = std::min(a[i], b[j]);
     while (i < a.size() && a[i] <= x) ++i;
     while (j < b.size() && b[j] <= x) ++j;
-    d = std::max(d, std::fabs(static_cast<double>(i) / static_cast<double>(a.size()) - static_cast<double>(j) / static_cast<double>(b.size())));
+    d = std::max(d, std::fabs(static_cast<double>(i) / static_cast<double>(a.size()) -
+                              static_cast<double>(j) / static_cast<double>(b.size())));
   }
   return d;
 }
@@ -110,9 +115,10 @@ void expect_schedulers_agree(const RunRecord& a, const RunRecord& b) {
   const double ks = ks_statistic(a.arrival_times, b.arrival_times);
   const double ca = static_cast<double>(a.touching_samples) / static_cast<double>(std::max<Index>(1, a.samples));
   const double cb = static_cast<double>(b.touching_samples) / static_cast<double>(std::max<Index>(1, b.samples));
-  std::printf("  mean arrival: double buffer %.1f s, four colour %.1f s; KS statistic %.3f; steps %lld / %lld\n", ma, mb, ks,
-              static_cast<long long>(a.steps), static_cast<long long>(b.steps));
-  std::printf("  pairs in contact per sample %.2f / %.2f; deepest overlap %.3f / %.3f m\n", ca, cb, a.max_overlap_depth, b.max_overlap_depth);
+  std::printf("  mean arrival: double buffer %.1f s, four colour %.1f s; KS statistic %.3f; steps %lld / %lld\n", ma,
+              mb, ks, static_cast<long long>(a.steps), static_cast<long long>(b.steps));
+  std::printf("  pairs in contact per sample %.2f / %.2f; deepest overlap %.3f / %.3f m\n", ca, cb, a.max_overlap_depth,
+              b.max_overlap_depth);
   EXPECT_LT(std::fabs(ma - mb), 0.1 * std::max(ma, mb));
   EXPECT_LT(ks, 0.15);
   EXPECT_LE(ca, 2.0 * cb + 1.0);
@@ -128,15 +134,19 @@ void acceptance(const char* name, Index agents, Index sanitized_agents, Schedule
   const ScenarioSpec spec = test::builtin(name, n);
   ASSERT_EQ(spec.total_agents(), n);
   const RunRecord r = run_to_arrival(spec, scheduler, spec.step_count());
-  std::printf("  %s, %lld agents, %s: %lld steps, mean arrival %.1f s, deepest overlap %.3f m, pairs deeper than %.2f m at most %lld\n",
-              name, static_cast<long long>(n), to_string(scheduler), static_cast<long long>(r.steps), mean(r.arrival_times), r.max_overlap_depth,
-              static_cast<double>(kOverlapTolerance), static_cast<long long>(r.max_deep_pairs));
+  std::printf(
+      "  %s, %lld agents, %s: %lld steps, mean arrival %.1f s, deepest overlap %.3f m, pairs deeper than %.2f m at "
+      "most %lld\n",
+      name, static_cast<long long>(n), to_string(scheduler), static_cast<long long>(r.steps), mean(r.arrival_times),
+      r.max_overlap_depth, static_cast<double>(kOverlapTolerance), static_cast<long long>(r.max_deep_pairs));
   expect_acceptance(r, n, to_string(scheduler));
 }
 
 TEST(Acceptance, CircleThousandAgentsDoubleBuffer) { acceptance("circle", 1000, 300, SchedulerKind::DoubleBuffer); }
 TEST(Acceptance, CircleThousandAgentsFourColour) { acceptance("circle", 1000, 300, SchedulerKind::FourColour); }
-TEST(Acceptance, CrossingTwoThousandAgentsDoubleBuffer) { acceptance("crossing", 2000, 600, SchedulerKind::DoubleBuffer); }
+TEST(Acceptance, CrossingTwoThousandAgentsDoubleBuffer) {
+  acceptance("crossing", 2000, 600, SchedulerKind::DoubleBuffer);
+}
 TEST(Acceptance, CrossingTwoThousandAgentsFourColour) { acceptance("crossing", 2000, 600, SchedulerKind::FourColour); }
 
 // A crowd pressed into a corner it cannot reach, found by the structure-
@@ -169,8 +179,8 @@ TEST(Contacts, ACrowdPressedIntoASharpCornerKeepsTheOverlapBound) {
   const ScenarioSpec spec = io::parse_scenario(kCornerJam, "corner_jam").spec;
   for (const SchedulerKind scheduler : {SchedulerKind::DoubleBuffer, SchedulerKind::FourColour}) {
     const RunRecord r = run_to_arrival(spec, scheduler, 600);
-    std::printf("  corner jam, %s: %lld steps, deepest overlap %.3f m\n", to_string(scheduler), static_cast<long long>(r.steps),
-                r.max_overlap_depth);
+    std::printf("  corner jam, %s: %lld steps, deepest overlap %.3f m\n", to_string(scheduler),
+                static_cast<long long>(r.steps), r.max_overlap_depth);
     EXPECT_FALSE(r.all_arrived) << to_string(scheduler);  // the goal lies inside the wedge: the crowd stays pressed
     EXPECT_EQ(r.max_penetrations, 0) << to_string(scheduler);
     EXPECT_LT(r.max_overlap_depth, kOverlapLimit) << to_string(scheduler);
@@ -194,10 +204,12 @@ SqueezeResult squeeze_one_step(SchedulerKind scheduler, int side, float spacing,
   spec.model.contact_extra_iterations = extra;
   Simulation sim(spec);
   Span<glm::vec2> p = sim.crowd().position.span();
-  for (Index i = 0; i < n; ++i) p[i] = glm::vec2(spacing * static_cast<float>(i % side), spacing * static_cast<float>(i / side));
+  for (Index i = 0; i < n; ++i)
+    p[i] = glm::vec2(spacing * static_cast<float>(i % side), spacing * static_cast<float>(i / side));
   sim.step();
   const CrowdState& c = sim.crowd();
-  return {sim.last_contact_passes(), measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, sim.contact_cell()).max_depth};
+  return {sim.last_contact_passes(),
+          measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, sim.contact_cell()).max_depth};
 }
 
 TEST(Contacts, ExtraPassesRunWhileAPairIsDeeperThanTheTolerance) {
@@ -215,8 +227,9 @@ TEST(Contacts, ExtraPassesRunWhileAPairIsDeeperThanTheTolerance) {
 
     const SqueezeResult fixed = squeeze_one_step(scheduler, 8, 0.44f, 0);
     const SqueezeResult extra = squeeze_one_step(scheduler, 8, 0.44f, d.contact_extra_iterations);
-    std::printf("  %s: 5 x 5 squeeze %d passes, %.4f m; 8 x 8: %d passes, %.4f m, with the extra passes %d, %.4f m\n", to_string(scheduler),
-                small.passes, small.deepest, fixed.passes, fixed.deepest, extra.passes, extra.deepest);
+    std::printf("  %s: 5 x 5 squeeze %d passes, %.4f m; 8 x 8: %d passes, %.4f m, with the extra passes %d, %.4f m\n",
+                to_string(scheduler), small.passes, small.deepest, fixed.passes, fixed.deepest, extra.passes,
+                extra.deepest);
     EXPECT_EQ(fixed.passes, d.contact_iterations);
     EXPECT_EQ(extra.passes, d.contact_iterations + d.contact_extra_iterations);
     EXPECT_GT(fixed.deepest, d.contact_tolerance);
@@ -235,7 +248,8 @@ TEST(Schedulers, ArrivalTimesAndCollisionsAgreeStatistically) {
     for (std::uint64_t seed : {1, 2, 3}) {
       ScenarioSpec spec = test::builtin(name, agents);
       spec.seed = seed;
-      for (auto [scheduler, pooled] : {std::pair{SchedulerKind::DoubleBuffer, &db}, std::pair{SchedulerKind::FourColour, &fc}}) {
+      for (auto [scheduler, pooled] :
+           {std::pair{SchedulerKind::DoubleBuffer, &db}, std::pair{SchedulerKind::FourColour, &fc}}) {
         const RunRecord r = run_to_arrival(spec, scheduler, spec.step_count());
         expect_acceptance(r, agents, to_string(scheduler));
         pooled->arrival_times.insert(pooled->arrival_times.end(), r.arrival_times.begin(), r.arrival_times.end());
@@ -285,7 +299,8 @@ void expect_identical(const Snapshot& a, const Snapshot& b, int threads) {
 // agents under the sanitizers.
 // Every model.
 TEST(Determinism, DoubleBufferIsBitwiseTheSameForOneTwoAndFourThreads) {
-  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce})
+  for (const ModelKind model :
+       {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce})
     for (const auto& [name, agents, steps] : {std::tuple{"bottleneck", 300, 400}, std::tuple{"crossing", 1200, 500}}) {
       SCOPED_TRACE(std::string(name) + ", " + to_string(model));
       ScenarioSpec spec = test::builtin(name, test::sanitized() ? agents / 3 : agents);
@@ -300,7 +315,8 @@ TEST(Determinism, DoubleBufferIsBitwiseTheSameForOneTwoAndFourThreads) {
 // The four-colour batches never let two cells of a batch touch the same
 // agents, so they too are independent of the thread count (every model).
 TEST(Determinism, FourColourIsBitwiseTheSameForOneTwoAndFourThreads) {
-  for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce}) {
+  for (const ModelKind model :
+       {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc, ModelKind::SocialForce}) {
     SCOPED_TRACE(to_string(model));
     ScenarioSpec spec = test::builtin("bottleneck", 300);
     spec.model.kind = model;

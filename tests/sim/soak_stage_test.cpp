@@ -28,7 +28,8 @@ TEST(CountNonFinite, CountsAgentsWithANaNOrInfinitePositionOrVelocity) {
 }
 
 TEST(SoakCheckStage, AHealthyRunPassesWithALinePerCheck) {
-  const std::string report = (std::filesystem::temp_directory_path() / ("throng_soak_" + std::to_string(getpid()) + ".jsonl")).string();
+  const std::string report =
+      (std::filesystem::temp_directory_path() / ("throng_soak_" + std::to_string(getpid()) + ".jsonl")).string();
   Simulation sim(test::builtin("corridor", 40));
   FrameLoop loop(sim);
   SoakOptions o;
@@ -74,16 +75,25 @@ void expect_check_fails(const std::function<void(CrowdState&)>& change, const st
 }
 
 TEST(SoakCheckStage, ANonFiniteAgentFailsTheCheck) {
-  expect_check_fails([](CrowdState& c) { c.velocity[0] = {std::numeric_limits<float>::quiet_NaN(), 0.0f}; }, "non-finite");
+  expect_check_fails(
+      [](CrowdState& c) {
+        c.velocity[0] = {std::numeric_limits<float>::quiet_NaN(), 0.0f};
+      },
+      "non-finite");
 }
 
 TEST(SoakCheckStage, AnAgentOutsideTheWalkableAreaFailsTheCheck) {
-  expect_check_fails([](CrowdState& c) { c.position[0] = {0.0f, 40.0f}; }, "outside free space");  // the corridor is 6 m wide
+  expect_check_fails(
+      [](CrowdState& c) {
+        c.position[0] = {0.0f, 40.0f};
+      },
+      "outside free space");  // the corridor is 6 m wide
 }
 
 TEST(SoakCheckStage, AnOverlapBeyondTheBoundFailsTheCheck) {
   // Radii 0.25 m and 20 cm apart: 30 cm deep.
-  expect_check_fails([](CrowdState& c) { c.position[1] = c.position[0] + glm::vec2(0.2f, 0.0f); }, "overlap by more than the model's bound");
+  expect_check_fails([](CrowdState& c) { c.position[1] = c.position[0] + glm::vec2(0.2f, 0.0f); },
+                     "overlap by more than the model's bound");
 }
 
 }  // namespace

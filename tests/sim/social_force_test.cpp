@@ -51,7 +51,9 @@ TEST(SocialForce, AnisotropyWeighsNeighboursAheadMoreThanBehind) {
   // (cos phi = 1, w = 1), walking north beside (w = lambda + (1 - lambda) / 2),
   // walking east behind (w = lambda).
   const float full = 2000.0f * std::exp(-2.5f);
-  auto social = [&](glm::vec2 heading) { return sf_neighbour_force({0.6f, 0.0f}, {0, 0}, {0, 0}, 0.4f, heading, kAnisotropic, 0.0f).x; };
+  auto social = [&](glm::vec2 heading) {
+    return sf_neighbour_force({0.6f, 0.0f}, {0, 0}, {0, 0}, 0.4f, heading, kAnisotropic, 0.0f).x;
+  };
   EXPECT_NEAR(social({-1, 0}), full, 1e-3f * full);
   EXPECT_NEAR(social({0, 1}), 0.65f * full, 1e-3f * full);
   EXPECT_NEAR(social({1, 0}), 0.3f * full, 1e-3f * full);
@@ -145,7 +147,8 @@ TEST(SocialForce, DenseJamStaysStable) {
   for (int k = 0; k < 200; ++k) {
     sim.step();
     const CrowdState& c = sim.crowd();
-    deepest = std::max(deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
+    deepest =
+        std::max(deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
   }
   const CrowdState& c = sim.crowd();
   for (Index i = 0; i < c.count; ++i) {
@@ -175,4 +178,3 @@ TEST(SocialForce, EncountersResolve) {
 
 }  // namespace
 }  // namespace throng::sim
-

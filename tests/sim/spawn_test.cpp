@@ -25,7 +25,9 @@ ScenarioSpec field(std::int64_t count, glm::vec2 min, glm::vec2 max, float radiu
   return s;
 }
 
-CrowdHost spawn(const ScenarioSpec& spec) { return spawn_crowd(spec, World::build(spec.world, spec.model.query_radius())); }
+CrowdHost spawn(const ScenarioSpec& spec) {
+  return spawn_crowd(spec, World::build(spec.world, spec.model.query_radius()));
+}
 
 std::string spawn_error(const ScenarioSpec& spec) {
   try {

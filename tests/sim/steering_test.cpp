@@ -79,7 +79,7 @@ TEST(ObstacleAvoidance, WallAlongsideGivesNoForce) {
 
 TEST(ObstacleAvoidance, NothingAheadOrBeyondTheProbe) {
   const Probe p = probe_east();
-  EXPECT_FALSE(probe_segment(p, {1.3f, -2.0f}, {1.3f, 2.0f}).hit);   // beyond the 1.25 m length
+  EXPECT_FALSE(probe_segment(p, {1.3f, -2.0f}, {1.3f, 2.0f}).hit);    // beyond the 1.25 m length
   EXPECT_FALSE(probe_segment(p, {-1.0f, -2.0f}, {-1.0f, 2.0f}).hit);  // behind
   EXPECT_FALSE(probe_segment(p, {0.0f, 0.5f}, {1.0f, 0.5f}).hit);     // outside the 0.35 m band
   EXPECT_FALSE(probe_circle(p, {3.0f, 0.0f}, 1.0f).hit);
@@ -209,7 +209,8 @@ struct Scene {
   ModelParams m;
   StepContext ctx;
 
-  Scene(std::vector<glm::vec2> positions, std::vector<glm::vec2> velocities, std::vector<glm::vec2> goals, const WorldSpec& spec) {
+  Scene(std::vector<glm::vec2> positions, std::vector<glm::vec2> velocities, std::vector<glm::vec2> goals,
+        const WorldSpec& spec) {
     world = World::build(spec, m.query_radius());
     CrowdHost h;
     h.position = positions;

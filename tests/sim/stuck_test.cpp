@@ -102,19 +102,19 @@ TEST(StuckAgents, AgentsWaitingBehindOthersAreNotStuck) {
   const World w = World::build(room(), 4.0f);
   Crowd c;
   const glm::vec2 east{30, 0};
-  c.add({-15, 0}, {0, 0}, glm::vec2{-15, 0} + east);        // 0: queue tail: not
+  c.add({-15, 0}, {0, 0}, glm::vec2{-15, 0} + east);          // 0: queue tail: not
   c.add({-14.45f, 0}, {0, 0}, glm::vec2{-14.45f, 0} + east);  // 1: middle: not
   c.add({-13.9f, 0}, {0, 0}, glm::vec2{-13.9f, 0} + east);    // 2: head, floor free before it: stuck
-  c.add({-15, 5}, {0, 0}, {10, 5});                          // 3: the next one's disc 0.5 m away, inside the probe: not
-  c.add({-14.0f, 5}, {0, 0}, {10, 5});                       // 4: free: stuck
-  c.add({-15, 7}, {0, 0}, {10, 7});                          // 5: the next one's disc 0.7 m away: stuck
-  c.add({-13.8f, 7}, {0, 0}, {10, 7});                       // 6: free: stuck
-  c.add({-15, -5}, {0, 0}, {10, -5});                        // 7: the one ahead is inactive (left): stuck
-  c.add({-14.45f, -5}, {0, 0}, {10, -5}, 0);                 // 8
-  c.add({-15, -8}, {0, 0}, {10, -8});                        // 9: behind one stopped at its goal: not
+  c.add({-15, 5}, {0, 0}, {10, 5});           // 3: the next one's disc 0.5 m away, inside the probe: not
+  c.add({-14.0f, 5}, {0, 0}, {10, 5});        // 4: free: stuck
+  c.add({-15, 7}, {0, 0}, {10, 7});           // 5: the next one's disc 0.7 m away: stuck
+  c.add({-13.8f, 7}, {0, 0}, {10, 7});        // 6: free: stuck
+  c.add({-15, -5}, {0, 0}, {10, -5});         // 7: the one ahead is inactive (left): stuck
+  c.add({-14.45f, -5}, {0, 0}, {10, -5}, 0);  // 8
+  c.add({-15, -8}, {0, 0}, {10, -8});         // 9: behind one stopped at its goal: not
   c.add({-14.45f, -8}, {0, 0}, {-14.45f, -8}, kStoppedAtGoal);  // 10: stopped: not
-  c.add({-15, -12}, {0, 0}, {-15, -2});                      // 11: the one ahead stands to the side of the way up: stuck
-  c.add({-14.4f, -11.6f}, {0.3f, 0}, {10, -11.6f});         // 12: walking
+  c.add({-15, -12}, {0, 0}, {-15, -2});              // 11: the one ahead stands to the side of the way up: stuck
+  c.add({-14.4f, -11.6f}, {0.3f, 0}, {10, -11.6f});  // 12: walking
   StuckTracker t;
   for (std::int64_t k = 1; k <= 60; ++k) step(t, w, c, k);
   std::vector<Index> got;
@@ -145,9 +145,11 @@ TEST(StuckAgents, MatchesBruteForceAndIsTheSameOnOneAndFourThreads) {
     const glm::vec2 q = c.p[i] + ((r + 0.3f) / len) * d;
     if (!point_in_polygon(q, spec.walkable) || closest_boundary_point(q, spec.walkable).distance < r) return false;
     if (point_in_polygon(q, spec.polygons[0]) || distance_to_polygon(q, spec.polygons[0]) < r) return false;
-    if (std::hypot(q.x - spec.circles[0].center.x, q.y - spec.circles[0].center.y) < spec.circles[0].radius + r) return false;
+    if (std::hypot(q.x - spec.circles[0].center.x, q.y - spec.circles[0].center.y) < spec.circles[0].radius + r)
+      return false;
     for (std::size_t j = 0; j < c.p.size(); ++j)
-      if (j != i && (c.flags[j] & kAgentActive) != 0 && std::hypot(c.p[j].x - q.x, c.p[j].y - q.y) < r + c.r[j]) return false;
+      if (j != i && (c.flags[j] & kAgentActive) != 0 && std::hypot(c.p[j].x - q.x, c.p[j].y - q.y) < r + c.r[j])
+        return false;
     return true;
   };
   std::vector<std::int32_t> want(c.p.size());

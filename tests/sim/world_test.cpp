@@ -106,22 +106,25 @@ TEST(WorldGeometry, LongWallsOutOfTheGridAreStillFoundNearby) {
   };
   std::vector<glm::vec2> probes;
   for (int i = 0; i < 300; ++i) {
-    probes.push_back({uniform(-8, 8), uniform(-8, 8)});                     // the short obstacle
-    probes.push_back({kHalf - uniform(0, 6), uniform(-1e5f, 1e5f)});        // the east side
-    probes.push_back({uniform(-1e5f, 1e5f), -kHalf + uniform(0, 6)});       // the south side
+    probes.push_back({uniform(-8, 8), uniform(-8, 8)});                // the short obstacle
+    probes.push_back({kHalf - uniform(0, 6), uniform(-1e5f, 1e5f)});   // the east side
+    probes.push_back({uniform(-1e5f, 1e5f), -kHalf + uniform(0, 6)});  // the south side
     const float t = uniform(1000, 6650);
-    probes.push_back({t + uniform(-5, 5), t + uniform(-5, 5)});             // along the diagonal
+    probes.push_back({t + uniform(-5, 5), t + uniform(-5, 5)});  // along the diagonal
   }
   for (const glm::vec2 p : probes) {
     std::vector<const Segment*> seen;
-    for_each_obstacle(v, obstacle_cell(v, p), [&](const Segment& s) { seen.push_back(&s); }, [](const Circle&) {});
+    for_each_obstacle(
+        v, obstacle_cell(v, p), [&](const Segment& s) { seen.push_back(&s); }, [](const Circle&) {});
     std::vector<const Segment*> near;
     for_each_wall_near(v, p, [&](const Segment& s) { near.push_back(&s); });
     for (const Segment& s : w.segments()) {
       if (distance_to_segment(p, s.a, s.b) > cell * 0.999f) continue;
-      EXPECT_NE(std::find(seen.begin(), seen.end(), &s), seen.end()) << "wall (" << s.a.x << ", " << s.a.y << ")-(" << s.b.x << ", " << s.b.y
-                                                                     << ") missed at " << p.x << ", " << p.y;
-      EXPECT_NE(std::find(near.begin(), near.end(), &s), near.end()) << "for_each_wall_near missed it at " << p.x << ", " << p.y;
+      EXPECT_NE(std::find(seen.begin(), seen.end(), &s), seen.end())
+          << "wall (" << s.a.x << ", " << s.a.y << ")-(" << s.b.x << ", " << s.b.y << ") missed at " << p.x << ", "
+          << p.y;
+      EXPECT_NE(std::find(near.begin(), near.end(), &s), near.end())
+          << "for_each_wall_near missed it at " << p.x << ", " << p.y;
     }
   }
 }
@@ -133,7 +136,8 @@ TEST(Spawn, AgentsStartApartInFreeSpaceWithTheirGoals) {
   ASSERT_EQ(h.position.size(), 300u);
   for (std::size_t i = 0; i < h.position.size(); ++i) {
     EXPECT_TRUE(w.disc_fits(h.position[i], h.radius[i])) << i;
-    for (std::size_t j = i + 1; j < h.position.size(); ++j) ASSERT_GE(length_of(h.position[i] - h.position[j]), h.radius[i] + h.radius[j]);
+    for (std::size_t j = i + 1; j < h.position.size(); ++j)
+      ASSERT_GE(length_of(h.position[i] - h.position[j]), h.radius[i] + h.radius[j]);
     // Route: the door, then a random goal in the yard (the goal is last).
     ASSERT_EQ(h.waypoint_count[i], 2);
     EXPECT_EQ(h.waypoint_goal[i], 1);
@@ -195,10 +199,11 @@ TEST(Spawn, ClearErrorsForSpawnRegionsGoalsAndParameters) {
 // fixed point above the obstacle.
 class DetourPlanner : public RoutePlanner {
  public:
-  std::vector<std::vector<glm::vec2>> plan(const World&, std::span<const glm::vec2> starts, std::span<const glm::vec2> goals,
-                                           float) const override {
+  std::vector<std::vector<glm::vec2>> plan(const World&, std::span<const glm::vec2> starts,
+                                           std::span<const glm::vec2> goals, float) const override {
     std::vector<std::vector<glm::vec2>> routes;
-    for (std::size_t i = 0; i < starts.size(); ++i) routes.push_back({glm::vec2(0.0f, 6.0f), glm::vec2(goals[i].x, 6.0f)});
+    for (std::size_t i = 0; i < starts.size(); ++i)
+      routes.push_back({glm::vec2(0.0f, 6.0f), glm::vec2(goals[i].x, 6.0f)});
     return routes;
   }
 };

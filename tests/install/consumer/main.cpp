@@ -11,8 +11,7 @@ int main() {
     const auto scenario = throng::io::load_builtin_scenario("circle");
     auto sim = throng::io::build_simulation(scenario);
     for (int i = 0; i < 10; ++i) sim->step();
-    std::printf("scenario=circle steps=10 agents=%lld spec_agents=%lld\n",
-                static_cast<long long>(sim->agent_count()),
+    std::printf("scenario=circle steps=10 agents=%lld spec_agents=%lld\n", static_cast<long long>(sim->agent_count()),
                 static_cast<long long>(scenario.spec.total_agents()));
     return 0;
   } catch (const std::exception& e) {
