@@ -106,8 +106,8 @@ class Reader : public YamlReader {
     return c;
   }
 
-  path::GroupSpec group(const std::string& name, const YAML::Node& n, const std::string& path) {
-    path::GroupSpec g;
+  path::StateGroupSpec group(const std::string& name, const YAML::Node& n, const std::string& path) {
+    path::StateGroupSpec g;
     g.name = name;
     g.where = where(n, path);
     if (!n.IsNull()) {

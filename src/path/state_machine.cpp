@@ -97,14 +97,14 @@ void check_limits(const StateMachineSpec& spec) {
 // names.group_of.
 std::vector<MachineGroup> name_groups(const StateMachineSpec& spec, Names& names) {
   std::vector<MachineGroup> groups;
-  for (const GroupSpec& g : spec.groups) {
+  for (const StateGroupSpec& g : spec.groups) {
     if (g.name.empty()) fail("a group needs a name", g.where);
     if (names.group_of.count(g.name)) fail("group '" + g.name + "' is defined twice", g.where);
     names.group_of[g.name] = static_cast<std::int32_t>(groups.size());
     groups.push_back({g.name, -1});
   }
   for (std::size_t i = 0; i < spec.groups.size(); ++i) {
-    const GroupSpec& g = spec.groups[i];
+    const StateGroupSpec& g = spec.groups[i];
     if (g.parent.empty()) continue;
     auto it = names.group_of.find(g.parent);
     if (it == names.group_of.end()) fail("unknown parent group '" + g.parent + "'", g.where);

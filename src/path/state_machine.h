@@ -62,7 +62,7 @@ struct StateSpec {
   Location where;
 };
 
-struct GroupSpec {
+struct StateGroupSpec {
   std::string name;
   std::string parent;  // may be empty
   Location where;
@@ -84,7 +84,7 @@ struct StateMachineSpec {
   std::string start_state;   // the sequence starts after this state ("" = free)
   std::string end_state;     // and ends before it
   std::vector<ClipSpec> clips;
-  std::vector<GroupSpec> groups;
+  std::vector<StateGroupSpec> groups;
   std::vector<StateSpec> states;
   std::vector<EdgeSpec> edges;
 };
