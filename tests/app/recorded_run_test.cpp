@@ -13,7 +13,6 @@
 //   THRONG_RECORD_RUN=tests/data/recorded_run.txt build/release/tests/app_tests --gtest_filter='RecordedRun.*'
 // (THRONG_RECORD_EXE=/path/to/throng records with another build of it.)
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cinttypes>
@@ -29,10 +28,12 @@
 #include <vector>
 
 #include "io/crowd_gltf.h"
+#include "tests/io/throng_exe.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using throng::io::testing::Result;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -67,24 +68,11 @@ const char* exe() {
   return other != nullptr && *other != '\0' ? other : THRONG_EXE;
 }
 
-// Runs `throng args...` with its output to `log`; returns the exit status.
-int run_throng(const std::vector<std::string>& args, const fs::path& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::FILE* f = std::fopen(log.c_str(), "w");
-    if (f != nullptr) {
-      dup2(fileno(f), STDOUT_FILENO);
-      dup2(fileno(f), STDERR_FILENO);
-    }
-    std::vector<char*> argv{const_cast<char*>(exe())};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(exe(), argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+// `throng args...` as io::testing::run runs it (CPU backend, warnings only), with its output.
+Result run_throng(const std::vector<std::string>& args) {
+  std::string line;
+  for (const std::string& arg : args) line += (line.empty() ? "" : " ") + arg;
+  return throng::io::testing::run(exe(), line);
 }
 
 // stats.json without what depends on the machine: timings, thread counts,
@@ -162,8 +150,8 @@ Record read_record(const fs::path& file) {
   std::ifstream in(file);
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;
-    const auto tab = line.rfind(' ');
-    if (tab != std::string::npos) r[line.substr(0, tab)] = line.substr(tab + 1);
+    const auto space = line.rfind(' ');
+    if (space != std::string::npos) r[line.substr(0, space)] = line.substr(space + 1);
   }
   return r;
 }
@@ -183,7 +171,8 @@ class RecordedRun : public ::testing::Test {
     args.insert(args.begin(), "run");
     for (const char* a : {"--every", "1", "--quiet", "--out"}) args.emplace_back(a);
     args.push_back(d.string());
-    ASSERT_EQ(run_throng(args, dir_ / (name + ".log")), 0) << slurp(dir_ / (name + ".log"));
+    const Result r = run_throng(args);
+    ASSERT_EQ(r.code, 0) << r.out;
     record_file(name + " trajectories.csv", d / "trajectories.csv", out);
     record_stats(name, d / "stats.json", dir_, out);
   }
@@ -211,19 +200,16 @@ TEST_F(RecordedRun, RunsExportsAndAnimationsMatchTheRecording) {
 
   // Joint positions of every exported agent.
   const fs::path glb = dir_ / "crowd.glb";
-  ASSERT_EQ(run_throng({"export-crowd", "plaza", "--agents", "12", "--seconds", "4", "--fps", "24", "--seed", "7",
-                        "--out", glb.string()},
-                       dir_ / "export.log"),
-            0)
-      << slurp(dir_ / "export.log");
+  const Result exported = run_throng({"export-crowd", "plaza", "--agents", "12", "--seconds", "4", "--fps", "24",
+                                      "--seed", "7", "--out", glb.string()});
+  ASSERT_EQ(exported.code, 0) << exported.out;
   record_glb_joints("export plaza", glb, now);
 
   // The formation animation (no simulation): its stats.json.
   const fs::path anim = dir_ / "animate";
-  ASSERT_EQ(run_throng({"animate", "formation", "--duration", "4", "--characters", "30", "--out", anim.string()},
-                       dir_ / "animate.log"),
-            0)
-      << slurp(dir_ / "animate.log");
+  const Result animated =
+      run_throng({"animate", "formation", "--duration", "4", "--characters", "30", "--out", anim.string()});
+  ASSERT_EQ(animated.code, 0) << animated.out;
   record_stats("animate formation", anim / "stats.json", dir_, now);
 
   const fs::path recording = fs::path(THRONG_SOURCE_DIR) / "tests" / "data" / "recorded_run.txt";
