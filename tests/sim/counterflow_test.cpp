@@ -61,18 +61,18 @@ CounterflowRun counterflow(ModelKind model, std::int64_t per_side, float block, 
   s.planning = PlanningKind::None;
   s.duration = duration;
   s.world.has_walkable = true;
-  const float L = block;
-  s.world.walkable.outer = {{-22.0f - L, 0.0f}, {22.0f + L, 0.0f}, {22.0f + L, 4.0f}, {-22.0f - L, 4.0f}};
+  s.world.walkable.outer = {
+      {-22.0f - block, 0.0f}, {22.0f + block, 0.0f}, {22.0f + block, 4.0f}, {-22.0f - block, 4.0f}};
   for (int side : {1, -1}) {
     GroupSpec g;
     g.count = per_side;
     g.radius = 0.2f;
     g.speed = {1.34f, 0.26f, 0.8f, 1.8f};
     g.spawn.kind = Region::Kind::rect;
-    g.spawn.min = {side > 0 ? -18.0f - L : 18.0f, 0.3f};
-    g.spawn.max = {side > 0 ? -18.0f : 18.0f + L, 3.7f};
+    g.spawn.min = {side > 0 ? -18.0f - block : 18.0f, 0.3f};
+    g.spawn.max = {side > 0 ? -18.0f : 18.0f + block, 3.7f};
     g.goal.kind = GoalSpec::Kind::Offset;
-    g.goal.value = {(20.0f + L) * static_cast<float>(side), 0.0f};
+    g.goal.value = {(20.0f + block) * static_cast<float>(side), 0.0f};
     g.arrival = ArrivalBehaviour::Despawn;
     s.groups.push_back(g);
   }
@@ -95,32 +95,36 @@ CounterflowRun counterflow(ModelKind model, std::int64_t per_side, float block, 
   return r;
 }
 
-CounterflowRun report(ModelKind model, std::int64_t per_side, float block, float duration) {
-  const CounterflowRun r = counterflow(model, per_side, block, duration);
-  std::printf(
-      "  %s, 2 x %lld from %.0f m blocks: lane order after 20 s %.2f, arrived %lld of %lld within %.0f s, mean "
-      "progress speed %.2f m/s\n",
-      to_string(model), static_cast<long long>(per_side), block, r.lane_order_20s, static_cast<long long>(r.arrived),
-      static_cast<long long>(r.agents), duration, r.progress_speed);
-  return r;
-}
-
 constexpr ModelKind kModels[] = {ModelKind::Priority, ModelKind::CollisionFreeSpeed, ModelKind::Ttc,
                                  ModelKind::SocialForce};
 
-// Dense: 1.5 P/m^2 in each block, about 3 P/m^2 where the streams overlap.
-TEST(Counterflow, DenseStreamsInAFourMetreCorridorPassEachOther) {
+// Runs the counterflow from `block` m blocks under every model, prints each
+// run, asserts that lanes form (the order is far above a mixed crowd's) and
+// hands the run to check(model, run) for the rest.
+template <class Check>
+void run_every_model(float block, float duration, const Check& check) {
   const std::int64_t per_side = test::sanitized() ? 100 : 200;
   for (const ModelKind model : kModels) {
     SCOPED_TRACE(to_string(model));
-    const CounterflowRun r = report(model, per_side, 40.0f, 300.0f);
-    // Lanes form under every model (the order is far above a mixed crowd's).
-    // The collision-free speed, time-to-collision and social force models
-    // get everyone through; the priority model leaves a few swirling against
-    // the walls at 300 s.
+    const CounterflowRun r = counterflow(model, per_side, block, duration);
+    std::printf(
+        "  %s, 2 x %lld from %.0f m blocks: lane order after 20 s %.2f, arrived %lld of %lld within %.0f s, mean "
+        "progress speed %.2f m/s\n",
+        to_string(model), static_cast<long long>(per_side), block, r.lane_order_20s, static_cast<long long>(r.arrived),
+        static_cast<long long>(r.agents), duration, r.progress_speed);
     EXPECT_GE(r.lane_order_20s, 0.6);
-    EXPECT_GE(r.arrived, model == ModelKind::Priority ? r.agents * 97 / 100 : r.agents);
+    check(model, r);
   }
+}
+
+// Dense: 1.5 P/m^2 in each block, about 3 P/m^2 where the streams overlap.
+// The collision-free speed, time-to-collision and social force models get
+// everyone through; the priority model leaves a few swirling against the
+// walls at 300 s.
+TEST(Counterflow, DenseStreamsInAFourMetreCorridorPassEachOther) {
+  run_every_model(40.0f, 300.0f, [](ModelKind model, const CounterflowRun& r) {
+    EXPECT_GE(r.arrived, model == ModelKind::Priority ? r.agents * 97 / 100 : r.agents);
+  });
 }
 
 // Moderate: 0.74 P/m^2 in each block, about 1.5 P/m^2 where the streams
@@ -130,16 +134,12 @@ TEST(Counterflow, DenseStreamsInAFourMetreCorridorPassEachOther) {
 // keep 0.8 m/s of progress; the others are reported. Each agent walks
 // 100 m here, so the run is given 400 s.
 TEST(Counterflow, ModerateStreamsFormLanesAndKeepTheirPace) {
-  const std::int64_t per_side = test::sanitized() ? 100 : 200;
-  for (const ModelKind model : kModels) {
-    SCOPED_TRACE(to_string(model));
-    const CounterflowRun r = report(model, per_side, 80.0f, 400.0f);
-    EXPECT_GE(r.lane_order_20s, 0.6);
+  run_every_model(80.0f, 400.0f, [](ModelKind model, const CounterflowRun& r) {
     EXPECT_EQ(r.arrived, r.agents);
     if (model == ModelKind::CollisionFreeSpeed || model == ModelKind::SocialForce) {
       EXPECT_GE(r.progress_speed, 0.8);
     }
-  }
+  });
 }
 
 }  // namespace
