@@ -23,14 +23,21 @@
 //
 // The anticipation term A_ij (this engine's addition; the published model
 // has no lateral avoidance, so two agents head-on on one line stop nose to
-// nose for ever): a neighbour ahead whose path will come within l_ij +
-// side_margin of the agent's own line, and who closes in at relative speed
-// c > 0, pushes the agent sideways, away from the side the neighbour is on,
-// with strength k (1 - tau / avoid_time) for time to contact tau =
-// (d_ij - l_ij) / c < avoid_time. A neighbour dead ahead is passed on the
-// right: every agent keeps right, which breaks head-on and circle
-// symmetries deterministically (the same bits for any thread count; no
-// random draw) and lets counterflows sort into lanes.
+// nose for ever): a neighbour ahead that walks towards the agent, against or
+// across its goal direction, and closes in at relative speed c > 0, is
+// looked at where it will be at the time to contact tau = (d_ij - l_ij) / c:
+// where it is for an oncoming walker, moved by its relative sideways speed
+// times tau for one crossing the agent's way (walking 45-135 degrees off
+// e0). If that lateral offset is within l_ij + side_margin of the agent's
+// line and tau < avoid_time, it pushes the agent sideways, away from that
+// side, with strength k (1 - tau / avoid_time) (1 - |offset| / band): beside
+// an oncoming neighbour, behind a crossing one (heading for where a crosser
+// is now leads in front of it, and both brake). A neighbour dead ahead is
+// passed on the right: every agent keeps right, which breaks head-on and
+// circle symmetries deterministically (the same bits for any thread count;
+// no random draw) and lets counterflows sort into lanes. Only oncoming
+// neighbours are extrapolated by their position, not their velocity: in a
+// dense counterflow their sideways jostling would flip the side every step.
 //
 // Host+device; the kernels (simulation_kernels.cpp) feed neighbours from the
 // 3x3 bins, tests call these functions on hand-computed cases.
@@ -43,8 +50,17 @@
 
 namespace throng::sim {
 
-// m/s: a neighbour walking towards the agent at least this fast is oncoming.
+// m/s: a neighbour walking towards the agent at least this fast is coming.
 inline constexpr float kCfsOncoming = 0.05f;
+// A coming neighbour is anticipated when its walking direction is at least
+// 60 degrees off the agent's goal direction (cos 60 = 0.5): one in the same
+// stream pushed back towards the agent (a jostling queue at a door) is not.
+inline constexpr float kCfsAgainst = 0.5f;
+// A neighbour walking at least this fast (m/s) with |cos| of its angle to
+// the agent's goal direction below this crosses the agent's way (45-135
+// degrees): its side is judged where it will be at contact.
+inline constexpr float kCfsCrossingSpeed = 0.3f;
+inline constexpr float kCfsCrossingCos = 0.7f;
 
 // The agent being steered: position, velocity, radius and e0.
 struct CfsAgent {
@@ -65,16 +81,19 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::v
   const glm::vec2 u = d * (1.0f / dist);
   glm::vec2 f = u * (-m.neighbour_strength * expf((l - dist) / m.neighbour_range));
   // Anticipation: only neighbours ahead, closing in, soon, near our line,
-  // and walking towards us (or parked for good). A slower walker ahead in
-  // the same direction is followed at the time gap, not dodged: dodging
-  // every slower neighbour spreads a queue sideways and chokes a door.
+  // and walking towards us against or across our way (or parked for good).
+  // A slower walker ahead in the same direction is followed at the time
+  // gap, not dodged: dodging every slower neighbour spreads a queue
+  // sideways and chokes a door.
   const float ahead = dot2(d, i.e0);
   const float closing = -dot2(w - i.v, u);
-  const bool coming = parked || -dot2(w, u) > kCfsOncoming;
+  const float speed = length_of(w), along = dot2(w, i.e0);
+  const bool coming = parked || (-dot2(w, u) > kCfsOncoming && along < kCfsAgainst * speed);
   if (m.avoid_strength > 0.0f && coming && ahead > 0.0f && closing > 1e-3f) {
     const float tau = fmaxf(dist - l, 0.0f) / closing;
     const glm::vec2 left = perp_left(i.e0);
-    const float lateral = dot2(d, left);
+    const bool crosser = speed > kCfsCrossingSpeed && fabsf(along) < kCfsCrossingCos * speed;
+    const float lateral = dot2(d, left) + (crosser ? dot2(w - i.v, left) * tau : 0.0f);
     const float band = l + m.side_margin;
     if (tau < m.avoid_time && fabsf(lateral) < band) {
       const float strength = m.avoid_strength * (1.0f - tau / m.avoid_time) * (1.0f - fabsf(lateral) / band);

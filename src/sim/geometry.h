@@ -104,6 +104,13 @@ THRONG_HOST_DEVICE inline bool segment_meets_box(glm::vec2 a, glm::vec2 b, glm::
   return clip(-d.x, a.x - lo.x) && clip(d.x, hi.x - a.x) && clip(-d.y, a.y - lo.y) && clip(d.y, hi.y - a.y);
 }
 
+// [a, b] and [c, d] cross at a point inside both (touching does not count;
+// float, for kernels: geometry validation uses segments_intersect).
+THRONG_HOST_DEVICE inline bool segments_cross(glm::vec2 a, glm::vec2 b, glm::vec2 c, glm::vec2 d) {
+  const glm::vec2 ab = b - a, cd = d - c;
+  return cross2(ab, c - a) * cross2(ab, d - a) < 0.0f && cross2(cd, a - c) * cross2(cd, b - c) < 0.0f;
+}
+
 // Crossing-number step of the even-odd rule for edge (a, b) and a ray from p
 // towards +x: true when the edge toggles "inside".
 THRONG_HOST_DEVICE inline bool edge_crosses_ray(glm::vec2 p, glm::vec2 a, glm::vec2 b) {

@@ -31,13 +31,20 @@ THRONG_HOST_DEVICE inline bool passed_waypoint(glm::vec2 p, glm::vec2 leg_start,
 // the nearest point of the same gate (the segment through the waypoint
 // square to its leg, kWaypointHalfWidth each side), so agents stream
 // through a door side by side in lanes instead of converging on one point
-// in single file. A gate end inside a wall is harmless: the model slides
-// the agent along the wall.
-THRONG_HOST_DEVICE inline glm::vec2 waypoint_aim(glm::vec2 p, glm::vec2 leg_start, glm::vec2 waypoint) {
+// in single file. A door narrower than the gate puts its ends behind the
+// wall: an agent that sees a wall (within a cell side) between itself and
+// the gate point heads for the waypoint instead; else it walks into the wall
+// beside the door, and a straggler there can slide along it away from the
+// door (seen in a 0.5 m door's room).
+THRONG_HOST_DEVICE inline glm::vec2 waypoint_aim(const WorldView& w, glm::vec2 p, glm::vec2 leg_start,
+                                                 glm::vec2 waypoint) {
   const glm::vec2 along = normalize_or(waypoint - leg_start, glm::vec2(0.0f));
   const glm::vec2 across = perp_left(along);
   const float offset = dot2(p - waypoint, across);
-  return waypoint + across * fminf(fmaxf(offset, -kWaypointHalfWidth), kWaypointHalfWidth);
+  const glm::vec2 gate = waypoint + across * fminf(fmaxf(offset, -kWaypointHalfWidth), kWaypointHalfWidth);
+  bool blocked = false;
+  for_each_wall_near(w, p, [&](const Segment& s) { blocked = blocked || segments_cross(p, gate, s.a, s.b); });
+  return blocked ? waypoint : gate;
 }
 
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
@@ -69,7 +76,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx,
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
   const glm::vec2 p = a.position[i];
   const bool final_goal = a.waypoint_cursor[i] == a.waypoint_goal[i];
-  const glm::vec2 aim = final_goal ? a.goal[i] : waypoint_aim(p, a.path_start[i], a.goal[i]);
+  const glm::vec2 aim = final_goal ? a.goal[i] : waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
   const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f))};
   return collision_free_velocity(ctx.world, i, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
 }

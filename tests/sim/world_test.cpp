@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/ground.h"
 #include "sim/crowd.h"
+#include "sim/geometry.h"
 #include "sim/simulation.h"
 #include "tests/sim/test_scenarios.h"
 
@@ -82,6 +83,30 @@ TEST(WorldGeometry, FreeSpaceAndHoles) {
   EXPECT_TRUE(contains(w.what_blocks({15, 15}), "world.circles[0]"));
   EXPECT_TRUE(w.disc_fits({6, 6}, 0.25f));
   EXPECT_FALSE(w.disc_fits({4.1f, 3.0f}, 0.25f));  // too close to the obstacle's wall
+}
+
+// The kernels' float crossing test against the validation's exact one on
+// random segments (general position: touching or collinear cases have
+// probability zero here).
+TEST(WorldGeometry, SegmentsCrossAgreesWithSegmentsIntersect) {
+  std::uint64_t state = 99;
+  auto uniform = [&state](float lo, float hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * static_cast<float>(state >> 40) / static_cast<float>(1ull << 24);
+  };
+  int crossing = 0, apart = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const glm::vec2 a(uniform(-5, 5), uniform(-5, 5)), b(uniform(-5, 5), uniform(-5, 5));
+    const glm::vec2 c(uniform(-5, 5), uniform(-5, 5)), d(uniform(-5, 5), uniform(-5, 5));
+    const bool exact = segments_intersect(a, b, c, d);
+    EXPECT_EQ(segments_cross(a, b, c, d), exact) << a.x << "," << a.y << " " << b.x << "," << b.y;
+    (exact ? crossing : apart) += 1;
+  }
+  EXPECT_GT(crossing, 2000);  // both outcomes well represented
+  EXPECT_GT(apart, 2000);
+  // Touching at an end point does not count as crossing.
+  EXPECT_FALSE(segments_cross({0, 0}, {1, 0}, {1, -1}, {1, 1}));
+  EXPECT_TRUE(segments_cross({0, 0}, {2, 0}, {1, -1}, {1, 1}));
 }
 
 // Walls crossing more than a thousand cells (the sides of a walkable region
