@@ -87,15 +87,17 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::v
   // sideways and chokes a door.
   const float ahead = dot2(d, i.e0);
   const float closing = -dot2(w - i.v, u);
-  const float speed = length_of(w), along = dot2(w, i.e0);
-  const bool coming = parked || (-dot2(w, u) > kCfsOncoming && along < kCfsAgainst * speed);
-  if (m.avoid_strength > 0.0f && coming && ahead > 0.0f && closing > 1e-3f) {
+  const bool towards = parked || -dot2(w, u) > kCfsOncoming;
+  if (m.avoid_strength > 0.0f && towards && ahead > 0.0f && closing > 1e-3f) {
+    // Past the cheap tests (most neighbours stop there): j's speed and heading.
+    const float speed = length_of(w), along = dot2(w, i.e0);
+    const bool against = parked || along < kCfsAgainst * speed;
     const float tau = fmaxf(dist - l, 0.0f) / closing;
     const glm::vec2 left = perp_left(i.e0);
     const bool crosser = speed > kCfsCrossingSpeed && fabsf(along) < kCfsCrossingCos * speed;
     const float lateral = dot2(d, left) + (crosser ? dot2(w - i.v, left) * tau : 0.0f);
     const float band = l + m.side_margin;
-    if (tau < m.avoid_time && fabsf(lateral) < band) {
+    if (against && tau < m.avoid_time && fabsf(lateral) < band) {
       const float strength = m.avoid_strength * (1.0f - tau / m.avoid_time) * (1.0f - fabsf(lateral) / band);
       // Away from the neighbour's side; dead ahead (within 1 cm), to the right.
       f += (lateral > 0.01f ? -left : (lateral < -0.01f ? left : -left)) * strength;
