@@ -210,8 +210,8 @@ class Reader : public YamlReader {
     static const std::vector<std::string_view> priority = {"pred_time",       "max_force",       "personal_space",
                                                            "lane_half_width", "relaxation_time", "probe_margin"};
     static const std::vector<std::string_view> cfs = {
-        "time_gap",       "neighbour_strength", "neighbour_range", "wall_strength", "wall_range",
-        "avoid_strength", "avoid_time",         "side_margin",     "turn_time",     "anticipation_time"};
+        "time_gap",   "neighbour_strength", "neighbour_range", "wall_strength",     "wall_range", "avoid_strength",
+        "avoid_time", "side_margin",        "turn_time",       "anticipation_time", "lane_width"};
     static const std::vector<std::string_view> ttc = {"ttc_strength",         "ttc_time_horizon",
                                                       "ttc_relaxation_time",  "ttc_sensing_radius",
                                                       "ttc_max_acceleration", "ttc_side_bias"};
@@ -265,6 +265,7 @@ class Reader : public YamlReader {
     opt("side_margin", m.cfs.side_margin);
     opt("turn_time", m.cfs.turn_time);
     opt("anticipation_time", m.cfs.anticipation_time);
+    opt("lane_width", m.cfs.lane_width);
     opt("ttc_strength", m.ttc.strength);
     opt("ttc_time_horizon", m.ttc.time_horizon);
     opt("ttc_relaxation_time", m.ttc.relaxation_time);

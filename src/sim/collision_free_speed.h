@@ -117,12 +117,15 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_wall_push(const CfsAgent& i, glm::vec2 q
 }
 
 // The gap to neighbour j if it is in front of the agent along e inside the
-// agent's corridor, else +inf.
-THRONG_HOST_DEVICE inline float cfs_gap_ahead(glm::vec2 p, float ri, glm::vec2 e, glm::vec2 q, float rj) {
+// agent's corridor, else +inf. The corridor is lane_width (r_i + r_j) to
+// either side of the agent's line: 1 is the published model (whoever the
+// body would touch), less lets staggered lanes interleave (a zipper).
+THRONG_HOST_DEVICE inline float cfs_gap_ahead(glm::vec2 p, float ri, glm::vec2 e, glm::vec2 q, float rj,
+                                              float lane_width = 1.0f) {
   const glm::vec2 d = q - p;
   if (dot2(d, e) < 0.0f) return INFINITY;
   const float l = ri + rj;
-  if (fabsf(dot2(d, perp_left(e))) > l) return INFINITY;
+  if (fabsf(dot2(d, perp_left(e))) > l * lane_width) return INFINITY;
   return length_of(d) - l;
 }
 

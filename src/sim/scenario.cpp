@@ -45,6 +45,7 @@ void ModelParams::validate() const {
   check_range(cfs.side_margin, 0.0f, 10.0f, true, "model.side_margin", "anticipation side margin (m)");
   check_range(cfs.turn_time, 0.0f, 10.0f, true, "model.turn_time", "turn time (s)");
   check_range(cfs.anticipation_time, 0.0f, 10.0f, true, "model.anticipation_time", "anticipation time (s)");
+  check_range(cfs.lane_width, 0.5f, 1.0f, true, "model.lane_width", "lane width (of the summed radii)");
   check_range(ttc.strength, 0.0f, 100.0f, true, "model.ttc_strength", "interaction strength k (m^2)");
   check_range(ttc.time_horizon, 0.1f, 100.0f, true, "model.ttc_time_horizon", "interaction time horizon tau0 (s)");
   check_range(ttc.relaxation_time, 0.01f, 100.0f, true, "model.ttc_relaxation_time", "goal relaxation time (s)");

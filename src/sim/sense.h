@@ -147,13 +147,14 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
       cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
   if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
   // The time gap is kept to where neighbours will be in anticipation_time
-  // (one crossing the agent's path will have left it); no step may end in a
-  // body where it is now.
+  // (one crossing the agent's path will have left it), to those within the
+  // lane; no step may end in a body where it is now.
   float gap = INFINITY, gap_now = INFINITY;
   for_each_candidate([&](Index j) {
     if (!is_neighbour(j)) return;
     const glm::vec2 q = n.position[j];
-    gap = fminf(gap, cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j]));
+    gap = fminf(gap,
+                cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j], c.lane_width));
     gap_now = fminf(gap_now, cfs_gap_ahead(me.p, me.radius, e, q, n.radius[j]));
   });
   return e * fminf(cfs_speed(gap, v0, c.time_gap), fmaxf(gap_now, 0.0f) / dt);

@@ -35,7 +35,9 @@ THRONG_HOST_DEVICE inline bool passed_waypoint(glm::vec2 p, glm::vec2 leg_start,
 // wall: an agent that sees a wall (within a cell side) between itself and
 // the gate point heads for the waypoint instead; else it walks into the wall
 // beside the door, and a straggler there can slide along it away from the
-// door (seen in a 0.5 m door's room).
+// door (seen in a 0.5 m door's room). So does a wall between the gate point
+// and the waypoint: for a leg that comes in diagonally the gate's end lies
+// in the room beside the door, and an agent pushed there circled it.
 THRONG_HOST_DEVICE inline glm::vec2 waypoint_aim(const WorldView& w, glm::vec2 p, glm::vec2 leg_start,
                                                  glm::vec2 waypoint) {
   const glm::vec2 along = normalize_or(waypoint - leg_start, glm::vec2(0.0f));
@@ -43,8 +45,19 @@ THRONG_HOST_DEVICE inline glm::vec2 waypoint_aim(const WorldView& w, glm::vec2 p
   const float offset = dot2(p - waypoint, across);
   const glm::vec2 gate = waypoint + across * fminf(fmaxf(offset, -kWaypointHalfWidth), kWaypointHalfWidth);
   bool blocked = false;
-  for_each_wall_near(w, p, [&](const Segment& s) { blocked = blocked || segments_cross(p, gate, s.a, s.b); });
+  for_each_wall_near(w, p, [&](const Segment& s) {
+    blocked = blocked || segments_cross(p, gate, s.a, s.b) || segments_cross(gate, waypoint, s.a, s.b);
+  });
   return blocked ? waypoint : gate;
+}
+
+// True when no wall within a cell side of p stands between p and the
+// waypoint: a gate line crossed behind a wall (its end in the room beside a
+// door, for a leg that came in diagonally) does not count as passed.
+THRONG_HOST_DEVICE inline bool waypoint_in_view(const WorldView& w, glm::vec2 p, glm::vec2 waypoint) {
+  bool blocked = false;
+  for_each_wall_near(w, p, [&](const Segment& s) { blocked = blocked || segments_cross(p, waypoint, s.a, s.b); });
+  return !blocked;
 }
 
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
@@ -329,7 +342,8 @@ struct Finalize {
       const std::int32_t cursor = a.waypoint_cursor[i];
       // (The priority model keeps the paper's point waypoints.)
       const bool through = ctx.model.kind == ModelKind::CollisionFreeSpeed && cursor != a.waypoint_goal[i] &&
-                           passed_waypoint(p, a.path_start[i], goal, g.arrival_radius);
+                           passed_waypoint(p, a.path_start[i], goal, g.arrival_radius) &&
+                           waypoint_in_view(ctx.world, p, goal);
       if (through || length2(goal - p) <= g.arrival_radius * g.arrival_radius) {
         const std::int32_t begin = a.waypoint_begin[i], count = a.waypoint_count[i];
         if (cursor == a.waypoint_goal[i] && a.arrival_time[i] < 0.0f) {
