@@ -7,6 +7,8 @@
 // width. Laboratory flows are higher (about 1.9 P/(m s), Seyfried et al.
 // 2009; docs/simulation.md): the bounds here guard the measured 1.05-1.2
 // P/(m s) of this model, fitted to Weidmann's curve, whose capacity is 1.22.
+// With the body size of the laboratory validations (r = 0.15 m) the same
+// room passes the laboratory flows (the last test).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -45,13 +47,13 @@ ScenarioSpec door_room(float width, float duration) {
                                     {0, 10}});
 }
 
-DoorRun empty_room(float width, std::int64_t agents, float lane_width = 1.0f) {
+DoorRun empty_room(float width, std::int64_t agents, float lane_width = 1.0f, float radius = 0.2f) {
   const float lo = 5.0f - 0.5f * width, hi = 5.0f + 0.5f * width;
   ScenarioSpec s = door_room(width, 600.0f);
   s.model.cfs.lane_width = lane_width;
   GroupSpec g;
   g.count = agents;
-  g.radius = 0.2f;
+  g.radius = radius;
   g.speed = {1.34f, 0.26f, 0.5f, 2.0f};
   g.spawn.kind = Region::Kind::rect;
   g.spawn.min = {0.3f, 0.3f};
@@ -128,6 +130,30 @@ TEST(Bottleneck, NarrowerLanesInterleaveAndRaiseTheFlow) {
   EXPECT_EQ(narrow.left, narrow.agents);
   EXPECT_LE(narrow.deepest, 0.05f);
   EXPECT_GE(narrow.flow.flow, 1.08 * wide.flow.flow);
+}
+
+// The Jülich bottleneck experiments modelled as JuPedSim's validation of
+// them models their participants: discs of r = 0.15 m (the time gap stays
+// the default fitted to Weidmann). Laboratory specific flows at 0.8-1.6 m:
+// 1.61-1.97 P/(m s) (Seyfried et al. 2009, Transportation Science 43),
+// 1.79-1.85 (Kretz et al. 2006, J. Stat. Mech. P10014), 1.90-2.11 (Liddle
+// et al. 2011, 0.9-1.6 m); docs/simulation.md has the table. Each door's
+// flow must fall inside that envelope, every agent leave, bodies not
+// overlap by more than 5 cm.
+TEST(Bottleneck, LaboratoryBodySizePassesLaboratoryFlows) {
+  const std::vector<float> widths =
+      test::sanitized() ? std::vector<float>{1.2f} : std::vector<float>{0.8f, 1.2f, 1.6f};
+  for (float w : widths) {
+    SCOPED_TRACE(w);
+    const DoorRun r = empty_room(w, 150, 1.0f, 0.15f);
+    std::printf("  r = 0.15 m, door %.1f m: %lld of %lld out, %.2f P/s (%.2f P/(m s)), deepest overlap %.3f m\n", w,
+                static_cast<long long>(r.left), static_cast<long long>(r.agents), r.flow.flow, r.flow.specific_flow,
+                r.deepest);
+    EXPECT_EQ(r.left, r.agents);
+    EXPECT_LE(r.deepest, 0.05f);
+    EXPECT_GE(r.flow.specific_flow, 1.6);
+    EXPECT_LE(r.flow.specific_flow, 2.2);
+  }
 }
 
 }  // namespace
