@@ -201,6 +201,35 @@ class Reader : public YamlReader {
     return s;
   }
 
+  // One number: every agent waits that long. A map: `distribution` (uniform
+  // needs min and max; normal and lognormal need mean and stddev, and take
+  // min, default 0, and max, default the mean plus four spreads).
+  sim::PremovementSpec premovement(const YAML::Node& n, const std::string& path) {
+    using Kind = sim::PremovementSpec::Kind;
+    sim::PremovementSpec p;
+    if (n.IsScalar()) {
+      p.kind = Kind::uniform;
+      p.min = p.max = real(n, path);
+      return p;
+    }
+    expect_map(n, path, {"distribution", "mean", "stddev", "min", "max"});
+    const std::string d =
+        word(required(n, path, "distribution"), child(path, "distribution"), {"uniform", "normal", "lognormal"});
+    p.kind = d == "uniform" ? Kind::uniform : (d == "normal" ? Kind::normal : Kind::lognormal);
+    if (p.kind == Kind::uniform) {
+      for (const char* key : {"mean", "stddev"})
+        if (n[key]) fail(n[key], child(path, key), "a uniform distribution takes min and max only");
+      p.min = real(required(n, path, "min"), child(path, "min"));
+      p.max = real(required(n, path, "max"), child(path, "max"));
+      return p;
+    }
+    p.mean = real(required(n, path, "mean"), child(path, "mean"));
+    p.stddev = real(required(n, path, "stddev"), child(path, "stddev"));
+    p.min = n["min"] ? real(n["min"], child(path, "min")) : 0.0f;
+    p.max = n["max"] ? real(n["max"], child(path, "max")) : p.mean + 4.0f * p.stddev;
+    return p;
+  }
+
   // `type` picks the model; the other keys are that model's parameters or
   // those every model shares. A parameter of another model is an error that
   // says which type it belongs to.
@@ -350,7 +379,8 @@ class Reader : public YamlReader {
 
   sim::GroupSpec group(const YAML::Node& n, const std::string& path, const sim::ModelParams& model) {
     expect_map(n, path,
-               {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius"});
+               {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius",
+                "premovement"});
     sim::GroupSpec g;
     if (n["name"]) g.name = text(n["name"], child(path, "name"));
     // count may be left out when the group spawns at points: one agent per point.
@@ -384,6 +414,7 @@ class Reader : public YamlReader {
                               : (a == "despawn" ? sim::ArrivalBehaviour::Despawn : sim::ArrivalBehaviour::Loop);
     }
     if (n["arrival_radius"]) g.arrival_radius = real(n["arrival_radius"], child(path, "arrival_radius"));
+    if (n["premovement"]) g.premovement = premovement(n["premovement"], child(path, "premovement"));
     return g;
   }
 

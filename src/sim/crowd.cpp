@@ -182,6 +182,32 @@ void check_goal(const GoalSpec& goal, const std::string& gf, const ScenarioLimit
   }
 }
 
+// Pre-movement times (s) within [0, the scenario's duration]: finite bounds
+// in order, a positive mean and a non-negative spread where the
+// distribution has them.
+void check_premovement(const PremovementSpec& P, const std::string& field, float duration) {
+  if (P.kind == PremovementSpec::Kind::none) return;
+  auto finite = [&](float x, const char* key) {
+    if (!std::isfinite(x))
+      throw Error(fmt::format("{} must be a finite number of seconds", key), at_field(field + "." + key));
+  };
+  finite(P.min, "min");
+  finite(P.max, "max");
+  if (P.min < 0) throw Error(fmt::format("min must be >= 0 s (got {})", P.min), at_field(field + ".min"));
+  if (P.max < P.min)
+    throw Error(fmt::format("max ({} s) must be >= min ({} s)", P.max, P.min), at_field(field + ".max"));
+  if (P.max > duration)
+    throw Error(fmt::format("max ({} s; by default mean + 4 stddev) exceeds the scenario's duration ({} s): those "
+                            "agents would never walk",
+                            P.max, duration),
+                at_field(field + ".max"));
+  if (P.kind == PremovementSpec::Kind::uniform) return;
+  finite(P.mean, "mean");
+  finite(P.stddev, "stddev");
+  if (!(P.mean > 0)) throw Error(fmt::format("mean must be > 0 s (got {})", P.mean), at_field(field + ".mean"));
+  if (P.stddev < 0) throw Error(fmt::format("stddev must be >= 0 s (got {})", P.stddev), at_field(field + ".stddev"));
+}
+
 // Group G (field groups[g]) against the model: radius and speeds (m, m/s)
 // within what its time step and bins of side `cell` (m) allow.
 void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::string& field, float cell) {
@@ -216,6 +242,7 @@ void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::s
   if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
     throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius),
                 at_field(field + ".arrival_radius"));
+  check_premovement(G.premovement, field + ".premovement", static_cast<float>(spec.step_count()) * spec.dt);
 }
 
 // Group G (field groups[g]): its body, spawn region and route points.
@@ -529,6 +556,26 @@ void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std
         at_field(gf));
 }
 
+// One agent's pre-movement time (s) from its own generator (a stream apart
+// from the one that draws its speed and goals, so adding pre-movement to a
+// group changes nothing else): see PremovementSpec.
+double draw_premovement(const PremovementSpec& P, Rng& rng) {
+  if (P.kind == PremovementSpec::Kind::none) return 0.0;
+  const double lo = P.min, hi = P.max;
+  if (P.kind == PremovementSpec::Kind::uniform) return rng.uniform(lo, hi);
+  const double mean = P.mean, sd = P.stddev;
+  // Log-normal: mu and sigma of the logarithm from the mean and spread of the times.
+  const double s2 = std::log1p((sd / mean) * (sd / mean));
+  const double mu = std::log(mean) - 0.5 * s2, sigma = std::sqrt(s2);
+  double t = mean;
+  for (int k = 0; k < 64; ++k) {
+    const double z = rng.normal();
+    t = P.kind == PremovementSpec::Kind::normal ? mean + sd * z : std::exp(mu + sigma * z);
+    if (t >= lo && t <= hi) return t;
+  }
+  return std::clamp(t, lo, hi);
+}
+
 // Appends group g's agents at `chosen` to `out` (position, radius, speed
 // drawn per agent, group) and to `placed`; returns every agent's waypoints
 // and goal resolved, stride waypoints + 1.
@@ -552,6 +599,9 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
     out.position.push_back(p);
     out.radius.push_back(ctx.r);
     out.pref_speed.push_back(static_cast<float>(speed));
+    Rng prng(spec.seed,
+             (std::uint64_t{1} << 62) + (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
+    out.start_time.push_back(static_cast<float>(draw_premovement(G.premovement, prng)));
     out.group.push_back(static_cast<std::int32_t>(g));
     glm::vec2 from = p;
     for (std::size_t w = 0; w <= W; ++w) {
@@ -653,7 +703,13 @@ CrowdState upload_crowd(const CrowdHost& h, Memory m) {
   c.waypoint_goal = up(h.waypoint_goal);
   c.waypoint_cursor = Buffer<std::int32_t>::zeros(n, m);
   c.group = up(h.group);
-  c.flags = up(std::vector<std::uint8_t>(h.position.size(), kAgentActive));
+  std::vector<float> start(h.position.size(), 0.0f);
+  std::copy(h.start_time.begin(), h.start_time.begin() + std::min(h.start_time.size(), start.size()), start.begin());
+  std::vector<std::uint8_t> flags(h.position.size(), kAgentActive);
+  for (std::size_t i = 0; i < flags.size(); ++i)
+    if (start[i] > 0.0f) flags[i] |= kAgentWaiting;
+  c.flags = up(flags);
+  c.start_time = up(start);
   c.arrival_time = up(std::vector<float>(h.position.size(), -1.0f));
   c.waypoints = up(h.waypoints);
   c.groups = up(h.groups);

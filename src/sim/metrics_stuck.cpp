@@ -26,7 +26,7 @@ struct AtRestInFreeSpace {
   float speed_below, gap;
   THRONG_HOST_DEVICE bool operator()(Index i) const {
     const std::uint8_t f = flags[i];
-    if ((f & kAgentActive) == 0 || (f & kAgentStopped) != 0) return false;
+    if ((f & kAgentActive) == 0 || (f & (kAgentStopped | kAgentWaiting)) != 0) return false;
     if (!(length2(v[i]) < speed_below * speed_below)) return false;
     const glm::vec2 to_goal = goal[i] - p[i];
     const float d = length_of(to_goal);

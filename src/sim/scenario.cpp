@@ -88,6 +88,16 @@ const char* to_string(ArrivalBehaviour a) {
   return "?";
 }
 
+const char* to_string(PremovementSpec::Kind k) {
+  switch (k) {
+    case PremovementSpec::Kind::none: return "none";
+    case PremovementSpec::Kind::uniform: return "uniform";
+    case PremovementSpec::Kind::normal: return "normal";
+    case PremovementSpec::Kind::lognormal: return "lognormal";
+  }
+  return "?";
+}
+
 const char* to_string(SchedulerKind s) { return s == SchedulerKind::FourColour ? "four_colour" : "double_buffer"; }
 const char* to_string(PlanningKind p) { return p == PlanningKind::None ? "none" : "roadmap"; }
 

@@ -172,6 +172,21 @@ struct SpeedSpec {
   float max = 2.0f;
 };
 
+// Pre-movement (reaction) time: how long each agent of a group stands where
+// it spawned before it starts walking (RiMEA 3.0 test 5). Drawn per agent
+// from the seed: uniform in [min, max]; normal or log-normal with the given
+// mean and standard deviation of the times themselves, redrawn until inside
+// [min, max] (then clamped after 64 draws). None: every agent walks at once.
+struct PremovementSpec {
+  enum class Kind : std::uint8_t { none, uniform, normal, lognormal };  // named as in YAML
+  Kind kind = Kind::none;
+  float mean = 0.0f;    // s (normal, lognormal)
+  float stddev = 0.0f;  // s (normal, lognormal)
+  float min = 0.0f;     // s
+  float max = 0.0f;     // s
+};
+const char* to_string(PremovementSpec::Kind k);
+
 struct GroupSpec {
   std::string name;
   std::int64_t count = 0;
@@ -186,6 +201,7 @@ struct GroupSpec {
   GoalSpec goal;
   ArrivalBehaviour arrival = ArrivalBehaviour::Stop;  // loop: back along the route to the start, and again
   float arrival_radius = 0.5f;
+  PremovementSpec premovement;
 };
 
 struct OutputSpec {

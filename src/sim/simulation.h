@@ -65,6 +65,7 @@ struct AgentArrays {
   Span<float> arrival_time;
   Span<const glm::vec2> waypoints;
   Span<const GroupRuntime> groups;
+  Span<const float> start_time;
 };
 AgentArrays arrays_of(CrowdState& c);
 

@@ -61,7 +61,7 @@ THRONG_HOST_DEVICE inline bool waypoint_in_view(const WorldView& w, glm::vec2 p,
 }
 
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
-  return (flags & kAgentActive) != 0 && (flags & kAgentStopped) == 0;
+  return (flags & kAgentActive) != 0 && (flags & (kAgentStopped | kAgentWaiting)) == 0;
 }
 
 // Sense under the priority model: the higher-priority force of one agent,
@@ -335,8 +335,11 @@ struct Finalize {
     glm::vec2 v = clamp_length((p - from) * (1.0f / ctx.dt), ctx.model.max_speed);
     if ((flags & kAgentStopped) != 0) v = glm::vec2(0.0f);
     a.position[i] = p;
-    if (length2(v) > 0.05f * 0.05f) a.heading[i] = atan2f(v.y, v.x);
-    if ((flags & kAgentStopped) == 0) {
+    if (length2(v) > 0.05f * 0.05f && (flags & kAgentWaiting) == 0) a.heading[i] = atan2f(v.y, v.x);
+    // A waiting agent starts walking in the step that begins at its start time.
+    if ((flags & kAgentWaiting) != 0 && ctx.time_after >= a.start_time[i])
+      flags = static_cast<std::uint8_t>(flags & ~kAgentWaiting);
+    else if ((flags & (kAgentStopped | kAgentWaiting)) == 0) {
       const GroupRuntime g = a.groups[a.group[i]];
       const glm::vec2 goal = a.goal[i];
       const std::int32_t cursor = a.waypoint_cursor[i];

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -356,6 +357,31 @@ void expect_owner_named(const std::string& model, const std::string& owner) {
   }
   EXPECT_NE(message.find(owner), std::string::npos) << message;
 }
+// Pre-movement: one number (every agent waits that long) or a distribution
+// (normal and lognormal: min defaults to 0, max to the mean + 4 stddev).
+TEST(ScenarioYaml, PremovementForms) {
+  using Kind = sim::PremovementSpec::Kind;
+  auto read = [](const std::string& value) {
+    return parse_scenario(std::string(kOneGroup) + "    premovement: " + value + "\n", "p.yaml")
+        .spec.groups[0]
+        .premovement;
+  };
+  const sim::PremovementSpec none = parse_scenario(kOneGroup, "p.yaml").spec.groups[0].premovement;
+  EXPECT_EQ(none.kind, Kind::none);
+  auto expect = [](const sim::PremovementSpec& p, Kind kind, std::array<float, 4> mean_stddev_min_max) {
+    EXPECT_EQ(p.kind, kind);
+    const std::array<float, 4> got = {p.mean, p.stddev, p.min, p.max};
+    for (std::size_t k = 0; k < got.size(); ++k) EXPECT_FLOAT_EQ(got[k], mean_stddev_min_max[k]) << k;
+  };
+  expect(read("12.5"), Kind::uniform, {0, 0, 12.5f, 12.5f});
+  expect(read("{distribution: uniform, min: 10, max: 100}"), Kind::uniform, {0, 0, 10, 100});
+  expect(read("{distribution: normal, mean: 30, stddev: 5}"), Kind::normal, {30, 5, 0, 50});
+  expect(read("{distribution: lognormal, mean: 20, stddev: 8, min: 1, max: 90}"), Kind::lognormal, {20, 8, 1, 90});
+  EXPECT_THROW(read("{distribution: normal, mean: 30}"), Error);  // stddev is required
+  EXPECT_THROW(read("{distribution: uniform, min: 1}"), Error);   // max too
+  EXPECT_THROW(read("{min: 1, max: 2}"), Error);                  // and the distribution
+}
+
 TEST(ScenarioYaml, TtcModelKeys) {
   const std::string text = std::string(kOneGroup) + R"(model:
   type: ttc

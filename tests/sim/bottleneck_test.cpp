@@ -141,8 +141,7 @@ TEST(Bottleneck, NarrowerLanesInterleaveAndRaiseTheFlow) {
 // flow must fall inside that envelope, every agent leave, bodies not
 // overlap by more than 5 cm.
 TEST(Bottleneck, LaboratoryBodySizePassesLaboratoryFlows) {
-  const std::vector<float> widths =
-      test::sanitized() ? std::vector<float>{1.2f} : std::vector<float>{0.8f, 1.2f, 1.6f};
+  const std::vector<float> widths = test::sanitized() ? std::vector<float>{1.2f} : std::vector<float>{0.8f, 1.2f, 1.6f};
   for (float w : widths) {
     SCOPED_TRACE(w);
     const DoorRun r = empty_room(w, 150, 1.0f, 0.15f);

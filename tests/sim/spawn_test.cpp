@@ -25,18 +25,8 @@ ScenarioSpec field(std::int64_t count, glm::vec2 min, glm::vec2 max, float radiu
   return s;
 }
 
-CrowdHost spawn(const ScenarioSpec& spec) {
-  return spawn_crowd(spec, World::build(spec.world, spec.model.query_radius()));
-}
-
-std::string spawn_error(const ScenarioSpec& spec) {
-  try {
-    spawn(spec);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::spawn;
+using test::spawn_error;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

@@ -3,11 +3,15 @@
 // hand-made worlds for unit cases.
 #pragma once
 
+#include <string>
 #include <string_view>
 #include <utility>
 
+#include "core/error.h"
 #include "io/scenario_yaml.h"
+#include "sim/crowd.h"
 #include "sim/scenario.h"
+#include "sim/world.h"
 
 namespace throng::sim::test {
 
@@ -52,6 +56,21 @@ inline ScenarioSpec collision_free_spec(const char* name, float dt, float durati
 inline bool sanitized() {
   const char* v = std::getenv("THRONG_SANITIZED");
   return v != nullptr && *v != '\0' && std::string_view(v) != "0";
+}
+
+// The crowd spawn_crowd places for `spec` in its own world.
+inline CrowdHost spawn(const ScenarioSpec& spec) {
+  return spawn_crowd(spec, World::build(spec.world, spec.model.query_radius()));
+}
+
+// The message of the Error spawning `spec` throws, or "no error".
+inline std::string spawn_error(const ScenarioSpec& spec) {
+  try {
+    spawn(spec);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
 }
 
 }  // namespace throng::sim::test
