@@ -230,6 +230,23 @@ class Reader : public YamlReader {
     return p;
   }
 
+  // {rate: P/s, from: s (0), until: s (none)} or {times: [s, ...]}.
+  sim::InflowSpec inflow(const YAML::Node& n, const std::string& path) {
+    sim::InflowSpec in;
+    in.enabled = true;
+    if (n.IsMap() && n["times"]) {
+      expect_map(n, path, {"times"});
+      each_item(n["times"], child(path, "times"), 1, static_cast<std::size_t>(limits_.scenario.max_agents),
+                "entry times", [&](const YAML::Node& t, const std::string& tp) { in.times.push_back(real(t, tp)); });
+      return in;
+    }
+    expect_map(n, path, {"rate", "from", "until"});
+    in.rate = real(required(n, path, "rate"), child(path, "rate"));
+    if (n["from"]) in.from = real(n["from"], child(path, "from"));
+    if (n["until"]) in.until = real(n["until"], child(path, "until"));
+    return in;
+  }
+
   // `type` picks the model; the other keys are that model's parameters or
   // those every model shares. A parameter of another model is an error that
   // says which type it belongs to.
@@ -380,13 +397,16 @@ class Reader : public YamlReader {
   sim::GroupSpec group(const YAML::Node& n, const std::string& path, const sim::ModelParams& model) {
     expect_map(n, path,
                {"name", "count", "radius", "speed", "spawn", "waypoints", "goal", "on_arrival", "arrival_radius",
-                "premovement"});
+                "premovement", "inflow"});
     sim::GroupSpec g;
     if (n["name"]) g.name = text(n["name"], child(path, "name"));
-    // count may be left out when the group spawns at points: one agent per point.
+    // count may be left out when the group spawns at points (one agent per
+    // point) or enters at listed times (one agent per time).
     const YAML::Node spawn = required(n, path, "spawn");
     const bool at_points = spawn.IsMap() && spawn["points"];
-    if (n["count"] || !at_points)
+    if (n["inflow"]) g.inflow = inflow(n["inflow"], child(path, "inflow"));
+    if (!n["count"] && !g.inflow.times.empty()) g.count = static_cast<std::int64_t>(g.inflow.times.size());
+    if (n["count"] || (!at_points && g.inflow.times.empty()))
       g.count = integer(required(n, path, "count"), child(path, "count"), 0, limits_.scenario.max_agents);
     if (n["radius"]) g.radius = real(n["radius"], child(path, "radius"));
     // Unless given, speeds stay within the model's maximum.

@@ -208,6 +208,42 @@ void check_premovement(const PremovementSpec& P, const std::string& field, float
   if (P.stddev < 0) throw Error(fmt::format("stddev must be >= 0 s (got {})", P.stddev), at_field(field + ".stddev"));
 }
 
+// An inflow (field) of a group of `count` agents spawning in `spawn`: an
+// area to enter, entry times finite, ascending and within the duration.
+void check_inflow(const InflowSpec& I, const Region& spawn, std::int64_t count, const std::string& field,
+                  float duration) {
+  if (!I.enabled) return;
+  if (spawn.kind == Region::Kind::points || spawn.kind == Region::Kind::ring)
+    throw Error("agents arriving over time need an area to enter: a rect, disc or polygon spawn",
+                at_field(field + ".spawn"));
+  const std::string in = field + ".inflow";
+  if (!I.times.empty()) {
+    if (static_cast<std::int64_t>(I.times.size()) != count)
+      throw Error(fmt::format("{} entry times for a count of {}: give one time per agent", I.times.size(), count),
+                  at_field(in + ".times"));
+    for (std::size_t k = 0; k < I.times.size(); ++k) {
+      const float t = I.times[k];
+      if (!std::isfinite(t) || t < 0 || t > duration || (k > 0 && t < I.times[k - 1]))
+        throw Error(fmt::format("entry times must be ascending, in [0, {} s] (the duration); got {} after {}", duration,
+                                t, k > 0 ? I.times[k - 1] : 0.0f),
+                    at_field(fmt::format("{}.times[{}]", in, k)));
+    }
+    return;
+  }
+  if (!std::isfinite(I.rate) || !(I.rate > 0))
+    throw Error(fmt::format("rate must be > 0 persons per second (got {})", I.rate), at_field(in + ".rate"));
+  if (!std::isfinite(I.from) || I.from < 0)
+    throw Error(fmt::format("from must be >= 0 s (got {})", I.from), at_field(in + ".from"));
+  if (std::isnan(I.until) || !(I.until > I.from))
+    throw Error(fmt::format("until ({} s) must come after from ({} s)", I.until, I.from), at_field(in + ".until"));
+  const float last = count > 0 ? I.entry_time(count - 1) : I.from;
+  if (last > I.until || last > duration)
+    throw Error(
+        fmt::format("{} agents at {} P/s from {} s enter until {:.4g} s, after {} {:.4g} s", count, I.rate, I.from,
+                    last, last > I.until ? "until" : "the duration", last > I.until ? I.until : duration),
+        at_field(in + ".rate"));
+}
+
 // Group G (field groups[g]) against the model: radius and speeds (m, m/s)
 // within what its time step and bins of side `cell` (m) allow.
 void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::string& field, float cell) {
@@ -242,7 +278,12 @@ void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::s
   if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
     throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius),
                 at_field(field + ".arrival_radius"));
-  check_premovement(G.premovement, field + ".premovement", static_cast<float>(spec.step_count()) * spec.dt);
+  const float duration = static_cast<float>(spec.step_count()) * spec.dt;
+  check_premovement(G.premovement, field + ".premovement", duration);
+  check_inflow(G.inflow, G.spawn, G.count, field, duration);
+  if (G.inflow.enabled && G.premovement.kind != PremovementSpec::Kind::none)
+    throw Error("agents arriving over time walk as they enter: pre-movement is for those present at the start",
+                at_field(field + ".premovement"));
 }
 
 // Group G (field groups[g]): its body, spawn region and route points.
@@ -493,9 +534,35 @@ std::vector<glm::vec2> place_on_lattice(const Placement& at, std::uint64_t seed,
   return chosen;
 }
 
+// Where each agent of an arriving group g enters: a point of its spawn area
+// where its disc fits (clear of walls by the placement's clearance), drawn
+// per agent from the seed. Agents entering at different times may share a
+// point: the simulation admits each when its point is free.
+std::vector<glm::vec2> place_entries(const Placement& at, std::uint64_t seed, std::size_t g) {
+  const Aabb b = region_bounds(at.G.spawn);
+  std::vector<glm::vec2> out;
+  out.reserve(static_cast<std::size_t>(at.G.count));
+  for (std::int64_t k = 0; k < at.G.count; ++k) {
+    Rng rng(seed, (std::uint64_t{3} << 61) + (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
+    bool found = false;
+    glm::vec2 q(0.0f);
+    for (int attempt = 0; attempt < 200 && !found; ++attempt) {
+      q = glm::vec2(static_cast<float>(rng.uniform(b.min.x, b.max.x)),
+                    static_cast<float>(rng.uniform(b.min.y, b.max.y)));
+      found = region_contains(at.G.spawn, q) && at.world.disc_fits(q, at.wall_clearance);
+    }
+    if (!found)
+      throw Error(fmt::format("found no free place for an agent of radius {} m to enter", at.r),
+                  at_field(at.field + ".spawn"));
+    out.push_back(q);
+  }
+  return out;
+}
+
 // The spawn positions of group g, by its spawn region's kind.
 std::vector<glm::vec2> place_group(const Placement& at, std::uint64_t seed, std::size_t g) {
   if (at.G.count == 0) return {};
+  if (at.G.inflow.enabled) return place_entries(at, seed, g);
   if (at.G.spawn.kind == Region::Kind::ring) return place_on_ring(at);
   if (at.G.spawn.kind == Region::Kind::points) return place_at_points(at);
   return place_on_lattice(at, seed, g);
@@ -591,7 +658,7 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
     const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
     if ((k & 4095) == 4095)
       setup_checkpoint("choosing goals", static_cast<double>(k) / static_cast<double>(chosen.size()));
-    placed.add(p, ctx.r, agent);
+    if (!G.inflow.enabled) placed.add(p, ctx.r, agent);  // arriving agents take their point only when they enter
     Rng arng(spec.seed, (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
     const double speed =
         std::clamp(static_cast<double>(G.speed.mean) + static_cast<double>(G.speed.stddev) * arng.normal(),
@@ -601,7 +668,11 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
     out.pref_speed.push_back(static_cast<float>(speed));
     Rng prng(spec.seed,
              (std::uint64_t{1} << 62) + (static_cast<std::uint64_t>(g) << 40) + static_cast<std::uint64_t>(k));
-    out.start_time.push_back(static_cast<float>(draw_premovement(G.premovement, prng)));
+    const float start = G.inflow.enabled ? G.inflow.entry_time(static_cast<std::int64_t>(k))
+                                         : static_cast<float>(draw_premovement(G.premovement, prng));
+    out.start_time.push_back(start);
+    out.flags.push_back(G.inflow.enabled ? kAgentPending
+                                         : (start > 0.0f ? kAgentActive | kAgentWaiting : kAgentActive));
     out.group.push_back(static_cast<std::int32_t>(g));
     glm::vec2 from = p;
     for (std::size_t w = 0; w <= W; ++w) {
@@ -703,13 +774,9 @@ CrowdState upload_crowd(const CrowdHost& h, Memory m) {
   c.waypoint_goal = up(h.waypoint_goal);
   c.waypoint_cursor = Buffer<std::int32_t>::zeros(n, m);
   c.group = up(h.group);
-  std::vector<float> start(h.position.size(), 0.0f);
-  std::copy(h.start_time.begin(), h.start_time.begin() + std::min(h.start_time.size(), start.size()), start.begin());
-  std::vector<std::uint8_t> flags(h.position.size(), kAgentActive);
-  for (std::size_t i = 0; i < flags.size(); ++i)
-    if (start[i] > 0.0f) flags[i] |= kAgentWaiting;
-  c.flags = up(flags);
-  c.start_time = up(start);
+  // (Hand-made crowds may leave start times and flags out: all walk at once.)
+  c.flags = up(h.flags.empty() ? std::vector<std::uint8_t>(h.position.size(), kAgentActive) : h.flags);
+  c.start_time = up(h.start_time.empty() ? std::vector<float>(h.position.size(), 0.0f) : h.start_time);
   c.arrival_time = up(std::vector<float>(h.position.size(), -1.0f));
   c.waypoints = up(h.waypoints);
   c.groups = up(h.groups);

@@ -13,10 +13,11 @@
 namespace throng::sim {
 
 // Agent flags (bits of CrowdState::flags).
-inline constexpr std::uint8_t kAgentActive = 1;   // simulated and binned
-inline constexpr std::uint8_t kAgentArrived = 2;  // reached its final waypoint at least once
-inline constexpr std::uint8_t kAgentStopped = 4;  // arrived with behaviour `stop`: no more steering
-inline constexpr std::uint8_t kAgentWaiting = 8;  // before its start time (pre-movement): stands, is sensed
+inline constexpr std::uint8_t kAgentActive = 1;    // simulated and binned
+inline constexpr std::uint8_t kAgentArrived = 2;   // reached its final waypoint at least once
+inline constexpr std::uint8_t kAgentStopped = 4;   // arrived with behaviour `stop`: no more steering
+inline constexpr std::uint8_t kAgentWaiting = 8;   // before its start time (pre-movement): stands, is sensed
+inline constexpr std::uint8_t kAgentPending = 16;  // not yet entered (inflow): inactive until Simulation admits it
 
 // Per-group constants the kernels need.
 struct GroupRuntime {
@@ -40,7 +41,7 @@ struct CrowdState {
   Buffer<std::int32_t> group;
   Buffer<std::uint8_t> flags;
   Buffer<float> arrival_time;   // s, -1 until arrived
-  Buffer<float> start_time;     // s: stands (kAgentWaiting) until then
+  Buffer<float> start_time;     // s: stands (kAgentWaiting) or stays out (kAgentPending) until then
   Buffer<glm::vec2> waypoints;  // every agent's waypoint list, flattened
   Buffer<GroupRuntime> groups;
 };
@@ -49,7 +50,8 @@ struct CrowdState {
 struct CrowdHost {
   std::vector<glm::vec2> position;
   std::vector<float> heading, radius, pref_speed;
-  std::vector<float> start_time;  // s (pre-movement); empty = every agent walks at once
+  std::vector<float> start_time;    // s (pre-movement or entry); empty = every agent walks at once
+  std::vector<std::uint8_t> flags;  // initial flags; empty = every agent active
   std::vector<std::int32_t> group, waypoint_begin, waypoint_count, waypoint_goal;
   std::vector<glm::vec2> waypoints;
   std::vector<GroupRuntime> groups;

@@ -88,16 +88,6 @@ const char* to_string(ArrivalBehaviour a) {
   return "?";
 }
 
-const char* to_string(PremovementSpec::Kind k) {
-  switch (k) {
-    case PremovementSpec::Kind::none: return "none";
-    case PremovementSpec::Kind::uniform: return "uniform";
-    case PremovementSpec::Kind::normal: return "normal";
-    case PremovementSpec::Kind::lognormal: return "lognormal";
-  }
-  return "?";
-}
-
 const char* to_string(SchedulerKind s) { return s == SchedulerKind::FourColour ? "four_colour" : "double_buffer"; }
 const char* to_string(PlanningKind p) { return p == PlanningKind::None ? "none" : "roadmap"; }
 
@@ -139,11 +129,16 @@ void scale_agent_counts(ScenarioSpec& spec, std::int64_t total) {
   if (groups == 0) throw Error("the scenario has no groups to resize", at_field("--agents"));
   if (total < groups)
     throw Error(fmt::format("need at least one agent per group ({} groups)", groups), at_field("--agents"));
-  for (std::size_t g = 0; g < spec.groups.size(); ++g)
+  for (std::size_t g = 0; g < spec.groups.size(); ++g) {
     if (spec.groups[g].spawn.kind == Region::Kind::points)
       throw Error(fmt::format("groups[{}] spawns at {} fixed points and cannot be resized", g,
                               spec.groups[g].spawn.points.size()),
                   at_field("--agents"));
+    if (!spec.groups[g].inflow.times.empty())
+      throw Error(fmt::format("groups[{}] enters at {} listed times and cannot be resized", g,
+                              spec.groups[g].inflow.times.size()),
+                  at_field("--agents"));
+  }
   const std::int64_t old_total = spec.total_agents();
   std::vector<std::int64_t> counts(spec.groups.size(), 1);
   std::vector<std::pair<double, std::size_t>> remainders;

@@ -4,6 +4,7 @@
 // from it. Field paths used in errors ("groups[1].spawn") follow the YAML keys.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -185,7 +186,22 @@ struct PremovementSpec {
   float min = 0.0f;     // s
   float max = 0.0f;     // s
 };
-const char* to_string(PremovementSpec::Kind k);
+
+// People arriving over time (a source): agent k of the group enters at
+// times[k], or else at from + k / rate, at a free point of the group's
+// spawn area drawn from the seed; one whose point is taken by someone at its
+// time waits there, unseen, until the point is free.
+struct InflowSpec {
+  bool enabled = false;
+  float rate = 0.0f;         // P/s
+  float from = 0.0f;         // s: the first entry
+  float until = INFINITY;    // s: no entry is scheduled after this
+  std::vector<float> times;  // s, ascending, one per agent; replaces rate and from
+  // When agent k of the group is scheduled to enter (s).
+  float entry_time(std::int64_t k) const {
+    return times.empty() ? from + static_cast<float>(k) / rate : times[static_cast<std::size_t>(k)];
+  }
+};
 
 struct GroupSpec {
   std::string name;
@@ -202,6 +218,7 @@ struct GroupSpec {
   ArrivalBehaviour arrival = ArrivalBehaviour::Stop;  // loop: back along the route to the start, and again
   float arrival_radius = 0.5f;
   PremovementSpec premovement;
+  InflowSpec inflow;
 };
 
 struct OutputSpec {
@@ -299,7 +316,8 @@ Camera overview_camera(const Aabb& extent);
 
 // Resizes group counts so they add up to `total` (largest remainder), keeping
 // their proportions; throws Error when total < number of groups or <= 0, or
-// when a group spawns at fixed points (its count is the number of points).
+// when a group spawns at fixed points or enters at listed times (its count is
+// the number of points or times).
 void scale_agent_counts(ScenarioSpec& spec, std::int64_t total);
 
 }  // namespace throng::sim

@@ -20,7 +20,14 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
     : spec_(spec), scheduler_(spec.scheduler), neighbours_(options.neighbours) {
   spec_.model.validate();
   world_ = World::build(spec_.world, spec_.model.query_radius(), options.limits, current_memory());
-  crowd_ = upload_crowd(spawn_crowd(spec_, world_, options.limits, options.planner), current_memory());
+  const CrowdHost host = spawn_crowd(spec_, world_, options.limits, options.planner);
+  for (std::size_t i = 0; i < host.flags.size(); ++i)
+    if ((host.flags[i] & kAgentPending) != 0)
+      pending_.push_back({host.start_time[i], static_cast<Index>(i), host.position[i], host.radius[i]});
+  std::sort(pending_.begin(), pending_.end(), [](const PendingEntry& a, const PendingEntry& b) {
+    return a.time < b.time || (a.time == b.time && a.agent < b.agent);
+  });
+  crowd_ = upload_crowd(host, current_memory());
   bins_ = AgentGrid(spec_.model.query_radius());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
   contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));
@@ -49,6 +56,7 @@ StepContext Simulation::context() const {
 void Simulation::step() {
   ScopedTimer timer("sim.step");
   bin();
+  if (!pending_.empty() && admit_entries()) bin();
   const StepContext ctx = context();
   copy_positions(crowd_.position.span(), anchor_.span());
   sense_and_steer(ctx);
@@ -59,6 +67,40 @@ void Simulation::step() {
 void Simulation::bin() {
   bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
   contact_bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
+}
+
+// The arriving agents due by now, in order of entry time, each entering
+// where its disc overlaps no agent in the scene and no agent admitted before
+// it in this step (the rest wait at their points). True when any entered.
+bool Simulation::admit_entries() {
+  std::size_t due = 0;
+  while (due < pending_.size() && static_cast<double>(pending_[due].time) <= time() + 1e-6) ++due;
+  if (due == 0) return false;
+  std::vector<glm::vec2> spots(due);
+  std::vector<float> radii(due);
+  for (std::size_t k = 0; k < due; ++k) {
+    spots[k] = pending_[k].spot;
+    radii[k] = pending_[k].radius;
+  }
+  const Memory m = current_memory();
+  const Buffer<glm::vec2> spot_buffer(std::span<const glm::vec2>(spots), m);
+  const Buffer<float> radius_buffer(std::span<const float>(radii), m);
+  Buffer<float> clearance = Buffer<float>::zeros(static_cast<Index>(due), m);
+  entry_clearance(contact_bins_.view(), crowd_.position.span(), crowd_.radius.span(), crowd_.flags.span(),
+                  spot_buffer.span(), radius_buffer.span(), clearance.span());
+  const std::vector<float> gap = clearance.to_vector();
+  std::vector<PendingEntry> waiting, entered;
+  for (std::size_t k = 0; k < due; ++k) {
+    bool free = gap[k] >= 0.0f;
+    for (const PendingEntry& e : entered)
+      free = free && length2(e.spot - spots[k]) >= (e.radius + radii[k]) * (e.radius + radii[k]);
+    (free ? entered : waiting).push_back(pending_[k]);
+  }
+  const std::uint8_t active = kAgentActive;
+  for (const PendingEntry& e : entered) crowd_.flags.write(e.agent, std::span<const std::uint8_t>(&active, 1));
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(due));
+  pending_.insert(pending_.begin(), waiting.begin(), waiting.end());
+  return !entered.empty();
 }
 
 void Simulation::sense_and_steer(const StepContext& ctx) {

@@ -121,6 +121,20 @@ void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm:
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to);
 // Agents whose flags have `bit` set (deterministic reduction).
 Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit);
+// Per spot k: the smallest gap (m) between a disc of spot_radius[k] there
+// and any active agent binned in the 3x3 cells of `bins` around it (cells
+// at least as wide as two radii); +inf when none is near.
+void entry_clearance(const GridView& bins, Span<const glm::vec2> position, Span<const float> radius,
+                     Span<const std::uint8_t> flags, Span<const glm::vec2> spots, Span<const float> spot_radius,
+                     Span<float> clearance);
+
+// An agent arriving over time (kAgentPending): when and where it enters.
+struct PendingEntry {
+  float time = 0.0f;  // s
+  Index agent = 0;
+  glm::vec2 spot{0.0f};
+  float radius = 0.0f;
+};
 
 // How the sense stage finds neighbours: the paper's bins, or every agent
 // (the O(N^2) reference of benchmarks and tests; double buffer only).
@@ -138,7 +152,8 @@ class Simulation {
   // the scenario field at fault (io/scenario_yaml maps them to file lines).
   explicit Simulation(const ScenarioSpec& spec, const SimulationOptions& options = {});
 
-  // One step of dt: bin, sense, steer, move.
+  // One step of dt: bin (and admit the arriving agents whose time has come
+  // and whose point is free), sense, steer, move.
   void step();
   void run(std::int64_t steps);
 
@@ -165,12 +180,14 @@ class Simulation {
   std::vector<float> headings() const { return crowd_.heading.to_vector(); }
   std::vector<std::uint8_t> flags() const { return crowd_.flags.to_vector(); }
   std::vector<float> arrival_times() const { return crowd_.arrival_time.to_vector(); }
-  Index active_count() const;   // not despawned
-  Index arrived_count() const;  // reached their goal at least once
+  Index active_count() const;  // in the scene: entered and not despawned
+  Index pending_count() const { return static_cast<Index>(pending_.size()); }  // yet to enter
+  Index arrived_count() const;                                                 // reached their goal at least once
   bool all_arrived() const { return arrived_count() == agent_count(); }
 
  private:
   void bin();
+  bool admit_entries();
   void sense_and_steer(const StepContext& ctx);
   void move(const StepContext& ctx);
   StepContext context() const;
@@ -188,6 +205,7 @@ class Simulation {
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
   Buffer<float> contact_depth_;  // per agent: the deepest overlap the last contact pass found
   Buffer<MoveCells> move_cells_;
+  std::vector<PendingEntry> pending_;  // by entry time, then agent
 };
 
 }  // namespace throng::sim

@@ -432,6 +432,20 @@ void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to) {
       "sim.move.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
 }
 
+void entry_clearance(const GridView& bins, Span<const glm::vec2> position, Span<const float> radius,
+                     Span<const std::uint8_t> flags, Span<const glm::vec2> spots, Span<const float> spot_radius,
+                     Span<float> clearance) {
+  parallel_for(
+      "sim.inflow.clearance", spots.size(), THRONG_LAMBDA(Index k) {
+        const glm::vec2 q = spots[k];
+        float gap = INFINITY;
+        for_each_in_3x3(bins, q, [&](Index j) {
+          if ((flags[j] & kAgentActive) != 0) gap = fminf(gap, length_of(position[j] - q) - radius[j] - spot_radius[k]);
+        });
+        clearance[k] = gap;
+      });
+}
+
 Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit) {
   return parallel_reduce(
       "sim.count", flags.size(), Index{0}, THRONG_LAMBDA(Index i)->Index { return (flags[i] & bit) != 0 ? 1 : 0; },

@@ -382,6 +382,29 @@ TEST(ScenarioYaml, PremovementForms) {
   EXPECT_THROW(read("{min: 1, max: 2}"), Error);                  // and the distribution
 }
 
+// Inflow: a rate (from 0 and without end unless given) or listed times (the
+// count may then be left out: one agent per time).
+TEST(ScenarioYaml, InflowForms) {
+  const std::string head = "groups:\n  - spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: {point: [20, 2]}\n";
+  const sim::GroupSpec rate =
+      parse_scenario(head + "    count: 8\n    inflow: {rate: 2.5, from: 3, until: 9}\n", "i.yaml").spec.groups[0];
+  EXPECT_TRUE(rate.inflow.enabled);
+  EXPECT_EQ(rate.count, 8);
+  EXPECT_FLOAT_EQ(rate.inflow.rate, 2.5f);
+  EXPECT_FLOAT_EQ(rate.inflow.from, 3.0f);
+  EXPECT_FLOAT_EQ(rate.inflow.until, 9.0f);
+  EXPECT_FLOAT_EQ(rate.inflow.entry_time(2), 3.8f);
+  const sim::GroupSpec open = parse_scenario(head + "    count: 8\n    inflow: {rate: 1}\n", "i.yaml").spec.groups[0];
+  EXPECT_FLOAT_EQ(open.inflow.from, 0.0f);
+  EXPECT_TRUE(std::isinf(open.inflow.until));
+  const sim::GroupSpec listed = parse_scenario(head + "    inflow: {times: [1, 2, 4]}\n", "i.yaml").spec.groups[0];
+  EXPECT_EQ(listed.count, 3);
+  EXPECT_EQ(listed.inflow.times, (std::vector<float>{1, 2, 4}));
+  EXPECT_THROW(parse_scenario(head + "    inflow: {rate: 1}\n", "i.yaml"), Error);  // count is required with a rate
+  EXPECT_THROW(parse_scenario(head + "    inflow: {times: []}\n", "i.yaml"), Error);
+  EXPECT_THROW(parse_scenario(head + "    count: 2\n    inflow: {times: [1], rate: 2}\n", "i.yaml"), Error);
+}
+
 TEST(ScenarioYaml, TtcModelKeys) {
   const std::string text = std::string(kOneGroup) + R"(model:
   type: ttc
