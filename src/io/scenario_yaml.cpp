@@ -173,8 +173,12 @@ class Reader : public YamlReader {
       g.value = point(n, path);
       return g;
     }
-    const std::string k = one_of(n, path, {"point", "offset", "mirror", "random"});
+    const std::string k = one_of(n, path, {"point", "offset", "mirror", "random", "exits"}, {"choice", "reconsider"});
     const std::string sub = child(path, k);
+    if (k == "exits") return exits(n, path);
+    if (n["choice"] || n["reconsider"])
+      fail(n["choice"] ? n["choice"] : n["reconsider"], child(path, n["choice"] ? "choice" : "reconsider"),
+           "only a goal of exits takes a choice");
     if (k == "random") {
       g.kind = GoalSpec::Kind::Random;
       g.region = region(n[k], sub);
@@ -182,6 +186,26 @@ class Reader : public YamlReader {
     }
     g.kind = k == "point" ? GoalSpec::Kind::Point : (k == "offset" ? GoalSpec::Kind::Offset : GoalSpec::Kind::Mirror);
     g.value = point(n[k], sub);
+    return g;
+  }
+
+  // {exits: [{point: [x, y], width: m}, ...], choice: nearest | quickest,
+  // reconsider: s}.
+  GoalSpec exits(const YAML::Node& n, const std::string& path) {
+    GoalSpec g;
+    g.kind = GoalSpec::Kind::Exits;
+    each_item(n["exits"], child(path, "exits"), 1, 1000, "exits", [&](const YAML::Node& x, const std::string& xp) {
+      expect_map(x, xp, {"point", "width"});
+      sim::ExitSpec e;
+      e.point = point(required(x, xp, "point"), child(xp, "point"));
+      if (x["width"]) e.width = real(x["width"], child(xp, "width"));
+      g.exits.push_back(e);
+    });
+    if (n["choice"])
+      g.choice = word(n["choice"], child(path, "choice"), {"nearest", "quickest"}) == "quickest"
+                     ? sim::ExitChoice::Quickest
+                     : sim::ExitChoice::Nearest;
+    if (n["reconsider"]) g.reconsider_s = real(n["reconsider"], child(path, "reconsider"));
     return g;
   }
 

@@ -173,6 +173,20 @@ void check_goal(const GoalSpec& goal, const std::string& gf, const ScenarioLimit
   if (!std::isfinite(goal.value.x) || !std::isfinite(goal.value.y) || std::fabs(goal.value.x) > limits.max_extent ||
       std::fabs(goal.value.y) > limits.max_extent)
     throw Error("goal coordinates must be finite numbers within the extent limit", at_field(gf));
+  if (goal.kind == GoalSpec::Kind::Exits) {
+    if (goal.exits.empty()) throw Error("give at least one exit", at_field(gf + ".exits"));
+    for (std::size_t e = 0; e < goal.exits.size(); ++e) {
+      const ExitSpec& x = goal.exits[e];
+      const std::string ef = fmt::format("{}.exits[{}]", gf, e);
+      if (!std::isfinite(x.point.x) || !std::isfinite(x.point.y) || std::fabs(x.point.x) > limits.max_extent ||
+          std::fabs(x.point.y) > limits.max_extent)
+        throw Error("exit coordinates must be finite numbers within the extent limit", at_field(ef + ".point"));
+      if (!std::isfinite(x.width) || !(x.width > 0))
+        throw Error(fmt::format("width must be > 0 m (got {})", x.width), at_field(ef + ".width"));
+    }
+    if (!std::isfinite(goal.reconsider_s) || !(goal.reconsider_s > 0))
+      throw Error(fmt::format("reconsider must be > 0 s (got {})", goal.reconsider_s), at_field(gf + ".reconsider"));
+  }
   if (goal.kind == GoalSpec::Kind::Random) {
     check_region(goal.region, gf + ".random", limits.max_extent);
     if (goal.region.kind == Region::Kind::ring)
@@ -296,9 +310,14 @@ void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string
   if (G.spawn.kind == Region::Kind::points && static_cast<std::int64_t>(G.spawn.points.size()) != G.count)
     throw Error(fmt::format("{} points for a count of {}: give one point per agent", G.spawn.points.size(), G.count),
                 at_field(field + ".spawn.points"));
-  for (std::size_t w = 0; w < G.waypoints.size(); ++w)
-    check_goal(G.waypoints[w], fmt::format("{}.waypoints[{}]", field, w), limits);
+  for (std::size_t w = 0; w < G.waypoints.size(); ++w) {
+    const std::string wf = fmt::format("{}.waypoints[{}]", field, w);
+    if (G.waypoints[w].kind == GoalSpec::Kind::Exits) throw Error("exits can only be a group's goal", at_field(wf));
+    check_goal(G.waypoints[w], wf, limits);
+  }
   check_goal(G.goal, field + ".goal", limits);
+  if (G.goal.kind == GoalSpec::Kind::Exits && G.arrival == ArrivalBehaviour::Loop)
+    throw Error("agents leave by an exit: on_arrival stop or despawn, not loop", at_field(field + ".on_arrival"));
 }
 
 // Validates the whole spec against the world and limits (errors name the
@@ -349,6 +368,9 @@ void add_group_extent(const GroupSpec& G, Aabb& extent) {
         extent.add(2.0f * goal.value - sb.max);
         break;
       case GoalSpec::Kind::Random: extent.add(region_bounds(goal.region)); break;
+      case GoalSpec::Kind::Exits:
+        for (const ExitSpec& x : goal.exits) extent.add(x.point);
+        break;
     }
   }
 }
@@ -576,6 +598,24 @@ struct RouteContext {
   float r;
 };
 
+// Errors unless route point q (field gf) of `agent` lies in the world, free
+// and reachable from `from`. Planned routes go around obstacles; only a
+// missing path is an error.
+void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std::int64_t agent,
+                       const std::string& gf) {
+  const float max_extent = ctx.limits.max_extent;
+  if (!std::isfinite(q.x) || !std::isfinite(q.y) || std::fabs(q.x) > max_extent || std::fabs(q.y) > max_extent)
+    throw Error(fmt::format("goal {} of agent {} is beyond the extent limit", point_text(q), agent), at_field(gf));
+  if (const std::string blocked = ctx.world.what_blocks(q); !blocked.empty())
+    throw Error(fmt::format("goal {} of agent {} lies {}", point_text(q), agent, blocked), at_field(gf));
+  if (ctx.reach && !ctx.reach->connected(from, q))
+    throw Error(
+        fmt::format(
+            "goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
+            point_text(q), agent, point_text(from), ctx.reach->cell_size()),
+        at_field(gf));
+}
+
 // Route point `goal` (field gf) of an agent that spawned at p and comes
 // from `from`: a point, or one drawn from a region with arng (free for a
 // disc of radius r and reachable from `from`).
@@ -586,6 +626,20 @@ glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std:
     case GoalSpec::Kind::Point: q = goal.value; break;
     case GoalSpec::Kind::Offset: q = p + goal.value; break;
     case GoalSpec::Kind::Mirror: q = 2.0f * goal.value - p; break;
+    case GoalSpec::Kind::Exits: {
+      // Every exit must be reachable (a quickest choice may switch to any);
+      // the agent starts towards the nearest in a straight line.
+      float best = INFINITY;
+      for (std::size_t e = 0; e < goal.exits.size(); ++e) {
+        const glm::vec2 x = goal.exits[e].point;
+        check_route_point(ctx, x, from, agent, fmt::format("{}.exits[{}]", gf, e));
+        if (length_of(x - from) < best) {
+          best = length_of(x - from);
+          q = x;
+        }
+      }
+      break;
+    }
     case GoalSpec::Kind::Random: {
       const Aabb rb = region_bounds(goal.region);
       bool found = false;
@@ -603,24 +657,6 @@ glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std:
     }
   }
   return q;
-}
-
-// Errors unless route point q (field gf) of `agent` lies in the world, free
-// and reachable from `from`. Planned routes go around obstacles; only a
-// missing path is an error.
-void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std::int64_t agent,
-                       const std::string& gf) {
-  const float max_extent = ctx.limits.max_extent;
-  if (!std::isfinite(q.x) || !std::isfinite(q.y) || std::fabs(q.x) > max_extent || std::fabs(q.y) > max_extent)
-    throw Error(fmt::format("goal {} of agent {} is beyond the extent limit", point_text(q), agent), at_field(gf));
-  if (const std::string blocked = ctx.world.what_blocks(q); !blocked.empty())
-    throw Error(fmt::format("goal {} of agent {} lies {}", point_text(q), agent, blocked), at_field(gf));
-  if (ctx.reach && !ctx.reach->connected(from, q))
-    throw Error(
-        fmt::format(
-            "goal {} of agent {} is unreachable from {}: no free path joins them (checked on a {:.3g} m raster)",
-            point_text(q), agent, point_text(from), ctx.reach->cell_size()),
-        at_field(gf));
 }
 
 // One agent's pre-movement time (s) from its own generator (a stream apart
@@ -696,7 +732,9 @@ void add_routes(const GroupSpec& G, const std::string& field, const std::vector<
                 const ScenarioLimits& limits, float r, CrowdHost& out) {
   const std::size_t W = G.waypoints.size();
   std::vector<std::vector<glm::vec2>> planned;
-  if (planner != nullptr && W == 0 && !chosen.empty()) {
+  // (Agents choosing among exits walk straight: a planned route would hold
+  // them to the exit they started towards.)
+  if (planner != nullptr && W == 0 && !chosen.empty() && G.goal.kind != GoalSpec::Kind::Exits) {
     planned = planner->plan(world, chosen, resolved, r);
     if (planned.size() != chosen.size())
       throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()),

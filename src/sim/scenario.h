@@ -153,6 +153,18 @@ struct Region {
   std::vector<glm::vec2> points;   // Points: agent k starts at points[k]
 };
 
+// A way out: agents heading for it aim at `point` (the middle of the door,
+// say) and leave through `width` metres, which sizes its capacity.
+struct ExitSpec {
+  glm::vec2 point{0.0f};
+  float width = 1.0f;  // m
+};
+// How an agent picks among its group's exits: the nearest in a straight
+// line (once, at the start), or the quickest (sim/exit_choice.h: walking
+// time plus the wait behind those heading there, weighed again every
+// reconsider_s seconds).
+enum class ExitChoice : std::uint8_t { Nearest, Quickest };
+
 // One waypoint of a group: the same for every agent, or per agent.
 struct GoalSpec {
   enum class Kind : std::uint8_t {
@@ -160,10 +172,19 @@ struct GoalSpec {
     Offset,  // spawn position + value
     Mirror,  // 2 * value - spawn position (the antipode through value)
     Random,  // a random free point of `region` per agent
+    Exits,   // one of `exits` per agent, chosen by `choice` (a group's goal only)
   };
   Kind kind = Kind::Point;
   glm::vec2 value{0.0f};
-  Region region;  // Random
+  Region region;                // Random
+  std::vector<ExitSpec> exits;  // Exits
+  ExitChoice choice = ExitChoice::Nearest;
+  float reconsider_s = 2.0f;  // Exits, quickest: how often each agent weighs the exits again
+  static GoalSpec at(glm::vec2 p) {
+    GoalSpec g;
+    g.value = p;
+    return g;
+  }
 };
 
 struct SpeedSpec {

@@ -28,6 +28,7 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
     return a.time < b.time || (a.time == b.time && a.agent < b.agent);
   });
   crowd_ = upload_crowd(host, current_memory());
+  exits_ = ExitChooser(spec_, host);
   bins_ = AgentGrid(spec_.model.query_radius());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
   contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));
@@ -55,6 +56,10 @@ StepContext Simulation::context() const {
 
 void Simulation::step() {
   ScopedTimer timer("sim.step");
+  if (!exits_.empty()) {
+    ScopedTimer choose("sim.exit_choice");
+    exits_.update(time(), crowd_);
+  }
   bin();
   if (!pending_.empty() && admit_entries()) bin();
   const StepContext ctx = context();

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "sim/crowd.h"
+#include "sim/exit_choice.h"
 #include "sim/grid.h"
 #include "sim/scenario.h"
 #include "sim/world.h"
@@ -152,8 +153,9 @@ class Simulation {
   // the scenario field at fault (io/scenario_yaml maps them to file lines).
   explicit Simulation(const ScenarioSpec& spec, const SimulationOptions& options = {});
 
-  // One step of dt: bin (and admit the arriving agents whose time has come
-  // and whose point is free), sense, steer, move.
+  // One step of dt: exits chosen again where due, bin (and admit the
+  // arriving agents whose time has come and whose point is free), sense,
+  // steer, move.
   void step();
   void run(std::int64_t steps);
 
@@ -206,6 +208,7 @@ class Simulation {
   Buffer<float> contact_depth_;  // per agent: the deepest overlap the last contact pass found
   Buffer<MoveCells> move_cells_;
   std::vector<PendingEntry> pending_;  // by entry time, then agent
+  ExitChooser exits_;                  // groups choosing the quickest exit
 };
 
 }  // namespace throng::sim

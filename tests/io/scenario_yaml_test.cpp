@@ -405,6 +405,29 @@ TEST(ScenarioYaml, InflowForms) {
   EXPECT_THROW(parse_scenario(head + "    count: 2\n    inflow: {times: [1], rate: 2}\n", "i.yaml"), Error);
 }
 
+// A goal of exits: points with widths (1 m by default), nearest unless the
+// choice says quickest, reconsidered every 2 s unless given.
+TEST(ScenarioYaml, ExitsGoal) {
+  const std::string head = "groups:\n  - count: 4\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n";
+  const sim::GoalSpec nearest =
+      parse_scenario(head + "    goal: {exits: [{point: [20, 2], width: 1.5}, {point: [-9, 3]}]}\n", "e.yaml")
+          .spec.groups[0]
+          .goal;
+  EXPECT_EQ(nearest.kind, sim::GoalSpec::Kind::Exits);
+  EXPECT_EQ(nearest.choice, sim::ExitChoice::Nearest);
+  ASSERT_EQ(nearest.exits.size(), 2u);
+  EXPECT_EQ(nearest.exits[0].point, glm::vec2(20, 2));
+  EXPECT_FLOAT_EQ(nearest.exits[0].width, 1.5f);
+  EXPECT_FLOAT_EQ(nearest.exits[1].width, 1.0f);
+  EXPECT_FLOAT_EQ(nearest.reconsider_s, 2.0f);
+  const sim::GoalSpec quickest =
+      parse_scenario(head + "    goal: {exits: [{point: [20, 2]}], choice: quickest, reconsider: 5}\n", "e.yaml")
+          .spec.groups[0]
+          .goal;
+  EXPECT_EQ(quickest.choice, sim::ExitChoice::Quickest);
+  EXPECT_FLOAT_EQ(quickest.reconsider_s, 5.0f);
+}
+
 TEST(ScenarioYaml, TtcModelKeys) {
   const std::string text = std::string(kOneGroup) + R"(model:
   type: ttc

@@ -37,8 +37,8 @@ inline ScenarioSpec encounter(const std::vector<Walker>& walkers, const WorldSpe
     g.speed = {1.3f, 0.0f, 1.3f, 1.3f};
     g.spawn.kind = Region::Kind::points;
     g.spawn.points = {w.from};
-    for (glm::vec2 v : w.via) g.waypoints.push_back({GoalSpec::Kind::Point, v, {}});
-    g.goal = {GoalSpec::Kind::Point, w.to, {}};
+    for (glm::vec2 v : w.via) g.waypoints.push_back(GoalSpec::at(v));
+    g.goal = GoalSpec::at(w.to);
     g.arrival = ArrivalBehaviour::Despawn;
     g.arrival_radius = 0.3f;
     s.groups.push_back(g);

@@ -139,7 +139,7 @@ TEST(SocialForce, DenseJamStaysStable) {
   g.spawn.kind = Region::Kind::rect;
   g.spawn.min = {0.3f, 0.3f};
   g.spawn.max = {5.7f, 5.7f};
-  g.goal = {GoalSpec::Kind::Point, {5.75f, 3.0f}, {}};
+  g.goal = GoalSpec::at({5.75f, 3.0f});
   g.arrival_radius = 0.05f;
   s.groups.push_back(g);
   Simulation sim(s);

@@ -1,0 +1,102 @@
+#include "sim/exit_choice.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/random.h"
+
+namespace throng::sim {
+
+ExitChooser::ExitChooser(const ScenarioSpec& spec, const CrowdHost& host) {
+  exits_.resize(spec.groups.size());
+  exit_offset_.resize(spec.groups.size(), 0);
+  std::int32_t flat = 0;
+  bool any = false;
+  for (std::size_t g = 0; g < spec.groups.size(); ++g) {
+    const GoalSpec& goal = spec.groups[g].goal;
+    exit_offset_[g] = flat;
+    if (goal.kind != GoalSpec::Kind::Exits || goal.choice != ExitChoice::Quickest) continue;
+    exits_[g] = goal.exits;
+    flat += static_cast<std::int32_t>(goal.exits.size());
+    exit_count_ = static_cast<std::size_t>(flat);
+    period_ = any ? std::min(period_, static_cast<double>(goal.reconsider_s)) : goal.reconsider_s;
+    any = true;
+  }
+  for (std::size_t i = 0; i < host.group.size(); ++i) {
+    const auto g = static_cast<std::size_t>(host.group[i]);
+    if (exits_[g].empty()) continue;
+    Chooser c;
+    c.agent = static_cast<Index>(i);
+    c.group = host.group[i];
+    c.goal_index = host.waypoint_goal[i];
+    c.goal_slot = host.waypoint_begin[i] + c.goal_index;
+    c.speed = std::max(host.pref_speed[i], 0.1f);
+    // Spawning aimed the agent at its nearest exit: find which it is.
+    const glm::vec2 aim = host.waypoints[static_cast<std::size_t>(c.goal_slot)];
+    for (std::uint32_t e = 0; e < exits_[g].size(); ++e)
+      if (exits_[g][e].point == aim) c.exit = e;
+    c.tie = Rng(spec.seed, (std::uint64_t{5} << 60) + static_cast<std::uint64_t>(i)).next();
+    agents_.push_back(c);
+  }
+}
+
+float ExitChooser::exit_cost(const Chooser& c, glm::vec2 p, std::uint32_t e, const std::vector<Index>& queued) const {
+  const ExitSpec& x = exits_[static_cast<std::size_t>(c.group)][e];
+  const auto q =
+      static_cast<float>(queued[static_cast<std::size_t>(exit_offset_[static_cast<std::size_t>(c.group)]) + e]);
+  const float cost = length_of(x.point - p) / c.speed + q / (kExitSpecificFlow * x.width);
+  return e == c.exit ? cost * (1.0f - kExitSwitchGain) : cost;
+}
+
+Index ExitChooser::update(double time, CrowdState& crowd) {
+  if (agents_.empty() || time + 1e-9 < next_) return 0;
+  next_ = time + period_;
+  const std::vector<glm::vec2> position = crowd.position.to_vector();
+  const std::vector<std::uint8_t> flags = crowd.flags.to_vector();
+  const std::vector<std::int32_t> cursor = crowd.waypoint_cursor.to_vector();
+  std::vector<glm::vec2> waypoints = crowd.waypoints.to_vector(), goal = crowd.goal.to_vector();
+  // Those still to leave (in the scene or yet to enter), nearest an exit first.
+  std::vector<std::pair<float, std::size_t>> order;
+  for (std::size_t k = 0; k < agents_.size(); ++k) {
+    const Chooser& c = agents_[k];
+    const auto i = static_cast<std::size_t>(c.agent);
+    if ((flags[i] & kAgentArrived) != 0 || (flags[i] & (kAgentActive | kAgentPending)) == 0) continue;
+    float nearest = INFINITY;
+    for (const ExitSpec& x : exits_[static_cast<std::size_t>(c.group)])
+      nearest = std::min(nearest, length_of(x.point - position[i]));
+    order.push_back({nearest, k});
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<Index> queued(exit_count_, 0);
+  Index switched = 0;
+  for (const auto& [nearest, k] : order) {
+    Chooser& c = agents_[k];
+    const auto i = static_cast<std::size_t>(c.agent);
+    const auto count = static_cast<std::uint32_t>(exits_[static_cast<std::size_t>(c.group)].size());
+    std::uint32_t best = c.exit;
+    float best_cost = exit_cost(c, position[i], best, queued);
+    for (std::uint32_t r = 0; r < count; ++r) {
+      const std::uint32_t e = static_cast<std::uint32_t>((c.tie + r) % count);  // the agent's own order on ties
+      const float cost = exit_cost(c, position[i], e, queued);
+      if (cost < best_cost) {
+        best = e;
+        best_cost = cost;
+      }
+    }
+    ++queued[static_cast<std::size_t>(exit_offset_[static_cast<std::size_t>(c.group)]) + best];
+    if (best == c.exit) continue;
+    c.exit = best;
+    ++switched;
+    const glm::vec2 to = exits_[static_cast<std::size_t>(c.group)][best].point;
+    waypoints[static_cast<std::size_t>(c.goal_slot)] = to;
+    if (cursor[i] == c.goal_index) goal[i] = to;  // on its last leg: the current goal too
+  }
+  if (switched > 0) {
+    crowd.waypoints.write(0, std::span<const glm::vec2>(waypoints));
+    crowd.goal.write(0, std::span<const glm::vec2>(goal));
+  }
+  return switched;
+}
+
+}  // namespace throng::sim
