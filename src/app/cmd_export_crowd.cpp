@@ -12,6 +12,7 @@
 
 #include "anim/rig.h"
 #include "app/commands.h"
+#include "app/scenario_choice.h"
 #include "app/sim_locomotion.h"
 #include "core/error.h"
 #include "core/memory_budget.h"
@@ -24,28 +25,24 @@ namespace throng::app {
 namespace {
 
 struct ExportOptions {
-  std::string scenario = "circle";
+  ScenarioChoice choice;
   std::string out;
   std::string format = "gltf";
-  Index agents = 0;
   double seconds = 20.0;
   double fps = 24.0;
-  std::optional<std::uint64_t> seed;
   double max_megabytes = 512.0;
 };
 
 void export_crowd(const ExportOptions& o) {
   std::error_code ec;
-  if (std::filesystem::is_directory(o.scenario, ec))
+  if (std::filesystem::is_directory(o.choice.scenario, ec))
     throw Error(
         "is a folder: export-crowd runs a scenario (a YAML file or a built-in name); give it the scenario the run "
         "used, with "
         "its --agents and --seed",
-        at_field("scenario", o.scenario));
-  io::LoadedScenario loaded = io::load_scenario(o.scenario);
+        at_field("scenario", o.choice.scenario));
+  io::LoadedScenario loaded = o.choice.load();
   sim::ScenarioSpec& spec = loaded.spec;
-  if (o.agents > 0) sim::scale_agent_counts(spec, o.agents);
-  if (o.seed) spec.seed = *o.seed;
   const auto steps = static_cast<std::int64_t>(std::ceil(o.seconds / static_cast<double>(spec.dt) - 1e-9));
   const auto frames = static_cast<std::int64_t>(std::floor(o.seconds * o.fps + 1e-9)) + 1;
   const std::string out = !o.out.empty() ? o.out : "out/" + spec.name + "/crowd.glb";
@@ -112,15 +109,13 @@ void add_export_crowd_command(CLI::App& app, const GlobalOptions& g) {
       "Run a scenario and write its animated crowd as glTF 2.0 (.glb): the skinned mannequin and every agent's "
       "joints keyed at --fps, for Blender, Maya, Houdini or Unreal");
   static ExportOptions o;
-  cmd->add_option("scenario", o.scenario, "Scenario file, or a built-in name")->capture_default_str();
+  o.choice.add_options(*cmd);
   cmd->add_option("--out", o.out, "The .glb to write (default: out/<scenario>/crowd.glb)");
   cmd->add_option("--format", o.format, "Export format")->check(CLI::IsMember({"gltf"}))->capture_default_str();
-  cmd->add_option("--agents", o.agents, "Total agents (groups keep their proportions)")->check(at_least(1));
   cmd->add_option("--seconds", o.seconds, "Simulated seconds to export")
       ->check(between(0.01, 3600))
       ->capture_default_str();
   cmd->add_option("--fps", o.fps, "Keys per simulated second")->check(between(1, 120))->capture_default_str();
-  cmd->add_option("--seed", o.seed, "Random seed (spawn positions, speeds, random goals)");
   cmd->add_option("--max-size", o.max_megabytes, "Refuse an export estimated above this many MB")
       ->check(greater_than(0))
       ->capture_default_str();

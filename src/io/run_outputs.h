@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <span>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -100,5 +101,9 @@ class TrajectoryWriter : public sim::FrameStage {
 void write_text_file(const std::string& path, const std::string& text);
 // Writes `j` to `path` (pretty-printed) the same way.
 void write_json_file(const std::string& path, const nlohmann::json& j);
+
+// A coordinate in metres rounded to the millimetre, for files: printed as
+// typed (0.1, not the float's 0.100000001...), and never "-0".
+inline double round_to_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0 + 0.0; }
 
 }  // namespace throng::io

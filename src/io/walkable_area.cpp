@@ -16,10 +16,6 @@ namespace throng::io {
 
 namespace {
 
-// FreeSpace snaps to 1 mm; printing the float it returns would show its
-// binary error (0.1f is 0.100000001...). Rounded doubles print as typed.
-double mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0 + 0.0; }  // + 0.0: no "-0"
-
 // Boost's union leaves the vertices where merged obstacles met on a straight
 // edge; a vertex whose neighbours continue straight through it says nothing.
 void drop_straight_vertices(sim::Ring& ring) {
@@ -58,7 +54,7 @@ void append_ring_wkt(Out out, const sim::Ring& r) {
   *out++ = '(';
   for (std::size_t i = 0; i <= r.size(); ++i) {
     const glm::vec2 p = r[i % r.size()];
-    fmt::format_to(out, "{}{} {}", i == 0 ? "" : ", ", mm(p.x), mm(p.y));
+    fmt::format_to(out, "{}{} {}", i == 0 ? "" : ", ", round_to_mm(p.x), round_to_mm(p.y));
   }
   *out++ = ')';
 }
@@ -76,7 +72,8 @@ void append_polygon_wkt(Out out, const sim::Polygon& p) {
 
 nlohmann::json ring_json(const sim::Ring& r) {
   nlohmann::json ring = nlohmann::json::array();
-  for (std::size_t i = 0; i <= r.size(); ++i) ring.push_back({mm(r[i % r.size()].x), mm(r[i % r.size()].y)});
+  for (std::size_t i = 0; i <= r.size(); ++i)
+    ring.push_back({round_to_mm(r[i % r.size()].x), round_to_mm(r[i % r.size()].y)});
   return ring;
 }
 

@@ -183,6 +183,27 @@ TEST(Cli, LogsGoToStderrNotStdout) {
   std::filesystem::remove_all(dir);
 }
 
+// `throng route`: one line per sampled agent on stdout, the file in the
+// folder asked for (GeoJSON by default, CSV on request), logs on stderr.
+TEST(Cli, RoutePrintsAndWritesTheSampledRoutes) {
+  const auto dir = fresh_dir("throng_cli_route");
+  Streams r = run_split("route maze --agents 30 --sample 4 --out " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::size_t lines = 0;
+  for (std::size_t at = 0; (at = r.out.find("agent ", at)) != std::string::npos; ++at) ++lines;
+  EXPECT_EQ(lines, 4u) << r.out;
+  EXPECT_NE(r.err.find("routes.geojson"), std::string::npos) << r.err;
+  std::ifstream in(dir / "routes.geojson");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["features"].size(), 4u);
+  r = run_split("route maze --agents 30 --sample 2 --format csv --out " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "routes.csv"));
+  EXPECT_NE(run_split("route maze --sample 0").code, 0);
+  EXPECT_NE(run_split("route maze --format kml").code, 0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Cli, InfoJsonStdoutIsOnlyJson) {
   // Default log level: whatever info logs (e.g. "no usable GPU") stays off stdout.
   Streams r = run_split("info --json");

@@ -1,0 +1,73 @@
+#include "io/routes_output.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "io/run_outputs.h"
+
+namespace throng::io {
+
+namespace {
+
+double path_length(const std::vector<glm::vec2>& p) {
+  double length = 0;
+  for (std::size_t k = 1; k < p.size(); ++k) length += static_cast<double>(sim::length_of(p[k] - p[k - 1]));
+  return length;
+}
+
+}  // namespace
+
+std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
+  const sim::CrowdState& c = sim.crowd();
+  const Index n = sim.agent_count();
+  const std::vector<glm::vec2> position = c.position.to_vector(), waypoints = c.waypoints.to_vector();
+  const std::vector<std::int32_t> begin = c.waypoint_begin.to_vector(), goal = c.waypoint_goal.to_vector(),
+                                  group = c.group.to_vector();
+  std::vector<AgentRoute> out;
+  const Index k_max = std::min(count, n);
+  for (Index k = 0; k < k_max; ++k) {
+    const auto i = static_cast<std::size_t>(k * n / k_max);
+    AgentRoute r;
+    r.agent = static_cast<Index>(i);
+    const auto g = static_cast<std::size_t>(group[i]);
+    const std::string& name = sim.spec().groups[g].name;
+    r.group = name.empty() ? fmt::format("groups[{}]", g) : name;
+    r.points.push_back(position[i]);
+    const auto first = waypoints.begin() + begin[i];
+    r.points.insert(r.points.end(), first, first + goal[i] + 1);
+    r.length_m = path_length(r.points);
+    r.straight_m = static_cast<double>(sim::length_of(r.points.back() - r.points.front()));
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+nlohmann::json routes_geojson(const std::vector<AgentRoute>& routes) {
+  nlohmann::json features = nlohmann::json::array();
+  for (const AgentRoute& r : routes) {
+    nlohmann::json line = nlohmann::json::array();
+    for (glm::vec2 p : r.points) line.push_back({round_to_mm(p.x), round_to_mm(p.y)});
+    features.push_back({{"type", "Feature"},
+                        {"properties",
+                         {{"agent", r.agent},
+                          {"group", r.group},
+                          {"length_m", std::round(r.length_m * 1000.0) / 1000.0},
+                          {"straight_m", std::round(r.straight_m * 1000.0) / 1000.0},
+                          {"waypoints", r.points.size() - 2}}},
+                        {"geometry", {{"type", "LineString"}, {"coordinates", line}}}});
+  }
+  return {{"type", "FeatureCollection"}, {"features", features}};
+}
+
+std::string routes_csv(const std::vector<AgentRoute>& routes) {
+  std::string out = "agent,group,point,x,y\n";
+  for (const AgentRoute& r : routes)
+    for (std::size_t k = 0; k < r.points.size(); ++k)
+      out +=
+          fmt::format("{},{},{},{},{}\n", r.agent, r.group, k, round_to_mm(r.points[k].x), round_to_mm(r.points[k].y));
+  return out;
+}
+
+}  // namespace throng::io

@@ -1,0 +1,69 @@
+// The routes `throng route` reports: on the built-in maze (routes planned on
+// the roadmap), each sampled route starts where its agent stands, ends at
+// its goal, and every segment of it runs through free space (sampled every
+// 5 cm against the world); its length adds up; GeoJSON and CSV hold the same
+// points.
+#include "io/routes_output.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "io/scenario_yaml.h"
+
+namespace throng::io {
+namespace {
+
+TEST(RoutesOutput, SampledRoutesRunThroughFreeSpaceFromStartToGoal) {
+  LoadedScenario maze = load_builtin_scenario("maze");
+  sim::scale_agent_counts(maze.spec, 40);
+  const std::unique_ptr<sim::Simulation> sim = build_simulation(maze);
+  const std::vector<AgentRoute> routes = sample_routes(*sim, 7);
+  ASSERT_EQ(routes.size(), 7u);
+  const std::vector<glm::vec2> start = sim->positions();
+  const std::vector<float> radius = sim->crowd().radius.to_vector();
+  bool detour = false;
+  for (std::size_t k = 0; k < routes.size(); ++k) {
+    const AgentRoute& r = routes[k];
+    SCOPED_TRACE(r.agent);
+    EXPECT_EQ(r.agent, static_cast<Index>(k * 40 / 7));
+    ASSERT_GE(r.points.size(), 2u);
+    EXPECT_EQ(r.points.front(), start[static_cast<std::size_t>(r.agent)]);
+    double length = 0;
+    for (std::size_t s = 1; s < r.points.size(); ++s) {
+      const glm::vec2 a = r.points[s - 1], b = r.points[s];
+      length += sim::length_of(b - a);
+      const int n = static_cast<int>(std::ceil(sim::length_of(b - a) / 0.05f));
+      for (int i = 0; i <= n; ++i) {
+        const glm::vec2 p = a + (b - a) * (static_cast<float>(i) / static_cast<float>(std::max(n, 1)));
+        ASSERT_TRUE(sim->world().in_free_space(p)) << "segment " << s << " leaves free space at " << p.x << ", " << p.y;
+      }
+    }
+    EXPECT_NEAR(r.length_m, length, 1e-3);
+    EXPECT_GE(r.length_m, r.straight_m - 1e-6);
+    detour = detour || r.length_m > 1.2 * r.straight_m;
+    EXPECT_GT(radius[static_cast<std::size_t>(r.agent)], 0.0f);
+  }
+  EXPECT_TRUE(detour) << "the maze's walls make routes longer than the straight line";
+
+  const nlohmann::json j = routes_geojson(routes);
+  ASSERT_EQ(j["features"].size(), routes.size());
+  const nlohmann::json& f = j["features"][2];
+  EXPECT_EQ(f["geometry"]["type"], "LineString");
+  EXPECT_EQ(f["properties"]["agent"], routes[2].agent);
+  EXPECT_EQ(f["geometry"]["coordinates"].size(), routes[2].points.size());
+  EXPECT_NEAR(f["geometry"]["coordinates"][1][0].get<double>(), routes[2].points[1].x, 1e-3);
+  std::istringstream csv(routes_csv(routes));
+  std::string line;
+  std::size_t rows = 0, points = 0;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "agent,group,point,x,y");
+  while (std::getline(csv, line)) ++rows;
+  for (const AgentRoute& r : routes) points += r.points.size();
+  EXPECT_EQ(rows, points);
+}
+
+}  // namespace
+}  // namespace throng::io
