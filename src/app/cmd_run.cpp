@@ -172,6 +172,8 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
     std::printf(" (mean %.1f s, last %.1f s)", at["mean"].get<double>(), at["max"].get<double>());
   if (const auto waiting = crowd["not_entered_at_end"].get<long long>(); waiting > 0)
     std::printf("; %lld still waiting to enter", waiting);
+  if (const auto replanned = crowd["replanned"].get<long long>(); replanned > 0)
+    std::printf("; %lld route(s) planned again", replanned);
   std::printf("; mean speed %.2f m/s\n", crowd["mean_speed_mps"]["over_samples"].get<double>());
   const auto& ov = crowd["overlaps"];
   std::printf(

@@ -17,6 +17,15 @@ double path_length(const std::vector<glm::vec2>& p) {
   return length;
 }
 
+// A CSV field (RFC 4180): quoted, with its quotes doubled, when it holds a
+// comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
 }  // namespace
 
 std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
@@ -63,10 +72,11 @@ nlohmann::json routes_geojson(const std::vector<AgentRoute>& routes) {
 
 std::string routes_csv(const std::vector<AgentRoute>& routes) {
   std::string out = "agent,group,point,x,y\n";
-  for (const AgentRoute& r : routes)
+  for (const AgentRoute& r : routes) {
+    const std::string group = csv_field(r.group);
     for (std::size_t k = 0; k < r.points.size(); ++k)
-      out +=
-          fmt::format("{},{},{},{},{}\n", r.agent, r.group, k, round_to_mm(r.points[k].x), round_to_mm(r.points[k].y));
+      out += fmt::format("{},{},{},{},{}\n", r.agent, group, k, round_to_mm(r.points[k].x), round_to_mm(r.points[k].y));
+  }
   return out;
 }
 

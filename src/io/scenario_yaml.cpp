@@ -234,6 +234,7 @@ class Reader : public YamlReader {
     if (n.IsScalar()) {
       p.kind = Kind::uniform;
       p.min = p.max = real(n, path);
+      if (p.min < 0) fail(n, path, fmt::format("must be >= 0 s (got {})", p.min));
       return p;
     }
     expect_map(n, path, {"distribution", "mean", "stddev", "min", "max"});
@@ -452,6 +453,8 @@ class Reader : public YamlReader {
       for (std::size_t i = 0; i < list.size(); ++i) g.waypoints.push_back(goal(list[i], item(lp, i)));
     }
     g.goal = goal(required(n, path, "goal"), child(path, "goal"));
+    // Agents leave by their exit unless told to stand there.
+    if (g.goal.kind == GoalSpec::Kind::Exits) g.arrival = sim::ArrivalBehaviour::Despawn;
     if (n["on_arrival"]) {
       const std::string a = word(n["on_arrival"], child(path, "on_arrival"), {"stop", "despawn", "loop"});
       g.arrival = a == "stop" ? sim::ArrivalBehaviour::Stop
@@ -745,11 +748,12 @@ std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario
       return std::make_unique<sim::Simulation>(scenario.spec, straight);
     }
     if (options.planner != nullptr) return std::make_unique<sim::Simulation>(scenario.spec, options);
-    const path::RoadmapRoutePlanner planner;
+    const auto planner = std::make_shared<const path::RoadmapRoutePlanner>();
     sim::SimulationOptions planned = options;
-    planned.planner = &planner;
+    planned.planner = planner.get();
+    planned.replanner = planner;  // the run keeps it to plan again for agents pushed off their routes
     auto simulation = std::make_unique<sim::Simulation>(scenario.spec, planned);
-    if (const path::RoutePlannerStats st = planner.stats(); st.queries > 0)
+    if (const path::RoutePlannerStats st = planner->stats(); st.queries > 0)
       spdlog::info(
           "planning: {} of {} agents routed over the roadmap, {} straight, {} without a route ({} roadmap(s) in {:.2f} "
           "s, "

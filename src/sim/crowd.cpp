@@ -196,10 +196,10 @@ void check_goal(const GoalSpec& goal, const std::string& gf, const ScenarioLimit
   }
 }
 
-// Pre-movement times (s) within [0, the scenario's duration]: finite bounds
-// in order, a positive mean and a non-negative spread where the
-// distribution has them.
-void check_premovement(const PremovementSpec& P, const std::string& field, float duration) {
+// Pre-movement times (s) within [0, last_start], the start of the run's
+// last step (a later start would never walk): finite bounds in order, a
+// positive mean and a non-negative spread where the distribution has them.
+void check_premovement(const PremovementSpec& P, const std::string& field, float last_start) {
   if (P.kind == PremovementSpec::Kind::none) return;
   auto finite = [&](float x, const char* key) {
     if (!std::isfinite(x))
@@ -210,11 +210,12 @@ void check_premovement(const PremovementSpec& P, const std::string& field, float
   if (P.min < 0) throw Error(fmt::format("min must be >= 0 s (got {})", P.min), at_field(field + ".min"));
   if (P.max < P.min)
     throw Error(fmt::format("max ({} s) must be >= min ({} s)", P.max, P.min), at_field(field + ".max"));
-  if (P.max > duration)
-    throw Error(fmt::format("max ({} s; by default mean + 4 stddev) exceeds the scenario's duration ({} s): those "
-                            "agents would never walk",
-                            P.max, duration),
-                at_field(field + ".max"));
+  if (P.max > last_start)
+    throw Error(
+        fmt::format("max ({} s{}) is past the start of the run's last step ({:.4g} s): those agents would never "
+                    "walk",
+                    P.max, P.kind == PremovementSpec::Kind::uniform ? "" : "; by default mean + 4 stddev", last_start),
+        at_field(field + ".max"));
   if (P.kind == PremovementSpec::Kind::uniform) return;
   finite(P.mean, "mean");
   finite(P.stddev, "stddev");
@@ -223,9 +224,10 @@ void check_premovement(const PremovementSpec& P, const std::string& field, float
 }
 
 // An inflow (field) of a group of `count` agents spawning in `spawn`: an
-// area to enter, entry times finite, ascending and within the duration.
+// area to enter, entry times finite, ascending and up to last_start (the
+// start of the run's last step).
 void check_inflow(const InflowSpec& I, const Region& spawn, std::int64_t count, const std::string& field,
-                  float duration) {
+                  float last_start) {
   if (!I.enabled) return;
   if (spawn.kind == Region::Kind::points || spawn.kind == Region::Kind::ring)
     throw Error("agents arriving over time need an area to enter: a rect, disc or polygon spawn",
@@ -237,10 +239,12 @@ void check_inflow(const InflowSpec& I, const Region& spawn, std::int64_t count, 
                   at_field(in + ".times"));
     for (std::size_t k = 0; k < I.times.size(); ++k) {
       const float t = I.times[k];
-      if (!std::isfinite(t) || t < 0 || t > duration || (k > 0 && t < I.times[k - 1]))
-        throw Error(fmt::format("entry times must be ascending, in [0, {} s] (the duration); got {} after {}", duration,
-                                t, k > 0 ? I.times[k - 1] : 0.0f),
-                    at_field(fmt::format("{}.times[{}]", in, k)));
+      if (!std::isfinite(t) || t < 0 || t > last_start || (k > 0 && t < I.times[k - 1]))
+        throw Error(
+            fmt::format("entry times must be ascending, in [0, {:.4g} s] (up to the start of the run's last step); "
+                        "got {} after {}",
+                        last_start, t, k > 0 ? I.times[k - 1] : 0.0f),
+            at_field(fmt::format("{}.times[{}]", in, k)));
     }
     return;
   }
@@ -251,11 +255,11 @@ void check_inflow(const InflowSpec& I, const Region& spawn, std::int64_t count, 
   if (std::isnan(I.until) || !(I.until > I.from))
     throw Error(fmt::format("until ({} s) must come after from ({} s)", I.until, I.from), at_field(in + ".until"));
   const float last = count > 0 ? I.entry_time(count - 1) : I.from;
-  if (last > I.until || last > duration)
-    throw Error(
-        fmt::format("{} agents at {} P/s from {} s enter until {:.4g} s, after {} {:.4g} s", count, I.rate, I.from,
-                    last, last > I.until ? "until" : "the duration", last > I.until ? I.until : duration),
-        at_field(in + ".rate"));
+  if (last > I.until || last > last_start)
+    throw Error(fmt::format("{} agents at {} P/s from {} s enter until {:.4g} s, after {} {:.4g} s", count, I.rate,
+                            I.from, last, last > I.until ? "until" : "the start of the run's last step",
+                            last > I.until ? I.until : last_start),
+                at_field(in + ".rate"));
 }
 
 // Group G (field groups[g]) against the model: radius and speeds (m, m/s)
@@ -292,9 +296,9 @@ void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::s
   if (!std::isfinite(G.arrival_radius) || !(G.arrival_radius > 0))
     throw Error(fmt::format("arrival radius must be > 0 (got {})", G.arrival_radius),
                 at_field(field + ".arrival_radius"));
-  const float duration = static_cast<float>(spec.step_count()) * spec.dt;
-  check_premovement(G.premovement, field + ".premovement", duration);
-  check_inflow(G.inflow, G.spawn, G.count, field, duration);
+  const float last_start = static_cast<float>(spec.step_count() - 1) * spec.dt;
+  check_premovement(G.premovement, field + ".premovement", last_start);
+  check_inflow(G.inflow, G.spawn, G.count, field, last_start);
   if (G.inflow.enabled && G.premovement.kind != PremovementSpec::Kind::none)
     throw Error("agents arriving over time walk as they enter: pre-movement is for those present at the start",
                 at_field(field + ".premovement"));

@@ -55,13 +55,15 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
   const std::vector<glm::vec2> position = crowd.position.to_vector();
   const std::vector<std::uint8_t> flags = crowd.flags.to_vector();
   const std::vector<std::int32_t> cursor = crowd.waypoint_cursor.to_vector();
-  std::vector<glm::vec2> waypoints = crowd.waypoints.to_vector(), goal = crowd.goal.to_vector();
-  // Those still to leave (in the scene or yet to enter), nearest an exit first.
+  std::vector<glm::vec2> waypoints = crowd.waypoints.to_vector(), goal = crowd.goal.to_vector(),
+                         path_start = crowd.path_start.to_vector();
+  // Those in the scene still to leave, nearest an exit first (one yet to
+  // enter chooses at the first round after it entered).
   std::vector<std::pair<float, std::size_t>> order;
   for (std::size_t k = 0; k < agents_.size(); ++k) {
     const Chooser& c = agents_[k];
     const auto i = static_cast<std::size_t>(c.agent);
-    if ((flags[i] & kAgentArrived) != 0 || (flags[i] & (kAgentActive | kAgentPending)) == 0) continue;
+    if ((flags[i] & kAgentArrived) != 0 || (flags[i] & kAgentActive) == 0) continue;
     float nearest = INFINITY;
     for (const ExitSpec& x : exits_[static_cast<std::size_t>(c.group)])
       nearest = std::min(nearest, length_of(x.point - position[i]));
@@ -90,11 +92,15 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
     ++switched;
     const glm::vec2 to = exits_[static_cast<std::size_t>(c.group)][best].point;
     waypoints[static_cast<std::size_t>(c.goal_slot)] = to;
-    if (cursor[i] == c.goal_index) goal[i] = to;  // on its last leg: the current goal too
+    if (cursor[i] == c.goal_index) {  // on its last leg: a new leg from where it stands
+      goal[i] = to;
+      path_start[i] = position[i];
+    }
   }
   if (switched > 0) {
     crowd.waypoints.write(0, std::span<const glm::vec2>(waypoints));
     crowd.goal.write(0, std::span<const glm::vec2>(goal));
+    crowd.path_start.write(0, std::span<const glm::vec2>(path_start));
   }
   return switched;
 }

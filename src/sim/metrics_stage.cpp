@@ -146,6 +146,7 @@ void CrowdMetricsStage::finish(const Simulation& sim, nlohmann::json& stats) {
       {"agents", sim.agent_count()},
       {"active_at_end", sim.active_count()},
       {"not_entered_at_end", sim.pending_count()},
+      {"replanned", sim.replanned_count()},
       {"arrived", arrivals.arrived},
       {"arrival_time_s", {{"mean", arrivals.mean_time}, {"min", arrivals.min_time}, {"max", arrivals.max_time}}},
       {"samples", samples_.seen()},

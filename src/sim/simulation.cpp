@@ -29,6 +29,7 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   });
   crowd_ = upload_crowd(host, current_memory());
   exits_ = ExitChooser(spec_, host);
+  replan_ = Replanner(spec_, host, options.replanner);
   bins_ = AgentGrid(spec_.model.query_radius());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
   contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));
@@ -60,6 +61,10 @@ void Simulation::step() {
     ScopedTimer choose("sim.exit_choice");
     exits_.update(time(), crowd_);
   }
+  if (!replan_.empty()) {
+    ScopedTimer replan("sim.replan");
+    replan_.update(time(), world_, crowd_);
+  }
   bin();
   if (!pending_.empty() && admit_entries()) bin();
   const StepContext ctx = context();
@@ -79,7 +84,9 @@ void Simulation::bin() {
 // it in this step (the rest wait at their points). True when any entered.
 bool Simulation::admit_entries() {
   std::size_t due = 0;
-  while (due < pending_.size() && static_cast<double>(pending_[due].time) <= time() + 1e-6) ++due;
+  // (1% of a step absorbs the float rounding of the entry times.)
+  const double now = time() + 0.01 * static_cast<double>(spec_.dt);
+  while (due < pending_.size() && static_cast<double>(pending_[due].time) <= now) ++due;
   if (due == 0) return false;
   std::vector<glm::vec2> spots(due);
   std::vector<float> radii(due);

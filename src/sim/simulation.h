@@ -37,10 +37,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "sim/crowd.h"
 #include "sim/exit_choice.h"
+#include "sim/replanning.h"
 #include "sim/grid.h"
 #include "sim/scenario.h"
 #include "sim/world.h"
@@ -144,6 +146,9 @@ enum class NeighbourSearch : std::uint8_t { Bins, AllPairs };
 struct SimulationOptions {
   ScenarioLimits limits;
   const RoutePlanner* planner = nullptr;  // path planning for groups with a goal and no waypoints
+  // Re-plans, during the run, the planned routes of agents pushed off them
+  // (sim/replanning.h); null: routes stay as spawned.
+  std::shared_ptr<const RoutePlanner> replanner;
   NeighbourSearch neighbours = NeighbourSearch::Bins;
 };
 
@@ -184,6 +189,7 @@ class Simulation {
   std::vector<float> arrival_times() const { return crowd_.arrival_time.to_vector(); }
   Index active_count() const;  // in the scene: entered and not despawned
   Index pending_count() const { return static_cast<Index>(pending_.size()); }  // yet to enter
+  Index replanned_count() const { return replan_.replanned(); }                // routes planned anew so far
   Index arrived_count() const;                                                 // reached their goal at least once
   bool all_arrived() const { return arrived_count() == agent_count(); }
 
@@ -209,6 +215,7 @@ class Simulation {
   Buffer<MoveCells> move_cells_;
   std::vector<PendingEntry> pending_;  // by entry time, then agent
   ExitChooser exits_;                  // groups choosing the quickest exit
+  Replanner replan_;                   // planned routes, planned again for agents pushed off them
 };
 
 }  // namespace throng::sim

@@ -337,7 +337,8 @@ struct Finalize {
     a.position[i] = p;
     if (length2(v) > 0.05f * 0.05f && (flags & kAgentWaiting) == 0) a.heading[i] = atan2f(v.y, v.x);
     // A waiting agent starts walking in the step that begins at its start time.
-    if ((flags & kAgentWaiting) != 0 && ctx.time_after >= a.start_time[i])
+    // (1% of a step absorbs the float rounding of both times.)
+    if ((flags & kAgentWaiting) != 0 && ctx.time_after + 0.01f * ctx.dt >= a.start_time[i])
       flags = static_cast<std::uint8_t>(flags & ~kAgentWaiting);
     else if ((flags & (kAgentStopped | kAgentWaiting)) == 0) {
       const GroupRuntime g = a.groups[a.group[i]];

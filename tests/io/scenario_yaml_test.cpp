@@ -420,6 +420,13 @@ TEST(ScenarioYaml, ExitsGoal) {
   EXPECT_FLOAT_EQ(nearest.exits[0].width, 1.5f);
   EXPECT_FLOAT_EQ(nearest.exits[1].width, 1.0f);
   EXPECT_FLOAT_EQ(nearest.reconsider_s, 2.0f);
+  // Agents leave by their exit unless the group says otherwise.
+  EXPECT_EQ(parse_scenario(head + "    goal: {exits: [{point: [20, 2]}]}\n", "e.yaml").spec.groups[0].arrival,
+            sim::ArrivalBehaviour::Despawn);
+  EXPECT_EQ(parse_scenario(head + "    goal: {exits: [{point: [20, 2]}]}\n    on_arrival: stop\n", "e.yaml")
+                .spec.groups[0]
+                .arrival,
+            sim::ArrivalBehaviour::Stop);
   const sim::GoalSpec quickest =
       parse_scenario(head + "    goal: {exits: [{point: [20, 2]}], choice: quickest, reconsider: 5}\n", "e.yaml")
           .spec.groups[0]

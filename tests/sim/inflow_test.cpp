@@ -108,6 +108,21 @@ TEST(Inflow, ACrowdedEntranceHoldsAgentsBackWithoutOverlaps) {
   EXPECT_GT(late, 30);
 }
 
+// Late in a run the float entry times round away from the step times
+// (32.15 s at dt 0.05 is 32.1500015 as a float): each still enters in the
+// step that starts at its time, not one later (a 30 m entrance: room for all).
+TEST(Inflow, LateEntriesAreOnTimeToo) {
+  const InflowSpec in = at_rate(20.0f / 3.0f, 32.0f);
+  ScenarioSpec s = corridor(6, in, {30.0f, 3.7f});
+  s.groups[0].goal = GoalSpec::at({39.0f, 2.0f});
+  s.duration = 80.0f;
+  const EntryRun r = run(s);
+  for (std::size_t k = 0; k < r.entered.size(); ++k) {
+    const double t = in.entry_time(static_cast<std::int64_t>(k));
+    EXPECT_NEAR(r.entered[k], std::round(t / s.dt) * s.dt, 1e-4) << "agent " << k << " due at " << t;
+  }
+}
+
 // Listed times: agent k enters at times[k].
 TEST(Inflow, ListedTimes) {
   InflowSpec in;
@@ -155,7 +170,7 @@ TEST(Inflow, BadSchedulesAreLocatedErrors) {
   EXPECT_TRUE(has(error_of(corridor(10, at_rate(NAN, 0.0f), {3, 3})), "groups[0].inflow.rate"));
   EXPECT_TRUE(has(error_of(corridor(10, at_rate(1.0f, -2.0f), {3, 3})), "groups[0].inflow.from"));
   // 1000 agents at 1 P/s do not fit in 200 s.
-  EXPECT_TRUE(has(error_of(corridor(1000, at_rate(1.0f, 0.0f), {3, 3})), "the duration"));
+  EXPECT_TRUE(has(error_of(corridor(1000, at_rate(1.0f, 0.0f), {3, 3})), "the start of the run's last step"));
   InflowSpec until = at_rate(1.0f, 0.0f);
   until.until = 5.0f;
   EXPECT_TRUE(has(error_of(corridor(10, until, {3, 3})), "after until"));

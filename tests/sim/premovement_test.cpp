@@ -101,7 +101,7 @@ TEST(Premovement, BadBoundsAndSpreadsAreLocatedErrors) {
   EXPECT_NE(error_of({Kind::lognormal, 0, 1, 0, 10}).find("groups[0].premovement.mean"), std::string::npos);
   EXPECT_NE(error_of({Kind::normal, 5, -1, 0, 10}).find("groups[0].premovement.stddev"), std::string::npos);
   // Beyond the scenario's end the agents would never walk.
-  EXPECT_NE(error_of({Kind::uniform, 0, 0, 0, 500}).find("duration"), std::string::npos);
+  EXPECT_NE(error_of({Kind::uniform, 0, 0, 0, 500}).find("the run's last step"), std::string::npos);
 }
 
 // Agents far apart (no neighbour in reach), each waiting a different time:
@@ -145,6 +145,28 @@ TEST(Premovement, EveryModelHoldsEachAgentUntilItsTime) {
       EXPECT_LE(arrived[i], when[i] + 10.0f / 1.3f * 1.5f) << "agent " << i;
     }
   }
+}
+
+// A start time that falls on a step walks in that step, whatever the float
+// rounding of the two (0.01 s steps are slightly under 0.01 as floats).
+TEST(Premovement, AStartOnAStepWalksInThatStep) {
+  ScenarioSpec s = field(0, {PremovementSpec::Kind::uniform, 0, 0, 0.05f, 0.05f});
+  s.planning = PlanningKind::None;
+  s.dt = 0.01f;
+  s.duration = 1.0f;
+  s.model.max_speed = 1.5f;
+  GroupSpec& g = s.groups[0];
+  g.spawn.kind = Region::Kind::points;
+  g.spawn.points = {{0.0f, 0.0f}};
+  g.count = 1;
+  g.radius = 0.2f;
+  g.speed = {1.3f, 0.0f, 1.3f, 1.3f};
+  Simulation sim(s);
+  const glm::vec2 start = sim.positions()[0];
+  sim.run(5);  // the steps that start at 0 .. 0.04 s: standing
+  EXPECT_EQ(sim.positions()[0], start);
+  sim.step();  // the step that starts at 0.05 s
+  EXPECT_GT(length_of(sim.positions()[0] - start), 0.0f);
 }
 
 // Waiting is not being stuck: a crowd that waits 10 s counts no stuck agent.
