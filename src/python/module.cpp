@@ -187,6 +187,7 @@ PYBIND11_MODULE(throng, m) {
       .def_property_readonly("agent_count", [](const PySimulation& s) { return s.sim().agent_count(); })
       .def_property_readonly("active_count", [](const PySimulation& s) { return s.sim().active_count(); })
       .def_property_readonly("arrived_count", [](const PySimulation& s) { return s.sim().arrived_count(); })
+      .def_property_readonly("pending_count", [](const PySimulation& s) { return s.sim().pending_count(); })
       .def_property_readonly("all_arrived", [](const PySimulation& s) { return s.sim().all_arrived(); })
       .def_property_readonly(
           "positions", [](const PySimulation& s) { return vec2_array(s.sim().positions()); },
@@ -208,7 +209,7 @@ PYBIND11_MODULE(throng, m) {
           "(n,) float32 copy, seconds; -1 until the agent arrived")
       .def_property_readonly(
           "active", [](const PySimulation& s) { return flag_array(s.sim().flags(), sim::kAgentActive); },
-          "(n,) bool copy: simulated (not despawned)")
+          "(n,) bool copy: in the scene (entered, when the group arrives over time, and not despawned)")
       .def_property_readonly(
           "arrived", [](const PySimulation& s) { return flag_array(s.sim().flags(), sim::kAgentArrived); },
           "(n,) bool copy: reached its goal at least once")

@@ -159,3 +159,26 @@ def throng_yaml_text():
     import pathlib
 
     return (pathlib.Path(__file__).resolve().parents[2] / "examples" / "circle.yaml").read_text()
+
+
+def test_agents_arriving_over_time_are_pending_then_active():
+    spec = {
+        "name": "inflow",
+        "dt": 0.1,
+        "duration": 60,
+        "planning": "none",
+        "groups": [
+            {
+                "count": 4,
+                "radius": 0.25,
+                "spawn": {"rect": {"min": [0, 0], "max": [20, 20]}},
+                "inflow": {"times": [0, 1, 2, 30]},
+                "goal": {"offset": [5, 0]},
+            }
+        ],
+    }
+    sim = throng.Simulation(spec)
+    assert sim.pending_count == 4 and sim.active_count == 0
+    sim.step(25)  # 2.5 s: the first three are in
+    assert sim.pending_count == 1
+    assert list(sim.active) == [True, True, True, False]
