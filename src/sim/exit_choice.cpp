@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "core/random.h"
 
@@ -10,16 +9,14 @@ namespace throng::sim {
 
 ExitChooser::ExitChooser(const ScenarioSpec& spec, const CrowdHost& host) {
   exits_.resize(spec.groups.size());
-  exit_offset_.resize(spec.groups.size(), 0);
-  std::int32_t flat = 0;
+  std::vector<std::size_t> first_exit(spec.groups.size(), 0);
   bool any = false;
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
     const GoalSpec& goal = spec.groups[g].goal;
-    exit_offset_[g] = flat;
+    first_exit[g] = exit_count_;
     if (goal.kind != GoalSpec::Kind::Exits || goal.choice != ExitChoice::Quickest) continue;
     exits_[g] = goal.exits;
-    flat += static_cast<std::int32_t>(goal.exits.size());
-    exit_count_ = static_cast<std::size_t>(flat);
+    exit_count_ += goal.exits.size();
     period_ = any ? std::min(period_, static_cast<double>(goal.reconsider_s)) : goal.reconsider_s;
     any = true;
   }
@@ -32,6 +29,7 @@ ExitChooser::ExitChooser(const ScenarioSpec& spec, const CrowdHost& host) {
     c.goal_index = host.waypoint_goal[i];
     c.goal_slot = host.waypoint_begin[i] + c.goal_index;
     c.speed = std::max(host.pref_speed[i], 0.1f);
+    c.queue_base = first_exit[g];
     // Spawning aimed the agent at its nearest exit: find which it is.
     const glm::vec2 aim = host.waypoints[static_cast<std::size_t>(c.goal_slot)];
     for (std::uint32_t e = 0; e < exits_[g].size(); ++e)
@@ -43,8 +41,7 @@ ExitChooser::ExitChooser(const ScenarioSpec& spec, const CrowdHost& host) {
 
 float ExitChooser::exit_cost(const Chooser& c, glm::vec2 p, std::uint32_t e, const std::vector<Index>& queued) const {
   const ExitSpec& x = exits_[static_cast<std::size_t>(c.group)][e];
-  const auto q =
-      static_cast<float>(queued[static_cast<std::size_t>(exit_offset_[static_cast<std::size_t>(c.group)]) + e]);
+  const auto q = static_cast<float>(queued[c.queue_base + e]);
   const float cost = length_of(x.point - p) / c.speed + q / (kExitSpecificFlow * x.width);
   return e == c.exit ? cost * (1.0f - kExitSwitchGain) : cost;
 }
@@ -86,7 +83,7 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
         best_cost = cost;
       }
     }
-    ++queued[static_cast<std::size_t>(exit_offset_[static_cast<std::size_t>(c.group)]) + best];
+    ++queued[c.queue_base + best];
     if (best == c.exit) continue;
     c.exit = best;
     ++switched;

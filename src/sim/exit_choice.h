@@ -50,13 +50,13 @@ class ExitChooser {
     std::int32_t goal_slot = 0;   // of the goal in the flattened waypoints
     float speed = 1.0f;           // preferred, m/s
     std::uint32_t exit = 0;       // current choice, into the group's exits
+    std::size_t queue_base = 0;   // the group's first exit in the flat queue counts
     std::uint64_t tie = 0;        // seeded draw ranking the exits on a tie
   };
   float exit_cost(const Chooser& c, glm::vec2 p, std::uint32_t e, const std::vector<Index>& queued) const;
 
   std::vector<std::vector<ExitSpec>> exits_;  // per group (empty where the group does not choose)
-  std::vector<std::int32_t> exit_offset_;     // per group: its first exit in the flat queue counts
-  std::size_t exit_count_ = 0;                // exits of all choosing groups
+  std::size_t exit_count_ = 0;                // exits of all choosing groups (the flat queue counts)
   std::vector<Chooser> agents_;
   double period_ = 2.0;  // s: the shortest reconsider_s of the choosing groups
   double next_ = 0.0;    // s: when to choose next

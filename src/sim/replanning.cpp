@@ -52,22 +52,16 @@ Index Replanner::update(double time, const World& world, CrowdState& crowd) {
     if (walking && stalled && !in_view(world, position[i], goal[i])) lost.push_back(k);
   }
   if (lost.empty()) return 0;
-  std::vector<glm::vec2> starts, ends;
-  for (std::size_t k : lost) {
-    const auto i = static_cast<std::size_t>(agents_[k]);
-    starts.push_back(position[i]);
-    ends.push_back(waypoints[static_cast<std::size_t>(begin[i] + goal_index[i])]);
-  }
   // One query per agent: the planner reuses its roadmap for the radius.
   std::vector<glm::vec2> path_start = crowd.path_start.to_vector(), current = goal;
-  for (std::size_t q = 0; q < lost.size(); ++q) {
-    const std::size_t k = lost[q];
+  for (std::size_t k : lost) {
     const auto i = static_cast<std::size_t>(agents_[k]);
-    const std::vector<std::vector<glm::vec2>> route = planner_->plan(
-        world, std::span<const glm::vec2>(&starts[q], 1), std::span<const glm::vec2>(&ends[q], 1), radius_[k]);
+    const glm::vec2 from = position[i], to = waypoints[static_cast<std::size_t>(begin[i] + goal_index[i])];
+    const std::vector<std::vector<glm::vec2>> route =
+        planner_->plan(world, std::span<const glm::vec2>(&from, 1), std::span<const glm::vec2>(&to, 1), radius_[k]);
     begin[i] = static_cast<std::int32_t>(waypoints.size());
     if (!route.empty()) waypoints.insert(waypoints.end(), route[0].begin(), route[0].end());
-    waypoints.push_back(ends[q]);
+    waypoints.push_back(to);
     count[i] = static_cast<std::int32_t>(waypoints.size()) - begin[i];
     goal_index[i] = count[i] - 1;
     cursor[i] = 0;
