@@ -206,6 +206,7 @@ void register_path(const Options& options) {
   add(options, {"path/route_plan/field", {1000, 10000}, route_plan("field")});
   add(options, {"path/route_plan/maze", {100}, route_plan("maze")});
   add(options, {"path/route_plan/crossing", {10000}, route_plan("crossing")});
+  add(options, {"path/route_plan/plaza", {1000, 10000}, route_plan("plaza")});
 }
 
 }  // namespace

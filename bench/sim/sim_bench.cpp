@@ -33,6 +33,9 @@ sim::Simulation& plaza(Index n, sim::ModelKind model, Variant variant) {
     s.spec.model.kind = model;
     s.spec.scheduler =
         variant == Variant::FourColour ? sim::SchedulerKind::FourColour : sim::SchedulerKind::DoubleBuffer;
+    // The rows time the step; routes for 10^6 agents would take a minute and
+    // a half to plan first (the path/route_plan/plaza rows time planning).
+    s.spec.planning = sim::PlanningKind::None;
     sim::SimulationOptions options;
     if (variant == Variant::AllPairs) options.neighbours = sim::NeighbourSearch::AllPairs;
     slot = io::build_simulation(s, options);

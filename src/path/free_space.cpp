@@ -216,27 +216,31 @@ std::int32_t FreeSpace::component_of(glm::vec2 p) const {
 bool FreeSpace::contains(glm::vec2 p) const {
   if (!bounds_.contains(p)) return false;
   const sim::GridView g = grid_.host_view();
-  const std::int32_t cy = sim::cell_coord(p.y, cell_);
-  const std::int32_t x_end = sim::cell_coord(bounds_.max.x, cell_);
+  const std::int32_t cx = sim::cell_coord(p.x, cell_), cy = sim::cell_coord(p.y, cell_);
+  // The ray runs to the nearer side of the bounds (+x or -x): half the row
+  // on average.
+  const bool right = bounds_.max.x - p.x <= p.x - bounds_.min.x;
+  const std::int32_t x_first = right ? cx : sim::cell_coord(bounds_.min.x, cell_);
+  const std::int32_t x_last = right ? sim::cell_coord(bounds_.max.x, cell_) : cx;
   bool inside = false;
   // A row longer than there are boundary edges (a huge, nearly empty world)
   // is cheaper to answer from every edge: the cost stays bounded by what the
   // world contains, not by its extent.
-  if (static_cast<double>(x_end) - sim::cell_coord(p.x, cell_) + 1 > static_cast<double>(boundary_.size())) {
+  if (static_cast<double>(x_last) - x_first + 1 > static_cast<double>(boundary_.size())) {
     for (const sim::Segment& e : boundary_)
       if (sim::edge_crosses_ray(p, e.a, e.b)) inside = !inside;
     return inside;
   }
   // Each crossing is counted in the one cell of the row that holds it (an
   // edge is registered in every cell its pieces' boxes touch).
-  for (std::int32_t x = sim::cell_coord(p.x, cell_); x <= x_end; ++x) {
+  for (std::int32_t x = x_first; x <= x_last; ++x) {
     const Index slot = g.find(x, cy);
     if (slot < 0) continue;
     for (std::int32_t i = 0; i < g.count[slot]; ++i) {
       const sim::Segment& e = boundary_[static_cast<std::size_t>(g.items[g.start[slot] + i])];
       if ((e.a.y > p.y) == (e.b.y > p.y)) continue;
       const float cross_x = e.a.x + (p.y - e.a.y) * (e.b.x - e.a.x) / (e.b.y - e.a.y);
-      if (cross_x > p.x && sim::cell_coord(cross_x, cell_) == x) inside = !inside;
+      if ((right ? cross_x > p.x : cross_x < p.x) && sim::cell_coord(cross_x, cell_) == x) inside = !inside;
     }
   }
   return inside;
@@ -297,9 +301,13 @@ void FreeSpace::for_cells_near_segment(glm::vec2 a, glm::vec2 b, float reach, Fn
   }
   // Row by row, only the cells of the band around the part of [a, b] within
   // `grow` of the row (a long diagonal segment would otherwise visit its
-  // whole bounding box).
+  // whole bounding box). Rows and cells are visited from b's end: callers
+  // that extend a line of sight from a point already seen clear (the
+  // planner's shortcuts) find what blocks it near b, and stop there.
   const glm::vec2 d = b - a;
-  for (std::int32_t y = y0; y <= y1; ++y) {
+  const bool rows_down = b.y >= a.y, cells_left = b.x >= a.x;
+  for (std::int32_t row = 0; row <= y1 - y0; ++row) {
+    const std::int32_t y = rows_down ? y1 - row : y0 + row;
     const float y_lo = static_cast<float>(y) * cell_ - grow, y_hi = static_cast<float>(y + 1) * cell_ + grow;
     float t0 = 0.0f, t1 = 1.0f;
     if (std::fabs(d.y) > 1e-12f) {
@@ -314,7 +322,8 @@ void FreeSpace::for_cells_near_segment(glm::vec2 a, glm::vec2 b, float reach, Fn
     const float xa = a.x + t0 * d.x, xb = a.x + t1 * d.x;
     const std::int32_t row_x0 = std::max(x0, sim::cell_coord(std::min(xa, xb) - grow, cell_));
     const std::int32_t row_x1 = std::min(x1, sim::cell_coord(std::max(xa, xb) + grow, cell_));
-    for (std::int32_t x = row_x0; x <= row_x1; ++x) {
+    for (std::int32_t col = 0; col <= row_x1 - row_x0; ++col) {
+      const std::int32_t x = cells_left ? row_x1 - col : row_x0 + col;
       const glm::vec2 centre((static_cast<float>(x) + 0.5f) * cell_, (static_cast<float>(y) + 0.5f) * cell_);
       if (sim::distance_to_segment(centre, a, b) > keep) continue;
       const Index s = g.find(x, y);
@@ -325,10 +334,14 @@ void FreeSpace::for_cells_near_segment(glm::vec2 a, glm::vec2 b, float reach, Fn
   }
 }
 
-bool FreeSpace::segment_clear(glm::vec2 a, glm::vec2 b, float r) const {
-  if (!contains(a)) return false;
+bool FreeSpace::segment_clear(glm::vec2 a, glm::vec2 b, float r, bool a_known_free) const {
+  if (!a_known_free && !contains(a)) return false;
   bool clear = true;
   for_cells_near_segment(a, b, r, [&](const sim::Segment& s) {
+    // Most edges offered lie well off the segment: the disc round the edge's
+    // midpoint that holds it is a cheaper first test.
+    const float half = 0.5f * sim::length_of(s.b - s.a);
+    if (sim::distance_to_segment(0.5f * (s.a + s.b), a, b) - half >= r) return true;
     if (segment_segment_distance(a, b, s.a, s.b) < r || sim::segments_intersect(a, b, s.a, s.b)) clear = false;
     return clear;
   });

@@ -64,7 +64,7 @@ class FreeSpace {
   // Index of the component containing p, or -1 (in an obstacle or outside).
   std::int32_t component_of(glm::vec2 p) const;
   // p lies in free space (some component): parity of the boundary edges a
-  // ray from p to +x crosses, walking only the index cells of p's row (the
+  // ray from p to +x or -x crosses, walking only the index cells of p's row (the
   // components of a large world have thousands of holes: a plain
   // point-in-polygon test per query would visit every vertex).
   bool contains(glm::vec2 p) const;
@@ -74,7 +74,9 @@ class FreeSpace {
   float clearance(glm::vec2 p) const { return contains(p) ? boundary_distance(p) : 0.0f; }
   // A disc of radius r swept from a to b stays in free space: a is free and
   // every boundary edge is at least r from the segment [a, b].
-  bool segment_clear(glm::vec2 a, glm::vec2 b, float r) const;
+  // `a_known_free`: the caller knows a lies in free space (a point of a
+  // planned path), so its containment test is skipped.
+  bool segment_clear(glm::vec2 a, glm::vec2 b, float r, bool a_known_free = false) const;
   // Smallest distance from the segment [a, b] to the boundary.
   float segment_clearance(glm::vec2 a, glm::vec2 b) const;
 

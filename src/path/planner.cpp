@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <tuple>
 
 #include "core/error.h"
 #include "path/host_parallel.h"
@@ -44,6 +45,87 @@ float polyline_length(std::span<const glm::vec2> points) {
   return len;
 }
 
+namespace {
+
+// Cost of a whole roadmap edge (cumulative cost at its last point).
+float edge_total(std::span<const float> cumulative_cost, const RoadmapEdge& edge) {
+  return cumulative_cost[static_cast<std::size_t>(edge.point_begin + edge.point_count - 1)];
+}
+
+// Cheapest cost from `source` to every node (INFINITY where unreachable).
+std::vector<float> node_costs_from(const Roadmap& m, std::span<const float> cumulative_cost, std::int32_t source) {
+  std::vector<float> cost(static_cast<std::size_t>(m.node_count()), INFINITY);
+  using Entry = std::pair<float, std::int32_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  cost[static_cast<std::size_t>(source)] = 0;
+  open.push({0.0f, source});
+  while (!open.empty()) {
+    const auto [c, v] = open.top();
+    open.pop();
+    if (c > cost[static_cast<std::size_t>(v)]) continue;
+    for (std::int32_t k = m.adjacency_begin[static_cast<std::size_t>(v)];
+         k < m.adjacency_begin[static_cast<std::size_t>(v) + 1]; ++k) {
+      const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(m.adjacency[static_cast<std::size_t>(k)])];
+      const std::int32_t to = edge.a == v ? edge.b : edge.a;
+      const float c2 = c + edge_total(cumulative_cost, edge);
+      if (c2 < cost[static_cast<std::size_t>(to)]) {
+        cost[static_cast<std::size_t>(to)] = c2;
+        open.push({c2, to});
+      }
+    }
+  }
+  return cost;
+}
+
+}  // namespace
+
+// Landmarks by farthest-point selection: the first is the node farthest
+// from node 0 in cost, each next the node farthest from those chosen (over
+// every component: a node another component's landmarks cannot reach is
+// farthest of all). Farther landmarks bound more routes well.
+RoadmapLandmarks choose_landmarks(const Roadmap& m, std::span<const float> cumulative_cost, std::int32_t count) {
+  RoadmapLandmarks out;
+  const auto n = static_cast<std::size_t>(m.node_count());
+  if (n == 0) return out;
+  std::vector<float> nearest(n, INFINITY);  // cost to the nearest landmark chosen so far
+  std::int32_t next = 0;
+  {
+    const std::vector<float> from0 = node_costs_from(m, cumulative_cost, 0);
+    for (std::size_t v = 0; v < n; ++v)
+      if (from0[v] < INFINITY && from0[v] > from0[static_cast<std::size_t>(next)]) next = static_cast<std::int32_t>(v);
+  }
+  for (std::int32_t l = 0; l < count; ++l) {
+    const std::vector<float> cost = node_costs_from(m, cumulative_cost, next);
+    out.cost.insert(out.cost.end(), cost.begin(), cost.end());
+    ++out.count;
+    std::int32_t far = -1;
+    for (std::size_t v = 0; v < n; ++v) {
+      nearest[v] = std::min(nearest[v], cost[v]);
+      if (far < 0 || nearest[v] > nearest[static_cast<std::size_t>(far)]) far = static_cast<std::int32_t>(v);
+    }
+    if (!(nearest[static_cast<std::size_t>(far)] > 0)) break;  // every node is a landmark
+    next = far;
+  }
+  // Node-major: a node's costs to every landmark side by side.
+  std::vector<float> by_node(out.cost.size());
+  for (std::int32_t l = 0; l < out.count; ++l)
+    for (std::size_t v = 0; v < n; ++v)
+      by_node[v * static_cast<std::size_t>(out.count) + static_cast<std::size_t>(l)] =
+          out.cost[static_cast<std::size_t>(l) * n + v];
+  out.cost = std::move(by_node);
+  return out;
+}
+
+float RoadmapLandmarks::lower_bound(std::int32_t v, std::span<const float> goal_cost) const {
+  float best = 0;
+  const float* node = cost.data() + static_cast<std::size_t>(v) * static_cast<std::size_t>(count);
+  for (std::int32_t l = 0; l < count; ++l) {
+    const float a = node[l], b = goal_cost[static_cast<std::size_t>(l)];
+    if (a < INFINITY && b < INFINITY) best = std::max(best, std::fabs(a - b));
+  }
+  return best;
+}
+
 Planner Planner::build(const sim::World& world, const PlanOptions& options) {
   options.validate();
   return build(FreeSpace::build(world, options.free_space), options);
@@ -67,12 +149,18 @@ Planner Planner::build(FreeSpace space, const PlanOptions& options) {
       p.cumulative_cost_[k] = acc;
     }
   }
+  // Eight landmarks: the bound tightens little with more, each costs a
+  // search over the roadmap at build and a float per node.
+  p.landmarks_ = choose_landmarks(m, p.cumulative_cost_, 8);
   return p;
 }
 
 EdgePoint Planner::attach(glm::vec2 p) const {
   const float r = options_.radius;
-  for (std::int32_t limit : {options_.attach_candidates, roadmap_.edge_count()}) {
+  // The nearest few usually answer; the lists are prefixes of each other,
+  // so trying fewer first never changes the point chosen.
+  for (std::int32_t limit :
+       {std::min(4, options_.attach_candidates), options_.attach_candidates, roadmap_.edge_count()}) {
     for (const EdgePoint& e : roadmap_.nearest_points(p, limit))
       if (space_.segment_clear(p, e.point, r)) return e;
     if (limit >= roadmap_.edge_count()) break;
@@ -111,11 +199,6 @@ struct Attachment {
   float s_from_a = 0, g_from_a = 0, s_total = 0, g_total = 0, s_attach = 0, g_attach = 0;
 };
 
-// Cost of a whole roadmap edge (cumulative cost at its last point).
-float edge_total(std::span<const float> cumulative_cost, const RoadmapEdge& edge) {
-  return cumulative_cost[static_cast<std::size_t>(edge.point_begin + edge.point_count - 1)];
-}
-
 // The attachment of start s and goal g (both on an edge); s_from_a and
 // g_from_a are their costs from their edges' node a.
 Attachment attachment(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q, const EdgePoint& s,
@@ -137,8 +220,8 @@ Attachment attachment(const Roadmap& m, std::span<const float> cumulative_cost, 
 // A* from S (node n, the start) to G (node n + 1, the goal) over the roadmap
 // nodes. Returns the chain of nodes S..G, empty when G is not reached (or
 // start and goal lie in different components).
-std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumulative_cost, const PathQuery& q,
-                                 const Attachment& at) {
+std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumulative_cost,
+                                 const RoadmapLandmarks& landmarks, const PathQuery& q, const Attachment& at) {
   const std::int32_t n = m.node_count();
   const std::int32_t S = n, G = n + 1;
   const RoadmapEdge& se = at.se;
@@ -146,25 +229,39 @@ std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumula
   if (m.node_component[static_cast<std::size_t>(se.a)] != m.node_component[static_cast<std::size_t>(ge.a)]) return {};
   std::vector<float> cost(static_cast<std::size_t>(n + 2), INFINITY);
   std::vector<std::int32_t> parent(static_cast<std::size_t>(n + 2), -1);
+  // The goal's cost from each landmark: through either end of its edge.
+  std::vector<float> goal_cost(static_cast<std::size_t>(landmarks.count));
+  for (std::int32_t l = 0; l < landmarks.count; ++l) {
+    auto from = [&](std::int32_t node) {
+      return landmarks.cost[static_cast<std::size_t>(node) * static_cast<std::size_t>(landmarks.count) +
+                            static_cast<std::size_t>(l)];
+    };
+    goal_cost[static_cast<std::size_t>(l)] =
+        std::min(from(ge.a) + at.g_from_a, from(ge.b) + at.g_total - at.g_from_a) + at.g_attach;
+  }
   auto h = [&](std::int32_t v) {
-    return v == G ? 0.0f : sim::length_of((v == S ? q.start : m.nodes[static_cast<std::size_t>(v)]) - q.goal);
+    if (v == G) return 0.0f;
+    if (v == S) return sim::length_of(q.start - q.goal);
+    return std::max(sim::length_of(m.nodes[static_cast<std::size_t>(v)] - q.goal), landmarks.lower_bound(v, goal_cost));
   };
-  using Entry = std::pair<float, std::int32_t>;  // (f, node): ties broken by node index
+  // (f, node, cost when pushed): ties broken by node index; an entry whose
+  // cost is above the node's current one is stale.
+  using Entry = std::tuple<float, std::int32_t, float>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
   auto relax = [&](std::int32_t from, std::int32_t to, float c) {
     const float g2 = cost[static_cast<std::size_t>(from)] + c;
     if (g2 < cost[static_cast<std::size_t>(to)]) {
       cost[static_cast<std::size_t>(to)] = g2;
       parent[static_cast<std::size_t>(to)] = from;
-      open.push({g2 + h(to), to});
+      open.push({g2 + h(to), to, g2});
     }
   };
   cost[static_cast<std::size_t>(S)] = 0;
-  open.push({h(S), S});
+  open.push({h(S), S, 0.0f});
   while (!open.empty()) {
-    const auto [f, v] = open.top();
+    const auto [f, v, g] = open.top();
     open.pop();
-    if (f > cost[static_cast<std::size_t>(v)] + h(v) + 1e-6f * std::max(1.0f, f)) continue;  // stale
+    if (g > cost[static_cast<std::size_t>(v)]) continue;  // stale
     if (v == G) break;
     if (v == S) {
       relax(S, se.a, at.s_attach + at.s_from_a);
@@ -249,20 +346,20 @@ std::vector<glm::vec2> chain_polyline(const Roadmap& m, std::span<const float> c
 }  // namespace
 
 // Stages: start and goal checks; the straight line, or attachment, search
-// and chain polyline; then smoothing and the path's length and clearance.
+// and chain polyline; then smoothing and the path's length.
 PlannedPath Planner::plan(const PathQuery& q) const {
   PlannedPath out;
   const float r = options_.radius;
-  if (!space_.contains(q.start) || space_.boundary_distance(q.start) < r) {
+  if (space_.clearance(q.start) < r) {
     out.status = PlanStatus::StartBlocked;
     return out;
   }
-  if (!space_.contains(q.goal) || space_.boundary_distance(q.goal) < r) {
+  if (space_.clearance(q.goal) < r) {
     out.status = PlanStatus::GoalBlocked;
     return out;
   }
   std::vector<glm::vec2> raw;
-  if (space_.segment_clear(q.start, q.goal, r)) {
+  if (!q.straight_blocked && space_.segment_clear(q.start, q.goal, r, true)) {
     raw = {q.start, q.goal};
   } else {
     const EdgePoint s = attach(q.start), g = attach(q.goal);
@@ -271,7 +368,7 @@ PlannedPath Planner::plan(const PathQuery& q) const {
       return out;
     }
     const Attachment at = attachment(roadmap_, cumulative_cost_, q, s, g, cost_to_edge_start(s), cost_to_edge_start(g));
-    const std::vector<std::int32_t> chain = search(roadmap_, cumulative_cost_, q, at);
+    const std::vector<std::int32_t> chain = search(roadmap_, cumulative_cost_, landmarks_, q, at);
     if (chain.empty()) {
       out.status = PlanStatus::Unreachable;
       return out;
@@ -279,36 +376,51 @@ PlannedPath Planner::plan(const PathQuery& q) const {
     raw = chain_polyline(roadmap_, cumulative_cost_, q, at, chain);
   }
   out.status = PlanStatus::Found;
-  out.roadmap_points = raw;
   out.points = options_.smooth ? shortcut(raw, options_.kept_clearance()) : raw;
+  out.roadmap_points = std::move(raw);
   if (options_.smooth && options_.corner_radius > 0) out.points = round_corners(out.points, options_.corner_radius);
+
   out.length = polyline_length(out.points);
-  out.min_clearance = INFINITY;
-  for (std::size_t i = 1; i < out.points.size(); ++i)
-    out.min_clearance = std::min(out.min_clearance, space_.segment_clearance(out.points[i - 1], out.points[i]));
   return out;
 }
 
 std::vector<glm::vec2> Planner::shortcut(std::span<const glm::vec2> poly, float clearance) const {
   if (poly.size() <= 2) return {poly.begin(), poly.end()};
-  // Greedy sweep: from each kept point extend while the line of sight holds.
-  std::vector<glm::vec2> pass;
+  // Every point of the polyline is in free space (the start, the goal and
+  // the roadmap's points), so the line-of-sight tests skip containment.
+  auto visible = [&](std::size_t a, std::size_t b) { return space_.segment_clear(poly[a], poly[b], clearance, true); };
+  // Greedy sweep: from each kept point the farthest point found visible by
+  // steps that double while the line of sight holds, then halve between the
+  // last visible and the first hidden one (a route of a kilometre has
+  // thousands of roadmap points: a point-by-point sweep tests them all).
+  std::vector<std::size_t> pass = {0};
   std::size_t i = 0;
-  pass.push_back(poly[0]);
   while (i + 1 < poly.size()) {
-    std::size_t j = i + 1;
-    while (j + 1 < poly.size() && space_.segment_clear(poly[i], poly[j + 1], clearance)) ++j;
-    pass.push_back(poly[j]);
-    i = j;
+    std::size_t seen = i + 1, step = 1;
+    while (seen + step < poly.size() && visible(i, seen + step)) {
+      seen += step;
+      step *= 2;
+    }
+    std::size_t hidden = std::min(seen + step, poly.size());  // hidden, or past the end
+    while (hidden - seen > 1) {
+      const std::size_t mid = seen + (hidden - seen) / 2;
+      (visible(i, mid) ? seen : hidden) = mid;
+    }
+    pass.push_back(seen);
+    i = seen;
   }
-  if (pass.size() > 256) return pass;
+  std::vector<glm::vec2> out;
+  if (pass.size() > 256) {
+    for (std::size_t k : pass) out.push_back(poly[k]);
+    return out;
+  }
   // Farthest visible point from each kept point.
-  std::vector<glm::vec2> out = {pass[0]};
+  out.push_back(poly[0]);
   i = 0;
   while (i + 1 < pass.size()) {
     std::size_t j = pass.size() - 1;
-    while (j > i + 1 && !space_.segment_clear(pass[i], pass[j], clearance)) --j;
-    out.push_back(pass[j]);
+    while (j > i + 1 && !visible(pass[i], pass[j])) --j;
+    out.push_back(poly[pass[j]]);
     i = j;
   }
   return out;
@@ -341,7 +453,7 @@ std::vector<glm::vec2> Planner::round_corners(std::span<const glm::vec2> poly, f
         }
         bool clear = true;
         for (std::size_t k = 1; k < pts.size() && clear; ++k)
-          clear = space_.segment_clear(pts[k - 1], pts[k], options_.radius);
+          clear = space_.segment_clear(pts[k - 1], pts[k], options_.radius, true);  // from a free point
         if (clear) arc = std::move(pts);
       }
     }

@@ -43,6 +43,10 @@ struct PlanOptions {
 struct PathQuery {
   glm::vec2 start{0.0f};
   glm::vec2 goal{0.0f};
+  // The caller already found the straight line from start to goal blocked
+  // for this radius: plan() goes to the roadmap without testing it again
+  // (a long line's test costs as much as the search).
+  bool straight_blocked = false;
 };
 
 enum class PlanStatus : std::uint8_t { Found, StartBlocked, GoalBlocked, Unreachable };
@@ -53,8 +57,19 @@ struct PlannedPath {
   std::vector<glm::vec2> points;          // smoothed polyline from start to goal (empty unless Found)
   std::vector<glm::vec2> roadmap_points;  // the same before smoothing
   float length = 0.0f;                    // m, of `points`
-  float min_clearance = 0.0f;             // m: smallest distance from `points` to an obstacle
   bool found() const { return status == PlanStatus::Found; }
+};
+
+// Landmarks for the A* heuristic (ALT: A*, landmarks, triangle
+// inequality): the cheapest cost from a few far-apart roadmap nodes to every
+// node. For any node v and goal G, cost(v, G) >= |cost(L, G) - cost(L, v)|,
+// a far tighter bound than the straight line where the roadmap's costs run
+// above lengths (clearance weight, detours round obstacles).
+struct RoadmapLandmarks {
+  std::int32_t count = 0;
+  std::vector<float> cost;  // node-major: cost[v * count + l]; INFINITY where l cannot reach v
+  // The bound for node v given the goal's costs from every landmark.
+  float lower_bound(std::int32_t v, std::span<const float> goal_cost) const;
 };
 
 class Planner {
@@ -74,6 +89,7 @@ class Planner {
 
   // Shortcut pass on its own: drops points while the segment that replaces
   // them keeps `clearance` (first a greedy sweep, then farthest-visible).
+  // Every point of the polyline must lie in free space.
   std::vector<glm::vec2> shortcut(std::span<const glm::vec2> polyline, float clearance) const;
   // Replaces each corner by a circular arc of at most `radius` whose chords
   // keep the planner's radius (halving the arc's radius up to 4 times, else
@@ -89,7 +105,12 @@ class Planner {
   FreeSpace space_;
   Roadmap roadmap_;
   std::vector<float> cumulative_cost_;  // per roadmap point: cost from its edge's start
+  RoadmapLandmarks landmarks_;
 };
+
+// `count` landmarks of the roadmap whose point costs are `cumulative_cost`
+// (as the planner's), chosen far apart (farthest-point selection).
+RoadmapLandmarks choose_landmarks(const Roadmap& m, std::span<const float> cumulative_cost, std::int32_t count);
 
 // Length of a polyline.
 float polyline_length(std::span<const glm::vec2> points);

@@ -295,6 +295,98 @@ void link_nodes(Roadmap& map) {
   for (std::size_t k = 0; k < n; ++k) map.node_component[k] = uf.find(static_cast<std::int32_t>(k));
 }
 
+// One chain of the contraction: from a kept node along edge `first`
+// through nodes of degree two to the next kept node.
+struct Chain {
+  std::int32_t from = 0, to = 0;
+  std::vector<std::int32_t> point_ids;  // old point indices in walking order, junctions once
+};
+
+Chain walk_chain(const Roadmap& map, const std::vector<char>& kept, std::int32_t from, std::int32_t first,
+                 std::vector<char>& consumed) {
+  Chain c;
+  c.from = from;
+  std::int32_t node = from, e = first;
+  for (;;) {
+    consumed[static_cast<std::size_t>(e)] = 1;
+    const RoadmapEdge& edge = map.edges[static_cast<std::size_t>(e)];
+    const bool forward = edge.a == node;
+    for (std::int32_t i = c.point_ids.empty() ? 0 : 1; i < edge.point_count; ++i)
+      c.point_ids.push_back(edge.point_begin + (forward ? i : edge.point_count - 1 - i));
+    node = forward ? edge.b : edge.a;
+    if (kept[static_cast<std::size_t>(node)]) break;
+    // A node of degree two: leave by its other edge.
+    const std::int32_t k = map.adjacency_begin[static_cast<std::size_t>(node)];
+    e = map.adjacency[static_cast<std::size_t>(k)] == e ? map.adjacency[static_cast<std::size_t>(k) + 1]
+                                                        : map.adjacency[static_cast<std::size_t>(k)];
+  }
+  c.to = node;
+  return c;
+}
+
+// Joins the edges meeting at nodes of degree two into one edge each: the
+// medial axis of polygonal obstacles has a node wherever the nearest sites
+// change, most of them on the way between two junctions, and a search over
+// the junctions alone visits several times fewer nodes. A loop without a
+// junction (round an obstacle in a ring-shaped room) keeps one of its nodes.
+void contract_chains(Roadmap& map) {
+  const std::size_t n = map.nodes.size();
+  std::vector<char> kept(n, 1), consumed(map.edges.size(), 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    const std::int32_t b = map.adjacency_begin[v], count = map.adjacency_begin[v + 1] - b;
+    if (count != 2) continue;
+    const RoadmapEdge& e0 = map.edges[static_cast<std::size_t>(map.adjacency[static_cast<std::size_t>(b)])];
+    const RoadmapEdge& e1 = map.edges[static_cast<std::size_t>(map.adjacency[static_cast<std::size_t>(b) + 1])];
+    kept[v] = e0.a == e0.b || e1.a == e1.b ? 1 : 0;
+  }
+  std::vector<Chain> chains;
+  auto walk_from = [&](std::size_t v) {
+    for (std::int32_t k = map.adjacency_begin[v]; k < map.adjacency_begin[v + 1]; ++k) {
+      const std::int32_t e = map.adjacency[static_cast<std::size_t>(k)];
+      if (!consumed[static_cast<std::size_t>(e)])
+        chains.push_back(walk_chain(map, kept, static_cast<std::int32_t>(v), e, consumed));
+    }
+  };
+  for (std::size_t v = 0; v < n; ++v)
+    if (kept[v]) walk_from(v);
+  for (std::size_t e = 0; e < map.edges.size(); ++e)
+    if (!consumed[e]) {  // a loop of degree-two nodes only
+      const auto v = static_cast<std::size_t>(map.edges[e].a);
+      kept[v] = 1;
+      walk_from(v);
+    }
+  std::vector<std::int32_t> new_index(n, -1);
+  Roadmap out;
+  for (std::size_t v = 0; v < n; ++v)
+    if (kept[v]) {
+      new_index[v] = static_cast<std::int32_t>(out.nodes.size());
+      out.nodes.push_back(map.nodes[v]);
+      out.node_clearance.push_back(map.node_clearance[v]);
+    }
+  for (const Chain& c : chains) {
+    RoadmapEdge e;
+    e.a = new_index[static_cast<std::size_t>(c.from)];
+    e.b = new_index[static_cast<std::size_t>(c.to)];
+    e.point_begin = static_cast<std::int32_t>(out.points.size());
+    e.point_count = static_cast<std::int32_t>(c.point_ids.size());
+    e.min_clearance = INFINITY;
+    for (std::size_t k = 0; k < c.point_ids.size(); ++k) {
+      const auto id = static_cast<std::size_t>(c.point_ids[k]);
+      out.points.push_back(map.points[id]);
+      out.point_clearance.push_back(map.point_clearance[id]);
+      e.min_clearance = std::min(e.min_clearance, map.point_clearance[id]);
+      if (k > 0) e.length += sim::length_of(out.points.back() - out.points[out.points.size() - 2]);
+    }
+    out.edges.push_back(e);
+  }
+  map.nodes = std::move(out.nodes);
+  map.node_clearance = std::move(out.node_clearance);
+  map.edges = std::move(out.edges);
+  map.points = std::move(out.points);
+  map.point_clearance = std::move(out.point_clearance);
+  link_nodes(map);
+}
+
 }  // namespace
 
 void RoadmapOptions::validate() const {
@@ -328,31 +420,32 @@ Roadmap build_roadmap(const FreeSpace& space, const RoadmapOptions& options) {
     add_voronoi_edge(space, edge, segments, tol, step, keep, map, builder);
   }
   link_nodes(map);
+  contract_chains(map);
+  map.index_pieces();
   return map;
 }
 
-std::vector<EdgePoint> Roadmap::nearest_points(glm::vec2 p, std::int32_t limit) const {
-  std::vector<EdgePoint> best;
-  best.reserve(edges.size());
-  for (std::size_t e = 0; e < edges.size(); ++e) {
-    const RoadmapEdge& edge = edges[e];
-    EdgePoint ep;
-    ep.edge = static_cast<std::int32_t>(e);
-    for (std::int32_t i = 0; i + 1 < edge.point_count; ++i) {
-      const glm::vec2 a = points[static_cast<std::size_t>(edge.point_begin + i)],
-                      b = points[static_cast<std::size_t>(edge.point_begin + i + 1)];
-      float t = 0;
-      const glm::vec2 q = sim::closest_point_on_segment(p, a, b, &t);
-      const float d = sim::length_of(p - q);
-      if (d < ep.distance) {
-        ep.piece = i;
-        ep.t = t;
-        ep.point = q;
-        ep.distance = d;
-      }
-    }
-    if (ep.distance < INFINITY) best.push_back(ep);
+namespace {
+
+// The nearest point of piece k (points k, k + 1) to p, kept in `best` when
+// nearer than what it holds (the lower piece on a tie, as a scan in order).
+void offer_piece(const Roadmap& m, glm::vec2 p, std::int32_t k, EdgePoint& best) {
+  const RoadmapEdge& edge = m.edges[static_cast<std::size_t>(m.point_edge[static_cast<std::size_t>(k)])];
+  float t = 0;
+  const glm::vec2 q = sim::closest_point_on_segment(p, m.points[static_cast<std::size_t>(k)],
+                                                    m.points[static_cast<std::size_t>(k) + 1], &t);
+  const float d = sim::length_of(p - q);
+  const std::int32_t piece = k - edge.point_begin;
+  if (d < best.distance || (d == best.distance && piece < best.piece)) {
+    best.piece = piece;
+    best.t = t;
+    best.point = q;
+    best.distance = d;
   }
+}
+
+// The `limit` nearest of one point per edge, nearest first, ties by edge.
+std::vector<EdgePoint> nearest_first(std::vector<EdgePoint> best, std::int32_t limit) {
   auto closer = [](const EdgePoint& x, const EdgePoint& y) {
     return x.distance < y.distance || (x.distance == y.distance && x.edge < y.edge);
   };
@@ -360,6 +453,93 @@ std::vector<EdgePoint> Roadmap::nearest_points(glm::vec2 p, std::int32_t limit) 
   std::partial_sort(best.begin(), best.begin() + static_cast<std::ptrdiff_t>(k), best.end(), closer);
   best.resize(k);
   return best;
+}
+
+}  // namespace
+
+std::vector<EdgePoint> Roadmap::nearest_points_brute_force(glm::vec2 p, std::int32_t limit) const {
+  std::vector<EdgePoint> best;
+  best.reserve(edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    EdgePoint ep;
+    ep.edge = static_cast<std::int32_t>(e);
+    for (std::int32_t i = 0; i + 1 < edges[e].point_count; ++i) offer_piece(*this, p, edges[e].point_begin + i, ep);
+    if (ep.distance < INFINITY) best.push_back(ep);
+  }
+  return nearest_first(std::move(best), limit);
+}
+
+void Roadmap::index_pieces() {
+  point_edge.assign(points.size(), -1);
+  index_bounds = sim::Aabb{};
+  for (glm::vec2 q : points) index_bounds.add(q);
+  // Cells of a few pieces each where the roadmap is dense, never smaller
+  // than two of its longest regular pieces (a huge nearly empty world has
+  // few pieces, kilometres long: its cells grow with them).
+  const double area = std::max(1.0, static_cast<double>(index_bounds.size().x) * index_bounds.size().y);
+  index_cell = static_cast<float>(std::max(
+      2.0 * options.max_step, 2.0 * std::sqrt(area / static_cast<double>(std::max<std::size_t>(1, points.size())))));
+  std::vector<std::pair<std::uint64_t, std::int32_t>> pairs;
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    for (std::int32_t i = 0; i < edges[e].point_count; ++i) {
+      const std::int32_t k = edges[e].point_begin + i;
+      point_edge[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(e);
+      if (i + 1 == edges[e].point_count) continue;
+      // A piece longer than a cell is registered by parts, each in the cells
+      // of its own bounding box (a long diagonal stays a thin band).
+      const glm::vec2 a = points[static_cast<std::size_t>(k)], b = points[static_cast<std::size_t>(k) + 1];
+      const int parts = std::max(1, static_cast<int>(std::ceil(sim::length_of(b - a) / index_cell)));
+      for (int j = 0; j < parts; ++j) {
+        const glm::vec2 p0 = a + (b - a) * (static_cast<float>(j) / static_cast<float>(parts));
+        const glm::vec2 p1 = a + (b - a) * (static_cast<float>(j + 1) / static_cast<float>(parts));
+        for (std::int32_t y = sim::cell_coord(std::min(p0.y, p1.y), index_cell);
+             y <= sim::cell_coord(std::max(p0.y, p1.y), index_cell); ++y)
+          for (std::int32_t x = sim::cell_coord(std::min(p0.x, p1.x), index_cell);
+               x <= sim::cell_coord(std::max(p0.x, p1.x), index_cell); ++x)
+            pairs.emplace_back(sim::cell_key(x, y), k);
+      }
+    }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  piece_index = sim::StaticGrid(index_cell, std::move(pairs), Memory::Host);
+}
+
+// Rings of cells around p's cell: after ring k every piece within k cells of
+// p has been offered, so an edge whose best point lies nearer than k cell
+// sides is final; the search stops once `limit` edges are final or the rings
+// cover the whole roadmap.
+std::vector<EdgePoint> Roadmap::nearest_points(glm::vec2 p, std::int32_t limit) const {
+  if (limit <= 0 || edges.empty()) return {};
+  if (point_edge.size() != points.size()) return nearest_points_brute_force(p, limit);
+  const sim::GridView g = piece_index.host_view();
+  const std::int32_t cx = sim::cell_coord(p.x, index_cell), cy = sim::cell_coord(p.y, index_cell);
+  const std::int32_t far = std::max({std::abs(cx - sim::cell_coord(index_bounds.min.x, index_cell)),
+                                     std::abs(cx - sim::cell_coord(index_bounds.max.x, index_cell)),
+                                     std::abs(cy - sim::cell_coord(index_bounds.min.y, index_cell)),
+                                     std::abs(cy - sim::cell_coord(index_bounds.max.y, index_cell))});
+  std::vector<EdgePoint> best;  // one per edge met, in the order met (few: a linear search finds them)
+  for (std::int32_t k = 0; k <= far; ++k) {
+    // A ring wider than the roadmap has pieces: one scan is cheaper.
+    if (static_cast<std::size_t>(8 * k) > points.size()) return nearest_points_brute_force(p, limit);
+    for (std::int32_t dy = -k; dy <= k; ++dy)
+      for (std::int32_t dx = -k; dx <= k; dx += (std::abs(dy) == k ? 1 : 2 * k)) {
+        const Index s = g.find(cx + dx, cy + dy);
+        if (s < 0) continue;
+        for (std::int32_t i = 0; i < g.count[s]; ++i) {
+          const std::int32_t piece = g.items[g.start[s] + i];
+          const std::int32_t e = point_edge[static_cast<std::size_t>(piece)];
+          auto it = std::find_if(best.begin(), best.end(), [e](const EdgePoint& ep) { return ep.edge == e; });
+          if (it == best.end()) it = best.insert(best.end(), EdgePoint{e, 0, 0.0f, glm::vec2(0.0f), INFINITY});
+          offer_piece(*this, p, piece, *it);
+        }
+      }
+    if (best.size() > 256) return nearest_points_brute_force(p, limit);  // the linear search would dominate
+    const float reach = static_cast<float>(k) * index_cell;
+    std::int32_t final_count = 0;
+    for (const EdgePoint& ep : best) final_count += ep.distance < reach ? 1 : 0;
+    if (final_count >= limit) break;
+  }
+  return nearest_first(std::move(best), limit);
 }
 
 }  // namespace throng::path

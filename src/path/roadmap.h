@@ -70,9 +70,22 @@ struct Roadmap {
   glm::vec2 edge_point(std::int32_t edge, std::int32_t i) const {
     return points[static_cast<std::size_t>(edges[static_cast<std::size_t>(edge)].point_begin + i)];
   }
-  // The nearest points of the roadmap to p, one per edge, nearest first, at
-  // most `limit` of them.
+  // The nearest points of the roadmap to p, one per edge, nearest first (ties
+  // by edge index), at most `limit` of them. Searches the piece index ring
+  // by ring outwards from p, so the cost follows the roadmap near p, not the
+  // whole roadmap (see nearest_points_brute_force, the reference).
   std::vector<EdgePoint> nearest_points(glm::vec2 p, std::int32_t limit) const;
+  // The same by a scan of every edge.
+  std::vector<EdgePoint> nearest_points_brute_force(glm::vec2 p, std::int32_t limit) const;
+
+  // The piece index: every polyline piece (points k, k + 1 of one edge,
+  // named by k) registered in the cells its bounding box touches.
+  // build_roadmap makes it; index_pieces() remakes it after the points change.
+  void index_pieces();
+  float index_cell = 1.0f;               // m
+  sim::Aabb index_bounds;                // of every point
+  std::vector<std::int32_t> point_edge;  // the edge each point belongs to
+  sim::StaticGrid piece_index;
 };
 
 // Builds the roadmap of `space` for discs of options.radius.

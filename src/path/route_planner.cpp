@@ -131,6 +131,8 @@ std::vector<std::vector<glm::vec2>> RoadmapRoutePlanner::plan(const sim::World& 
   std::int64_t fallback = 0, planned = 0;
   if (straight_count < n) {
     const Planner& planner = planner_for(agent_radius);
+    if (n - straight_count >= 10000)  // seconds of work: say so before it starts
+      spdlog::info("route planner: routing {} agents over the roadmap", n - straight_count);
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<PlanStatus> status(starts.size(), PlanStatus::Found);
     host_parallel_for(
@@ -138,7 +140,7 @@ std::vector<std::vector<glm::vec2>> RoadmapRoutePlanner::plan(const sim::World& 
         [&](Index i) {
           const auto k = static_cast<std::size_t>(i);
           if (straight[k] != 0 || interrupt_flag().load(std::memory_order_relaxed)) return;
-          const PlannedPath p = planner.plan({starts[k], goals[k]});
+          const PlannedPath p = planner.plan({starts[k], goals[k], true});
           status[k] = p.status;
           if (p.found() && p.points.size() > 2) routes[k].assign(p.points.begin() + 1, p.points.end() - 1);
         },
