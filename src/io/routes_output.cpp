@@ -43,9 +43,16 @@ std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
     const auto g = static_cast<std::size_t>(group[i]);
     const std::string& name = sim.spec().groups[g].name;
     r.group = name.empty() ? fmt::format("groups[{}]", g) : name;
-    r.points.push_back(position[i]);
     const auto first = waypoints.begin() + begin[i];
-    r.points.insert(r.points.end(), first, first + goal[i] + 1);
+    // A goal reached over a navigation field: the way down the field.
+    const sim::FieldsView fields = sim.fields().host_view();
+    const std::int32_t field = goal[i] == 0 ? sim::field_of(fields, *first) : -1;
+    if (field >= 0) {
+      r.points = sim::trace_field(fields, field, position[i]);
+    } else {
+      r.points.push_back(position[i]);
+      r.points.insert(r.points.end(), first, first + goal[i] + 1);
+    }
     r.length_m = path_length(r.points);
     r.straight_m = static_cast<double>(sim::length_of(r.points.back() - r.points.front()));
     out.push_back(std::move(r));

@@ -23,6 +23,8 @@ struct AgentRoute {
 // The routes of up to `count` agents spread evenly over the crowd (agents
 // k * N / count), read from the simulation as spawned (before any step).
 // A loop's way back is left out; an agent yet to enter starts where it will.
+// An agent whose goal has a navigation field (`planning: field`) gets the
+// way down the field (sim::trace_field), its bends as waypoints.
 std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count);
 
 // A GeoJSON FeatureCollection (RFC 7946) of LineStrings, one per route, with

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <chrono>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "core/ground.h"
 #include "io/embedded.h"
 #include "io/yaml_reader.h"
+#include "path/distance_field.h"
 #include "path/route_planner.h"
 
 namespace throng::io {
@@ -600,9 +602,12 @@ class Reader : public YamlReader {
     if (root["scheduler"])
       s.scheduler = sim::parse_scheduler(
           word(root["scheduler"], "scheduler", {"double_buffer", "four_colour", "four_color"}), "scheduler");
-    if (root["planning"])
-      s.planning = word(root["planning"], "planning", {"roadmap", "none"}) == "none" ? sim::PlanningKind::None
-                                                                                     : sim::PlanningKind::Roadmap;
+    if (root["planning"]) {
+      const std::string p = word(root["planning"], "planning", {"roadmap", "field", "none"});
+      s.planning = p == "none"    ? sim::PlanningKind::None
+                   : p == "field" ? sim::PlanningKind::Field
+                                  : sim::PlanningKind::Roadmap;
+    }
     if (root["dt"]) s.dt = real_in(root["dt"], "dt", 1e-4, 10.0);
     if (root["duration"]) s.duration = real_in(root["duration"], "duration", 1e-3, 1e9);
     if (root["steps"]) s.steps = integer(root["steps"], "steps", 1, limits_.scenario.max_steps);
@@ -746,6 +751,22 @@ std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario
       sim::SimulationOptions straight = options;
       straight.planner = nullptr;
       return std::make_unique<sim::Simulation>(scenario.spec, straight);
+    }
+    // `planning: field`: a navigation field per target, no routes.
+    if (scenario.spec.planning == sim::PlanningKind::Field) {
+      const path::FastMarchingFieldBuilder builder;
+      sim::SimulationOptions fields = options;
+      fields.planner = nullptr;
+      fields.replanner = nullptr;
+      if (fields.fields == nullptr) fields.fields = &builder;
+      const auto t0 = std::chrono::steady_clock::now();
+      auto simulation = std::make_unique<sim::Simulation>(scenario.spec, fields);
+      const sim::NavigationFields& f = simulation->fields();
+      if (f.count() > 0)
+        spdlog::info("planning: {} navigation field(s) ({:.1f} MB, cell {:.2f} m); world, crowd and fields in {:.2f} s",
+                     f.count(), static_cast<double>(f.bytes()) / 1e6, static_cast<double>(f.grid(0).cell),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      return simulation;
     }
     if (options.planner != nullptr) return std::make_unique<sim::Simulation>(scenario.spec, options);
     const auto planner = std::make_shared<const path::RoadmapRoutePlanner>();

@@ -89,7 +89,14 @@ const char* to_string(ArrivalBehaviour a) {
 }
 
 const char* to_string(SchedulerKind s) { return s == SchedulerKind::FourColour ? "four_colour" : "double_buffer"; }
-const char* to_string(PlanningKind p) { return p == PlanningKind::None ? "none" : "roadmap"; }
+const char* to_string(PlanningKind p) {
+  switch (p) {
+    case PlanningKind::None: return "none";
+    case PlanningKind::Field: return "field";
+    case PlanningKind::Roadmap: break;
+  }
+  return "roadmap";
+}
 
 SchedulerKind parse_scheduler(const std::string& text, const std::string& field) {
   if (text == "double_buffer") return SchedulerKind::DoubleBuffer;

@@ -132,8 +132,10 @@ enum class ArrivalBehaviour : std::uint8_t { Stop, Despawn, Loop };
 enum class SchedulerKind : std::uint8_t { DoubleBuffer, FourColour };
 // How groups with a goal and no waypoints find their way: routes planned on
 // the roadmap of free space (path/route_planner.h; io::build_simulation
-// supplies the planner), or straight to the goal.
-enum class PlanningKind : std::uint8_t { Roadmap, None };
+// supplies the planner), navigation fields shared by every agent heading
+// to the same target (sim/navigation_field.h, path/distance_field.h), or
+// straight to the goal.
+enum class PlanningKind : std::uint8_t { Roadmap, None, Field };
 const char* to_string(ArrivalBehaviour a);
 const char* to_string(SchedulerKind s);
 const char* to_string(PlanningKind p);

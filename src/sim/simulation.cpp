@@ -30,6 +30,7 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   crowd_ = upload_crowd(host, current_memory());
   exits_ = ExitChooser(spec_, host);
   replan_ = Replanner(spec_, host, options.replanner);
+  if (options.fields != nullptr) build_fields(*options.fields);
   bins_ = AgentGrid(spec_.model.query_radius());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
   contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));
@@ -52,7 +53,34 @@ StepContext Simulation::context() const {
   ctx.time_after = static_cast<float>(static_cast<double>(steps_done_ + 1) * spec_.dt);
   // The move stage accepts at most 0.95 radius per step (simulation_kernels.cpp).
   ctx.bin_slack = scheduler_ == SchedulerKind::FourColour ? max_radius_ : 0.0f;
+  ctx.fields = fields_.view();
   return ctx;
+}
+
+// One field per target of the groups that walk to one point or choose among
+// exits (their own waypoints, or goals that differ per agent, keep the
+// straight legs), for the largest radius heading there, in group order.
+void Simulation::build_fields(const FieldBuilder& builder) {
+  std::vector<std::pair<glm::vec2, float>> targets;
+  auto add = [&](glm::vec2 t, float radius) {
+    for (auto& [target, r] : targets)
+      if (target == t) {
+        r = std::max(r, radius);
+        return;
+      }
+    targets.emplace_back(t, radius);
+  };
+  for (const GroupSpec& g : spec_.groups) {
+    if (!g.waypoints.empty() || g.count == 0) continue;
+    if (g.goal.kind == GoalSpec::Kind::Point) add(g.goal.value, g.radius);
+    if (g.goal.kind == GoalSpec::Kind::Exits)
+      for (const ExitSpec& e : g.goal.exits) add(e.point, g.radius);
+  }
+  for (const auto& [target, radius] : targets) {
+    FieldData f = builder.build(world_, target, radius);
+    if (f.grid.nx > 0) fields_.add(std::move(f));  // none: nothing in the way
+  }
+  fields_.upload();
 }
 
 void Simulation::step() {

@@ -44,6 +44,7 @@
 #include "sim/exit_choice.h"
 #include "sim/replanning.h"
 #include "sim/grid.h"
+#include "sim/navigation_field.h"
 #include "sim/scenario.h"
 #include "sim/world.h"
 
@@ -90,6 +91,7 @@ struct StepContext {
   // How far an agent may be from where it was binned when others read it:
   // 0 for the double buffer, one step's largest move for the four colours.
   float bin_slack = 0.0f;
+  FieldsView fields;  // navigation fields (none: every agent steers at its waypoint)
 };
 
 // Stages (each one or more parallel_for launches named "sim.<stage>...").
@@ -149,6 +151,10 @@ struct SimulationOptions {
   // Re-plans, during the run, the planned routes of agents pushed off them
   // (sim/replanning.h); null: routes stay as spawned.
   std::shared_ptr<const RoutePlanner> replanner;
+  // Navigation fields (sim/navigation_field.h) for the groups with a goal
+  // and no waypoints whose goal is one point or a set of exits: one field
+  // per target, for the largest radius heading there. Null: none.
+  const FieldBuilder* fields = nullptr;
   NeighbourSearch neighbours = NeighbourSearch::Bins;
 };
 
@@ -190,12 +196,14 @@ class Simulation {
   Index active_count() const;  // in the scene: entered and not despawned
   Index pending_count() const { return static_cast<Index>(pending_.size()); }  // yet to enter
   Index replanned_count() const { return replan_.replanned(); }                // routes planned anew so far
-  Index arrived_count() const;                                                 // reached their goal at least once
+  const NavigationFields& fields() const { return fields_; }
+  Index arrived_count() const;  // reached their goal at least once
   bool all_arrived() const { return arrived_count() == agent_count(); }
 
  private:
   void bin();
   bool admit_entries();
+  void build_fields(const FieldBuilder& builder);
   void sense_and_steer(const StepContext& ctx);
   void move(const StepContext& ctx);
   StepContext context() const;
@@ -216,6 +224,7 @@ class Simulation {
   std::vector<PendingEntry> pending_;  // by entry time, then agent
   ExitChooser exits_;                  // groups choosing the quickest exit
   Replanner replan_;                   // planned routes, planned again for agents pushed off them
+  NavigationFields fields_;
 };
 
 }  // namespace throng::sim

@@ -60,6 +60,17 @@ THRONG_HOST_DEVICE inline bool waypoint_in_view(const WorldView& w, glm::vec2 p,
   return !blocked;
 }
 
+// Where a navigation field leads agent i (its current waypoint is the
+// field's target): the point the field aims at (sim/navigation_field.h).
+// False when no field leads to its waypoint.
+THRONG_HOST_DEVICE inline bool field_target(const StepContext& ctx, const AgentArrays& a, Index i, glm::vec2& out) {
+  if (ctx.fields.grids.size() == 0) return false;
+  const std::int32_t f = field_of(ctx.fields, a.goal[i]);
+  if (f < 0) return false;
+  out = field_aim(ctx.fields, f, a.position[i]);
+  return true;
+}
+
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
   return (flags & kAgentActive) != 0 && (flags & (kAgentStopped | kAgentWaiting)) == 0;
 }
@@ -88,16 +99,22 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx,
                                                          const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
   const glm::vec2 p = a.position[i];
-  const bool final_goal = a.waypoint_cursor[i] == a.waypoint_goal[i];
-  const glm::vec2 aim = final_goal ? a.goal[i] : waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
+  glm::vec2 aim;
+  if (!field_target(ctx, a, i, aim)) {
+    const bool final_goal = a.waypoint_cursor[i] == a.waypoint_goal[i];
+    aim = final_goal ? a.goal[i] : waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
+  }
   const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f))};
   return collision_free_velocity(ctx.world, i, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
 }
 
-// Agent i as the force models see it: heading straight for its goal.
-THRONG_HOST_DEVICE inline ForceAgent force_agent(const AgentArrays& a, Index i) {
+// Agent i as the force models see it: heading straight for its goal, or
+// where its navigation field leads.
+THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const AgentArrays& a, Index i) {
   const glm::vec2 p = a.position[i];
-  return {p, a.velocity[i], a.radius[i], normalize_or(a.goal[i] - p, glm::vec2(0.0f)), a.pref_speed[i]};
+  glm::vec2 aim = a.goal[i];
+  field_target(ctx, a, i, aim);
+  return {p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f)), a.pref_speed[i]};
 }
 
 // Sense under the time-to-collision model: the agent's total acceleration.
@@ -105,7 +122,7 @@ template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i,
                                               const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-  return ttc_force(ctx.world, i, force_agent(a, i), n, ctx.model, for_each_candidate);
+  return ttc_force(ctx.world, i, force_agent(ctx, a, i), n, ctx.model, for_each_candidate);
 }
 
 // Sense under the social force model: the step's mean velocity.
@@ -113,7 +130,7 @@ template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a, Index i,
                                                        const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
-  return social_force_velocity(ctx.world, i, force_agent(a, i), ctx.dt, n, ctx.model, for_each_candidate);
+  return social_force_velocity(ctx.world, i, force_agent(ctx, a, i), ctx.dt, n, ctx.model, for_each_candidate);
 }
 
 // The sense of the models that sum over every candidate neighbour
@@ -164,9 +181,13 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
   } else if (m.kind == ModelKind::Ttc) {
     out_v = clamp_length(v + sensed * ctx.dt, m.max_speed);
   } else {
-    // Priority: path following only when no avoidance force was sensed.
+    // Priority: path following only when no avoidance force was sensed; a
+    // field's aim is followed from where the agent stands (its leg's lane
+    // may run through the walls the field leads round).
+    glm::vec2 start = a.path_start[i], goal = a.goal[i];
+    if (field_target(ctx, a, i, goal)) start = p;
     const glm::vec2 force =
-        force_applies(sensed) ? sensed : path_following_force(p, v, a.pref_speed[i], a.path_start[i], a.goal[i], m);
+        force_applies(sensed) ? sensed : path_following_force(p, v, a.pref_speed[i], start, goal, m);
     // Forces turn and brake; none makes an agent walk faster than it prefers.
     out_v = clamp_length(v + force * ctx.dt, a.pref_speed[i]);
   }

@@ -16,6 +16,42 @@
 namespace throng::io {
 namespace {
 
+// With `planning: field`: the way down the field round the corner of an
+// L-shaped corridor (RiMEA test 6's), from the agent to its goal, keeps the
+// agent's radius from the walls (the field's blocked nodes) and bends at
+// the corner only.
+TEST(RoutesOutput, FieldRoutesFollowTheFieldRoundTheCorner) {
+  const LoadedScenario corner = parse_scenario(
+      "name: corner\nplanning: field\nworld:\n  walkable: {polygon: [[0, 0], [12, 0], [12, 12], [10, 12], [10, 2], "
+      "[0, 2]]}\ngroups:\n  - count: 20\n    radius: 0.25\n    spawn: {rect: {min: [0.3, 0.3], max: [6, 1.7]}}\n"
+      "    goal: {point: [11, 11.4]}\n",
+      "corner.yaml");
+  const std::unique_ptr<sim::Simulation> sim = build_simulation(corner);
+  const std::vector<AgentRoute> routes = sample_routes(*sim, 5);
+  ASSERT_EQ(routes.size(), 5u);
+  for (const AgentRoute& r : routes) {
+    SCOPED_TRACE(r.agent);
+    ASSERT_GE(r.points.size(), 3u);  // at least one bend
+    EXPECT_EQ(r.points.front(), sim->positions()[static_cast<std::size_t>(r.agent)]);
+    EXPECT_EQ(r.points.back(), glm::vec2(11, 11.4f));
+    EXPECT_LT(r.points.size(), 12u);  // thinned to its bends
+    for (std::size_t s = 1; s < r.points.size(); ++s) {
+      const glm::vec2 a = r.points[s - 1], b = r.points[s];
+      const int n = static_cast<int>(std::ceil(sim::length_of(b - a) / 0.05f));
+      for (int i = 0; i <= n; ++i) {
+        const glm::vec2 p = a + (b - a) * (static_cast<float>(i) / static_cast<float>(std::max(n, 1)));
+        // Inside the L, at least 0.15 m off its walls (radius 0.25 m less the thinning's 10 cm).
+        const bool leg1 = p.x >= 0.15f && p.x <= 11.85f && p.y >= 0.15f && p.y <= 1.85f;
+        const bool leg2 = p.x >= 10.15f && p.x <= 11.85f && p.y >= 0.15f && p.y <= 12.0f;
+        ASSERT_TRUE(leg1 || leg2) << "segment " << s << " at " << p.x << ", " << p.y;
+      }
+    }
+    // The corner costs a little: no more than the legs' sum from start to (11, 1) to the goal.
+    const glm::vec2 start = r.points.front();
+    EXPECT_LE(r.length_m, sim::length_of(glm::vec2(11, 1) - start) + 10.4 + 1e-3);
+  }
+}
+
 TEST(RoutesOutput, SampledRoutesRunThroughFreeSpaceFromStartToGoal) {
   LoadedScenario maze = load_builtin_scenario("maze");
   sim::scale_agent_counts(maze.spec, 40);

@@ -135,11 +135,6 @@ TEST(Inflow, ListedTimes) {
     EXPECT_NEAR(r.entered[k], std::ceil(in.times[k] / s.dt - 1e-6) * s.dt, 1e-4) << "agent " << k;
 }
 
-template <class T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
-
 // The same crowded entrance on 1, 2 and 4 threads, under both schedulers:
 // the same positions and flags, bit for bit, half way through the entries.
 TEST(Inflow, TheSameBitsOnAnyThreadCount) {
@@ -157,8 +152,8 @@ TEST(Inflow, TheSameBitsOnAnyThreadCount) {
     EXPECT_GT(std::count(one.second.begin(), one.second.end(), kAgentActive), 5);
     for (int t : {2, 4}) {
       const auto other = snapshot(t);
-      EXPECT_TRUE(same_bits(one.first, other.first)) << t << " threads";
-      EXPECT_TRUE(same_bits(one.second, other.second)) << t << " threads";
+      EXPECT_TRUE(test::same_bits(one.first, other.first)) << t << " threads";
+      EXPECT_TRUE(test::same_bits(one.second, other.second)) << t << " threads";
     }
   }
 }

@@ -281,17 +281,12 @@ Snapshot run_steps(const ScenarioSpec& spec, SchedulerKind scheduler, int thread
   return {sim.positions(), sim.velocities(), sim.headings(), sim.arrival_times(), sim.flags()};
 }
 
-template <class T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
-
 void expect_identical(const Snapshot& a, const Snapshot& b, int threads) {
-  EXPECT_TRUE(same_bits(a.position, b.position)) << threads << " threads";
-  EXPECT_TRUE(same_bits(a.velocity, b.velocity)) << threads << " threads";
-  EXPECT_TRUE(same_bits(a.heading, b.heading)) << threads << " threads";
-  EXPECT_TRUE(same_bits(a.arrival, b.arrival)) << threads << " threads";
-  EXPECT_TRUE(same_bits(a.flags, b.flags)) << threads << " threads";
+  EXPECT_TRUE(test::same_bits(a.position, b.position)) << threads << " threads";
+  EXPECT_TRUE(test::same_bits(a.velocity, b.velocity)) << threads << " threads";
+  EXPECT_TRUE(test::same_bits(a.heading, b.heading)) << threads << " threads";
+  EXPECT_TRUE(test::same_bits(a.arrival, b.arrival)) << threads << " threads";
+  EXPECT_TRUE(test::same_bits(a.flags, b.flags)) << threads << " threads";
 }
 
 // Dense scenes with walls, doors, arrivals and despawns: the bottleneck room
@@ -308,7 +303,7 @@ TEST(Determinism, DoubleBufferIsBitwiseTheSameForOneTwoAndFourThreads) {
       const Snapshot one = run_steps(spec, SchedulerKind::DoubleBuffer, 1, steps);
       for (int t : {2, 4}) expect_identical(one, run_steps(spec, SchedulerKind::DoubleBuffer, t, steps), t);
       // And the crowd actually moved.
-      EXPECT_FALSE(same_bits(one.position, Simulation(spec).positions()));
+      EXPECT_FALSE(test::same_bits(one.position, Simulation(spec).positions()));
     }
 }
 
@@ -337,8 +332,8 @@ TEST(Bins, SimulationWithBinsMatchesTheAllPairsReference) {
     Simulation binned(spec), all_pairs(spec, reference);
     binned.run(400);
     all_pairs.run(400);
-    EXPECT_TRUE(same_bits(binned.positions(), all_pairs.positions()));
-    EXPECT_TRUE(same_bits(binned.velocities(), all_pairs.velocities()));
+    EXPECT_TRUE(test::same_bits(binned.positions(), all_pairs.positions()));
+    EXPECT_TRUE(test::same_bits(binned.velocities(), all_pairs.velocities()));
   }
 }
 
@@ -389,8 +384,8 @@ TEST(Simulation, DifferentSeedsGiveDifferentCrowdsSameSeedTheSame) {
   ScenarioSpec b = a;
   b.seed = a.seed + 1;
   Simulation sa(a), sa2(a), sb(b);
-  EXPECT_TRUE(same_bits(sa.positions(), sa2.positions()));
-  EXPECT_FALSE(same_bits(sa.positions(), sb.positions()));
+  EXPECT_TRUE(test::same_bits(sa.positions(), sa2.positions()));
+  EXPECT_FALSE(test::same_bits(sa.positions(), sb.positions()));
 }
 
 TEST(Simulation, StoppedAgentsStayAndDespawnedAgentsLeave) {
@@ -402,7 +397,7 @@ TEST(Simulation, StoppedAgentsStayAndDespawnedAgentsLeave) {
   EXPECT_EQ(sc.active_count(), 40);
   const auto before = sc.positions();
   sc.run(20);
-  EXPECT_TRUE(same_bits(before, sc.positions()));  // nobody pushes them: all stand apart
+  EXPECT_TRUE(test::same_bits(before, sc.positions()));  // nobody pushes them: all stand apart
   for (const glm::vec2 v : sc.velocities()) EXPECT_EQ(v, glm::vec2(0.0f));
 
   ScenarioSpec crossing = test::builtin("crossing", 40);

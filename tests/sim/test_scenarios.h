@@ -3,9 +3,11 @@
 // hand-made worlds for unit cases.
 #pragma once
 
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "io/scenario_yaml.h"
@@ -50,6 +52,12 @@ inline ScenarioSpec collision_free_spec(const char* name, float dt, float durati
   s.world.has_walkable = true;
   s.world.walkable.outer = std::move(outer);
   return s;
+}
+
+// The two vectors hold the same bits (determinism across thread counts).
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
 // True when THRONG_SANITIZED is set (CI's ASan+UBSan run, several times slower).

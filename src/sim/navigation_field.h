@@ -1,0 +1,125 @@
+// Navigation fields: for a target (a goal or an exit), the walking distance
+// to it from every node of a regular grid over the walkable area, computed
+// once and shared by every agent heading there. An agent whose current
+// waypoint is a field's target steers down the field's gradient instead of
+// at the point: round corners and through openings along the shortest way,
+// across the whole width of a passage, with no waypoints at inner corners
+// and no per-agent search. path/distance_field.h builds them (fast
+// marching); the kernels here only sample them, on the CPU or the GPU.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <glm/vec2.hpp>
+#include <vector>
+
+#include "core/buffer.h"
+#include "core/config.h"
+#include "core/span.h"
+#include "sim/geometry.h"
+
+namespace throng::sim {
+
+// One field's grid: node (i, j) lies at origin + (i, j) * cell; its
+// distance is distance[offset + j * nx + i] (m of walking, weighted near
+// walls; INFINITY where the agent's disc does not fit).
+struct FieldGrid {
+  glm::vec2 origin{0.0f};
+  float cell = 0.2f;  // m
+  std::int32_t nx = 0, ny = 0;
+  std::int64_t offset = 0;
+  glm::vec2 target{0.0f};
+};
+
+// A field as the builder returns it, before it joins the run's fields.
+struct FieldData {
+  FieldGrid grid;  // offset ignored
+  std::vector<float> distance;
+};
+
+// Every field of a run, as the kernels read them.
+struct FieldsView {
+  Span<const FieldGrid> grids;
+  Span<const float> distance;
+};
+
+// The field whose target is `target` (exactly: targets are copied, not
+// computed), or -1.
+THRONG_HOST_DEVICE inline std::int32_t field_of(const FieldsView& f, glm::vec2 target) {
+  for (Index k = 0; k < f.grids.size(); ++k)
+    if (f.grids[k].target.x == target.x && f.grids[k].target.y == target.y) return static_cast<std::int32_t>(k);
+  return -1;
+}
+
+// Where an agent at p heading for the field's target steers: the target
+// itself within two cells of it, else a point a metre down the field's
+// gradient (bilinear over the four nodes round p; a node where the disc
+// does not fit counts as a cell farther than the farthest of the others, so
+// the gradient also leads away from walls). Outside the grid, or with every
+// node blocked: the target. (Comparing the field's distance with the
+// straight one cannot tell "in plain view": a wall corner the way grazes
+// lengthens it by centimetres, the grid's own error by per cent.)
+THRONG_HOST_DEVICE inline glm::vec2 field_aim(const FieldsView& f, std::int32_t field, glm::vec2 p) {
+  const FieldGrid& g = f.grids[field];
+  if (length_of(g.target - p) <= 2.0f * g.cell) return g.target;
+  const float gx = (p.x - g.origin.x) / g.cell, gy = (p.y - g.origin.y) / g.cell;
+  const float fx = floorf(gx), fy = floorf(gy);
+  const auto i = static_cast<std::int32_t>(fx), j = static_cast<std::int32_t>(fy);
+  if (!(i >= 0 && j >= 0 && i + 1 < g.nx && j + 1 < g.ny)) return g.target;
+  const float* d = f.distance.data() + g.offset + static_cast<std::int64_t>(j) * g.nx + i;
+  float v[4] = {d[0], d[1], d[g.nx], d[g.nx + 1]};  // (i, j), (i+1, j), (i, j+1), (i+1, j+1)
+  float worst = -1.0f;
+  for (float x : v)
+    if (x < INFINITY) worst = fmaxf(worst, x);
+  if (worst < 0.0f) return g.target;
+  for (float& x : v)
+    if (!(x < INFINITY)) x = worst + g.cell;
+  const float tx = gx - fx, ty = gy - fy;
+  const glm::vec2 grad((v[1] - v[0]) * (1 - ty) + (v[3] - v[2]) * ty, (v[2] - v[0]) * (1 - tx) + (v[3] - v[1]) * tx);
+  const float len = length_of(grad);
+  if (!(len > 0.0f)) return g.target;
+  return p - grad * (1.0f / len);
+}
+
+// A run's fields in current_memory(): added on the host, then uploaded.
+class NavigationFields {
+ public:
+  // Adds a field; returns its index.
+  std::int32_t add(FieldData field);
+  // Copies every field added to current_memory() (once, after the last add).
+  void upload();
+  FieldsView view() const { return {grids_.span(), distance_.span()}; }
+  FieldsView host_view() const;  // the host copies (outputs and tests)
+  std::int32_t count() const { return static_cast<std::int32_t>(host_grids_.size()); }
+  const FieldGrid& grid(std::int32_t k) const { return host_grids_[static_cast<std::size_t>(k)]; }
+  // The distances of field k, host copy (outputs and tests).
+  std::span<const float> distances(std::int32_t k) const;
+  std::size_t bytes() const { return host_distance_.size() * sizeof(float); }
+
+ private:
+  std::vector<FieldGrid> host_grids_;
+  std::vector<float> host_distance_;
+  Buffer<FieldGrid> grids_;
+  Buffer<float> distance_;
+};
+
+// The way an agent starting at `start` walks down field k, as the kernels
+// steer it (field_aim), with no one in the way: points `step` m apart until
+// the target (at most `max_points`; INFINITY-free), then thinned to where
+// the way bends by more than `tolerance` m. Starts with `start`, ends with
+// the target when it was reached. For route outputs.
+std::vector<glm::vec2> trace_field(const FieldsView& f, std::int32_t k, glm::vec2 start, float step = 0.1f,
+                                   std::int32_t max_points = 200000, float tolerance = 0.1f);
+
+class World;
+
+// The hook a run's navigation plugs into (path/distance_field.h has the
+// fast-marching builder `throng run` uses for `planning: field`): the field
+// of walking distances to `target` for discs of `radius`.
+class FieldBuilder {
+ public:
+  virtual ~FieldBuilder() = default;
+  virtual FieldData build(const World& world, glm::vec2 target, float radius) const = 0;
+};
+
+}  // namespace throng::sim
