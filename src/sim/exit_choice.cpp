@@ -39,10 +39,25 @@ ExitChooser::ExitChooser(const ScenarioSpec& spec, const CrowdHost& host) {
   }
 }
 
+void ExitChooser::use_fields(FieldsView host_fields) {
+  fields_ = host_fields;
+  exit_field_.assign(exits_.size(), {});
+  for (std::size_t g = 0; g < exits_.size(); ++g)
+    for (const ExitSpec& x : exits_[g]) exit_field_[g].push_back(field_of(fields_, x.point));
+}
+
+float ExitChooser::exit_distance(std::int32_t group, std::uint32_t e, glm::vec2 p) const {
+  const auto g = static_cast<std::size_t>(group);
+  const glm::vec2 to = exits_[g][e].point;
+  const std::int32_t f = exit_field_.empty() ? -1 : exit_field_[g][e];
+  const float along = f < 0 ? INFINITY : field_distance(fields_, f, p);
+  return along < INFINITY ? along : length_of(to - p);
+}
+
 float ExitChooser::exit_cost(const Chooser& c, glm::vec2 p, std::uint32_t e, const std::vector<Index>& queued) const {
   const ExitSpec& x = exits_[static_cast<std::size_t>(c.group)][e];
   const auto q = static_cast<float>(queued[c.queue_base + e]);
-  const float cost = length_of(x.point - p) / c.speed + q / (kExitSpecificFlow * x.width);
+  const float cost = exit_distance(c.group, e, p) / c.speed + q / (kExitSpecificFlow * x.width);
   return e == c.exit ? cost * (1.0f - kExitSwitchGain) : cost;
 }
 
@@ -62,8 +77,8 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
     const auto i = static_cast<std::size_t>(c.agent);
     if ((flags[i] & kAgentArrived) != 0 || (flags[i] & kAgentActive) == 0) continue;
     float nearest = INFINITY;
-    for (const ExitSpec& x : exits_[static_cast<std::size_t>(c.group)])
-      nearest = std::min(nearest, length_of(x.point - position[i]));
+    for (std::uint32_t e = 0; e < exits_[static_cast<std::size_t>(c.group)].size(); ++e)
+      nearest = std::min(nearest, exit_distance(c.group, e, position[i]));
     order.push_back({nearest, k});
   }
   std::sort(order.begin(), order.end());

@@ -3,7 +3,8 @@
 //
 //   cost_e = d_e / v0 + q_e / (kExitSpecificFlow * width_e)
 //
-// d_e the straight distance to the exit, v0 the agent's preferred speed and
+// d_e the distance to the exit (along its navigation field where the run
+// has one, sim/navigation_field.h; else straight), v0 the agent's preferred speed and
 // q_e the agents heading for e that are nearer the exits than it (each takes
 // its turn at the door, which passes kExitSpecificFlow persons per metre of
 // width and second), and heads for the cheapest. Agents decide in order of
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "sim/crowd.h"
+#include "sim/navigation_field.h"
 #include "sim/scenario.h"
 
 namespace throng::sim {
@@ -36,6 +38,9 @@ class ExitChooser {
   ExitChooser() = default;
   ExitChooser(const ScenarioSpec& spec, const CrowdHost& host);
   bool empty() const { return agents_.empty(); }
+  // Walking distances from the run's navigation fields (host copies, kept
+  // by the caller for the chooser's life) for the exits that have one.
+  void use_fields(FieldsView host_fields);
   // At the first call and then every reconsider_s seconds of `time`: the
   // exits weighed again and the goals of agents that switch rewritten in
   // `crowd` (the flattened waypoint and, on its last leg, the current goal).
@@ -54,9 +59,12 @@ class ExitChooser {
     std::uint64_t tie = 0;        // seeded draw ranking the exits on a tie
   };
   float exit_cost(const Chooser& c, glm::vec2 p, std::uint32_t e, const std::vector<Index>& queued) const;
+  float exit_distance(std::int32_t group, std::uint32_t e, glm::vec2 p) const;
 
-  std::vector<std::vector<ExitSpec>> exits_;  // per group (empty where the group does not choose)
-  std::size_t exit_count_ = 0;                // exits of all choosing groups (the flat queue counts)
+  std::vector<std::vector<ExitSpec>> exits_;           // per group (empty where the group does not choose)
+  std::vector<std::vector<std::int32_t>> exit_field_;  // per group and exit: its navigation field, or -1
+  FieldsView fields_;
+  std::size_t exit_count_ = 0;  // exits of all choosing groups (the flat queue counts)
   std::vector<Chooser> agents_;
   double period_ = 2.0;  // s: the shortest reconsider_s of the choosing groups
   double next_ = 0.0;    // s: when to choose next

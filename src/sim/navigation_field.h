@@ -81,6 +81,28 @@ THRONG_HOST_DEVICE inline glm::vec2 field_aim(const FieldsView& f, std::int32_t 
   return p - grad * (1.0f / len);
 }
 
+// The field's distance at p (bilinear over the four nodes round it; blocked
+// nodes left out, weights renormalised), or INFINITY outside the grid or
+// where all four are blocked.
+THRONG_HOST_DEVICE inline float field_distance(const FieldsView& f, std::int32_t field, glm::vec2 p) {
+  const FieldGrid& g = f.grids[field];
+  const float gx = (p.x - g.origin.x) / g.cell, gy = (p.y - g.origin.y) / g.cell;
+  const float fx = floorf(gx), fy = floorf(gy);
+  const auto i = static_cast<std::int32_t>(fx), j = static_cast<std::int32_t>(fy);
+  if (!(i >= 0 && j >= 0 && i + 1 < g.nx && j + 1 < g.ny)) return INFINITY;
+  const float* d = f.distance.data() + g.offset + static_cast<std::int64_t>(j) * g.nx + i;
+  const float tx = gx - fx, ty = gy - fy;
+  const float v[4] = {d[0], d[1], d[g.nx], d[g.nx + 1]};
+  const float w[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
+  float sum = 0.0f, weight = 0.0f;
+  for (int k = 0; k < 4; ++k)
+    if (v[k] < INFINITY) {
+      sum += w[k] * v[k];
+      weight += w[k];
+    }
+  return weight > 0.0f ? sum / weight : INFINITY;
+}
+
 // A run's fields in current_memory(): added on the host, then uploaded.
 class NavigationFields {
  public:

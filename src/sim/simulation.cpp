@@ -31,6 +31,7 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   exits_ = ExitChooser(spec_, host);
   replan_ = Replanner(spec_, host, options.replanner);
   if (options.fields != nullptr) build_fields(*options.fields);
+  exits_.use_fields(fields_.host_view());
   bins_ = AgentGrid(spec_.model.query_radius());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
   contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "io/scenario_yaml.h"
 #include "sim/simulation.h"
 #include "tests/sim/test_scenarios.h"
 
@@ -47,6 +48,26 @@ TEST(ExitChoice, QuickestWeighsTheQueueAhead) {
   EXPECT_EQ(goals[1], glm::vec2(0, 0));
   EXPECT_EQ(goals[2], glm::vec2(0, 0));
   EXPECT_EQ(goals[0], glm::vec2(20, 0));
+}
+
+// With navigation fields the quickest exit is weighed by the walk, not the
+// straight line: in a 20 x 10 m hall an agent at (2, 1) has door A at
+// (10, 1), 8 m away in a straight line but behind a wall from (6, 0) to
+// (6, 9) (a walk of about 18 m round its north end), and door B at (2, 10),
+// 9 m away in plain view. Straight distances send it to A; the fields to B.
+TEST(ExitChoice, QuickestWeighsTheWalkWithNavigationFields) {
+  for (PlanningKind planning : {PlanningKind::None, PlanningKind::Field}) {
+    const std::string yaml = std::string("name: hall\nplanning: ") + to_string(planning) +
+                             "\nworld:\n  walkable: {rect: {min: [0, 0], max: [20, 10]}}\n"
+                             "  obstacles:\n    - rect: {min: [6, 0], max: [6.2, 9]}\n"
+                             "groups:\n  - count: 1\n    radius: 0.25\n    spawn: {points: [[2, 1]]}\n"
+                             "    goal: {exits: [{point: [10, 1], width: 1}, {point: [2, 9.8], width: 1}], choice: "
+                             "quickest}\n";
+    const auto sim = io::build_simulation(io::parse_scenario(yaml, "hall.yaml"));
+    sim->step();
+    const glm::vec2 goal = sim->crowd().goal.to_vector()[0];
+    EXPECT_EQ(goal, planning == PlanningKind::Field ? glm::vec2(2, 9.8f) : glm::vec2(10, 1)) << to_string(planning);
+  }
 }
 
 // A 36 m x 24 m room with 1.2 m doors in its south wall at (16, 0) and its
