@@ -19,31 +19,33 @@ void DistanceFieldOptions::validate() const {
     throw Error("cell must be in [0.01, 100] m", at_field("field.cell"));
   if (!(std::isfinite(wall_band) && wall_band > 0)) throw Error("wall band must be > 0 m", at_field("field.wall_band"));
   if (!(std::isfinite(wall_cost) && wall_cost >= 0)) throw Error("wall cost must be >= 0", at_field("field.wall_cost"));
-  if (max_nodes < 4) throw Error("max nodes must be >= 4", at_field("field.max_nodes"));
+  if (max_nodes < 16) throw Error("max nodes must be >= 16", at_field("field.max_nodes"));
 }
 
 namespace {
 
-// The grid over `bounds`: `cell` or coarser, at most max_nodes nodes.
+// The grid over `bounds` with a cell round it: `cell` or coarser, so that
+// it holds at most max_nodes nodes (the cell grows until it does: the grid
+// always covers the bounds).
 sim::FieldGrid grid_over(const sim::Aabb& bounds, glm::vec2 target, const DistanceFieldOptions& o) {
   const glm::vec2 size = bounds.size();
-  double cell = o.cell;
-  const double area = static_cast<double>(size.x + 2 * o.cell) * static_cast<double>(size.y + 2 * o.cell);
-  if (area / (cell * cell) > static_cast<double>(o.max_nodes))
-    cell = std::sqrt(area / static_cast<double>(o.max_nodes));
   sim::FieldGrid g;
+  g.target = target;
+  double cell = o.cell;
+  for (;;) {
+    const double nx = std::ceil(static_cast<double>(size.x) / cell + 2.0) + 1.0;
+    const double ny = std::ceil(static_cast<double>(size.y) / cell + 2.0) + 1.0;
+    if (nx * ny <= static_cast<double>(o.max_nodes)) {
+      g.nx = static_cast<std::int32_t>(nx);
+      g.ny = static_cast<std::int32_t>(ny);
+      break;
+    }
+    // Step to the cell the budget allows were the grid exactly size / cell,
+    // then on by 1 % while the margin's nodes still overflow it.
+    cell = std::max(cell * 1.01, std::sqrt(static_cast<double>(size.x) * size.y / static_cast<double>(o.max_nodes)));
+  }
   g.cell = static_cast<float>(cell);
   g.origin = bounds.min - glm::vec2(g.cell);
-  g.nx = static_cast<std::int32_t>(std::ceil((size.x + 2 * g.cell) / g.cell)) + 1;
-  g.ny = static_cast<std::int32_t>(std::ceil((size.y + 2 * g.cell) / g.cell)) + 1;
-  // Rounding up can add a row or column past the budget: shrink to it.
-  while (static_cast<std::int64_t>(g.nx) * g.ny > o.max_nodes && (g.nx > 2 || g.ny > 2)) {
-    if (g.nx >= g.ny)
-      --g.nx;
-    else
-      --g.ny;
-  }
-  g.target = target;
   return g;
 }
 
@@ -87,30 +89,45 @@ float upwind(const std::vector<float>& t, const std::vector<std::uint8_t>& settl
   return 0.5f * (a + b + std::sqrt(2.0f * hf * hf - (a - b) * (a - b)));
 }
 
-// Fast marching from the nodes round the target.
-void march(std::vector<float>& t, const std::vector<float>& slow, const sim::FieldGrid& g) {
-  const auto n = t.size();
-  std::vector<std::uint8_t> settled(n, 0);
-  using Entry = std::pair<float, std::int64_t>;  // (T, node): ties by node index, so the order is fixed
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
-  // Seeds: the four nodes round the target (whether the disc fits there or
-  // not), and every free node within kSeedCells of it, at their straight
-  // distance: the front is a circle there, which the upwind differences
-  // resolve badly at a handful of cells.
+// The nodes the march starts from, with their values: the four round the
+// target (whether the disc fits there or not: a goal against a wall is
+// reached by walking up to it), and every free node within kSeedCells of
+// it that sees it (no wall in between), at the straight distance times its
+// slowness: the front is a circle there, which the upwind differences
+// resolve badly at a handful of cells.
+std::vector<std::pair<float, std::int64_t>> seeds(const FreeSpace& space, const std::vector<float>& slow,
+                                                  const sim::FieldGrid& g) {
   constexpr std::int32_t kSeedCells = 3;
   const float fx = (g.target.x - g.origin.x) / g.cell, fy = (g.target.y - g.origin.y) / g.cell;
   const auto ti = std::clamp(static_cast<std::int32_t>(std::floor(fx)), 0, g.nx - 2);
   const auto tj = std::clamp(static_cast<std::int32_t>(std::floor(fy)), 0, g.ny - 2);
+  std::vector<std::pair<float, std::int64_t>> out;
   for (std::int32_t y = std::max(0, tj - kSeedCells); y <= std::min(g.ny - 1, tj + 1 + kSeedCells); ++y)
     for (std::int32_t x = std::max(0, ti - kSeedCells); x <= std::min(g.nx - 1, ti + 1 + kSeedCells); ++x) {
       const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(x);
       const bool corner = (x == ti || x == ti + 1) && (y == tj || y == tj + 1);
       const glm::vec2 p = g.origin + glm::vec2(static_cast<float>(x), static_cast<float>(y)) * g.cell;
       const float d = sim::length_of(p - g.target);
-      if (!corner && !(slow[k] < INFINITY && d <= static_cast<float>(kSeedCells) * g.cell)) continue;
-      t[k] = d * (slow[k] < INFINITY ? slow[k] : 1.0f);
-      open.push({t[k], static_cast<std::int64_t>(k)});
+      const bool free = slow[k] < INFINITY;
+      if (!corner &&
+          !(free && d <= static_cast<float>(kSeedCells) * g.cell && space.segment_clear(p, g.target, 0.0f, true)))
+        continue;
+      out.emplace_back(d * (free ? slow[k] : 1.0f), static_cast<std::int64_t>(k));
     }
+  return out;
+}
+
+// Fast marching from the seeds.
+void march(std::vector<float>& t, const std::vector<float>& slow, const sim::FieldGrid& g,
+           const std::vector<std::pair<float, std::int64_t>>& start) {
+  const auto n = t.size();
+  std::vector<std::uint8_t> settled(n, 0);
+  using Entry = std::pair<float, std::int64_t>;  // (T, node): ties by node index, so the order is fixed
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  for (const auto& [value, k] : start) {
+    t[static_cast<std::size_t>(k)] = value;
+    open.push({value, k});
+  }
   std::int64_t pops = 0;
   while (!open.empty()) {
     const auto [tk, k] = open.top();
@@ -146,7 +163,7 @@ sim::FieldData build_distance_field(const FreeSpace& space, glm::vec2 target, fl
   field.grid = grid_over(bounds, target, options);
   const std::vector<float> slow = node_slowness(space, field.grid, radius, options);
   field.distance.assign(slow.size(), INFINITY);
-  march(field.distance, slow, field.grid);
+  march(field.distance, slow, field.grid, seeds(space, slow, field.grid));
   return field;
 }
 
@@ -157,8 +174,17 @@ FastMarchingFieldBuilder::FastMarchingFieldBuilder(DistanceFieldOptions options)
 sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec2 target, float radius) const {
   if (!world_has_obstacles(world)) return {};  // straight lines are the shortest ways
   std::lock_guard lock(mutex_);
-  if (world_ != &world || !space_) {
-    space_ = std::make_unique<FreeSpace>(FreeSpace::build(world));
+  // Without a walkable region the free space is the obstacles' box grown by
+  // a margin: grown again to hold every target asked for.
+  const bool outside = space_ && !world.has_walkable() && !space_->bounds().contains(target);
+  if (world_ != &world || !space_ || outside) {
+    FreeSpaceOptions o;
+    if (!world.has_walkable()) {
+      o.extent = space_ && world_ == &world ? extent_ : sim::Aabb{};
+      o.extent.add(target);
+      extent_ = o.extent;
+    }
+    space_ = std::make_unique<FreeSpace>(FreeSpace::build(world, o));
     world_ = &world;
   }
   return build_distance_field(*space_, target, radius, options_);

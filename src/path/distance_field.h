@@ -50,6 +50,7 @@ class FastMarchingFieldBuilder final : public sim::FieldBuilder {
   mutable std::mutex mutex_;
   mutable const sim::World* world_ = nullptr;
   mutable std::unique_ptr<FreeSpace> space_;
+  mutable sim::Aabb extent_;  // targets so far (a world without a walkable region)
 };
 
 }  // namespace throng::path

@@ -350,11 +350,11 @@ std::vector<glm::vec2> chain_polyline(const Roadmap& m, std::span<const float> c
 PlannedPath Planner::plan(const PathQuery& q) const {
   PlannedPath out;
   const float r = options_.radius;
-  if (space_.clearance(q.start) < r) {
+  if (!space_.contains(q.start) || space_.boundary_distance(q.start) < r) {
     out.status = PlanStatus::StartBlocked;
     return out;
   }
-  if (space_.clearance(q.goal) < r) {
+  if (!space_.contains(q.goal) || space_.boundary_distance(q.goal) < r) {
     out.status = PlanStatus::GoalBlocked;
     return out;
   }

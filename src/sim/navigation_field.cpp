@@ -64,10 +64,11 @@ std::vector<glm::vec2> trace_field(const FieldsView& f, std::int32_t k, glm::vec
   const glm::vec2 target = f.grids[k].target;
   std::vector<glm::vec2> walk = {start};
   glm::vec2 p = start;
+  const float near = 2.0f * f.grids[k].cell + step;  // field_aim's own "at the target", and a step
   while (static_cast<std::int32_t>(walk.size()) < max_points) {
     const glm::vec2 aim = field_aim(f, k, p);
-    if (aim == target || length_of(target - p) <= step) {
-      walk.push_back(target);
+    if (aim == target) {
+      if (length_of(target - p) <= near) walk.push_back(target);  // else the field ends here
       break;
     }
     p += normalize_or(aim - p, glm::vec2(0.0f)) * step;

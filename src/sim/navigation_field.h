@@ -63,9 +63,12 @@ THRONG_HOST_DEVICE inline glm::vec2 field_aim(const FieldsView& f, std::int32_t 
   const FieldGrid& g = f.grids[field];
   if (length_of(g.target - p) <= 2.0f * g.cell) return g.target;
   const float gx = (p.x - g.origin.x) / g.cell, gy = (p.y - g.origin.y) / g.cell;
+  // Checked as floats first: NaN or a huge position has no integer cell.
+  if (!(gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(g.nx - 1) && gy < static_cast<float>(g.ny - 1)))
+    return g.target;
   const float fx = floorf(gx), fy = floorf(gy);
   const auto i = static_cast<std::int32_t>(fx), j = static_cast<std::int32_t>(fy);
-  if (!(i >= 0 && j >= 0 && i + 1 < g.nx && j + 1 < g.ny)) return g.target;
+  if (!(i + 1 < g.nx && j + 1 < g.ny)) return g.target;
   const float* d = f.distance.data() + g.offset + static_cast<std::int64_t>(j) * g.nx + i;
   float v[4] = {d[0], d[1], d[g.nx], d[g.nx + 1]};  // (i, j), (i+1, j), (i, j+1), (i+1, j+1)
   float worst = -1.0f;
@@ -87,9 +90,11 @@ THRONG_HOST_DEVICE inline glm::vec2 field_aim(const FieldsView& f, std::int32_t 
 THRONG_HOST_DEVICE inline float field_distance(const FieldsView& f, std::int32_t field, glm::vec2 p) {
   const FieldGrid& g = f.grids[field];
   const float gx = (p.x - g.origin.x) / g.cell, gy = (p.y - g.origin.y) / g.cell;
+  if (!(gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(g.nx - 1) && gy < static_cast<float>(g.ny - 1)))
+    return INFINITY;
   const float fx = floorf(gx), fy = floorf(gy);
   const auto i = static_cast<std::int32_t>(fx), j = static_cast<std::int32_t>(fy);
-  if (!(i >= 0 && j >= 0 && i + 1 < g.nx && j + 1 < g.ny)) return INFINITY;
+  if (!(i + 1 < g.nx && j + 1 < g.ny)) return INFINITY;
   const float* d = f.distance.data() + g.offset + static_cast<std::int64_t>(j) * g.nx + i;
   const float tx = gx - fx, ty = gy - fy;
   const float v[4] = {d[0], d[1], d[g.nx], d[g.nx + 1]};
@@ -127,9 +132,11 @@ class NavigationFields {
 
 // The way an agent starting at `start` walks down field k, as the kernels
 // steer it (field_aim), with no one in the way: points `step` m apart until
-// the target (at most `max_points`; INFINITY-free), then thinned to where
-// the way bends by more than `tolerance` m. Starts with `start`, ends with
-// the target when it was reached. For route outputs.
+// the target (at most `max_points`), then thinned to where the way bends by
+// more than `tolerance` m. Starts with `start`; ends with the target when
+// the walk reached it, else where the field ends (outside its grid, or
+// every node round the point blocked) or the points ran out. For route
+// outputs.
 std::vector<glm::vec2> trace_field(const FieldsView& f, std::int32_t k, glm::vec2 start, float step = 0.1f,
                                    std::int32_t max_points = 200000, float tolerance = 0.1f);
 

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "sim/world.h"
 #include "tests/path/path_worlds.h"
 
 namespace throng::path {
@@ -145,8 +146,43 @@ TEST(DistanceField, WallCostOnlyLengthens) {
     }
 }
 
+// A target against a thin wall: the seeds round it do not reach through
+// the wall, so the far side's distance is the way round its end.
+TEST(DistanceField, SeedsDoNotLeakThroughAThinWall) {
+  Shapes s;
+  s.walkable.outer = sim::rect_ring({0, 0}, {10, 4});
+  s.polygons.push_back({sim::rect_ring({5, 0}, {5.1f, 3}), {}});  // open above y = 3
+  const glm::vec2 target(4.8f, 1);
+  const sim::FieldData f = build_distance_field(space_of(s), target, 0.25f, plain());
+  const float gx = (5.4f - f.grid.origin.x) / f.grid.cell, gy = (1.0f - f.grid.origin.y) / f.grid.cell;
+  const float behind =
+      node_distance(f, static_cast<std::int32_t>(std::lround(gx)), static_cast<std::int32_t>(std::lround(gy)));
+  // Up to the wall's end, over it and down: about 2 x 2.25 m + 0.6 m.
+  EXPECT_GT(behind, 4.5f);
+  EXPECT_LT(behind, 7.0f);
+}
+
+// Without a walkable region the field covers the obstacles' surroundings
+// and the target, however far it lies.
+TEST(DistanceField, AWorldWithoutWallsCoversAFarTarget) {
+  sim::WorldSpec spec;
+  spec.polygons.push_back({sim::rect_ring({0, -5}, {1, 5}), {}});
+  const sim::World world = sim::World::build(spec, 4.0f);
+  const FastMarchingFieldBuilder builder;
+  for (const glm::vec2 target : {glm::vec2(4, 0), glm::vec2(60, 0)}) {
+    const sim::FieldData f = builder.build(world, target, 0.25f);
+    const sim::FieldGrid grids[] = {f.grid};
+    const sim::FieldsView view{{grids, 1}, {f.distance.data(), static_cast<Index>(f.distance.size())}};
+    EXPECT_LT(sim::field_distance(view, 0, target + glm::vec2(0.5f, 0.5f)), 1.0f) << target.x;
+    // Behind the obstacle: round it, more than the straight line.
+    const float d = sim::field_distance(view, 0, glm::vec2(-1, 0));
+    EXPECT_LT(d, INFINITY) << target.x;
+    EXPECT_GT(d, sim::length_of(target - glm::vec2(-1, 0))) << target.x;
+  }
+}
+
 // A square kilometre at 0.2 m would be 25 million nodes: the cell grows so
-// the field stays within its budget.
+// the field stays within its budget, and still covers the whole area.
 TEST(DistanceField, StaysWithinTheNodeBudget) {
   Shapes s;
   s.walkable.outer = sim::rect_ring({0, 0}, {1000, 1000});
@@ -156,6 +192,10 @@ TEST(DistanceField, StaysWithinTheNodeBudget) {
   const sim::FieldData f = build_distance_field(space_of(s), glm::vec2(10, 10), 0.25f, o);
   EXPECT_LE(static_cast<std::int64_t>(f.grid.nx) * f.grid.ny, o.max_nodes);
   EXPECT_GT(f.grid.cell, 3.0f);
+  EXPECT_LE(f.grid.origin.x, 0.0f);
+  EXPECT_LE(f.grid.origin.y, 0.0f);
+  EXPECT_GE(f.grid.origin.x + static_cast<float>(f.grid.nx - 1) * f.grid.cell, 1000.0f);
+  EXPECT_GE(f.grid.origin.y + static_cast<float>(f.grid.ny - 1) * f.grid.cell, 1000.0f);
   EXPECT_EQ(f.distance.size(), static_cast<std::size_t>(f.grid.nx) * static_cast<std::size_t>(f.grid.ny));
 }
 
