@@ -34,6 +34,7 @@ std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
   const std::vector<glm::vec2> position = c.position.to_vector(), waypoints = c.waypoints.to_vector();
   const std::vector<std::int32_t> begin = c.waypoint_begin.to_vector(), goal = c.waypoint_goal.to_vector(),
                                   group = c.group.to_vector();
+  const sim::FieldsView fields = sim.fields().host_view();
   std::vector<AgentRoute> out;
   const Index k_max = std::min(count, n);
   for (Index k = 0; k < k_max; ++k) {
@@ -45,7 +46,6 @@ std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
     r.group = name.empty() ? fmt::format("groups[{}]", g) : name;
     const auto first = waypoints.begin() + begin[i];
     // A goal reached over a navigation field: the way down the field.
-    const sim::FieldsView fields = sim.fields().host_view();
     const std::int32_t field = goal[i] == 0 ? sim::field_of(fields, *first) : -1;
     if (field >= 0) {
       r.points = sim::trace_field(fields, field, position[i]);

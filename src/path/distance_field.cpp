@@ -24,6 +24,14 @@ void DistanceFieldOptions::validate() const {
 
 namespace {
 
+// Index of node (x, y) in the field's distances, and where it lies.
+std::size_t node(const sim::FieldGrid& g, std::int32_t x, std::int32_t y) {
+  return static_cast<std::size_t>(y) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(x);
+}
+glm::vec2 node_point(const sim::FieldGrid& g, std::int32_t x, std::int32_t y) {
+  return g.origin + glm::vec2(static_cast<float>(x), static_cast<float>(y)) * g.cell;
+}
+
 // The grid over `bounds` with a cell round it: `cell` or coarser, so that
 // it holds at most max_nodes nodes (the cell grows until it does: the grid
 // always covers the bounds).
@@ -58,11 +66,10 @@ std::vector<float> node_slowness(const FreeSpace& space, const sim::FieldGrid& g
       "path.field_clearance", g.ny,
       [&](Index j) {
         for (std::int32_t i = 0; i < g.nx; ++i) {
-          const glm::vec2 p = g.origin + glm::vec2(static_cast<float>(i), static_cast<float>(j)) * g.cell;
+          const glm::vec2 p = node_point(g, i, j);
           const float c = space.clearance(p);
           const float near_wall = std::clamp(1.0f - (c - radius) / o.wall_band, 0.0f, 1.0f);
-          slow[static_cast<std::size_t>(j) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(i)] =
-              c < radius ? INFINITY : 1.0f + o.wall_cost * near_wall;
+          slow[node(g, i, j)] = c < radius ? INFINITY : 1.0f + o.wall_cost * near_wall;
         }
       },
       1);
@@ -80,7 +87,7 @@ float upwind(const std::vector<float>& t, const std::vector<std::uint8_t>& settl
              std::int32_t i, std::int32_t j, float hf) {
   auto at = [&](std::int32_t x, std::int32_t y) {
     if (x < 0 || y < 0 || x >= g.nx || y >= g.ny) return INFINITY;
-    const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(x);
+    const std::size_t k = node(g, x, y);
     return settled[k] != 0 ? t[k] : INFINITY;
   };
   const float a = std::min(at(i - 1, j), at(i + 1, j)), b = std::min(at(i, j - 1), at(i, j + 1));
@@ -104,9 +111,9 @@ std::vector<std::pair<float, std::int64_t>> seeds(const FreeSpace& space, const 
   std::vector<std::pair<float, std::int64_t>> out;
   for (std::int32_t y = std::max(0, tj - kSeedCells); y <= std::min(g.ny - 1, tj + 1 + kSeedCells); ++y)
     for (std::int32_t x = std::max(0, ti - kSeedCells); x <= std::min(g.nx - 1, ti + 1 + kSeedCells); ++x) {
-      const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(x);
+      const std::size_t k = node(g, x, y);
       const bool corner = (x == ti || x == ti + 1) && (y == tj || y == tj + 1);
-      const glm::vec2 p = g.origin + glm::vec2(static_cast<float>(x), static_cast<float>(y)) * g.cell;
+      const glm::vec2 p = node_point(g, x, y);
       const float d = sim::length_of(p - g.target);
       const bool free = slow[k] < INFINITY;
       if (!corner &&
@@ -140,7 +147,7 @@ void march(std::vector<float>& t, const std::vector<float>& slow, const sim::Fie
     for (int m = 0; m < 4; ++m) {
       const std::int32_t x = i + di[m], y = j + dj[m];
       if (x < 0 || y < 0 || x >= g.nx || y >= g.ny) continue;
-      const std::size_t q = static_cast<std::size_t>(y) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(x);
+      const std::size_t q = node(g, x, y);
       if (settled[q] != 0 || !(slow[q] < INFINITY)) continue;
       const float tq = upwind(t, settled, g, x, y, g.cell * slow[q]);
       if (tq < t[q]) {

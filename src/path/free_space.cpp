@@ -186,24 +186,26 @@ void FreeSpace::index() {
   // Each edge is registered in the cells of its pieces' bounding boxes
   // (pieces no longer than a cell side), so a long diagonal wall stays cheap.
   std::vector<std::pair<std::uint64_t, std::int32_t>> pairs;
-  for (std::size_t k = 0; k < boundary_.size(); ++k) {
-    const sim::Segment& s = boundary_[k];
-    const float len = sim::length_of(s.b - s.a);
-    const int pieces = std::max(1, static_cast<int>(std::ceil(len / cell_)));
-    for (int i = 0; i < pieces; ++i) {
-      const glm::vec2 p0 = s.a + (s.b - s.a) * (static_cast<float>(i) / pieces);
-      const glm::vec2 p1 = s.a + (s.b - s.a) * (static_cast<float>(i + 1) / pieces);
-      const std::int32_t x0 = sim::cell_coord(std::min(p0.x, p1.x), cell_),
-                         x1 = sim::cell_coord(std::max(p0.x, p1.x), cell_);
-      const std::int32_t y0 = sim::cell_coord(std::min(p0.y, p1.y), cell_),
-                         y1 = sim::cell_coord(std::max(p0.y, p1.y), cell_);
-      for (std::int32_t y = y0; y <= y1; ++y)
-        for (std::int32_t x = x0; x <= x1; ++x) pairs.emplace_back(sim::cell_key(x, y), static_cast<std::int32_t>(k));
-    }
-  }
+  for (std::size_t k = 0; k < boundary_.size(); ++k)
+    add_segment_cells(boundary_[k].a, boundary_[k].b, cell_, static_cast<std::int32_t>(k), pairs);
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   grid_ = sim::StaticGrid(cell_, std::move(pairs), Memory::Host);
+}
+
+void add_segment_cells(glm::vec2 a, glm::vec2 b, float cell, std::int32_t item,
+                       std::vector<std::pair<std::uint64_t, std::int32_t>>& pairs) {
+  const int parts = std::max(1, static_cast<int>(std::ceil(sim::length_of(b - a) / cell)));
+  for (int i = 0; i < parts; ++i) {
+    const glm::vec2 p0 = a + (b - a) * (static_cast<float>(i) / static_cast<float>(parts));
+    const glm::vec2 p1 = a + (b - a) * (static_cast<float>(i + 1) / static_cast<float>(parts));
+    const std::int32_t x0 = sim::cell_coord(std::min(p0.x, p1.x), cell),
+                       x1 = sim::cell_coord(std::max(p0.x, p1.x), cell);
+    const std::int32_t y0 = sim::cell_coord(std::min(p0.y, p1.y), cell),
+                       y1 = sim::cell_coord(std::max(p0.y, p1.y), cell);
+    for (std::int32_t y = y0; y <= y1; ++y)
+      for (std::int32_t x = x0; x <= x1; ++x) pairs.emplace_back(sim::cell_key(x, y), item);
+  }
 }
 
 std::int32_t FreeSpace::component_of(glm::vec2 p) const {

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <glm/vec2.hpp>
+#include <utility>
 #include <vector>
 
 #include "sim/geometry.h"
@@ -94,6 +95,12 @@ class FreeSpace {
   float cell_ = 1.0f;
   sim::StaticGrid grid_;  // boundary segments by cell (host memory)
 };
+
+// Registers segment [a, b] as `item` in the cells (side `cell`) of the
+// bounding boxes of its parts no longer than a cell, so a long diagonal
+// stays a thin band of cells: (cell key, item) pairs for a sim::StaticGrid.
+void add_segment_cells(glm::vec2 a, glm::vec2 b, float cell, std::int32_t item,
+                       std::vector<std::pair<std::uint64_t, std::int32_t>>& pairs);
 
 // Smallest distance between segments [a, b] and [c, d] (0 when they cross).
 float segment_segment_distance(glm::vec2 a, glm::vec2 b, glm::vec2 c, glm::vec2 d);

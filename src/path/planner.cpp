@@ -118,9 +118,8 @@ RoadmapLandmarks choose_landmarks(const Roadmap& m, std::span<const float> cumul
 
 float RoadmapLandmarks::lower_bound(std::int32_t v, std::span<const float> goal_cost) const {
   float best = 0;
-  const float* node = cost.data() + static_cast<std::size_t>(v) * static_cast<std::size_t>(count);
   for (std::int32_t l = 0; l < count; ++l) {
-    const float a = node[l], b = goal_cost[static_cast<std::size_t>(l)];
+    const float a = at(v, l), b = goal_cost[static_cast<std::size_t>(l)];
     if (a < INFINITY && b < INFINITY) best = std::max(best, std::fabs(a - b));
   }
   return best;
@@ -232,12 +231,8 @@ std::vector<std::int32_t> search(const Roadmap& m, std::span<const float> cumula
   // The goal's cost from each landmark: through either end of its edge.
   std::vector<float> goal_cost(static_cast<std::size_t>(landmarks.count));
   for (std::int32_t l = 0; l < landmarks.count; ++l) {
-    auto from = [&](std::int32_t node) {
-      return landmarks.cost[static_cast<std::size_t>(node) * static_cast<std::size_t>(landmarks.count) +
-                            static_cast<std::size_t>(l)];
-    };
     goal_cost[static_cast<std::size_t>(l)] =
-        std::min(from(ge.a) + at.g_from_a, from(ge.b) + at.g_total - at.g_from_a) + at.g_attach;
+        std::min(landmarks.at(ge.a, l) + at.g_from_a, landmarks.at(ge.b, l) + at.g_total - at.g_from_a) + at.g_attach;
   }
   auto h = [&](std::int32_t v) {
     if (v == G) return 0.0f;

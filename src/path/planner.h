@@ -68,6 +68,9 @@ struct PlannedPath {
 struct RoadmapLandmarks {
   std::int32_t count = 0;
   std::vector<float> cost;  // node-major: cost[v * count + l]; INFINITY where l cannot reach v
+  float at(std::int32_t v, std::int32_t l) const {
+    return cost[static_cast<std::size_t>(v) * static_cast<std::size_t>(count) + static_cast<std::size_t>(l)];
+  }
   // The bound for node v given the goal's costs from every landmark.
   float lower_bound(std::int32_t v, std::span<const float> goal_cost) const;
 };

@@ -484,20 +484,9 @@ void Roadmap::index_pieces() {
     for (std::int32_t i = 0; i < edges[e].point_count; ++i) {
       const std::int32_t k = edges[e].point_begin + i;
       point_edge[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(e);
-      if (i + 1 == edges[e].point_count) continue;
-      // A piece longer than a cell is registered by parts, each in the cells
-      // of its own bounding box (a long diagonal stays a thin band).
-      const glm::vec2 a = points[static_cast<std::size_t>(k)], b = points[static_cast<std::size_t>(k) + 1];
-      const int parts = std::max(1, static_cast<int>(std::ceil(sim::length_of(b - a) / index_cell)));
-      for (int j = 0; j < parts; ++j) {
-        const glm::vec2 p0 = a + (b - a) * (static_cast<float>(j) / static_cast<float>(parts));
-        const glm::vec2 p1 = a + (b - a) * (static_cast<float>(j + 1) / static_cast<float>(parts));
-        for (std::int32_t y = sim::cell_coord(std::min(p0.y, p1.y), index_cell);
-             y <= sim::cell_coord(std::max(p0.y, p1.y), index_cell); ++y)
-          for (std::int32_t x = sim::cell_coord(std::min(p0.x, p1.x), index_cell);
-               x <= sim::cell_coord(std::max(p0.x, p1.x), index_cell); ++x)
-            pairs.emplace_back(sim::cell_key(x, y), k);
-      }
+      if (i + 1 < edges[e].point_count)
+        add_segment_cells(points[static_cast<std::size_t>(k)], points[static_cast<std::size_t>(k) + 1], index_cell, k,
+                          pairs);
     }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());

@@ -51,6 +51,27 @@ THRONG_HOST_DEVICE inline std::int32_t field_of(const FieldsView& f, glm::vec2 t
   return -1;
 }
 
+// The four nodes of field `field` round p: their distances (i, j), (i+1,
+// j), (i, j+1), (i+1, j+1) and p's place in the cell (tx, ty in [0, 1)).
+// False outside the grid (checked as floats first: NaN or a huge position
+// has no integer cell).
+struct FieldCell {
+  float v[4];
+  float tx, ty;
+};
+THRONG_HOST_DEVICE inline bool field_cell(const FieldsView& f, std::int32_t field, glm::vec2 p, FieldCell& out) {
+  const FieldGrid& g = f.grids[field];
+  const float gx = (p.x - g.origin.x) / g.cell, gy = (p.y - g.origin.y) / g.cell;
+  if (!(gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(g.nx - 1) && gy < static_cast<float>(g.ny - 1)))
+    return false;
+  const float fx = floorf(gx), fy = floorf(gy);
+  const auto i = static_cast<std::int32_t>(fx), j = static_cast<std::int32_t>(fy);
+  if (!(i + 1 < g.nx && j + 1 < g.ny)) return false;
+  const float* d = f.distance.data() + g.offset + static_cast<std::int64_t>(j) * g.nx + i;
+  out = {{d[0], d[1], d[g.nx], d[g.nx + 1]}, gx - fx, gy - fy};
+  return true;
+}
+
 // Where an agent at p heading for the field's target steers: the target
 // itself within two cells of it, else a point a metre down the field's
 // gradient (bilinear over the four nodes round p; a node where the disc
@@ -61,23 +82,16 @@ THRONG_HOST_DEVICE inline std::int32_t field_of(const FieldsView& f, glm::vec2 t
 // lengthens it by centimetres, the grid's own error by per cent.)
 THRONG_HOST_DEVICE inline glm::vec2 field_aim(const FieldsView& f, std::int32_t field, glm::vec2 p) {
   const FieldGrid& g = f.grids[field];
-  if (length_of(g.target - p) <= 2.0f * g.cell) return g.target;
-  const float gx = (p.x - g.origin.x) / g.cell, gy = (p.y - g.origin.y) / g.cell;
-  // Checked as floats first: NaN or a huge position has no integer cell.
-  if (!(gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(g.nx - 1) && gy < static_cast<float>(g.ny - 1)))
-    return g.target;
-  const float fx = floorf(gx), fy = floorf(gy);
-  const auto i = static_cast<std::int32_t>(fx), j = static_cast<std::int32_t>(fy);
-  if (!(i + 1 < g.nx && j + 1 < g.ny)) return g.target;
-  const float* d = f.distance.data() + g.offset + static_cast<std::int64_t>(j) * g.nx + i;
-  float v[4] = {d[0], d[1], d[g.nx], d[g.nx + 1]};  // (i, j), (i+1, j), (i, j+1), (i+1, j+1)
+  FieldCell c;
+  if (length_of(g.target - p) <= 2.0f * g.cell || !field_cell(f, field, p, c)) return g.target;
   float worst = -1.0f;
-  for (float x : v)
+  for (float x : c.v)
     if (x < INFINITY) worst = fmaxf(worst, x);
   if (worst < 0.0f) return g.target;
-  for (float& x : v)
+  for (float& x : c.v)
     if (!(x < INFINITY)) x = worst + g.cell;
-  const float tx = gx - fx, ty = gy - fy;
+  const float* v = c.v;
+  const float tx = c.tx, ty = c.ty;
   const glm::vec2 grad((v[1] - v[0]) * (1 - ty) + (v[3] - v[2]) * ty, (v[2] - v[0]) * (1 - tx) + (v[3] - v[1]) * tx);
   const float len = length_of(grad);
   if (!(len > 0.0f)) return g.target;
@@ -88,21 +102,13 @@ THRONG_HOST_DEVICE inline glm::vec2 field_aim(const FieldsView& f, std::int32_t 
 // nodes left out, weights renormalised), or INFINITY outside the grid or
 // where all four are blocked.
 THRONG_HOST_DEVICE inline float field_distance(const FieldsView& f, std::int32_t field, glm::vec2 p) {
-  const FieldGrid& g = f.grids[field];
-  const float gx = (p.x - g.origin.x) / g.cell, gy = (p.y - g.origin.y) / g.cell;
-  if (!(gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(g.nx - 1) && gy < static_cast<float>(g.ny - 1)))
-    return INFINITY;
-  const float fx = floorf(gx), fy = floorf(gy);
-  const auto i = static_cast<std::int32_t>(fx), j = static_cast<std::int32_t>(fy);
-  if (!(i + 1 < g.nx && j + 1 < g.ny)) return INFINITY;
-  const float* d = f.distance.data() + g.offset + static_cast<std::int64_t>(j) * g.nx + i;
-  const float tx = gx - fx, ty = gy - fy;
-  const float v[4] = {d[0], d[1], d[g.nx], d[g.nx + 1]};
-  const float w[4] = {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty};
+  FieldCell c;
+  if (!field_cell(f, field, p, c)) return INFINITY;
+  const float w[4] = {(1 - c.tx) * (1 - c.ty), c.tx * (1 - c.ty), (1 - c.tx) * c.ty, c.tx * c.ty};
   float sum = 0.0f, weight = 0.0f;
   for (int k = 0; k < 4; ++k)
-    if (v[k] < INFINITY) {
-      sum += w[k] * v[k];
+    if (c.v[k] < INFINITY) {
+      sum += w[k] * c.v[k];
       weight += w[k];
     }
   return weight > 0.0f ? sum / weight : INFINITY;
