@@ -177,14 +177,16 @@ void register_anim(const Options& options) {
   // world transforms) with full skeletons, + joint LOD under a camera
   // orbiting the crowd, + the motion cache with every character's speed
   // changing every 5 s. The registry runs each on 1 thread (the paper's CPU
-  // baseline) and on all threads, and on the GPU when there is one.
+  // baseline) and on all threads, and on the GPU when there is one. Feet
+  // are locked (anim/foot_lock.h) but in the _unlocked row, its cost.
   struct Variant {
     const char* name;
-    bool lod, cache;
+    bool lod, cache, foot_lock;
   };
   for (const Variant variant :
-       {Variant{"anim/locomotion_full", false, false}, Variant{"anim/locomotion_lod", true, false},
-        Variant{"anim/locomotion_lod_cache", true, true}}) {
+       {Variant{"anim/locomotion_full", false, false, true},
+        Variant{"anim/locomotion_full_unlocked", false, false, false},
+        Variant{"anim/locomotion_lod", true, false, true}, Variant{"anim/locomotion_lod_cache", true, true, true}}) {
     add(options, {variant.name,
                   {1000, 5000, 10000, 50000, 100000, 1000000},
                   [variant](benchmark::State& state, Index n) {
@@ -195,6 +197,7 @@ void register_anim(const Options& options) {
                     CrowdAnimatorConfig config;
                     config.lod = variant.lod;
                     config.cache = variant.cache;
+                    config.foot_lock = variant.foot_lock;
                     CrowdAnimator animator(space, n, config);
                     std::mt19937 rng(4);
                     std::uniform_real_distribution<float> unit(0.0f, 1.0f);

@@ -7,6 +7,7 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/timing.h"
+#include "motion/leg_ik.h"
 
 namespace throng::anim {
 
@@ -271,6 +272,7 @@ void CrowdAnimatorConfig::validate() const {
   if (cache) cache_config.validate();
   if (cache_frames < 0 || cache_frames > 100000) throw Error("must be in [0, 100000]", at_field("motion_cache.frames"));
   if (max_new_cycles_per_frame < 0) throw Error("must be >= 0", at_field("motion_cache.max_new_cycles_per_frame"));
+  if (foot_lock) foot_lock_config.validate();
 }
 
 CrowdAnimator::CrowdAnimator(const motion::BlendSpace1D& space, Index count, CrowdAnimatorConfig config)
@@ -306,6 +308,7 @@ CrowdAnimator::CrowdAnimator(const motion::BlendSpace1D& space, Index count, Cro
     masks_ = Buffer<std::uint32_t>(n * lod_config_->mask_words, m);
   }
   if (config_.cache) cache_.emplace(space, config_.cache_config, config_.cache_frames);
+  if (config_.foot_lock) locks_ = Buffer<FootLock>::zeros(2 * n, m);
 }
 
 void CrowdAnimator::place(std::span<const glm::vec3> positions, std::span<const float> yaws,
@@ -322,6 +325,7 @@ void CrowdAnimator::place(std::span<const glm::vec3> positions, std::span<const 
   if (!scales.empty()) scale_.copy_from(scales);
   if (!phases.empty()) phase_.copy_from(phases);
   blend_speed_ = filled(count_, -1.0f);
+  if (config_.foot_lock) locks_ = Buffer<FootLock>::zeros(2 * count_, current_memory());
 }
 
 void CrowdAnimator::set_lod_thresholds(const std::vector<float>& thresholds) {
@@ -393,13 +397,31 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
                                joint_position_.span(), joint_rotation_.span());
   if (lod) pose.joint_masks = masks_.span();
   if (cache_) pose.cache = cache_->view();
-  if (config_.draw_matrices) {
+  // With foot locking the draw matrices follow the locked legs (below).
+  if (config_.draw_matrices && !config_.foot_lock) {
     pose.joint_shapes = shapes_.span();
     pose.draw_matrices = draw_.span();
   }
   pose.evaluated = evaluated_.span();
   pose.from_cache = from_cache_.span();
   pose.run();
+  if (config_.foot_lock) {
+    FootLockJob lock;
+    lock.blend = view;
+    lock.config = config_.foot_lock_config;
+    lock.dt = input.dt;
+    lock.positions = position_.span();
+    lock.scales = scale_.span();
+    lock.phases = phase_.span();
+    lock.blend_speeds = blend_speed_.span();
+    if (lod) lock.joint_masks = masks_.span();
+    lock.locks = locks_.span();
+    lock.joint_positions = joint_position_.span();
+    lock.joint_rotations = joint_rotation_.span();
+    lock.run();
+    if (config_.draw_matrices)
+      write_draw_matrices(joint_position_.span(), joint_rotation_.span(), scale_.span(), shapes_.span(), draw_.span());
+  }
 
   const PoseTotals totals = pose_totals(evaluated_.span(), from_cache_.span());
   stats_.joints_synthesised = totals.joints_synthesised;
@@ -409,8 +431,17 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
   if (!skating_.tracked().empty()) {
     if (skating_.frames() == 0) track_dt_ = input.dt;
     const std::size_t J = static_cast<std::size_t>(joints_);
+    const Index words = mask_word_count(joints_);
+    std::vector<std::uint32_t> mask(static_cast<std::size_t>(words));
     for (std::size_t t = 0; t < skating_.tracked().size(); ++t) {
-      const motion::FootSkatingRecorder::Frame f = skating_.append(t);
+      // Legs that joint LOD holds are not synthesised: not measured.
+      bool feet = true;
+      if (lod) {
+        masks_.read(skating_.tracked()[t] * words, std::span<std::uint32_t>(mask));
+        for (int leg = 0; leg < 2; ++leg)
+          feet = feet && (view.legs[leg].count < 4 || motion::plants_leg(view, leg, mask.data()));
+      }
+      const motion::FootSkatingRecorder::Frame f = skating_.append(t, feet);
       const Index first = skating_.tracked()[t] * joints_;
       joint_position_.read(first, f.positions.first(J));
       joint_rotation_.read(first, f.rotations.first(J));

@@ -28,6 +28,7 @@
 #include <span>
 #include <vector>
 
+#include "anim/foot_lock.h"
 #include "anim/lod.h"
 #include "anim/motion_cache.h"
 #include "core/buffer.h"
@@ -155,6 +156,17 @@ THRONG_HOST_DEVICE inline glm::mat4x3 draw_matrix(const glm::vec3& p, const glm:
   return out;
 }
 
+// One character's J draw matrices from its world joints.
+THRONG_HOST_DEVICE inline void character_draw_matrices(std::int32_t J, const glm::vec3* p, const glm::quat* q, float s,
+                                                       const glm::mat4x3* shapes, glm::mat4x3* out) {
+  for (std::int32_t j = 0; j < J; ++j) out[j] = draw_matrix(p[j], q[j], s, shapes[j]);
+}
+
+// Every character's draw matrices ([c * J + j]) from world joints, scales
+// (empty = 1) and the J joint shapes: parallel_for "anim.draw_matrices".
+void write_draw_matrices(Span<const glm::vec3> joint_positions, Span<const glm::quat> joint_rotations,
+                         Span<const float> scales, Span<const glm::mat4x3> shapes, Span<glm::mat4x3> out);
+
 // The motion cache with a device mirror: MotionCache (motion_cache.h) keeps
 // keys, FIFO order, byte capacity and counters; the table keeps each held
 // cycle in a slot of one device buffer, and a slot per key, for PoseJob.
@@ -215,6 +227,9 @@ struct CrowdAnimatorConfig {
   std::int32_t cache_frames = 0;  // per cached cycle; 0 = default_cache_frames
   std::int32_t max_new_cycles_per_frame = 16;
   bool draw_matrices = false;  // also write J = F * O (48 bytes per joint)
+  // Planted feet stay where they landed (anim/foot_lock.h), after the pose.
+  bool foot_lock = true;
+  FootLockConfig foot_lock_config;
   void validate() const;
 };
 
@@ -234,7 +249,7 @@ struct FrameStats {
 };
 
 // Everything one crowd needs, per frame: LocomoteJob, LodJob, the cache
-// update, PoseJob. Buffers live in current_memory().
+// update, PoseJob, FootLockJob. Buffers live in current_memory().
 class CrowdAnimator {
  public:
   CrowdAnimator(const motion::BlendSpace1D& space, Index count, CrowdAnimatorConfig config = {});
@@ -259,6 +274,7 @@ class CrowdAnimator {
   const FrameStats& last_frame() const { return stats_; }
 
   // State and outputs (current_memory()).
+  Span<const FootLock> foot_locks() const { return locks_.span(); }  // [c * 2 + leg]; empty without foot_lock
   Span<const glm::vec3> positions() const { return position_.span(); }
   Span<const float> yaws() const { return yaw_.span(); }
   Span<const float> phases() const { return phase_.span(); }
@@ -300,6 +316,7 @@ class CrowdAnimator {
   Buffer<std::uint8_t> from_cache_;
   Buffer<std::uint8_t> levels_;
   Buffer<std::uint32_t> masks_;
+  Buffer<FootLock> locks_;  // characters * 2, with config.foot_lock
   std::optional<BodyParts> parts_;
   std::optional<LodConfig> lod_config_;
   std::optional<LodTables> lod_tables_;

@@ -203,10 +203,16 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
     if (l.contains("cache")) std::printf("; cache hits %.1f%%", 100.0 * l["cache"]["hit_rate"].get<double>());
     const auto& skate = l["foot_skating_cm"];
     if (skate["contacts"].get<int>() > 0)
-      std::printf("\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts\n", skate["mean"].get<double>(),
-                  skate["p95"].get<double>(), skate["contacts"].get<int>());
+      std::printf(
+          "\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts of %d agents (of %d sampled; legs that joint "
+          "LOD holds are not measured)\n",
+          skate["mean"].get<double>(), skate["p95"].get<double>(), skate["contacts"].get<int>(),
+          skate["agents_measured"].get<int>(), skate["agents"].get<int>());
     else
-      std::printf("\n  foot skating: no contacts measured\n");
+      std::printf(
+          "\n  foot skating: no contacts measured (%d agents sampled; legs that joint LOD holds are not "
+          "measured)\n",
+          skate["agents"].get<int>());
   }
   if (stats.contains("soak")) {
     const auto& s = stats["soak"];

@@ -78,6 +78,8 @@ class SimulationLocomotion {
   LocomotionTally tally_;                       // over the frames
   std::int32_t skating_frames_ = 0;             // frames in the current foot-tracking window
   ThinnedSample slides_cm_{kMaxSkatingSlides};  // contacts of the windows closed so far
+  std::vector<Index> skated_;                   // agents with a contact measured, windows closed so far
+  void add_skating(const motion::FootSkatingReport& r);
 };
 
 // `throng run`'s locomotion stage ("anim.locomotion"). Frames: one per

@@ -78,6 +78,9 @@ struct ClipInfo {
   float turn = 0.0f;                     // rad per cycle
   float period = 1.0f;                   // s per cycle
   float ankle_ground[2] = {0.0f, 0.0f};  // lowest ankle heights (m)
+  // Per leg, the phases of its touchdown and lift-off (the clip's foot
+  // events); -1 where the clip has none (idle: both feet stay down).
+  float contact[2][2] = {{-1.0f, -1.0f}, {-1.0f, -1.0f}};
 };
 
 // What per-character code reads, by pointer (host or device memory).

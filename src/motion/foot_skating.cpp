@@ -95,12 +95,15 @@ void FootSkatingRecorder::track(std::vector<Index> characters, Index character_c
   // run recording window after window allocates only for the first.
   positions_.resize(tracked_.size());
   rotations_.resize(tracked_.size());
+  synthesised_.resize(tracked_.size());
   for (auto& p : positions_) p.clear();
   for (auto& r : rotations_) r.clear();
+  for (auto& f : synthesised_) f.clear();
 }
 
-FootSkatingRecorder::Frame FootSkatingRecorder::append(std::size_t t) {
+FootSkatingRecorder::Frame FootSkatingRecorder::append(std::size_t t, bool feet_synthesised) {
   const auto J = static_cast<std::size_t>(joints_);
+  synthesised_[t].push_back(feet_synthesised ? 1 : 0);
   std::vector<glm::vec3>& p = positions_[t];
   std::vector<glm::quat>& r = rotations_[t];
   p.resize(p.size() + J);
@@ -108,20 +111,45 @@ FootSkatingRecorder::Frame FootSkatingRecorder::append(std::size_t t) {
   return {std::span<glm::vec3>(p).last(J), std::span<glm::quat>(r).last(J)};
 }
 
+namespace {
+constexpr double kMinRunSeconds = 1.5;  // about a gait cycle and a half
+}  // namespace
+
 FootSkatingReport FootSkatingRecorder::measure(const Skeleton& skeleton, double frame_time,
                                                const ContactOptions& options) const {
   std::vector<double> slides;
+  std::vector<Index> characters;
   if (frames_ < 3 || !(frame_time > 0.0)) return summarise_foot_skating(slides);
+  const auto J = static_cast<std::size_t>(joints_);
   for (std::size_t t = 0; t < tracked_.size(); ++t) {
-    ModelSpaceClip posed;
-    posed.joint_count = joints_;
-    posed.frame_count = frames_;
-    posed.positions = positions_[t];
-    posed.rotations = rotations_[t];
-    const FootSkatingReport r = measure_foot_skating(skeleton, posed, frame_time, options);
-    slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
+    const std::vector<std::uint8_t>& feet = synthesised_[t];
+    const std::size_t before = slides.size();
+    // Each run of frames with synthesised feet, measured on its own. A run
+    // that joint LOD cut short must last kMinRunSeconds: the ground its
+    // contacts are measured from is a low percentile of its own foot heights.
+    const auto shortest = static_cast<std::size_t>(std::max(3.0, std::ceil(kMinRunSeconds / frame_time)));
+    for (std::size_t begin = 0; begin < feet.size();) {
+      std::size_t end = begin;
+      while (end < feet.size() && feet[end] != 0) ++end;
+      const bool whole = begin == 0 && end == feet.size();
+      if (end - begin >= (whole ? std::size_t{3} : shortest)) {
+        ModelSpaceClip posed;
+        posed.joint_count = joints_;
+        posed.frame_count = static_cast<std::int32_t>(end - begin);
+        posed.positions.assign(positions_[t].begin() + static_cast<std::ptrdiff_t>(begin * J),
+                               positions_[t].begin() + static_cast<std::ptrdiff_t>(end * J));
+        posed.rotations.assign(rotations_[t].begin() + static_cast<std::ptrdiff_t>(begin * J),
+                               rotations_[t].begin() + static_cast<std::ptrdiff_t>(end * J));
+        const FootSkatingReport r = measure_foot_skating(skeleton, posed, frame_time, options);
+        slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
+      }
+      begin = end + 1;
+    }
+    if (slides.size() > before) characters.push_back(tracked_[t]);
   }
-  return summarise_foot_skating(std::move(slides));
+  FootSkatingReport r = summarise_foot_skating(std::move(slides));
+  r.characters = std::move(characters);
+  return r;
 }
 
 }  // namespace throng::motion

@@ -28,6 +28,7 @@ namespace throng::motion {
 // JSON writes them as null.
 struct FootSkatingReport {
   std::int32_t contacts = 0;
+  std::vector<Index> characters;  // recorders: the tracked characters with a contact measured
   double mean_cm = std::numeric_limits<double>::quiet_NaN();
   double p95_cm = std::numeric_limits<double>::quiet_NaN();  // nearest-rank 95th percentile over contacts
   double max_cm = std::numeric_limits<double>::quiet_NaN();
@@ -59,6 +60,10 @@ FootSkatingReport summarise_foot_skating(std::vector<double> slides_cm);
 //   recorder.track({3, 17}, crowd_size, joints);
 //   each frame: for t: copy character tracked()[t]'s joints into append(t); then end_frame();
 //   recorder.measure(skeleton, frame_time)
+// A frame appended with feet_synthesised = false (joint LOD held the legs
+// instead of synthesising them) is not measured: each character's frames
+// are measured in runs of frames whose feet were synthesised; a run that
+// LOD cut short counts if it lasts 1.5 s (the ground is not known otherwise).
 class FootSkatingRecorder {
  public:
   struct Frame {
@@ -70,7 +75,7 @@ class FootSkatingRecorder {
   void track(std::vector<Index> characters, Index character_count, std::int32_t joint_count);
   const std::vector<Index>& tracked() const { return tracked_; }
   // Room for tracked()[t]'s joints of the frame being recorded.
-  Frame append(std::size_t t);
+  Frame append(std::size_t t, bool feet_synthesised = true);
   void end_frame() { ++frames_; }
   std::int32_t frames() const { return frames_; }
   // Fewer than 3 frames or frame_time not positive: no contacts.
@@ -82,6 +87,7 @@ class FootSkatingRecorder {
   std::int32_t frames_ = 0;
   std::vector<std::vector<glm::vec3>> positions_;
   std::vector<std::vector<glm::quat>> rotations_;
+  std::vector<std::vector<std::uint8_t>> synthesised_;  // per tracked character, per frame
 };
 
 }  // namespace throng::motion

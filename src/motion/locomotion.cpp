@@ -629,6 +629,10 @@ BlendSpace1D::BlendSpace1D(Skeleton skeleton, std::vector<LocomotionClip> clips,
     info.period = static_cast<float>(c.period_s);
     info.ankle_ground[0] = c.ankle_ground[0];
     info.ankle_ground[1] = c.ankle_ground[1];
+    info.contact[0][0] = c.event(FootEvent::LeftDown);
+    info.contact[0][1] = c.event(FootEvent::LeftUp);
+    info.contact[1][0] = c.event(FootEvent::RightDown);
+    info.contact[1][1] = c.event(FootEvent::RightUp);
     clip_infos_.push_back(info);
     std::copy(c.cycle.rotations.begin(), c.cycle.rotations.end(),
               stacked.rotations.begin() + static_cast<std::ptrdiff_t>(row) * J);

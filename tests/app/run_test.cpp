@@ -232,8 +232,10 @@ TEST_F(RunCommand, TheDefaultDemoRunsTheCircleToTheEnd) {
 
 // The locomotion stage: every agent animated from its simulated velocity and
 // heading; stats.json's "locomotion" section holds the stage's timings, the
-// joint-LOD histogram, the cache counters and foot skating, which stays
-// under 2 cm per contact on the circle; the same on 1 and 2 threads.
+// joint-LOD histogram, the cache counters and foot skating, measured only
+// where the feet are synthesised: none under the overview camera's joint
+// LOD, every sampled agent with --no-lod, the feet locked (well under 1 cm
+// per contact on the circle); the same on 1 and 2 threads.
 TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) {
   const std::string agents = sanitized() ? "120" : "400";
   const auto run_with = [&](const std::string& threads) {
@@ -241,7 +243,8 @@ TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) 
     const Outcome o = run({"--threads", threads, "run", "circle", "--agents", agents, "--seconds", "12",
                            "--no-trajectories", "--out", out.string()});
     EXPECT_EQ(o.code, 0) << o.out;
-    EXPECT_NE(o.out.find("foot skating: mean"), std::string::npos) << o.out;
+    // Seen by the overview camera, characters are too small for joint LOD to synthesise their legs.
+    EXPECT_NE(o.out.find("foot skating: no contacts measured (64 agents sampled"), std::string::npos) << o.out;
     return nlohmann::json::parse(slurp(out / "stats.json"));
   };
   const nlohmann::json one = run_with("1");
@@ -259,9 +262,9 @@ TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) 
   for (const char* key : {"hits", "misses", "evictions", "bytes"}) EXPECT_TRUE(l["cache"].contains(key)) << key;
   EXPECT_GT(l["cache"]["hits"].get<long>() + l["cache"]["misses"].get<long>(), 0);
   const auto& skate = l["foot_skating_cm"];
-  EXPECT_GT(skate["contacts"].get<int>(), 50);
-  EXPECT_LT(skate["mean"].get<double>(), 2.0) << skate.dump();
-  EXPECT_GE(skate["p95"].get<double>(), skate["mean"].get<double>());
+  EXPECT_EQ(skate["contacts"].get<int>(), 0) << skate.dump();
+  EXPECT_EQ(skate["agents_measured"].get<int>(), 0) << skate.dump();
+  EXPECT_TRUE(skate["mean"].is_null()) << skate.dump();
   EXPECT_TRUE(one["timings"]["stages"].contains("anim.locomotion"));
 
   // Every joint synthesised (no LOD): the feet that skate are all measured.
@@ -270,8 +273,12 @@ TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) 
   ASSERT_EQ(full.code, 0) << full.out;
   const nlohmann::json all = nlohmann::json::parse(slurp(dir_ / "full" / "stats.json"))["locomotion"];
   EXPECT_EQ(all["joints_synthesised_per_character"].get<double>(), all["joints"].get<double>());
-  EXPECT_GT(all["foot_skating_cm"]["contacts"].get<int>(), skate["contacts"].get<int>());
-  EXPECT_LT(all["foot_skating_cm"]["mean"].get<double>(), 2.0) << all["foot_skating_cm"].dump();
+  const auto& feet = all["foot_skating_cm"];
+  EXPECT_GT(feet["contacts"].get<int>(), 50) << feet.dump();
+  EXPECT_EQ(feet["agents_measured"].get<int>(), 64) << feet.dump();
+  EXPECT_LT(feet["mean"].get<double>(), 0.5) << feet.dump();
+  EXPECT_LT(feet["p95"].get<double>(), 1.5) << feet.dump();
+  EXPECT_NE(full.out.find("foot skating: mean"), std::string::npos) << full.out;
 
   const nlohmann::json two = run_with("2");
   for (const char* key : {"lod", "cache", "foot_skating_cm", "joints_synthesised_per_character"})

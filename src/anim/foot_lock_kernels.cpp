@@ -1,0 +1,158 @@
+// Foot locking kernel: compiled by nvcc in CUDA builds, by g++ otherwise.
+#include <glm/geometric.hpp>
+
+#include "anim/foot_lock.h"
+#include "anim/lod.h"
+#include "core/parallel.h"
+#include "motion/leg_ik.h"
+
+namespace throng::anim {
+
+namespace {
+
+THRONG_HOST_DEVICE inline bool in_subtree(const std::int32_t* parents, std::int32_t j, std::int32_t top) {
+  for (std::int32_t p = j; p >= 0; p = parents[p])
+    if (p == top) return true;
+  return false;
+}
+
+THRONG_HOST_DEVICE inline glm::vec2 ground_xz(const glm::vec3& p) { return {p.x, p.z}; }
+
+// Moves one leg's ankle by `shift` (world): two-bone IK turns thigh and
+// knee (motion::two_bone_ik), the foot keeps its world rotation, and every
+// joint of the leg's subtree follows the bone it hangs from.
+THRONG_HOST_DEVICE inline void reach_with_leg(const motion::BlendSpaceView& v, int leg, float scale,
+                                              const glm::vec3& shift, glm::vec3* p, glm::quat* r) {
+  const motion::LegChain& chain = v.legs[leg];
+  const std::int32_t n = chain.count;
+  const std::int32_t thigh = chain.joints[n - 3], knee = chain.joints[n - 2], ankle = chain.joints[n - 1];
+  const glm::vec3 hip = p[thigh], knee_was = p[knee], ankle_was = p[ankle];
+  const glm::quat thigh_was = r[thigh], knee_rot_was = r[knee];
+  glm::quat rt = thigh_was, rk = knee_rot_was;
+  const glm::vec3 hinge(chain.hinge[0], chain.hinge[1], chain.hinge[2]);
+  if (!motion::two_bone_ik(hip, scale * v.offsets[knee], scale * v.offsets[ankle], hinge, ankle_was + shift, rt, rk))
+    return;
+  const glm::vec3 knee_now = hip + rt * (scale * v.offsets[knee]);
+  const glm::vec3 ankle_now = knee_now + rk * (scale * v.offsets[ankle]);
+  const glm::quat turn_thigh = rt * glm::inverse(thigh_was), turn_knee = rk * glm::inverse(knee_rot_was);
+  for (std::int32_t j = thigh + 1; j < v.joint_count; ++j) {
+    if (v.joint_group[j] != 1 + leg) continue;
+    if (in_subtree(v.parents, j, ankle)) {
+      p[j] += ankle_now - ankle_was;
+    } else if (in_subtree(v.parents, j, knee)) {
+      p[j] = knee_now + turn_knee * (p[j] - knee_was);
+      r[j] = turn_knee * r[j];
+    } else {
+      p[j] = hip + turn_thigh * (p[j] - hip);
+      r[j] = turn_thigh * r[j];
+    }
+  }
+  r[thigh] = rt;
+}
+
+// A step of the foot's own: in its first kStepShift the correction shrinks
+// smoothly to none, the foot going over to where the pose puts it; then it
+// comes down vertically, held there (the pose's foot turns on with the
+// body while it descends).
+inline constexpr float kStepShift = 0.5f;
+THRONG_HOST_DEVICE inline float step_remaining(float progress) {
+  const float u = glm::clamp(progress / kStepShift, 0.0f, 1.0f);
+  return 1.0f - u * u * (3.0f - 2.0f * u);
+}
+
+// One frame of such a step, given how far the pose's ankle moved since the
+// last frame; returns how high the foot is lifted (m, scale 1).
+THRONG_HOST_DEVICE inline float take_step(const FootLockConfig& config, float dt, const glm::vec2& moved,
+                                          FootLock& lock, glm::vec2& correction) {
+  const float was = 1.0f - lock.step_left / config.step_s;
+  lock.step_left = glm::max(lock.step_left - dt, 0.0f);
+  const float progress = 1.0f - lock.step_left / config.step_s;
+  if (was < kStepShift) {
+    const float before = step_remaining(was);
+    correction *= before > 0.0f ? step_remaining(progress) / before : 0.0f;
+  } else {
+    correction -= moved;
+  }
+  return config.step_height_m * glm::sin(3.14159265f * progress);
+}
+
+// The correction carried on to this frame while the foot is not stepping;
+// heel_down: the pinned point is the ankle, else the ball of the foot.
+THRONG_HOST_DEVICE inline glm::vec2 carried_correction(const FootLockJob& job, float scale, bool down, bool heel_down,
+                                                       const glm::vec3& ankle, const glm::vec3& ball,
+                                                       const FootLock& lock) {
+  glm::vec2 correction = lock.correction;
+  if (down && lock.down) {
+    correction -= heel_down ? ground_xz(ankle) - lock.ankle : ground_xz(ball) - lock.ball;
+  } else if (!down) {
+    correction *= glm::exp(-job.dt / job.config.release_s);
+  }
+  const float most = job.config.max_correction_m * scale;
+  const float length = glm::length(correction);
+  return length > most ? correction * (most / length) : correction;
+}
+
+// One leg: the correction carried on (FootLock), then the leg moved by it.
+THRONG_HOST_DEVICE inline void lock_leg(const FootLockJob& job, Index c, int leg, const motion::BlendPoint& point,
+                                        float scale, glm::vec3* p, glm::quat* r) {
+  const motion::BlendSpaceView& v = job.blend;
+  FootLock& lock = job.locks[2 * c + leg];
+  const std::uint32_t* mask =
+      job.joint_masks.empty() ? nullptr : job.joint_masks.data() + c * mask_word_count(v.joint_count);
+  if (!motion::plants_leg(v, leg, mask)) {
+    lock = FootLock{};
+    return;
+  }
+  const motion::LegChain& chain = v.legs[leg];
+  const std::int32_t ankle = chain.joints[chain.count - 1];
+  const glm::vec3 a = p[ankle];
+  const glm::vec3 ball =
+      chain.has_ball ? a + r[ankle] * (scale * glm::vec3(chain.ball[0], chain.ball[1], chain.ball[2])) : a;
+  const motion::ClipPhases phases = motion::warp_phase(v.sync[point.segment].group[1 + leg], point.w, job.phases[c]);
+  bool down = foot_down_in_blend(v, point, phases, leg);
+  glm::vec2 correction = lock.seen ? lock.correction : glm::vec2(0.0f);
+  float lift = 0.0f;
+  if (!lock.seen) {
+    lock.step_left = 0.0f;
+  } else if (lock.step_left > 0.0f) {
+    if (job.dt > 0.0f) lift = take_step(job.config, job.dt, ground_xz(a) - lock.ankle, lock, correction);
+    down = down && lock.step_left <= 0.0f;  // planted from the frame the step lands
+  } else if (job.dt > 0.0f) {
+    lock.correction = correction;
+    // The pinned point: the ankle while the heel is down (its height over
+    // its lowest in the blend, m at scale 1), then the ball of the foot.
+    const float ground =
+        motion::mix_weight(v.clips[point.a].ankle_ground[leg], v.clips[point.b].ankle_ground[leg], point.w);
+    const bool heel_down = (a.y - job.positions[c].y) / scale - ground < motion::kHeelLift;
+    correction = carried_correction(job, scale, down, heel_down, a, ball, lock);
+    const FootLock& other = job.locks[2 * c + 1 - leg];
+    if (down && lock.down && other.step_left <= 0.0f && glm::length(correction) > job.config.step_threshold_m * scale)
+      lock.step_left = job.config.step_s;
+  }
+  lock.correction = correction;
+  lock.ankle = ground_xz(a);
+  lock.ball = ground_xz(ball);
+  lock.seen = 1;
+  lock.down = down ? 1 : 0;
+  if (glm::dot(correction, correction) > 1e-12f || lift > 0.0f)
+    reach_with_leg(v, leg, scale, {correction.x, scale * lift, correction.y}, p, r);
+}
+
+}  // namespace
+
+void FootLockJob::run() const {
+  validate();
+  parallel_for(
+      "anim.foot_lock", character_count(),
+      THRONG_JOB_LAMBDA(Index c) {
+        const motion::BlendSpaceView& v = blend;
+        const float scale = scales.empty() ? 1.0f : scales[c];
+        const motion::BlendPoint point = motion::blend_point(v, motion::blend_coordinate(v, blend_speeds[c]));
+        glm::vec3* p = joint_positions.data() + c * v.joint_count;
+        glm::quat* r = joint_rotations.data() + c * v.joint_count;
+        for (int leg = 0; leg < 2; ++leg) lock_leg(*this, c, leg, point, scale, p, r);
+      },
+      64);
+}
+
+}  // namespace throng::anim

@@ -1,0 +1,301 @@
+// Foot locking (anim/foot_lock.h) on characters driven as the simulation
+// drives them: turning where they stand, stepping sideways, stopping and
+// starting. The reference is the foot skating metric (motion/foot_skating.h)
+// of the same motion without locking, and the skeleton's bone lengths.
+#include "anim/foot_lock.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <cstdlib>
+#include <cstdio>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "anim/crowd_animator.h"
+#include "core/error.h"
+#include "core/exec.h"
+#include "tests/anim/crowd_fixture.h"
+
+namespace throng::anim {
+namespace {
+
+using testing::kPi;
+const motion::BlendSpace1D& space() { return testing::default_space(); }
+
+constexpr float kFrame = 1.0f / 30.0f;
+
+// Where the simulation puts one agent at time t (map: x, y; heading CCW from +x).
+struct MapState {
+  glm::vec2 position{0.0f};
+  glm::vec2 velocity{0.0f};
+  float heading = 0.0f;
+};
+using Motion = std::function<MapState(float t)>;
+
+struct Drive {
+  motion::FootSkatingReport skating;
+  float largest_correction = 0.0f;  // m, over frames and legs
+  // The same metric blind to speed, with a strict height (a foot within
+  // about 1 cm of the ground is in contact, however fast it moves): the
+  // metric's contacts are slow by definition, so it cannot see a foot that
+  // slides faster than 0.42 m/s. Counts a heel's last glide before it lands.
+  motion::FootSkatingReport skating_low;
+};
+
+// One character driven through `motion` for `seconds`, its skating measured.
+Drive drive(const Motion& motion, float seconds, bool lock, float frame = kFrame) {
+  CrowdAnimatorConfig config;
+  config.lod = false;
+  config.foot_lock = lock;
+  CrowdAnimator animator(space(), 1, config);
+  const MapState s0 = motion(0.0f);
+  const std::vector<glm::vec3> at{glm::vec3(s0.position.x, 0.0f, -s0.position.y)};
+  animator.place(at, std::vector<float>{0.0f}, {}, std::vector<float>{0.0f});
+  Buffer<glm::vec2> p(1, current_memory()), v(1, current_memory());
+  Buffer<float> h(1, current_memory());
+  Drive run;
+  const int frames = static_cast<int>(std::lround(seconds / frame));
+  for (int k = 0; k <= frames; ++k) {
+    const MapState s = motion(static_cast<float>(k) * frame);
+    p.copy_from(std::vector<glm::vec2>{s.position});
+    v.copy_from(std::vector<glm::vec2>{s.velocity});
+    h.copy_from(std::vector<float>{s.heading});
+    animator.drive_from_map(p.span(), v.span(), h.span());
+    animator.animate({k == 0 ? 0.0f : frame, nullptr, false});
+    if (k == 0) animator.track({0});
+    if (lock) {
+      std::vector<FootLock> locks(2);
+      copy_to_host(animator.foot_locks(), std::span<FootLock>(locks));
+      for (const FootLock& l : locks)
+        run.largest_correction = std::max(run.largest_correction, glm::length(l.correction));
+    }
+  }
+  run.skating = animator.foot_skating();
+  motion::ContactOptions low;
+  low.speed_fraction = 50.0;
+  low.height_fraction = 0.012;
+  run.skating_low = animator.foot_skating(low);
+  return run;
+}
+
+// Prints and checks one motion with and without locking; returns both.
+std::pair<Drive, Drive> expect_planted(const char* what, const Motion& motion, float seconds, float frame = kFrame) {
+  const Drive free = drive(motion, seconds, false, frame);
+  const Drive locked = drive(motion, seconds, true, frame);
+  std::printf(
+      "%-22s without locking: %s (max %.2f cm; whatever the speed %.2f cm); locked: %s (max %.2f cm; "
+      "whatever the speed %.2f cm), largest correction %.1f cm\n",
+      what, motion::describe(free.skating).c_str(), free.skating.max_cm, free.skating_low.max_cm,
+      motion::describe(locked.skating).c_str(), locked.skating.max_cm, locked.skating_low.max_cm,
+      100.0f * locked.largest_correction);
+  EXPECT_TRUE(locked.skating.measured()) << what;
+  EXPECT_LT(locked.skating.max_cm, 2.0) << what << ": every contact slides less than 2 cm";
+  return {free, locked};
+}
+
+// Standing still, then turning by `angle` over a second, then standing.
+Motion turn_on_the_spot(float angle) {
+  return [angle](float t) {
+    MapState s;
+    s.heading = kPi / 2.0f + angle * std::clamp(t - 0.5f, 0.0f, 1.0f);
+    return s;
+  };
+}
+
+TEST(FootLock, TurningOnTheSpotKeepsTheFeetPlanted) {
+  expect_planted("turn 90 deg on the spot", turn_on_the_spot(kPi / 2.0f), 2.5f);
+  expect_planted("turn 180 deg on the spot", turn_on_the_spot(kPi), 2.5f);
+}
+
+TEST(FootLock, ASideStepKeepsTheFeetPlanted) {
+  // Facing +y, 0.5 m to the right (+x) at 0.5 m/s, then standing.
+  const auto [free, locked] = expect_planted(
+      "side-step 0.5 m",
+      [](float t) {
+        MapState s;
+        s.heading = kPi / 2.0f;
+        const float moving = std::clamp(t - 0.5f, 0.0f, 1.0f);
+        s.position = {0.5f * moving, 0.0f};
+        s.velocity = {t > 0.5f && t < 1.5f ? 0.5f : 0.0f, 0.0f};
+        return s;
+      },
+      2.5f);
+  // Sideways at 0.5 m/s, too fast for the metric's contacts: measured blind
+  // to speed, the feet slide half a metre without locking.
+  EXPECT_GT(free.skating_low.max_cm, 20.0);
+  EXPECT_LT(locked.skating_low.max_cm, 5.0);
+}
+
+// Walking along +x at 1.3 m/s, braking to a stop over 0.6 s, standing 1.5 s,
+// then starting again over 0.6 s: speed and the distance walked, closed form.
+MapState stop_and_start(float t) {
+  constexpr float v0 = 1.3f, t_stop = 2.0f, brake = 0.6f, rest = 1.5f;
+  const float t_go = t_stop + brake + rest;
+  const float d_stop = v0 * t_stop + 0.5f * v0 * brake;
+  float speed = 0.0f, x = 0.0f;
+  if (t < t_stop) {
+    speed = v0;
+    x = v0 * t;
+  } else if (t < t_stop + brake) {
+    const float u = t - t_stop;
+    speed = v0 * (1.0f - u / brake);
+    x = v0 * t_stop + v0 * u - 0.5f * v0 * u * u / brake;
+  } else if (t < t_go) {
+    x = d_stop;
+  } else if (t < t_go + brake) {
+    const float u = t - t_go;
+    speed = v0 * u / brake;
+    x = d_stop + 0.5f * v0 * u * u / brake;
+  } else {
+    speed = v0;
+    x = d_stop + 0.5f * v0 * brake + v0 * (t - t_go - brake);
+  }
+  MapState s;
+  s.position = {x, 0.0f};
+  s.velocity = {speed, 0.0f};
+  return s;
+}
+
+TEST(FootLock, StoppingAndStartingKeepTheFeetPlanted) { expect_planted("stop and start", stop_and_start, 7.0f); }
+
+TEST(FootLock, AStraightWalkIsBarelyCorrected) {
+  // Constant speed in a straight line: the clip's own motion, so the
+  // correction stays within the clip's own slide.
+  for (const float speed : {0.8f, 1.3f, 2.0f}) {
+    const Drive run = drive(
+        [speed](float t) {
+          MapState s;
+          s.position = {speed * t, 0.0f};
+          s.velocity = {speed, 0.0f};
+          return s;
+        },
+        4.0f, true);
+    std::printf("straight walk at %.1f m/s: %s, largest correction %.2f cm\n", speed,
+                motion::describe(run.skating).c_str(), 100.0f * run.largest_correction);
+    EXPECT_LT(run.largest_correction, 0.03f) << speed << " m/s";
+  }
+}
+
+// A crowd walking noisily: every leg keeps its bone lengths, and locking is
+// the same on one thread and several.
+TEST(FootLock, LegsKeepTheirBonesAndThreadsAgree) {
+  const Index n = 64;
+  const std::int32_t J = space().joint_count();
+  auto run = [&](int threads) {
+    ScopedExecution exec(Backend::Cpu, threads);
+    CrowdAnimatorConfig config;
+    config.lod = false;
+    CrowdAnimator animator(space(), n, config);
+    const testing::Crowd crowd = testing::random_crowd(n, 5, 20.0f);
+    animator.place(crowd.positions, crowd.yaws, crowd.scales, crowd.phases);
+    std::mt19937 rng(9);
+    std::normal_distribution<float> noise(0.0f, 0.6f);
+    std::vector<glm::vec2> p(static_cast<std::size_t>(n)), v(p.size());
+    std::vector<float> h(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = {crowd.positions[i].x, -crowd.positions[i].z};
+    Buffer<glm::vec2> bp(n, current_memory()), bv(n, current_memory());
+    Buffer<float> bh(n, current_memory());
+    for (int k = 0; k < 120; ++k) {
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        v[i] = {1.0f + noise(rng), noise(rng)};
+        h[i] += 0.2f * noise(rng);
+        p[i] += kFrame * v[i];
+      }
+      bp.copy_from(p);
+      bv.copy_from(v);
+      bh.copy_from(h);
+      animator.drive_from_map(bp.span(), bv.span(), bh.span());
+      animator.animate({kFrame, nullptr, false});
+    }
+    std::vector<glm::vec3> joints(static_cast<std::size_t>(n * J));
+    copy_to_host(animator.joint_positions(), std::span<glm::vec3>(joints));
+    std::vector<float> scales(static_cast<std::size_t>(n));
+    copy_to_host(animator.scales(), std::span<float>(scales));
+    return std::make_pair(joints, scales);
+  };
+  const auto [one, scales] = run(1);
+  const auto [two, unused] = run(2);
+  ASSERT_EQ(one.size(), two.size());
+  EXPECT_EQ(0, std::memcmp(one.data(), two.data(), one.size() * sizeof(glm::vec3)));
+  const motion::Skeleton& skeleton = space().skeleton();
+  double worst = 0.0;
+  for (Index c = 0; c < n; ++c)
+    for (std::int32_t j = 1; j < J; ++j) {
+      const std::int32_t parent = skeleton.parents[static_cast<std::size_t>(j)];
+      const float bone =
+          glm::length(one[static_cast<std::size_t>(c * J + j)] - one[static_cast<std::size_t>(c * J + parent)]);
+      const float rest =
+          scales[static_cast<std::size_t>(c)] * glm::length(skeleton.offsets[static_cast<std::size_t>(j)]);
+      worst = std::max(worst, static_cast<double>(std::abs(bone - rest)));
+    }
+  std::printf("largest bone length change: %.2e m\n", worst);
+  EXPECT_LT(worst, 1e-4);
+}
+
+// A walk round a circle as `throng run` animates it: simulation steps of
+// 0.1 s, frames between them (agents interpolated, at their displacement
+// over the step), the frame rate not a multiple of the step's. The metric
+// sampled this coarsely sees the foot's last glide before touchdown.
+TEST(FootLock, AWalkRoundACircleBetweenSimulationSteps) {
+  const auto on_circle = [](float t) {  // radius 5 m at 1.2 m/s, anticlockwise
+    const float rate = 1.2f / 5.0f;
+    MapState s;
+    s.position = {5.0f * std::cos(rate * t), 5.0f * std::sin(rate * t)};
+    s.heading = rate * t + kPi / 2.0f;
+    return s;
+  };
+  const auto between_steps = [&](float t) {
+    const float step = 0.1f;
+    const float k = std::floor(t / step);
+    const float alpha = t / step - k;
+    const MapState a = on_circle(k * step), b = on_circle((k + 1.0f) * step);
+    MapState s;
+    s.position = a.position + alpha * (b.position - a.position);
+    s.velocity = (b.position - a.position) / step;
+    s.heading = a.heading + alpha * (b.heading - a.heading);
+    return s;
+  };
+  // 10.08 frames a second: the demo's, a 50x time-lapse at 24 fps.
+  expect_planted("circle between steps", between_steps, 10.0f, 2.0833f / 21.0f);
+}
+
+TEST(FootLock, BadSettingsAreNamed) {
+  auto message = [](FootLockConfig c) {
+    try {
+      c.validate();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  FootLockConfig c;
+  c.max_correction_m = std::nanf("");
+  EXPECT_NE(message(c).find("foot_lock.max_correction_m"), std::string::npos);
+  c = {};
+  c.release_s = 0.0f;
+  EXPECT_NE(message(c).find("foot_lock.release_s"), std::string::npos);
+  c = {};
+  c.step_threshold_m = -1.0f;
+  EXPECT_NE(message(c).find("foot_lock.step_threshold_m"), std::string::npos);
+  c = {};
+  c.step_s = INFINITY;
+  EXPECT_NE(message(c).find("foot_lock.step_s"), std::string::npos);
+  FootLockJob job;
+  job.blend = space().view();
+  job.dt = kFrame;
+  EXPECT_NO_THROW(job.validate());
+  Buffer<glm::vec3> one(1, current_memory());
+  job.positions = one.span();
+  try {
+    job.validate();
+    ADD_FAILURE() << "a job with one character and no phases was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("phases"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace throng::anim
