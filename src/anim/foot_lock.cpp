@@ -18,12 +18,14 @@ void FootLockConfig::validate() const {
     throw Error("must be in (0, 10] s", at_field("foot_lock.step_s"));
   if (!(std::isfinite(step_height_m) && step_height_m >= 0.0f && step_height_m <= 1.0f))
     throw Error("must be in [0, 1] m", at_field("foot_lock.step_height_m"));
+  if (!(step_threshold_m < max_correction_m))
+    throw Error("must be below max_correction_m (no step could start)", at_field("foot_lock.step_threshold_m"));
 }
 
 void FootLockJob::validate() const {
   config.validate();
   if (blend.joint_count < 1 || blend.clip_count < 1 || blend.clips == nullptr || blend.sync == nullptr ||
-      blend.parents == nullptr || blend.offsets == nullptr)
+      blend.parents == nullptr || blend.offsets == nullptr || blend.joint_group == nullptr)
     throw Error("is not set (BlendSpaceTables::view())", at_field("FootLockJob.blend"));
   if (!(std::isfinite(dt) && dt >= 0.0f && dt <= 10.0f))
     throw Error("must be in [0, 10] s", at_field("FootLockJob.dt"));

@@ -13,21 +13,23 @@
 // the heel is down, the ball of the foot once it rises (feet roll over the
 // ball). So the pinned point of the shown foot stays put. From lift-off the
 // correction fades out (exponentially, over release_s), while the foot is
-// in the air, and the foot lands where the pose puts it. The correction is
+// in the air, and the foot lands about where the pose puts it. The correction is
 // at most max_correction_m (times the character's scale): beyond it the leg
 // could not reach, and the foot slides instead of the leg tearing.
 //
 // A planted foot whose correction grows past step_threshold_m (a character
 // turning where it stands, or pushed sideways, has its clip's feet down
 // throughout) takes a step of its own: over step_s it lifts by up to
-// step_height_m and goes back to where the pose puts it, one foot at a time.
+// step_height_m, goes over to where the pose puts it in the first half and
+// comes down vertically in the second; one foot at a time.
 //
 // Per-leg state lives in FootLock (two per character); a leg that LOD does
-// not synthesise (or a frame with dt = 0 after place()) starts again from no
-// correction.
+// not synthesise, and every leg after CrowdAnimator::place(), starts again
+// from no correction. A frame with dt = 0 (a paused viewer) moves nothing on.
 #pragma once
 
 #include <cstdint>
+#include <glm/common.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -60,13 +62,9 @@ struct FootLock {
 
 // Whether a clip has leg's foot on the ground at the clip's phase: between
 // its touchdown and lift-off. A clip with no foot events stands: feet down.
-// `early` (phases) moves the touchdown that much sooner.
-THRONG_HOST_DEVICE inline bool clip_foot_down(const motion::ClipInfo& clip, int leg, float phase, float early = 0.0f) {
-  float down = clip.contact[leg][0];
-  const float up = clip.contact[leg][1];
+THRONG_HOST_DEVICE inline bool clip_foot_down(const motion::ClipInfo& clip, int leg, float phase) {
+  const float down = clip.contact[leg][0], up = clip.contact[leg][1];
   if (down < 0.0f || up < 0.0f) return true;
-  down -= early;
-  if (down < 0.0f) down += 1.0f;
   return down <= up ? (phase >= down && phase < up) : (phase >= down || phase < up);
 }
 
@@ -74,20 +72,21 @@ THRONG_HOST_DEVICE inline bool clip_foot_down(const motion::ClipInfo& clip, int 
 // phase: the clip with the larger weight decides, except that a blend of a
 // standing clip with a striding one steps as the striding clip does (the
 // blend lifts the feet as soon as it moves at all, motion/leg_ik.h) unless
-// the striding clip weighs at most kStandingWeight: a character at rest
-// shows the motion cache's first bucket (w = 0.025), not a step.
+// the striding clip weighs at most kStandingWeight or the blend's quantum:
+// a character at rest shows the motion cache's first bucket (w half its
+// width), not a step.
 inline constexpr float kStandingWeight = 0.05f;
 THRONG_HOST_DEVICE inline bool foot_down_in_blend(const motion::BlendSpaceView& v, const motion::BlendPoint& point,
-                                                  const motion::ClipPhases& leg_phases, int leg, float early = 0.0f) {
+                                                  const motion::ClipPhases& leg_phases, int leg) {
   const motion::ClipInfo& a = v.clips[point.a];
   const motion::ClipInfo& b = v.clips[point.b];
   const bool a_strides = a.stride > motion::kMinStride, b_strides = b.stride > motion::kMinStride;
   if (a_strides != b_strides) {
     const float striding_weight = a_strides ? 1.0f - point.w : point.w;
-    if (striding_weight <= kStandingWeight) return true;
-    return a_strides ? clip_foot_down(a, leg, leg_phases.a, early) : clip_foot_down(b, leg, leg_phases.b, early);
+    if (striding_weight <= glm::max(kStandingWeight, v.quantum)) return true;
+    return a_strides ? clip_foot_down(a, leg, leg_phases.a) : clip_foot_down(b, leg, leg_phases.b);
   }
-  return point.w < 0.5f ? clip_foot_down(a, leg, leg_phases.a, early) : clip_foot_down(b, leg, leg_phases.b, early);
+  return point.w < 0.5f ? clip_foot_down(a, leg, leg_phases.a) : clip_foot_down(b, leg, leg_phases.b);
 }
 
 // After PoseJob: every character's legs locked, in place in the pose.

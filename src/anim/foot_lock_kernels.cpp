@@ -60,10 +60,21 @@ THRONG_HOST_DEVICE inline float step_remaining(float progress) {
   return 1.0f - u * u * (3.0f - 2.0f * u);
 }
 
-// One frame of such a step, given how far the pose's ankle moved since the
-// last frame; returns how high the foot is lifted (m, scale 1).
-THRONG_HOST_DEVICE inline float take_step(const FootLockConfig& config, float dt, const glm::vec2& moved,
-                                          FootLock& lock, glm::vec2& correction) {
+// How high a stepping foot is (m, scale 1) at how far on its step is.
+THRONG_HOST_DEVICE inline float step_lift(const FootLockConfig& config, const FootLock& lock) {
+  return config.step_height_m * glm::sin(3.14159265f * (1.0f - lock.step_left / config.step_s));
+}
+
+// The length of a correction at most `most` (m).
+THRONG_HOST_DEVICE inline glm::vec2 capped(const glm::vec2& correction, float most) {
+  const float length = glm::length(correction);
+  return length > most ? correction * (most / length) : correction;
+}
+
+// One frame (dt > 0) of such a step, given how far the pose's ankle moved
+// since the last frame.
+THRONG_HOST_DEVICE inline void take_step(const FootLockConfig& config, float dt, const glm::vec2& moved, FootLock& lock,
+                                         glm::vec2& correction) {
   const float was = 1.0f - lock.step_left / config.step_s;
   lock.step_left = glm::max(lock.step_left - dt, 0.0f);
   const float progress = 1.0f - lock.step_left / config.step_s;
@@ -73,7 +84,6 @@ THRONG_HOST_DEVICE inline float take_step(const FootLockConfig& config, float dt
   } else {
     correction -= moved;
   }
-  return config.step_height_m * glm::sin(3.14159265f * progress);
 }
 
 // The correction carried on to this frame while the foot is not stepping;
@@ -87,10 +97,10 @@ THRONG_HOST_DEVICE inline glm::vec2 carried_correction(const FootLockJob& job, f
   } else if (!down) {
     correction *= glm::exp(-job.dt / job.config.release_s);
   }
-  const float most = job.config.max_correction_m * scale;
-  const float length = glm::length(correction);
-  return length > most ? correction * (most / length) : correction;
+  return capped(correction, job.config.max_correction_m * scale);
 }
+
+inline constexpr float kTouchdownHeight = 0.005f;
 
 // One leg: the correction carried on (FootLock), then the leg moved by it.
 THRONG_HOST_DEVICE inline void lock_leg(const FootLockJob& job, Index c, int leg, const motion::BlendPoint& point,
@@ -109,22 +119,27 @@ THRONG_HOST_DEVICE inline void lock_leg(const FootLockJob& job, Index c, int leg
   const glm::vec3 ball =
       chain.has_ball ? a + r[ankle] * (scale * glm::vec3(chain.ball[0], chain.ball[1], chain.ball[2])) : a;
   const motion::ClipPhases phases = motion::warp_phase(v.sync[point.segment].group[1 + leg], point.w, job.phases[c]);
-  bool down = foot_down_in_blend(v, point, phases, leg);
-  glm::vec2 correction = lock.seen ? lock.correction : glm::vec2(0.0f);
+  // The ankle's height over its lowest in the blend (m, scale 1): a heel on
+  // the ground (within kTouchdownHeight) is down even where the clip's
+  // touchdown is still to come, as frames a tenth of a second apart catch
+  // the heel's last glide in.
+  const float ground =
+      motion::mix_weight(v.clips[point.a].ankle_ground[leg], v.clips[point.b].ankle_ground[leg], point.w);
+  const float height = (a.y - job.positions[c].y) / scale - ground;
+  bool down = foot_down_in_blend(v, point, phases, leg) || height < kTouchdownHeight;
+  if (!lock.seen) lock = FootLock{};
+  glm::vec2 correction = lock.correction;
   float lift = 0.0f;
-  if (!lock.seen) {
-    lock.step_left = 0.0f;
-  } else if (lock.step_left > 0.0f) {
-    if (job.dt > 0.0f) lift = take_step(job.config, job.dt, ground_xz(a) - lock.ankle, lock, correction);
+  if (lock.step_left > 0.0f) {
+    if (job.dt > 0.0f) {
+      take_step(job.config, job.dt, ground_xz(a) - lock.ankle, lock, correction);
+      correction = capped(correction, job.config.max_correction_m * scale);
+    }
+    lift = step_lift(job.config, lock);     // also while paused (dt = 0)
     down = down && lock.step_left <= 0.0f;  // planted from the frame the step lands
   } else if (job.dt > 0.0f) {
-    lock.correction = correction;
-    // The pinned point: the ankle while the heel is down (its height over
-    // its lowest in the blend, m at scale 1), then the ball of the foot.
-    const float ground =
-        motion::mix_weight(v.clips[point.a].ankle_ground[leg], v.clips[point.b].ankle_ground[leg], point.w);
-    const bool heel_down = (a.y - job.positions[c].y) / scale - ground < motion::kHeelLift;
-    correction = carried_correction(job, scale, down, heel_down, a, ball, lock);
+    // The pinned point: the ankle while the heel is down, then the ball.
+    correction = carried_correction(job, scale, down, height < motion::kHeelLift, a, ball, lock);
     const FootLock& other = job.locks[2 * c + 1 - leg];
     if (down && lock.down && other.step_left <= 0.0f && glm::length(correction) > job.config.step_threshold_m * scale)
       lock.step_left = job.config.step_s;
@@ -146,7 +161,7 @@ void FootLockJob::run() const {
       "anim.foot_lock", character_count(),
       THRONG_JOB_LAMBDA(Index c) {
         const motion::BlendSpaceView& v = blend;
-        const float scale = scales.empty() ? 1.0f : scales[c];
+        const float scale = scales.empty() || !(scales[c] > 0.0f) ? 1.0f : scales[c];  // as PoseJob
         const motion::BlendPoint point = motion::blend_point(v, motion::blend_coordinate(v, blend_speeds[c]));
         glm::vec3* p = joint_positions.data() + c * v.joint_count;
         glm::quat* r = joint_rotations.data() + c * v.joint_count;

@@ -38,6 +38,8 @@ using Motion = std::function<MapState(float t)>;
 struct Drive {
   motion::FootSkatingReport skating;
   float largest_correction = 0.0f;  // m, over frames and legs
+  int steps = 0;                    // steps of a foot's own started
+  int most_stepping = 0;            // feet stepping in one frame, at most
   // The same metric blind to speed, with a strict height (a foot within
   // about 1 cm of the ground is in contact, however fast it moves): the
   // metric's contacts are slow by definition, so it cannot see a foot that
@@ -57,6 +59,7 @@ Drive drive(const Motion& motion, float seconds, bool lock, float frame = kFrame
   Buffer<glm::vec2> p(1, current_memory()), v(1, current_memory());
   Buffer<float> h(1, current_memory());
   Drive run;
+  float last_step[2] = {0.0f, 0.0f};
   const int frames = static_cast<int>(std::lround(seconds / frame));
   for (int k = 0; k <= frames; ++k) {
     const MapState s = motion(static_cast<float>(k) * frame);
@@ -71,6 +74,13 @@ Drive drive(const Motion& motion, float seconds, bool lock, float frame = kFrame
       copy_to_host(animator.foot_locks(), std::span<FootLock>(locks));
       for (const FootLock& l : locks)
         run.largest_correction = std::max(run.largest_correction, glm::length(l.correction));
+      int stepping = 0;
+      for (int leg = 0; leg < 2; ++leg) {
+        if (locks[static_cast<std::size_t>(leg)].step_left > last_step[leg]) ++run.steps;
+        last_step[leg] = locks[static_cast<std::size_t>(leg)].step_left;
+        stepping += last_step[leg] > 0.0f ? 1 : 0;
+      }
+      run.most_stepping = std::max(run.most_stepping, stepping);
     }
   }
   run.skating = animator.foot_skating();
@@ -105,9 +115,59 @@ Motion turn_on_the_spot(float angle) {
   };
 }
 
+// Turning where it stands, a character steps: each foot at least once for
+// a quarter turn, twice for a half turn, never both feet at once.
 TEST(FootLock, TurningOnTheSpotKeepsTheFeetPlanted) {
-  expect_planted("turn 90 deg on the spot", turn_on_the_spot(kPi / 2.0f), 2.5f);
-  expect_planted("turn 180 deg on the spot", turn_on_the_spot(kPi), 2.5f);
+  const auto quarter = expect_planted("turn 90 deg on the spot", turn_on_the_spot(kPi / 2.0f), 2.5f);
+  const auto half = expect_planted("turn 180 deg on the spot", turn_on_the_spot(kPi), 2.5f);
+  std::printf("steps: %d for a quarter turn, %d for a half turn\n", quarter.second.steps, half.second.steps);
+  EXPECT_GE(quarter.second.steps, 2);
+  EXPECT_GE(half.second.steps, 4);
+  EXPECT_EQ(quarter.second.most_stepping, 1);
+  EXPECT_EQ(half.second.most_stepping, 1);
+}
+
+// A viewer paused in the middle of a step (frames with dt = 0) shows the
+// stepping foot where it was, in the air.
+TEST(FootLock, APausedFrameKeepsAStepInTheAir) {
+  CrowdAnimatorConfig config;
+  config.lod = false;
+  CrowdAnimator animator(space(), 1, config);
+  animator.place(std::vector<glm::vec3>{glm::vec3(0.0f)}, std::vector<float>{0.0f}, {}, std::vector<float>{0.0f});
+  const Motion turn = turn_on_the_spot(kPi);
+  Buffer<glm::vec2> p(1, current_memory()), v(1, current_memory());
+  Buffer<float> h(1, current_memory());
+  const motion::BlendSpaceView view = space().view();
+  const auto ankles = [&] {
+    std::vector<glm::vec3> joints(static_cast<std::size_t>(animator.joint_count()));
+    copy_to_host(animator.joint_positions(), std::span<glm::vec3>(joints));
+    std::vector<glm::vec3> out;
+    for (int leg = 0; leg < 2; ++leg)
+      out.push_back(joints[static_cast<std::size_t>(view.legs[leg].joints[view.legs[leg].count - 1])]);
+    return out;
+  };
+  bool paused = false;
+  for (int k = 0; k <= 75 && !paused; ++k) {
+    const MapState s = turn(static_cast<float>(k) * kFrame);
+    p.copy_from(std::vector<glm::vec2>{s.position});
+    v.copy_from(std::vector<glm::vec2>{s.velocity});
+    h.copy_from(std::vector<float>{s.heading});
+    animator.drive_from_map(p.span(), v.span(), h.span());
+    animator.animate({k == 0 ? 0.0f : kFrame, nullptr, false});
+    std::vector<FootLock> locks(2);
+    copy_to_host(animator.foot_locks(), std::span<FootLock>(locks));
+    if (locks[0].step_left > 0.3f * config.foot_lock_config.step_s &&
+        locks[0].step_left < 0.7f * config.foot_lock_config.step_s) {
+      const std::vector<glm::vec3> before = ankles();
+      animator.animate({0.0f, nullptr, false});
+      const std::vector<glm::vec3> after = ankles();
+      EXPECT_GT(before[0].y, 0.12f) << "the left foot is in the air mid-step";
+      EXPECT_LT(glm::length(after[0] - before[0]), 1e-5f);
+      EXPECT_LT(glm::length(after[1] - before[1]), 1e-5f);
+      paused = true;
+    }
+  }
+  EXPECT_TRUE(paused) << "no frame fell in the middle of a step";
 }
 
 TEST(FootLock, ASideStepKeepsTheFeetPlanted) {
@@ -163,7 +223,8 @@ TEST(FootLock, StoppingAndStartingKeepTheFeetPlanted) { expect_planted("stop and
 
 TEST(FootLock, AStraightWalkIsBarelyCorrected) {
   // Constant speed in a straight line: the clip's own motion, so the
-  // correction stays within the clip's own slide.
+  // correction stays within the clip's own slide, the most of it the heel's
+  // glide from its first touch of the ground to the clip's touchdown.
   for (const float speed : {0.8f, 1.3f, 2.0f}) {
     const Drive run = drive(
         [speed](float t) {
@@ -175,15 +236,22 @@ TEST(FootLock, AStraightWalkIsBarelyCorrected) {
         4.0f, true);
     std::printf("straight walk at %.1f m/s: %s, largest correction %.2f cm\n", speed,
                 motion::describe(run.skating).c_str(), 100.0f * run.largest_correction);
-    EXPECT_LT(run.largest_correction, 0.03f) << speed << " m/s";
+    EXPECT_LT(run.largest_correction, 0.05f) << speed << " m/s";
   }
 }
 
-// A crowd walking noisily: every leg keeps its bone lengths, and locking is
-// the same on one thread and several.
+// A crowd walking noisily (200 characters: several blocks of the kernel):
+// every joint sits where its parent's world rotation puts its rest offset
+// (bones keep their lengths, rotations agree with positions), and locking
+// is the same on one thread and several.
 TEST(FootLock, LegsKeepTheirBonesAndThreadsAgree) {
-  const Index n = 64;
+  const Index n = 200;
   const std::int32_t J = space().joint_count();
+  struct Posed {
+    std::vector<glm::vec3> p;
+    std::vector<glm::quat> q;
+    std::vector<float> scales;
+  };
   auto run = [&](int threads) {
     ScopedExecution exec(Backend::Cpu, threads);
     CrowdAnimatorConfig config;
@@ -210,29 +278,31 @@ TEST(FootLock, LegsKeepTheirBonesAndThreadsAgree) {
       animator.drive_from_map(bp.span(), bv.span(), bh.span());
       animator.animate({kFrame, nullptr, false});
     }
-    std::vector<glm::vec3> joints(static_cast<std::size_t>(n * J));
-    copy_to_host(animator.joint_positions(), std::span<glm::vec3>(joints));
-    std::vector<float> scales(static_cast<std::size_t>(n));
-    copy_to_host(animator.scales(), std::span<float>(scales));
-    return std::make_pair(joints, scales);
+    Posed out{std::vector<glm::vec3>(static_cast<std::size_t>(n * J)),
+              std::vector<glm::quat>(static_cast<std::size_t>(n * J)), std::vector<float>(static_cast<std::size_t>(n))};
+    copy_to_host(animator.joint_positions(), std::span<glm::vec3>(out.p));
+    copy_to_host(animator.joint_rotations(), std::span<glm::quat>(out.q));
+    copy_to_host(animator.scales(), std::span<float>(out.scales));
+    return out;
   };
-  const auto [one, scales] = run(1);
-  const auto [two, unused] = run(2);
-  ASSERT_EQ(one.size(), two.size());
-  EXPECT_EQ(0, std::memcmp(one.data(), two.data(), one.size() * sizeof(glm::vec3)));
+  const Posed one = run(1);
+  const Posed two = run(2);
+  ASSERT_EQ(one.p.size(), two.p.size());
+  EXPECT_EQ(0, std::memcmp(one.p.data(), two.p.data(), one.p.size() * sizeof(glm::vec3)));
+  EXPECT_EQ(0, std::memcmp(one.q.data(), two.q.data(), one.q.size() * sizeof(glm::quat)));
   const motion::Skeleton& skeleton = space().skeleton();
   double worst = 0.0;
   for (Index c = 0; c < n; ++c)
     for (std::int32_t j = 1; j < J; ++j) {
+      const auto at = [&](std::int32_t k) { return static_cast<std::size_t>(c * J + k); };
       const std::int32_t parent = skeleton.parents[static_cast<std::size_t>(j)];
-      const float bone =
-          glm::length(one[static_cast<std::size_t>(c * J + j)] - one[static_cast<std::size_t>(c * J + parent)]);
-      const float rest =
-          scales[static_cast<std::size_t>(c)] * glm::length(skeleton.offsets[static_cast<std::size_t>(j)]);
-      worst = std::max(worst, static_cast<double>(std::abs(bone - rest)));
+      const glm::vec3 expected =
+          one.p[at(parent)] +
+          one.q[at(parent)] * (one.scales[static_cast<std::size_t>(c)] * skeleton.offsets[static_cast<std::size_t>(j)]);
+      worst = std::max(worst, static_cast<double>(glm::length(one.p[at(j)] - expected)));
     }
-  std::printf("largest bone length change: %.2e m\n", worst);
-  EXPECT_LT(worst, 1e-4);
+  std::printf("largest joint off its parent's bone: %.2e m\n", worst);
+  EXPECT_LT(worst, 1e-5);
 }
 
 // A walk round a circle as `throng run` animates it: simulation steps of
@@ -259,7 +329,8 @@ TEST(FootLock, AWalkRoundACircleBetweenSimulationSteps) {
     return s;
   };
   // 10.08 frames a second: the demo's, a 50x time-lapse at 24 fps.
-  expect_planted("circle between steps", between_steps, 10.0f, 2.0833f / 21.0f);
+  const auto [free, locked] = expect_planted("circle between steps", between_steps, 10.0f, 2.0833f / 21.0f);
+  EXPECT_LT(locked.skating.mean_cm, 0.5 * free.skating.mean_cm);
 }
 
 TEST(FootLock, BadSettingsAreNamed) {
