@@ -71,6 +71,7 @@ void export_crowd(const ExportOptions& o) {
   LocomotionStageOptions lo;
   lo.fps = o.fps;
   lo.lod = false;  // every joint of every agent: what a DCC tool shows up close
+  lo.locomotion.space = load_scenario_motion(loaded);
   lo.locomotion.skating_agents = 0;
   lo.on_frame = [&](double, const Camera*, SimulationLocomotion& moved) {
     const anim::CrowdAnimator& crowd = moved.animator();

@@ -449,8 +449,9 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
 
 // The locomotion stage, on by default up to kAnimateUpTo agents: joint LOD
 // under the scenario's camera and, with --render, the recorder.
-RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec,
+RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& sim, const io::LoadedScenario& loaded,
                                  const RunOptions& o, const std::string& dir) {
+  const sim::ScenarioSpec& spec = loaded.spec;
   RenderHooks hooks;
   const Index n = sim.agent_count();
   if (o.no_animate && !o.render.empty())
@@ -463,6 +464,7 @@ RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& si
                  static_cast<long long>(n), static_cast<long long>(kAnimateUpTo));
   if (!animate) return hooks;
   LocomotionStageOptions lo;
+  lo.locomotion.space = load_scenario_motion(loaded);
   lo.locomotion.lod_thresholds = o.lod_thresholds;
   const Camera lod_camera = scenario_camera(sim);  // the camera that renders is the one LOD measures with
   lo.camera = [lod_camera](double) { return lod_camera; };
@@ -555,7 +557,7 @@ void run_scenario(const RunOptions& o) {
 
   sim::FrameLoop loop(*sim);
   RunOutputs outputs = add_output_stages(loop, *sim, loaded, o, dir, max_steps);
-  const RenderHooks hooks = add_locomotion_stage(loop, *sim, spec, o, dir);
+  const RenderHooks hooks = add_locomotion_stage(loop, *sim, loaded, o, dir);
   const sim::RunResult result = run_steps(loop, *sim, spec, max_steps, o.quiet);
   const nlohmann::json stats = run_stats(loop, loaded, outputs, hooks);
   write_and_report(*sim, result, stats, spec, dir, outputs);

@@ -81,7 +81,7 @@ class SimulationScene final : public render::ViewerScene {
  public:
   SimulationScene(const io::LoadedScenario& loaded, const std::vector<float>& lod_thresholds)
       : sim_(io::build_simulation(loaded)),
-        locomotion_(*sim_, locomotion_options(lod_thresholds)),
+        locomotion_(*sim_, locomotion_options(loaded, lod_thresholds)),
         camera_(scenario_camera(*sim_)) {
     max_steps_ = sim_->spec().step_count();
     sim::Aabb box = sim_->world().bounds();
@@ -116,8 +116,10 @@ class SimulationScene final : public render::ViewerScene {
   }
 
  private:
-  static SimulationLocomotionOptions locomotion_options(const std::vector<float>& thresholds) {
+  static SimulationLocomotionOptions locomotion_options(const io::LoadedScenario& loaded,
+                                                        const std::vector<float>& thresholds) {
     SimulationLocomotionOptions o;
+    o.space = load_scenario_motion(loaded);
     o.lod_thresholds = thresholds;
     o.skating_agents = 0;  // measured by throng run, not here
     return o;

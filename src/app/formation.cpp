@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 #include "core/math.h"
-#include "io/bvh_reader.h"
+#include "io/motion_set.h"
 
 namespace throng::app {
 
@@ -25,29 +25,6 @@ io::AnimateSpec load_animate_spec(const std::string& what, fs::path& folder) {
   if (std::find(names.begin(), names.end(), what) != names.end()) return io::builtin_animate_spec(what);
   throw Error(fmt::format("no such file or built-in scenario '{}' (built-in: {})", what, fmt::join(names, ", ")),
               at_field("scenario"));
-}
-
-motion::BlendSpace1D load_blend_space(const io::AnimateSpec& spec, const fs::path& folder) {
-  if (spec.clips.empty()) return motion::make_default_blend_space();
-  std::vector<motion::LocomotionClip> clips;
-  motion::Skeleton skeleton;
-  for (std::size_t i = 0; i < spec.clips.size(); ++i) {
-    const io::AnimateClipSource& src = spec.clips[i];
-    const fs::path path = fs::path(src.file).is_absolute() ? fs::path(src.file) : folder / src.file;
-    const io::BvhFile file = io::read_bvh(path.string());
-    if (i == 0)
-      skeleton = file.skeleton;
-    else if (file.skeleton.joint_count() != skeleton.joint_count())
-      throw Error("has " + std::to_string(file.skeleton.joint_count()) + " joints, the first clip " +
-                      std::to_string(skeleton.joint_count()) + ": clips of a blend space share one skeleton",
-                  at_field("motion[" + std::to_string(i) + "]", spec.source));
-    motion::LocomotionOptions options;
-    options.cycle.skip_frames = src.skip_frames;
-    clips.push_back(motion::prepare_locomotion_clip(skeleton, file.clip, src.name, options));
-    spdlog::info("{}: cycle of {} frames, {:.2f} m/s, stride {:.2f} m", src.name, clips.back().frame_count(),
-                 clips.back().speed, clips.back().stride_m);
-  }
-  return motion::BlendSpace1D(std::move(skeleton), std::move(clips));
 }
 
 Formation make_formation(const io::AnimateSpec& s) {
@@ -107,7 +84,7 @@ anim::CrowdAnimatorConfig animator_config(const io::AnimateSpec& spec) {
 
 FormationCrowd::FormationCrowd(io::AnimateSpec spec, const fs::path& folder)
     : spec_(std::move(spec)),
-      space_(load_blend_space(spec_, folder)),
+      space_(io::load_motion_set(spec_.motion, folder, "motion")),
       formation_(make_formation(spec_)),
       rng_(spec_.seed) {
   const Index n = spec_.characters;

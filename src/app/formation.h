@@ -22,9 +22,6 @@ namespace throng::app {
 // (clip paths are relative to it). Error naming "scenario" otherwise.
 io::AnimateSpec load_animate_spec(const std::string& what, std::filesystem::path& folder);
 
-// The default motion set, or the scenario's BVH clips prepared for locomotion.
-motion::BlendSpace1D load_blend_space(const io::AnimateSpec& spec, const std::filesystem::path& folder);
-
 // Where everyone stands, faces and turns.
 struct Formation {
   std::vector<glm::vec3> positions;

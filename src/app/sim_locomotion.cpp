@@ -32,6 +32,12 @@ std::vector<Index> tracked_agents(Index n, Index wanted) {
 
 }  // namespace
 
+std::shared_ptr<const motion::BlendSpace1D> load_scenario_motion(const io::LoadedScenario& loaded) {
+  if (loaded.motion.is_default()) return nullptr;
+  return std::make_shared<const motion::BlendSpace1D>(
+      io::load_motion_set(loaded.motion, loaded.motion_folder(), "motion"));
+}
+
 Camera scenario_camera(const sim::Simulation& sim) {
   if (sim.spec().camera) return *sim.spec().camera;
   sim::Aabb box = sim.world().bounds();
@@ -41,12 +47,14 @@ Camera scenario_camera(const sim::Simulation& sim) {
 }
 
 SimulationLocomotion::SimulationLocomotion(const sim::Simulation& sim, const SimulationLocomotionOptions& options)
-    : space_(motion::make_default_blend_space()), thresholds_(options.lod_thresholds) {
+    : space_(options.space ? options.space
+                           : std::make_shared<const motion::BlendSpace1D>(motion::make_default_blend_space())),
+      thresholds_(options.lod_thresholds) {
   const Index n = sim.agent_count();
   anim::CrowdAnimatorConfig config;
   if (!thresholds_.empty()) config.lod_thresholds = thresholds_;
   thresholds_ = config.lod_thresholds;
-  crowd_ = std::make_unique<anim::CrowdAnimator>(space_, n, config);
+  crowd_ = std::make_unique<anim::CrowdAnimator>(*space_, n, config);
   // Gait phases drawn from the scenario's seed, so neighbours do not step in unison.
   std::mt19937 rng(static_cast<std::uint32_t>(sim.spec().seed));
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);

@@ -25,6 +25,7 @@
 #include "app/locomotion_stats.h"
 #include "core/buffer.h"
 #include "core/camera.h"
+#include "io/scenario_yaml.h"
 #include "motion/locomotion.h"
 #include "sim/frame_loop.h"
 #include "sim/simulation.h"
@@ -32,9 +33,15 @@
 namespace throng::app {
 
 struct SimulationLocomotionOptions {
+  // The motion set (io::load_motion_set); null = the default set.
+  std::shared_ptr<const motion::BlendSpace1D> space;
   std::vector<float> lod_thresholds;  // square pixels, decreasing; empty = anim's defaults
   Index skating_agents = 64;          // agents, evenly spread over the crowd, whose foot skating is measured
 };
+
+// The scenario's motion set (its `motion` key, io/motion_set.h) loaded, or
+// null for the default set. Errors name the clip's file.
+std::shared_ptr<const motion::BlendSpace1D> load_scenario_motion(const io::LoadedScenario& loaded);
 
 // The scenario's camera, the one that renders and drives the LOD: its own,
 // else an overview of the world and the crowd (sim::overview_camera).
@@ -69,7 +76,7 @@ class SimulationLocomotion {
   nlohmann::json stats() const;
 
  private:
-  motion::BlendSpace1D space_;
+  std::shared_ptr<const motion::BlendSpace1D> space_;
   std::unique_ptr<anim::CrowdAnimator> crowd_;
   std::vector<float> thresholds_;
   Index tracked_ = 0;

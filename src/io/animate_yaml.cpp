@@ -33,7 +33,7 @@ class Reader : public YamlReader {
     if (const auto f = root["formation"]) formation(f, "formation", s);
     if (const auto sp = root["speed"]) speed(sp, "speed", s);
     if (const auto sc = root["scale"]) scale(sc, "scale", s);
-    if (const auto m = root["motion"]) motion(m, "motion", s);
+    if (const auto m = root["motion"]) s.motion = read_motion_set(*this, m, "motion");
     if (const auto n = root["mode"]) s.paper_mode = word(n, "mode", {"continuous", "paper"}) == "paper";
     if (const auto n = root["duration"]) s.duration_s = real_in(n, "duration", 1e-3, 3600.0);
     if (const auto n = root["fps"]) s.fps = real_in(n, "fps", 1.0, 1000.0);
@@ -80,31 +80,6 @@ class Reader : public YamlReader {
     if (const auto n = sc["min"]) s.scale_min = real_in(n, child(path, "min"), 0.1, 10.0);
     if (const auto n = sc["max"]) s.scale_max = real_in(n, child(path, "max"), 0.1, 10.0);
     if (s.scale_min > s.scale_max) fail(sc, path, "min must not exceed max");
-  }
-
-  // `default`, or a list of BVH clips: a file name or {file, name, skip_frames}.
-  void motion(const YAML::Node& m, const std::string& path, AnimateSpec& s) {
-    if (m.IsScalar()) {
-      word(m, path, {"default"});
-      return;
-    }
-    if (!m.IsSequence()) fail(m, path, "expected 'default' or a list of BVH clips, got " + kind(m));
-    each_item(m, path, 1, 64, "clips", [&](const YAML::Node& c, const std::string& field) {
-      AnimateClipSource src;
-      if (c.IsScalar()) {
-        src.file = text(c, field);
-      } else {
-        expect_map(c, field, {"file", "name", "skip_frames"});
-        if (!c["file"]) fail(c, child(field, "file"), "each clip needs a file");
-        src.file = text(c["file"], child(field, "file"));
-        if (const auto n = c["name"]) src.name = text(n, child(field, "name"));
-        if (const auto n = c["skip_frames"])
-          src.skip_frames = static_cast<std::int32_t>(integer(n, child(field, "skip_frames"), 0, 100000));
-      }
-      if (src.file.empty()) fail(c, field, "empty file name");
-      if (src.name.empty()) src.name = std::filesystem::path(src.file).stem().string();
-      s.clips.push_back(src);
-    });
   }
 
   void camera(const YAML::Node& c, const std::string& path, AnimateSpec& s) {

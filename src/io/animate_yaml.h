@@ -9,14 +9,9 @@
 #include <string_view>
 #include <vector>
 
-namespace throng::io {
+#include "io/motion_set.h"
 
-struct AnimateClipSource {
-  std::string file;              // BVH, relative to the scenario file's folder
-  std::string name;              // defaults to the file's stem
-  std::int32_t skip_frames = 0;  // leading frames the cycle search ignores (a T-pose)
-  bool operator==(const AnimateClipSource&) const = default;
-};
+namespace throng::io {
 
 struct AnimateSpec {
   std::string name = "formation_circle";
@@ -36,8 +31,8 @@ struct AnimateSpec {
   float scale_min = 1.0f;       // uniform scale per character
   float scale_max = 1.0f;
 
-  std::vector<AnimateClipSource> clips;  // empty: the default motion set
-  bool paper_mode = false;               // mode: paper (w changes at cycle ends) | continuous
+  MotionSetSpec motion;     // io/motion_set.h; default: the built-in set
+  bool paper_mode = false;  // mode: paper (w changes at cycle ends) | continuous
 
   float duration_s = 10.0f;
   float fps = 60.0f;

@@ -591,10 +591,11 @@ class Reader : public YamlReader {
     return o;
   }
 
-  sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name, TrajectoryFormat& format) {
+  sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name, TrajectoryFormat& format,
+                             MotionSetSpec& motion) {
     expect_map(root, "",
                {"name", "description", "seed", "scheduler", "planning", "dt", "duration", "steps", "stop_when_arrived",
-                "model", "world", "groups", "camera", "measurement", "outputs"});
+                "model", "world", "groups", "camera", "measurement", "outputs", "motion"});
     sim::ScenarioSpec s;
     s.name = root["name"] ? text(root["name"], "name") : default_name;
     if (root["description"]) s.description = text(root["description"], "description");
@@ -635,6 +636,7 @@ class Reader : public YamlReader {
     }
     if (const YAML::Node m = root["measurement"]) s.measurement = measurement(m, "measurement");
     if (root["outputs"]) s.outputs = outputs(root["outputs"], "outputs", format);
+    if (root["motion"]) motion = read_motion_set(*this, root["motion"], "motion");
     return s;
   }
 
@@ -692,13 +694,18 @@ LoadedScenario parse_scenario(std::string_view text, const std::string& name, co
     throw Error("the file is empty; a scenario needs at least 'groups'", Location{name, 1, 1, {}});
   try {
     Reader reader(name, limits, out.source);
-    out.spec = reader.scenario(root, stem_of(name), out.trajectory_format);
+    out.spec = reader.scenario(root, stem_of(name), out.trajectory_format, out.motion);
   } catch (const YAML::Exception& e) {
     throw yaml_error(e, name);  // yaml-cpp's own checks (e.g. a bad conversion) still get a position
   } catch (const Error& e) {
     throw out.source.located(e);
   }
   return out;
+}
+
+std::filesystem::path LoadedScenario::motion_folder() const {
+  if (source.file.rfind("builtin:", 0) == 0) return {};
+  return std::filesystem::path(source.file).parent_path();
 }
 
 LoadedScenario read_scenario_file(const std::string& path, const ScenarioReadLimits& limits) {

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "io/motion_set.h"
 #include "io/trajectory_format.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
@@ -57,6 +59,10 @@ struct LoadedScenario {
   // outputs.trajectories.format: kept here, beside the simulation's spec,
   // because only `throng run` reads it.
   TrajectoryFormat trajectory_format = TrajectoryFormat::Csv;
+  // motion: the clips characters are animated from (`throng run`, `throng
+  // view`); paths relative to the file's folder (motion_folder()).
+  MotionSetSpec motion;
+  std::filesystem::path motion_folder() const;
 };
 
 // Parses YAML text; `name` is the file name used in errors.

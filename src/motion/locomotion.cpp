@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "core/error.h"
 #include "core/math.h"
 #include "motion/default_set.h"
@@ -492,12 +494,39 @@ double clean_foot_contacts(const Skeleton& skeleton, LocomotionClip& c, const Lo
   return largest;
 }
 
+namespace {
+
+// Why a clip has no locomotion cycle, in the clip's own figures: how far
+// its root travels and in how long, against what a cycle needs.
+std::string no_cycle_message(const Clip& clip, const CycleOptions& o) {
+  const std::int32_t first = std::clamp(o.skip_frames, 0, std::max(clip.frame_count - 1, 0));
+  const double seconds = static_cast<double>(clip.frame_count - 1 - first) * clip.frame_time;
+  double travel = 0.0;
+  for (std::int32_t f = first + 1; f < clip.frame_count; ++f) {
+    const glm::vec3 d = clip.root_positions[at(f)] - clip.root_positions[at(f - 1)];
+    travel += std::hypot(static_cast<double>(d.x), static_cast<double>(d.z));
+  }
+  if (seconds < o.min_period_s)
+    return fmt::format("no locomotion cycle: the clip lasts {:.2f} s, shorter than a cycle ({:.1f} s at least)",
+                       seconds, o.min_period_s);
+  if (travel < o.min_mean_speed * seconds)
+    return fmt::format(
+        "no locomotion cycle: the root moves {:.2f} m in {:.1f} s ({:.2f} m/s): not locomotion (a walk or run "
+        "moves at {:.1f} m/s or more)",
+        travel, seconds, travel / seconds, o.min_mean_speed);
+  return fmt::format(
+      "no locomotion cycle: the root moves {:.2f} m in {:.1f} s, but no stretch of {:.1f} to {:.1f} s repeats "
+      "(steady walking or running is needed; a T-pose at the start can be skipped with skip_frames)",
+      travel, seconds, o.min_period_s, o.max_period_s);
+}
+
+}  // namespace
+
 LocomotionClip prepare_locomotion_clip(const Skeleton& skeleton, const Clip& clip, std::string name,
                                        const LocomotionOptions& o) {
   o.validate();
   const CycleReport r = analyze_cycle(skeleton, clip, o.cycle);
-  if (!r.found)
-    throw Error("no locomotion cycle found (see motion/cycle.h for the options)", clip_field(name, "cycle"));
+  if (!r.found) throw Error(no_cycle_message(clip, o.cycle), clip_field(name, "cycle"));
   LocomotionClip out = prepare_locomotion_cycle(skeleton, make_cyclic(clip, r), std::move(name), o);
   out.source_start_frame += r.start_frame;
   return out;

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "tests/render/video_probe.h"
+#include "tests/shared_data.h"
 
 namespace {
 
@@ -283,6 +284,38 @@ TEST_F(RunCommand, AnimatesEveryAgentWithPlantedFeetAndTheSameOnAnyThreadCount) 
   const nlohmann::json two = run_with("2");
   for (const char* key : {"lod", "cache", "foot_skating_cm", "joints_synthesised_per_character"})
     EXPECT_EQ(one["locomotion"][key], two["locomotion"][key]) << key;
+}
+
+// A scenario's own motion set: CMU subject 16's walk and jog (43 joints,
+// real motion capture) animate every agent, and stats.json has their foot
+// skating; a clip that is not there is an error naming it.
+TEST_F(RunCommand, AScenarioAnimatesItsOwnMotionCaptureClips) {
+  THRONG_NEED_SHARED_BVH(bvh);
+  const fs::path scenario = dir_ / "cmu.yaml";
+  std::ofstream(scenario) << "name: cmu\nduration: 40\ngroups:\n"
+                             "  - {count: 100, radius: 0.25, spawn: {ring: {center: [0, 0], spacing: 1.0}},\n"
+                             "     goal: {mirror: [0, 0]}, on_arrival: stop}\n"
+                             "motion:\n  clips:\n"
+                          << "    - {file: " << (*bvh / "cmu_16_15_walk_daz.bvh").string() << ", name: walk}\n"
+                          << "    - {file: " << (*bvh / "cmu_16_36_run_jog_daz.bvh").string() << ", name: jog}\n"
+                          << "  up_axis: auto\n  units: auto\n";
+  const Outcome o = run({"run", scenario.string(), "--no-lod", "--no-trajectories", "--out", (dir_ / "out").string()});
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("walk: cycle of"), std::string::npos) << o.out;
+  const nlohmann::json l = nlohmann::json::parse(slurp(dir_ / "out" / "stats.json"))["locomotion"];
+  EXPECT_EQ(l["joints"].get<int>(), 43) << l.dump(1);
+  const auto& feet = l["foot_skating_cm"];
+  std::printf("CMU walk + jog: %s\n", feet.dump().c_str());
+  EXPECT_GT(feet["contacts"].get<int>(), 100) << feet.dump();
+  EXPECT_EQ(feet["agents_measured"].get<int>(), 64) << feet.dump();
+  EXPECT_LT(feet["mean"].get<double>(), 1.0) << feet.dump();
+  EXPECT_LT(feet["p95"].get<double>(), 3.0) << feet.dump();
+
+  std::ofstream(dir_ / "missing.yaml") << "groups:\n  - {count: 2, spawn: {ring: {center: [0, 0], spacing: 1.0}}, "
+                                          "goal: {mirror: [0, 0]}}\nmotion: [no_such_walk.bvh]\n";
+  const Outcome missing = run({"run", (dir_ / "missing.yaml").string(), "--out", (dir_ / "m").string()});
+  EXPECT_EQ(missing.code, 1) << missing.out;
+  EXPECT_NE(missing.out.find("no_such_walk.bvh"), std::string::npos) << missing.out;
 }
 
 TEST_F(RunCommand, NoAnimateSkipsTheLocomotionStage) {

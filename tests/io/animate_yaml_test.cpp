@@ -71,11 +71,11 @@ output: out/marching
   EXPECT_FLOAT_EQ(s.change_every_s, 0.0f);
   EXPECT_FLOAT_EQ(s.scale_min, 0.9f);
   EXPECT_FLOAT_EQ(s.scale_max, 1.2f);
-  ASSERT_EQ(s.clips.size(), 2u);
-  EXPECT_EQ(s.clips[0].file, "walk.bvh");
-  EXPECT_EQ(s.clips[0].name, "walk");
-  EXPECT_EQ(s.clips[1].name, "jog");
-  EXPECT_EQ(s.clips[1].skip_frames, 1);
+  ASSERT_EQ(s.motion.clips.size(), 2u);
+  EXPECT_EQ(s.motion.clips[0].file, "walk.bvh");
+  EXPECT_EQ(s.motion.clips[0].name, "walk");
+  EXPECT_EQ(s.motion.clips[1].name, "jog");
+  EXPECT_EQ(s.motion.clips[1].skip_frames, 1);
   EXPECT_TRUE(s.paper_mode);
   EXPECT_FLOAT_EQ(s.duration_s, 2.5f);
   EXPECT_FLOAT_EQ(s.fps, 30.0f);
@@ -110,9 +110,9 @@ TEST(AnimateYaml, ErrorsNameFileLineColumnAndKey) {
       {"formation:\n  shape: square\n", "test.yaml:2:10"},
       {"duration: .nan\n", "duration"},
       {"lod: {thresholds: [30, 1000]}\n", "thresholds must decrease"},
-      {"motion:\n  - {name: walk}\n", "each clip needs a file"},
+      {"motion:\n  - {name: walk}\n", "motion[0]: missing required key 'file'"},
       {"motion: 3\n", "expected one of default, got '3'"},
-      {"motion: {file: a.bvh}\n", "expected 'default' or a list"},
+      {"motion: {file: a.bvh}\n", "motion.file: unknown key 'file'; expected one of clips, up_axis, units"},
       {"camera: {resolution: [640]}\n", "expected [width, height]"},
       {"characters: [1, 2\n", "YAML syntax"},
       {"- a list\n- at the top\n", "expected a map with keys name, characters"},

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "render/image.h"
+#include "tests/shared_data.h"
 
 extern char** environ;
 
@@ -126,6 +127,36 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
 // as a screenshot. Each is drawn twice, in joint-LOD colours and in
 // clothing colours, so the pixels that differ are the characters': a
 // picture of the ground alone, or a cleared one, fails.
+// The viewer animates a scenario's own motion-capture clips (CMU subject
+// 16's walk and jog, 43 joints) and draws them.
+TEST(Viewer, HeadlessDrawsAScenariosOwnMotionCaptureClips) {
+  THRONG_NEED_SHARED_BVH(bvh);
+  const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_cmu";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const auto scenario = dir / "cmu.yaml";
+  FILE* f = std::fopen(scenario.string().c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fprintf(f,
+               "name: cmu\ngroups:\n  - {count: 40, spawn: {ring: {center: [0, 0], spacing: 1.0}}, goal: {mirror: "
+               "[0, 0]}}\ncamera: {position: [-9, -9, 4], target: [0, 0, 0.8], fov_degrees: 40}\n"
+               "motion: [%s, %s]\n",
+               (*bvh / "cmu_16_15_walk_daz.bvh").string().c_str(),
+               (*bvh / "cmu_16_36_run_jog_daz.bvh").string().c_str());
+  std::fclose(f);
+  std::string out;
+  const std::string command = std::string(THRONG_EXE) + " view " + scenario.string() +
+                              " --headless --render frames --frames 3 --width 160 --height 90 --out ";
+  ASSERT_EQ(run(command + dir.string() + " --lod-colours", out), 0) << out;
+  out.clear();
+  ASSERT_EQ(run(command + (dir / "clothes").string(), out), 0) << out;
+  const Image im = read_png((dir / "frame_00002.png").string());
+  const Image clothes = read_png((dir / "clothes" / "frame_00002.png").string());
+  ASSERT_EQ(clothes.width, im.width);
+  EXPECT_GT(character_pixels(im, clothes), im.width * im.height / 100);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_headless";
   std::filesystem::remove_all(dir);

@@ -1,0 +1,120 @@
+#include "io/motion_set.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "core/error.h"
+#include "io/bvh_reader.h"
+
+namespace throng::io {
+
+namespace {
+
+MotionClipSource clip_source(YamlReader& r, const YAML::Node& c, const std::string& field) {
+  MotionClipSource src;
+  if (c.IsScalar()) {
+    src.file = r.text(c, field);
+  } else {
+    r.expect_map(c, field, {"file", "name", "skip_frames"});
+    src.file = r.text(r.required(c, field, "file"), field + ".file");
+    if (const auto n = c["name"]) src.name = r.text(n, field + ".name");
+    if (const auto n = c["skip_frames"])
+      src.skip_frames = static_cast<std::int32_t>(r.integer(n, field + ".skip_frames", 0, 100000));
+  }
+  if (src.file.empty()) r.fail(c, field, "empty file name");
+  if (src.name.empty()) src.name = std::filesystem::path(src.file).stem().string();
+  return src;
+}
+
+void clip_list(YamlReader& r, const YAML::Node& n, const std::string& path, MotionSetSpec& s) {
+  r.each_item(n, path, 1, 64, "BVH clips",
+              [&](const YAML::Node& c, const std::string& field) { s.clips.push_back(clip_source(r, c, field)); });
+}
+
+}  // namespace
+
+MotionSetSpec read_motion_set(YamlReader& r, const YAML::Node& m, const std::string& path) {
+  MotionSetSpec s;
+  if (m.IsScalar()) {
+    r.word(m, path, {"default"});
+    return s;
+  }
+  if (m.IsSequence()) {
+    clip_list(r, m, path, s);
+    return s;
+  }
+  if (!m.IsMap())
+    r.fail(m, path, "expected 'default', a list of BVH clips or {clips, up_axis, units}, got " + r.kind(m));
+  r.expect_map(m, path, {"clips", "up_axis", "units"});
+  clip_list(r, r.required(m, path, "clips"), path + ".clips", s);
+  if (const auto n = m["up_axis"]) {
+    const std::string a = r.word(n, path + ".up_axis", {"auto", "y", "z"});
+    if (a != "auto") s.up_axis = motion::parse_up_axis(a);
+  }
+  if (const auto n = m["units"]) {
+    const std::string u = r.text(n, path + ".units");
+    if (u != "auto") {
+      s.unit = motion::parse_length_unit(u);
+      if (!s.unit) r.fail(n, path + ".units", "expected auto, m, cm, mm, in or cmu, got '" + u + "'");
+    }
+  }
+  return s;
+}
+
+namespace {
+
+// One clip's file read and turned Y-up (Error naming the file otherwise).
+BvhFile read_clip(const MotionSetSpec& spec, const std::filesystem::path& path) {
+  BvhReadOptions options;
+  options.unit = spec.unit;
+  BvhFile file = read_bvh(path.string(), options);
+  const motion::UpAxisGuess guess = motion::guess_up_axis(file.skeleton, file.clip);
+  const std::string body = fmt::format("feet to head in the first frame: {:.2f}, {:.2f}, {:.2f} m", guess.body.x,
+                                       guess.body.y, guess.body.z);
+  if (spec.up_axis && guess.axis && *guess.axis != *spec.up_axis)
+    throw Error(fmt::format("the body stands along +{} ({}), but motion.up_axis is {}", motion::to_string(*guess.axis),
+                            body, motion::to_string(*spec.up_axis)),
+                Location{path.string(), 0, 0, "up_axis"});
+  if (!spec.up_axis && !guess.axis)
+    throw Error(fmt::format("cannot tell which way is up ({}); give motion.up_axis: y or z", body),
+                Location{path.string(), 0, 0, "up_axis"});
+  const motion::UpAxis up = spec.up_axis ? *spec.up_axis : *guess.axis;
+  if (up == motion::UpAxis::Z) motion::z_up_to_y_up(file.skeleton, file.clip);
+  spdlog::debug("{}: {}-up, unit {}{}", path.string(), motion::to_string(up), motion::to_string(file.unit),
+                file.unit_detected ? " (detected)" : "");
+  return file;
+}
+
+}  // namespace
+
+motion::BlendSpace1D load_motion_set(const MotionSetSpec& spec, const std::filesystem::path& folder,
+                                     const std::string& field) {
+  if (spec.is_default()) return motion::make_default_blend_space();
+  std::vector<motion::LocomotionClip> clips;
+  motion::Skeleton skeleton;
+  for (std::size_t i = 0; i < spec.clips.size(); ++i) {
+    const MotionClipSource& src = spec.clips[i];
+    const std::filesystem::path path =
+        std::filesystem::path(src.file).is_absolute() ? std::filesystem::path(src.file) : folder / src.file;
+    const BvhFile file = read_clip(spec, path);
+    if (i == 0)
+      skeleton = file.skeleton;
+    else if (file.skeleton.joint_count() != skeleton.joint_count())
+      throw Error(fmt::format("has {} joints, the first clip {}: the clips of a motion set share one skeleton",
+                              file.skeleton.joint_count(), skeleton.joint_count()),
+                  Location{path.string(), 0, 0, field + ".clips[" + std::to_string(i) + "]"});
+    motion::LocomotionOptions options;
+    options.cycle.skip_frames = src.skip_frames;
+    try {
+      clips.push_back(motion::prepare_locomotion_clip(skeleton, file.clip, src.name, options));
+    } catch (const Error& e) {
+      throw Error(e.message(), Location{path.string(), 0, 0, field + ".clips[" + std::to_string(i) + "]"});
+    }
+    const motion::LocomotionClip& c = clips.back();
+    spdlog::info("{}: cycle of {} frames ({:.2f} s), {:.2f} m/s, stride {:.2f} m", src.name, c.frame_count(),
+                 c.period_s, c.speed, c.stride_m);
+  }
+  return motion::BlendSpace1D(std::move(skeleton), std::move(clips));
+}
+
+}  // namespace throng::io
