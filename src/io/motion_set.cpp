@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+
 #include "core/error.h"
 #include "io/bvh_reader.h"
 
@@ -85,6 +87,28 @@ BvhFile read_clip(const MotionSetSpec& spec, const std::filesystem::path& path) 
   return file;
 }
 
+// Why a prepared cycle is no walk or run, or "": one that moves must step
+// with each foot once per cycle, the feet landing about half a cycle apart
+// (feet landing together hop or jump, which a speed blend of walks and runs
+// cannot show).
+std::string not_a_gait(const motion::LocomotionClip& c) {
+  if (!(c.stride_m > motion::kMinStride)) return {};
+  const float left = c.event(motion::FootEvent::LeftDown), right = c.event(motion::FootEvent::RightDown);
+  if (left < 0.0f || right < 0.0f)
+    return fmt::format(
+        "its cycle ({:.2f} s, {:.2f} m/s) does not have each foot land once: not a walk or run (hops, shuffles or "
+        "stumbles have no steady steps)",
+        c.period_s, c.speed);
+  float apart = right - left;
+  apart -= std::floor(apart);
+  if (apart < 0.25f || apart > 0.75f)
+    return fmt::format(
+        "the feet land together (right {:.2f} of a cycle after left; a walk or run lands them about 0.5 apart): "
+        "hops or jumps, not a walk or run",
+        apart);
+  return {};
+}
+
 }  // namespace
 
 motion::BlendSpace1D load_motion_set(const MotionSetSpec& spec, const std::filesystem::path& folder,
@@ -111,6 +135,8 @@ motion::BlendSpace1D load_motion_set(const MotionSetSpec& spec, const std::files
       throw Error(e.message(), Location{path.string(), 0, 0, field + ".clips[" + std::to_string(i) + "]"});
     }
     const motion::LocomotionClip& c = clips.back();
+    if (const std::string why = not_a_gait(c); !why.empty())
+      throw Error(why, Location{path.string(), 0, 0, field + ".clips[" + std::to_string(i) + "]"});
     spdlog::info("{}: cycle of {} frames ({:.2f} s), {:.2f} m/s, stride {:.2f} m", src.name, c.frame_count(),
                  c.period_s, c.speed, c.stride_m);
   }

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "io/bvh_writer.h"
 #include "motion/default_set.h"
+#include "tests/shared_data.h"
 
 namespace throng::io {
 namespace {
@@ -164,6 +165,29 @@ TEST_F(MotionSetFiles, RefusalsSayWhatIsWrongWithTheClip) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("nowhere.bvh"), std::string::npos) << e.what();
   }
+}
+
+// Real motion capture that is not a walk or run: CMU 01_01 hops (both feet
+// land together) and 13_32's jump (no foot lands once per cycle) are
+// refused, saying so; 16_15's walk is taken.
+TEST(MotionSetShared, HopsAndJumpsAreNotWalks) {
+  THRONG_NEED_SHARED_BVH(bvh);
+  const auto refusal = [&](const std::string& file) {
+    MotionSetSpec spec;
+    spec.clips = {{file, "clip", 1}};
+    try {
+      load_motion_set(spec, *bvh, "motion");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string hops = refusal("cmu_01_01_hops_turnaround_mb.bvh");
+  EXPECT_NE(hops.find("the feet land together"), std::string::npos) << hops;
+  EXPECT_NE(hops.find("cmu_01_01_hops_turnaround_mb.bvh"), std::string::npos) << hops;
+  const std::string jump = refusal("cmu_13_32_forward_jump_daz.bvh");
+  EXPECT_NE(jump.find("not a walk or run"), std::string::npos) << jump;
+  EXPECT_EQ(refusal("cmu_16_15_walk_daz.bvh"), "accepted");
 }
 
 }  // namespace
