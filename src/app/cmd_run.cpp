@@ -202,17 +202,23 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
                 l["joints_synthesised_per_character"].get<double>(), l["joints"].get<int>());
     if (l.contains("cache")) std::printf("; cache hits %.1f%%", 100.0 * l["cache"]["hit_rate"].get<double>());
     const auto& skate = l["foot_skating_cm"];
-    if (skate["contacts"].get<int>() > 0)
+    if (skate["contacts"].get<int>() > 0) {
       std::printf(
           "\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts of %d agents (of %d sampled; legs that joint "
-          "LOD holds are not measured)\n",
+          "LOD holds are not measured)\n    by what the body does (mean / p95 cm, contacts):",
           skate["mean"].get<double>(), skate["p95"].get<double>(), skate["contacts"].get<int>(),
           skate["agents_measured"].get<int>(), skate["agents"].get<int>());
-    else
+      for (const auto& [regime, f] : skate["by_regime"].items())
+        if (f["contacts"].get<int>() > 0)
+          std::printf(" %s %.2f / %.2f (%d);", regime.c_str(), f["mean"].get<double>(), f["p95"].get<double>(),
+                      f["contacts"].get<int>());
+      std::printf("\n");
+    } else {
       std::printf(
           "\n  foot skating: no contacts measured (%d agents sampled; legs that joint LOD holds are not "
           "measured)\n",
           skate["agents"].get<int>());
+    }
   }
   if (stats.contains("soak")) {
     const auto& s = stats["soak"];

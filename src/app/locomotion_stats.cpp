@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <limits>
 
 namespace throng::app {
 
@@ -65,6 +67,41 @@ nlohmann::json LocomotionTally::cache_json(const anim::CrowdAnimator& crowd) con
       {"entries", c.entries},
       {"hit_rate", c.hit_rate()},
       {"from_cache_fraction", character_frames() > 0.0 ? static_cast<double>(from_cache) / character_frames() : 0.0}};
+}
+
+void SkatingTally::add(const motion::FootSkatingReport& r) {
+  for (std::size_t i = 0; i < r.slides_cm.size(); ++i) {
+    all.push(r.slides_cm[i]);
+    if (i < r.regimes.size()) regimes[r.regimes[i] % motion::kGaitRegimes].push(r.slides_cm[i]);
+  }
+  std::vector<Index> both;
+  std::set_union(agents.begin(), agents.end(), r.characters.begin(), r.characters.end(), std::back_inserter(both));
+  agents = std::move(both);
+}
+
+namespace {
+
+// mean, p95 (of the kept slides), max (cm; null for none) and contacts.
+nlohmann::json slide_figures(const ThinnedSample& s) {
+  const bool any = s.count() > 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {{"mean", any ? s.mean() : nan},
+          {"p95", motion::summarise_foot_skating(s.values()).p95_cm},
+          {"max", any ? s.max() : nan},
+          {"contacts", s.count()}};
+}
+
+}  // namespace
+
+nlohmann::json SkatingTally::json(Index sampled) const {
+  nlohmann::json out = slide_figures(all);
+  out["agents"] = sampled;
+  out["agents_measured"] = static_cast<Index>(agents.size());
+  nlohmann::json by = nlohmann::json::object();
+  for (int k = 0; k < motion::kGaitRegimes; ++k)
+    by[motion::to_string(static_cast<motion::GaitRegime>(k))] = slide_figures(regimes[static_cast<std::size_t>(k)]);
+  out["by_regime"] = by;
+  return out;
 }
 
 }  // namespace throng::app

@@ -9,6 +9,7 @@
 
 #include "anim/crowd_animator.h"
 #include "core/thinned_series.h"
+#include "motion/foot_skating.h"
 
 namespace throng::app {
 
@@ -36,6 +37,24 @@ struct LocomotionTally {
   // bucket width, capacity, hits, misses, insertions, evictions, bytes,
   // entries, hit rate, share read from the cache; null without a cache.
   nlohmann::json cache_json(const anim::CrowdAnimator& crowd) const;
+};
+
+// Foot slides kept for the p95 of a long run (mean and max are exact).
+inline constexpr std::size_t kMaxSkatingSlides = 65536;
+
+// Foot skating pooled over the measuring windows of a run: every contact,
+// and the contacts of each gait regime (motion::GaitRegime), with the agents
+// that had a contact measured.
+struct SkatingTally {
+  ThinnedSample all{kMaxSkatingSlides};
+  std::vector<ThinnedSample> regimes =
+      std::vector<ThinnedSample>(motion::kGaitRegimes, ThinnedSample(kMaxSkatingSlides));
+  std::vector<Index> agents;  // sorted
+
+  void add(const motion::FootSkatingReport& r);
+  // stats.json's foot_skating_cm: mean, p95, max (cm; null with no contact),
+  // contacts, agents (sampled), agents_measured, by_regime.
+  nlohmann::json json(Index sampled) const;
 };
 
 }  // namespace throng::app

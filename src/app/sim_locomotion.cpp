@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <iterator>
 #include <cmath>
-#include <limits>
 #include <random>
 
 #include "anim/between_steps.h"
@@ -106,19 +104,12 @@ const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim
   tally_.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   // Foot tracking starts with the first frame that moves time on, in windows.
   if (dt > 0.0f && tracked_ > 0 && (skating_frames_ == 0 || skating_frames_ >= kSkatingWindow)) {
-    if (skating_frames_ > 0) add_skating(crowd_->foot_skating());
+    if (skating_frames_ > 0) skating_.add(crowd_->foot_skating());
     crowd_->track(tracked_agents(crowd_->count(), tracked_));
     skating_frames_ = 0;
   }
   if (skating_frames_ > 0 || (dt > 0.0f && tracked_ > 0)) ++skating_frames_;
   return s;
-}
-
-void SimulationLocomotion::add_skating(const motion::FootSkatingReport& r) {
-  for (const double slide : r.slides_cm) slides_cm_.push(slide);
-  std::vector<Index> both;
-  std::set_union(skated_.begin(), skated_.end(), r.characters.begin(), r.characters.end(), std::back_inserter(both));
-  skated_ = std::move(both);
 }
 
 nlohmann::json SimulationLocomotion::stats() const {
@@ -143,26 +134,9 @@ nlohmann::json SimulationLocomotion::stats() const {
                                       : 0.0;
   if (nlohmann::json lod = tally_.lod_json(crowd, thresholds_); !lod.is_null()) out["lod"] = lod;
   if (nlohmann::json cache = tally_.cache_json(crowd); !cache.is_null()) out["cache"] = cache;
-  ThinnedSample slides = slides_cm_;
-  std::vector<Index> skated = skated_;
-  if (skating_frames_ > 0) {
-    const motion::FootSkatingReport open = crowd.foot_skating();
-    for (const double slide : open.slides_cm) slides.push(slide);
-    std::vector<Index> both;
-    std::set_union(skated.begin(), skated.end(), open.characters.begin(), open.characters.end(),
-                   std::back_inserter(both));
-    skated = std::move(both);
-  }
-  // The p95 of the kept slides; mean, max and count over every contact.
-  const motion::FootSkatingReport kept = motion::summarise_foot_skating(slides.values());
-  const bool any = slides.count() > 0;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  out["foot_skating_cm"] = {{"mean", any ? slides.mean() : nan},
-                            {"p95", kept.p95_cm},
-                            {"max", any ? slides.max() : nan},
-                            {"contacts", slides.count()},
-                            {"agents", std::min(crowd.count(), tracked_)},
-                            {"agents_measured", static_cast<Index>(skated.size())}};
+  SkatingTally skating = skating_;
+  if (skating_frames_ > 0) skating.add(crowd.foot_skating());
+  out["foot_skating_cm"] = skating.json(std::min(crowd.count(), tracked_));
   return out;
 }
 

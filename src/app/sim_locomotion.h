@@ -47,9 +47,6 @@ std::shared_ptr<const motion::BlendSpace1D> load_scenario_motion(const io::Loade
 // else an overview of the world and the crowd (sim::overview_camera).
 Camera scenario_camera(const sim::Simulation& sim);
 
-// Foot slides kept for the p95 of a long run (mean and max are exact).
-inline constexpr std::size_t kMaxSkatingSlides = 65536;
-
 class SimulationLocomotion {
  public:
   SimulationLocomotion(const sim::Simulation& sim, const SimulationLocomotionOptions& options = {});
@@ -82,11 +79,9 @@ class SimulationLocomotion {
   Index tracked_ = 0;
   Buffer<glm::vec2> previous_positions_, shown_positions_, moved_, still_;
   Buffer<float> previous_headings_, shown_headings_;
-  LocomotionTally tally_;                       // over the frames
-  std::int32_t skating_frames_ = 0;             // frames in the current foot-tracking window
-  ThinnedSample slides_cm_{kMaxSkatingSlides};  // contacts of the windows closed so far
-  std::vector<Index> skated_;                   // agents with a contact measured, windows closed so far
-  void add_skating(const motion::FootSkatingReport& r);
+  LocomotionTally tally_;            // over the frames
+  std::int32_t skating_frames_ = 0;  // frames in the current foot-tracking window
+  SkatingTally skating_;             // the measuring windows closed so far
 };
 
 // `throng run`'s locomotion stage ("anim.locomotion"). Frames: one per

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <string>
 #include <utility>
@@ -72,11 +73,93 @@ std::string describe(const FootSkatingReport& r) {
   return fmt::format("mean {:.2f} cm, p95 {:.2f} cm over {} contacts", r.mean_cm, r.p95_cm, r.contacts);
 }
 
+const char* to_string(GaitRegime regime) {
+  switch (regime) {
+    case GaitRegime::Straight: return "straight";
+    case GaitRegime::Turning: return "turning";
+    case GaitRegime::SideStep: return "side_step";
+    case GaitRegime::StartStop: return "start_stop";
+    case GaitRegime::Standing: return "standing";
+  }
+  return "?";
+}
+
+namespace {
+
+// The hips' ground point and facing (radians about +Y, 0 = +Z) in a frame.
+struct Hips {
+  glm::dvec2 at{0.0};
+  double facing = 0.0;
+};
+Hips hips_at(const ModelSpaceClip& m, std::int32_t frame, std::int32_t left, std::int32_t right) {
+  const glm::dvec3 l(m.position(frame, left)), r(m.position(frame, right));
+  // Facing +Z with +Y up, the left thigh is on the +X side: forward = (l - r) x up.
+  const glm::dvec3 forward = glm::cross(l - r, glm::dvec3(0.0, 1.0, 0.0));
+  return {{0.5 * (l.x + r.x), 0.5 * (l.z + r.z)}, std::atan2(forward.x, forward.z)};
+}
+
+// The hips' facing averaged over +-0.3 s about a frame: the pelvis swings
+// left and right with every step, a running stride's by 10 degrees or more.
+double mean_facing(const ModelSpaceClip& m, double frame_time, std::int32_t frame, std::int32_t left,
+                   std::int32_t right) {
+  const auto half = static_cast<std::int32_t>(std::lround(0.3 / frame_time));
+  glm::dvec2 sum(0.0);
+  for (std::int32_t f = std::max(0, frame - half); f <= std::min(m.frame_count - 1, frame + half); ++f) {
+    const double a = hips_at(m, f, left, right).facing;
+    sum += glm::dvec2(std::sin(a), std::cos(a));
+  }
+  return std::atan2(sum.x, sum.y);
+}
+
+GaitRegime classify_contact(const ModelSpaceClip& m, double frame_time, const ContactInterval& c, std::int32_t left,
+                            std::int32_t right) {
+  const std::int32_t last = c.end - 1;
+  if (last <= c.begin) return GaitRegime::Standing;
+  const Hips a = hips_at(m, c.begin, left, right), b = hips_at(m, last, left, right);
+  const double seconds = static_cast<double>(last - c.begin) * frame_time;
+  const glm::dvec2 velocity = (b.at - a.at) / seconds;
+  const double turn =
+      std::remainder(mean_facing(m, frame_time, last, left, right) - mean_facing(m, frame_time, c.begin, left, right),
+                     2.0 * std::numbers::pi) /
+      seconds;
+  const glm::dvec2 forward(std::sin(a.facing), std::cos(a.facing));
+  const double along = glm::dot(velocity, forward);
+  const double across = std::abs(velocity.x * forward.y - velocity.y * forward.x);
+  const auto speed_at = [&](std::int32_t f) {
+    return glm::length(hips_at(m, f + 1, left, right).at - hips_at(m, f, left, right).at) / frame_time;
+  };
+  const double speed_change = std::abs(speed_at(last - 1) - speed_at(c.begin));
+  if (std::abs(turn) > 0.5) return GaitRegime::Turning;
+  if (across > 0.25 && across > 0.5 * std::abs(along)) return GaitRegime::SideStep;
+  if (speed_change > 0.3) return GaitRegime::StartStop;
+  if (glm::length(velocity) < 0.1) return GaitRegime::Standing;
+  return GaitRegime::Straight;
+}
+
+}  // namespace
+
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpaceClip& posed, double frame_time,
                                        const ContactOptions& options) {
   const FeetJoints feet = FeetJoints::from_roles(skeleton);
   const ContactReport contacts = detect_foot_contacts(skeleton, posed, frame_time, feet, options);
-  return measure_foot_skating(posed, contacts, feet);
+  FootSkatingReport r = measure_foot_skating(posed, contacts, feet);
+  const std::int32_t left = skeleton.role(Role::LeftThigh), right = skeleton.role(Role::RightThigh);
+  if (left < 0 || right < 0) return r;
+  // The same order as the slides: the left foot's contacts, then the right's.
+  for (const FootContacts& fc : contacts.feet)
+    for (const ContactInterval& c : fc.intervals)
+      r.regimes.push_back(static_cast<std::uint8_t>(classify_contact(posed, frame_time, c, left, right)));
+  if (r.regimes.size() != r.slides_cm.size()) r.regimes.clear();
+  return r;
+}
+
+std::vector<FootSkatingReport> by_regime(const FootSkatingReport& r) {
+  std::vector<std::vector<double>> slides(kGaitRegimes);
+  for (std::size_t i = 0; i < r.regimes.size() && i < r.slides_cm.size(); ++i)
+    slides[r.regimes[i] % kGaitRegimes].push_back(r.slides_cm[i]);
+  std::vector<FootSkatingReport> out;
+  for (std::vector<double>& s : slides) out.push_back(summarise_foot_skating(std::move(s)));
+  return out;
 }
 
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options) {
@@ -118,6 +201,7 @@ constexpr double kMinRunSeconds = 1.5;  // about a gait cycle and a half
 FootSkatingReport FootSkatingRecorder::measure(const Skeleton& skeleton, double frame_time,
                                                const ContactOptions& options) const {
   std::vector<double> slides;
+  std::vector<std::uint8_t> regimes;
   std::vector<Index> characters;
   if (frames_ < 3 || !(frame_time > 0.0)) return summarise_foot_skating(slides);
   const auto J = static_cast<std::size_t>(joints_);
@@ -142,6 +226,7 @@ FootSkatingReport FootSkatingRecorder::measure(const Skeleton& skeleton, double 
                                rotations_[t].begin() + static_cast<std::ptrdiff_t>(end * J));
         const FootSkatingReport r = measure_foot_skating(skeleton, posed, frame_time, options);
         slides.insert(slides.end(), r.slides_cm.begin(), r.slides_cm.end());
+        regimes.insert(regimes.end(), r.regimes.begin(), r.regimes.end());
       }
       begin = end + 1;
     }
@@ -149,6 +234,7 @@ FootSkatingReport FootSkatingRecorder::measure(const Skeleton& skeleton, double 
   }
   FootSkatingReport r = summarise_foot_skating(std::move(slides));
   r.characters = std::move(characters);
+  if (regimes.size() == r.slides_cm.size()) r.regimes = std::move(regimes);
   return r;
 }
 

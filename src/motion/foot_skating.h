@@ -23,6 +23,15 @@
 
 namespace throng::motion {
 
+// What the body does during a foot contact, from its hips (the thighs'
+// mid-point travelling, the line between them facing, averaged over +-0.3 s
+// against the pelvis' swing): turning (over 0.5 rad/s), stepping sideways (over 0.25 m/s across the facing and more than
+// half the speed along it), starting or stopping (speed changing by over
+// 0.3 m/s), standing (under 0.1 m/s), else walking straight; in that order.
+enum class GaitRegime : std::uint8_t { Straight, Turning, SideStep, StartStop, Standing };
+inline constexpr int kGaitRegimes = 5;
+const char* to_string(GaitRegime regime);  // "straight", "turning", "side_step", "start_stop", "standing"
+
 // With no contact measured the figures are NaN, not zero: nothing was
 // measured, so no bound on them can hold by accident (NaN < x is false), and
 // JSON writes them as null.
@@ -33,6 +42,9 @@ struct FootSkatingReport {
   double p95_cm = std::numeric_limits<double>::quiet_NaN();  // nearest-rank 95th percentile over contacts
   double max_cm = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> slides_cm;  // per contact: left foot's, then right's
+  // Per contact, the GaitRegime (as slides_cm); empty where not classified
+  // (no thigh roles, or a report summarised from slides alone).
+  std::vector<std::uint8_t> regimes;
 
   bool measured() const { return contacts > 0; }
 };
@@ -51,6 +63,9 @@ FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& cli
 // roles, then the measure.
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpaceClip& posed, double frame_time,
                                        const ContactOptions& options = {});
+
+// The report of the contacts of each regime (regimes must be classified).
+std::vector<FootSkatingReport> by_regime(const FootSkatingReport& r);
 
 // Mean, p95 and max of per-contact slides (cm), e.g. pooled over characters.
 FootSkatingReport summarise_foot_skating(std::vector<double> slides_cm);

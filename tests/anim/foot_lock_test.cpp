@@ -91,6 +91,13 @@ Drive drive(const Motion& motion, float seconds, bool lock, float frame = kFrame
   return run;
 }
 
+// Contacts of a report classified as `regime` (motion::GaitRegime).
+int contacts_of(const motion::FootSkatingReport& r, motion::GaitRegime regime) {
+  int n = 0;
+  for (const std::uint8_t k : r.regimes) n += k == static_cast<std::uint8_t>(regime) ? 1 : 0;
+  return n;
+}
+
 // Prints and checks one motion with and without locking; returns both.
 std::pair<Drive, Drive> expect_planted(const char* what, const Motion& motion, float seconds, float frame = kFrame) {
   const Drive free = drive(motion, seconds, false, frame);
@@ -125,6 +132,7 @@ TEST(FootLock, TurningOnTheSpotKeepsTheFeetPlanted) {
   EXPECT_GE(half.second.steps, 4);
   EXPECT_EQ(quarter.second.most_stepping, 1);
   EXPECT_EQ(half.second.most_stepping, 1);
+  EXPECT_GE(contacts_of(half.second.skating, motion::GaitRegime::Turning), 1);
 }
 
 // A viewer paused in the middle of a step (frames with dt = 0) shows the
@@ -187,6 +195,7 @@ TEST(FootLock, ASideStepKeepsTheFeetPlanted) {
   // to speed, the feet slide half a metre without locking.
   EXPECT_GT(free.skating_low.max_cm, 20.0);
   EXPECT_LT(locked.skating_low.max_cm, 5.0);
+  EXPECT_GE(contacts_of(locked.skating_low, motion::GaitRegime::SideStep), 1);
 }
 
 // Walking along +x at 1.3 m/s, braking to a stop over 0.6 s, standing 1.5 s,
@@ -219,7 +228,12 @@ MapState stop_and_start(float t) {
   return s;
 }
 
-TEST(FootLock, StoppingAndStartingKeepTheFeetPlanted) { expect_planted("stop and start", stop_and_start, 7.0f); }
+TEST(FootLock, StoppingAndStartingKeepTheFeetPlanted) {
+  const auto [free, locked] = expect_planted("stop and start", stop_and_start, 7.0f);
+  EXPECT_GE(contacts_of(locked.skating, motion::GaitRegime::StartStop), 1);
+  EXPECT_GE(contacts_of(locked.skating, motion::GaitRegime::Standing), 1);
+  EXPECT_GE(contacts_of(locked.skating, motion::GaitRegime::Straight), 1);
+}
 
 TEST(FootLock, AStraightWalkIsBarelyCorrected) {
   // Constant speed in a straight line: the clip's own motion, so the
@@ -237,6 +251,12 @@ TEST(FootLock, AStraightWalkIsBarelyCorrected) {
     std::printf("straight walk at %.1f m/s: %s, largest correction %.2f cm\n", speed,
                 motion::describe(run.skating).c_str(), 100.0f * run.largest_correction);
     EXPECT_LT(run.largest_correction, 0.05f) << speed << " m/s";
+    // Every contact of a straight walk at a steady speed is classified so.
+    for (int k = 0; k < motion::kGaitRegimes; ++k)
+      std::printf("  %s %d", motion::to_string(static_cast<motion::GaitRegime>(k)),
+                  contacts_of(run.skating, static_cast<motion::GaitRegime>(k)));
+    std::printf("\n");
+    EXPECT_EQ(contacts_of(run.skating, motion::GaitRegime::Straight), run.skating.contacts) << speed << " m/s";
   }
 }
 
