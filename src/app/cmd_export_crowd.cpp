@@ -49,8 +49,10 @@ void export_crowd(const ExportOptions& o) {
   if (std::filesystem::path(out).extension() != ".glb")
     throw Error("must name a .glb file (glTF 2.0 binary)", at_field("--out", out));
 
-  // Size and memory, before any work: the keys dominate both.
-  const anim::Rig probe = anim::make_rig("mannequin", motion::make_default_blend_space().skeleton());
+  // The motion set first (its skeleton sizes the file), then size and
+  // memory, before any work: the keys dominate both.
+  const std::shared_ptr<const motion::BlendSpace1D> motion_set = load_scenario_motion(loaded);
+  const anim::Rig probe = anim::make_rig("mannequin", motion_set->skeleton());
   const double bytes = io::CrowdTake::estimate_bytes(probe, spec.total_agents(), frames);
   if (bytes > o.max_megabytes * 1e6)
     throw Error(fmt::format("{} agents x {} frames would write about {:.0f} MB, over --max-size {:g} MB: lower --fps, "
@@ -71,7 +73,7 @@ void export_crowd(const ExportOptions& o) {
   LocomotionStageOptions lo;
   lo.fps = o.fps;
   lo.lod = false;  // every joint of every agent: what a DCC tool shows up close
-  lo.locomotion.space = load_scenario_motion(loaded);
+  lo.locomotion.space = motion_set;
   lo.locomotion.skating_agents = 0;
   lo.on_frame = [&](double, const Camera*, SimulationLocomotion& moved) {
     const anim::CrowdAnimator& crowd = moved.animator();

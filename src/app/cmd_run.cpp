@@ -208,10 +208,13 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
           "LOD holds are not measured)\n    by what the body does (mean / p95 cm, contacts):",
           skate["mean"].get<double>(), skate["p95"].get<double>(), skate["contacts"].get<int>(),
           skate["agents_measured"].get<int>(), skate["agents"].get<int>());
-      for (const auto& [regime, f] : skate["by_regime"].items())
+      for (int k = 0; k < motion::kGaitRegimes; ++k) {
+        const char* regime = motion::to_string(static_cast<motion::GaitRegime>(k));
+        const auto& f = skate["by_regime"][regime];
         if (f["contacts"].get<int>() > 0)
-          std::printf(" %s %.2f / %.2f (%d);", regime.c_str(), f["mean"].get<double>(), f["p95"].get<double>(),
+          std::printf(" %s %.2f / %.2f (%d);", regime, f["mean"].get<double>(), f["p95"].get<double>(),
                       f["contacts"].get<int>());
+      }
       std::printf("\n");
     } else {
       std::printf(
@@ -455,9 +458,9 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
 
 // The locomotion stage, on by default up to kAnimateUpTo agents: joint LOD
 // under the scenario's camera and, with --render, the recorder.
-RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& sim, const io::LoadedScenario& loaded,
-                                 const RunOptions& o, const std::string& dir) {
-  const sim::ScenarioSpec& spec = loaded.spec;
+RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& sim, const sim::ScenarioSpec& spec,
+                                 std::shared_ptr<const motion::BlendSpace1D> motion_set, const RunOptions& o,
+                                 const std::string& dir) {
   RenderHooks hooks;
   const Index n = sim.agent_count();
   if (o.no_animate && !o.render.empty())
@@ -470,7 +473,7 @@ RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& si
                  static_cast<long long>(n), static_cast<long long>(kAnimateUpTo));
   if (!animate) return hooks;
   LocomotionStageOptions lo;
-  lo.locomotion.space = load_scenario_motion(loaded);
+  lo.locomotion.space = std::move(motion_set);
   lo.locomotion.lod_thresholds = o.lod_thresholds;
   const Camera lod_camera = scenario_camera(sim);  // the camera that renders is the one LOD measures with
   lo.camera = [lod_camera](double) { return lod_camera; };
@@ -557,13 +560,16 @@ void run_scenario(const RunOptions& o) {
   io::LoadedScenario loaded = io::load_scenario(o.scenario);
   sim::ScenarioSpec& spec = loaded.spec;
   const std::int64_t max_steps = apply_run_options(spec, o);
+  // The user's own clips are read (and refused) before any work; null = the default set.
+  std::shared_ptr<const motion::BlendSpace1D> motion_set;
+  if (!o.no_animate && !loaded.motion.is_default()) motion_set = load_scenario_motion(loaded);
   const std::string dir = make_output_dir(loaded, o, max_steps);
   check_run_budget(spec, o);
   const std::unique_ptr<sim::Simulation> sim = build_or_exit(loaded, dir);
 
   sim::FrameLoop loop(*sim);
   RunOutputs outputs = add_output_stages(loop, *sim, loaded, o, dir, max_steps);
-  const RenderHooks hooks = add_locomotion_stage(loop, *sim, loaded, o, dir);
+  const RenderHooks hooks = add_locomotion_stage(loop, *sim, spec, motion_set, o, dir);
   const sim::RunResult result = run_steps(loop, *sim, spec, max_steps, o.quiet);
   const nlohmann::json stats = run_stats(loop, loaded, outputs, hooks);
   write_and_report(*sim, result, stats, spec, dir, outputs);

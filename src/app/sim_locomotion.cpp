@@ -31,7 +31,6 @@ std::vector<Index> tracked_agents(Index n, Index wanted) {
 }  // namespace
 
 std::shared_ptr<const motion::BlendSpace1D> load_scenario_motion(const io::LoadedScenario& loaded) {
-  if (loaded.motion.is_default()) return nullptr;
   return std::make_shared<const motion::BlendSpace1D>(
       io::load_motion_set(loaded.motion, loaded.motion_folder(), "motion"));
 }

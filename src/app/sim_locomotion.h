@@ -39,8 +39,8 @@ struct SimulationLocomotionOptions {
   Index skating_agents = 64;          // agents, evenly spread over the crowd, whose foot skating is measured
 };
 
-// The scenario's motion set (its `motion` key, io/motion_set.h) loaded, or
-// null for the default set. Errors name the clip's file.
+// The scenario's motion set (its `motion` key, io/motion_set.h; the default
+// set without one), loaded. Errors name the clip's file.
 std::shared_ptr<const motion::BlendSpace1D> load_scenario_motion(const io::LoadedScenario& loaded);
 
 // The scenario's camera, the one that renders and drives the LOD: its own,

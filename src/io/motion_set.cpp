@@ -65,22 +65,28 @@ MotionSetSpec read_motion_set(YamlReader& r, const YAML::Node& m, const std::str
 
 namespace {
 
-// One clip's file read and turned Y-up (Error naming the file otherwise).
-BvhFile read_clip(const MotionSetSpec& spec, const std::filesystem::path& path) {
+// One clip's file read and turned Y-up (Error naming the file and `field`,
+// the clip's key, otherwise).
+BvhFile read_clip(const MotionSetSpec& spec, const std::filesystem::path& path, const std::string& field) {
   BvhReadOptions options;
   options.unit = spec.unit;
   BvhFile file = read_bvh(path.string(), options);
   const motion::UpAxisGuess guess = motion::guess_up_axis(file.skeleton, file.clip);
+  const Location where{path.string(), 0, 0, field + ".up_axis"};
   const std::string body = fmt::format("feet to head in the first frame: {:.2f}, {:.2f}, {:.2f} m", guess.body.x,
                                        guess.body.y, guess.body.z);
   if (spec.up_axis && guess.axis && *guess.axis != *spec.up_axis)
     throw Error(fmt::format("the body stands along +{} ({}), but motion.up_axis is {}", motion::to_string(*guess.axis),
                             body, motion::to_string(*spec.up_axis)),
-                Location{path.string(), 0, 0, "up_axis"});
-  if (!spec.up_axis && !guess.axis)
-    throw Error(fmt::format("cannot tell which way is up ({}); give motion.up_axis: y or z", body),
-                Location{path.string(), 0, 0, "up_axis"});
-  const motion::UpAxis up = spec.up_axis ? *spec.up_axis : *guess.axis;
+                where);
+  if (!spec.up_axis && !guess.axis && guess.from_roles)
+    throw Error(fmt::format("cannot tell which way is up ({}); give motion.up_axis: y or z", body), where);
+  if (!spec.up_axis && !guess.from_roles)
+    spdlog::warn(
+        "{}: no ankle and head joints to tell the up axis by: taken as y (BVH's usual; motion.up_axis says "
+        "otherwise)",
+        path.string());
+  const motion::UpAxis up = spec.up_axis ? *spec.up_axis : guess.axis.value_or(motion::UpAxis::Y);
   if (up == motion::UpAxis::Z) motion::z_up_to_y_up(file.skeleton, file.clip);
   spdlog::debug("{}: {}-up, unit {}{}", path.string(), motion::to_string(up), motion::to_string(file.unit),
                 file.unit_detected ? " (detected)" : "");
@@ -120,23 +126,24 @@ motion::BlendSpace1D load_motion_set(const MotionSetSpec& spec, const std::files
     const MotionClipSource& src = spec.clips[i];
     const std::filesystem::path path =
         std::filesystem::path(src.file).is_absolute() ? std::filesystem::path(src.file) : folder / src.file;
-    const BvhFile file = read_clip(spec, path);
+    const std::string clip_field = field + ".clips[" + std::to_string(i) + "]";
+    const BvhFile file = read_clip(spec, path, field);
     if (i == 0)
       skeleton = file.skeleton;
     else if (file.skeleton.joint_count() != skeleton.joint_count())
       throw Error(fmt::format("has {} joints, the first clip {}: the clips of a motion set share one skeleton",
                               file.skeleton.joint_count(), skeleton.joint_count()),
-                  Location{path.string(), 0, 0, field + ".clips[" + std::to_string(i) + "]"});
+                  Location{path.string(), 0, 0, clip_field});
     motion::LocomotionOptions options;
     options.cycle.skip_frames = src.skip_frames;
     try {
       clips.push_back(motion::prepare_locomotion_clip(skeleton, file.clip, src.name, options));
     } catch (const Error& e) {
-      throw Error(e.message(), Location{path.string(), 0, 0, field + ".clips[" + std::to_string(i) + "]"});
+      throw Error(e.message(), Location{path.string(), 0, 0, clip_field});
     }
     const motion::LocomotionClip& c = clips.back();
     if (const std::string why = not_a_gait(c); !why.empty())
-      throw Error(why, Location{path.string(), 0, 0, field + ".clips[" + std::to_string(i) + "]"});
+      throw Error(why, Location{path.string(), 0, 0, clip_field});
     spdlog::info("{}: cycle of {} frames ({:.2f} s), {:.2f} m/s, stride {:.2f} m", src.name, c.frame_count(),
                  c.period_s, c.speed, c.stride_m);
   }

@@ -60,7 +60,8 @@ struct LoadedScenario {
   // because only `throng run` reads it.
   TrajectoryFormat trajectory_format = TrajectoryFormat::Csv;
   // motion: the clips characters are animated from (`throng run`, `throng
-  // view`); paths relative to the file's folder (motion_folder()).
+  // view`, `throng export-crowd`); paths relative to the file's folder
+  // (motion_folder(); a built-in's are relative to the working folder).
   MotionSetSpec motion;
   std::filesystem::path motion_folder() const;
 };

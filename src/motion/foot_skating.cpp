@@ -113,22 +113,27 @@ double mean_facing(const ModelSpaceClip& m, double frame_time, std::int32_t fram
 
 GaitRegime classify_contact(const ModelSpaceClip& m, double frame_time, const ContactInterval& c, std::int32_t left,
                             std::int32_t right) {
-  const std::int32_t last = c.end - 1;
-  if (last <= c.begin) return GaitRegime::Standing;
-  const Hips a = hips_at(m, c.begin, left, right), b = hips_at(m, last, left, right);
-  const double seconds = static_cast<double>(last - c.begin) * frame_time;
+  // At least two frames apart: a one-frame contact is measured across its
+  // neighbours.
+  std::int32_t first = c.begin, last = c.end - 1;
+  if (last <= first) {
+    first = std::max(0, first - 1);
+    last = std::min(m.frame_count - 1, last + 1);
+    if (last <= first) return GaitRegime::Standing;
+  }
+  const Hips a = hips_at(m, first, left, right), b = hips_at(m, last, left, right);
+  const double seconds = static_cast<double>(last - first) * frame_time;
   const glm::dvec2 velocity = (b.at - a.at) / seconds;
+  const double facing = mean_facing(m, frame_time, first, left, right);
   const double turn =
-      std::remainder(mean_facing(m, frame_time, last, left, right) - mean_facing(m, frame_time, c.begin, left, right),
-                     2.0 * std::numbers::pi) /
-      seconds;
-  const glm::dvec2 forward(std::sin(a.facing), std::cos(a.facing));
+      std::remainder(mean_facing(m, frame_time, last, left, right) - facing, 2.0 * std::numbers::pi) / seconds;
+  const glm::dvec2 forward(std::sin(facing), std::cos(facing));
   const double along = glm::dot(velocity, forward);
   const double across = std::abs(velocity.x * forward.y - velocity.y * forward.x);
   const auto speed_at = [&](std::int32_t f) {
     return glm::length(hips_at(m, f + 1, left, right).at - hips_at(m, f, left, right).at) / frame_time;
   };
-  const double speed_change = std::abs(speed_at(last - 1) - speed_at(c.begin));
+  const double speed_change = std::abs(speed_at(last - 1) - speed_at(first));
   if (std::abs(turn) > 0.5) return GaitRegime::Turning;
   if (across > 0.25 && across > 0.5 * std::abs(along)) return GaitRegime::SideStep;
   if (speed_change > 0.3) return GaitRegime::StartStop;
@@ -151,15 +156,6 @@ FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpac
       r.regimes.push_back(static_cast<std::uint8_t>(classify_contact(posed, frame_time, c, left, right)));
   if (r.regimes.size() != r.slides_cm.size()) r.regimes.clear();
   return r;
-}
-
-std::vector<FootSkatingReport> by_regime(const FootSkatingReport& r) {
-  std::vector<std::vector<double>> slides(kGaitRegimes);
-  for (std::size_t i = 0; i < r.regimes.size() && i < r.slides_cm.size(); ++i)
-    slides[r.regimes[i] % kGaitRegimes].push_back(r.slides_cm[i]);
-  std::vector<FootSkatingReport> out;
-  for (std::vector<double>& s : slides) out.push_back(summarise_foot_skating(std::move(s)));
-  return out;
 }
 
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& clip, const ContactOptions& options) {

@@ -64,9 +64,6 @@ FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const Clip& cli
 FootSkatingReport measure_foot_skating(const Skeleton& skeleton, const ModelSpaceClip& posed, double frame_time,
                                        const ContactOptions& options = {});
 
-// The report of the contacts of each regime (regimes must be classified).
-std::vector<FootSkatingReport> by_regime(const FootSkatingReport& r);
-
 // Mean, p95 and max of per-contact slides (cm), e.g. pooled over characters.
 FootSkatingReport summarise_foot_skating(std::vector<double> slides_cm);
 

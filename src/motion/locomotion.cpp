@@ -507,8 +507,9 @@ std::string no_cycle_message(const Clip& clip, const CycleOptions& o) {
     travel += std::hypot(static_cast<double>(d.x), static_cast<double>(d.z));
   }
   if (seconds < o.min_period_s)
-    return fmt::format("no locomotion cycle: the clip lasts {:.2f} s, shorter than a cycle ({:.1f} s at least)",
-                       seconds, o.min_period_s);
+    return fmt::format("no locomotion cycle: the clip lasts {:.2f} s{}, shorter than a cycle ({:.1f} s at least)",
+                       seconds, first > 0 ? fmt::format(" after skip_frames {}", first) : std::string(),
+                       o.min_period_s);
   if (travel < o.min_mean_speed * seconds)
     return fmt::format(
         "no locomotion cycle: the root moves {:.2f} m in {:.1f} s ({:.2f} m/s): not locomotion (a walk or run "
@@ -516,8 +517,9 @@ std::string no_cycle_message(const Clip& clip, const CycleOptions& o) {
         travel, seconds, travel / seconds, o.min_mean_speed);
   return fmt::format(
       "no locomotion cycle: the root moves {:.2f} m in {:.1f} s, but no stretch of {:.1f} to {:.1f} s repeats "
-      "(steady walking or running is needed; a T-pose at the start can be skipped with skip_frames)",
-      travel, seconds, o.min_period_s, o.max_period_s);
+      "(steady walking or running is needed{})",
+      travel, seconds, o.min_period_s, o.max_period_s,
+      first > 0 ? std::string() : "; a T-pose at the start can be skipped with skip_frames");
 }
 
 }  // namespace

@@ -58,6 +58,7 @@ UpAxisGuess guess_up_axis(const Skeleton& skeleton, const Clip& clip) {
     return g;
   }
   g.body = *body;
+  g.from_roles = true;
   const glm::vec3 a = glm::abs(g.body);
   if (g.body.y > 0.0f && a.y >= 2.0f * a.x && a.y >= 2.0f * a.z) g.axis = UpAxis::Y;
   if (g.body.z > 0.0f && a.z >= 2.0f * a.x && a.z >= 2.0f * a.y) g.axis = UpAxis::Z;

@@ -26,7 +26,8 @@ std::optional<UpAxis> parse_up_axis(std::string_view text);
 // components (a lying or crouching pose: the caller asks for up_axis).
 struct UpAxisGuess {
   std::optional<UpAxis> axis;
-  glm::vec3 body{0.0f};  // feet to head, metres as read; without roles the rest pose's extent
+  bool from_roles = false;  // the roles were there (else no guess at all)
+  glm::vec3 body{0.0f};     // feet to head, metres as read; without roles the rest pose's extent
 };
 UpAxisGuess guess_up_axis(const Skeleton& skeleton, const Clip& clip);
 

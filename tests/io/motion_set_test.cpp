@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "io/bvh_writer.h"
+#include "io/scenario_yaml.h"
 #include "motion/default_set.h"
 #include "tests/shared_data.h"
 
@@ -142,6 +143,25 @@ TEST_F(MotionSetFiles, AZUpFileIsDetectedAndGivesTheSameClips) {
     EXPECT_NE(m.find("the body stands along +z"), std::string::npos) << m;
     EXPECT_NE(m.find("motion.up_axis is y"), std::string::npos) << m;
   }
+}
+
+// A scenario file's clips are found beside it, wherever throng runs from.
+TEST_F(MotionSetFiles, AScenariosClipsAreRelativeToItsFile) {
+  write("walk", "walk.bvh", false);
+  write("run_slow", "run.bvh", false);
+  const fs::path scenario = dir_ / "scene.yaml";
+  FILE* f = std::fopen(scenario.string().c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs(
+      "groups:\n  - {count: 2, spawn: {ring: {center: [0, 0], spacing: 1.0}}, goal: {mirror: [0, 0]}}\n"
+      "motion: [walk.bvh, run.bvh]\n",
+      f);
+  std::fclose(f);
+  const LoadedScenario loaded = read_scenario_file(scenario.string());
+  EXPECT_EQ(loaded.motion_folder(), dir_);
+  const motion::BlendSpace1D space = load_motion_set(loaded.motion, loaded.motion_folder(), "motion");
+  EXPECT_EQ(space.clip_count(), 2);
+  EXPECT_EQ(load_builtin_scenario("circle").motion_folder(), fs::path());
 }
 
 TEST_F(MotionSetFiles, RefusalsSayWhatIsWrongWithTheClip) {

@@ -122,11 +122,6 @@ TEST(Viewer, RendersUnderXvfbAndQuitsWithAScreenshot) {
   EXPECT_GT(distinct_colours(im), 200u);
 }
 
-// Without a window: a scenario simulated and animated, written as PNG
-// frames under its camera set in motion; the formation of throng animate
-// as a screenshot. Each is drawn twice, in joint-LOD colours and in
-// clothing colours, so the pixels that differ are the characters': a
-// picture of the ground alone, or a cleared one, fails.
 // The viewer animates a scenario's own motion-capture clips (CMU subject
 // 16's walk and jog, 43 joints) and draws them.
 TEST(Viewer, HeadlessDrawsAScenariosOwnMotionCaptureClips) {
@@ -148,6 +143,9 @@ TEST(Viewer, HeadlessDrawsAScenariosOwnMotionCaptureClips) {
   const std::string command = std::string(THRONG_EXE) + " view " + scenario.string() +
                               " --headless --render frames --frames 3 --width 160 --height 90 --out ";
   ASSERT_EQ(run(command + dir.string() + " --lod-colours", out), 0) << out;
+  // The clips' cycles, found as the viewer loads them (the default set logs none).
+  EXPECT_NE(out.find("cmu_16_15_walk_daz: cycle of"), std::string::npos) << out;
+  EXPECT_NE(out.find("cmu_16_36_run_jog_daz: cycle of"), std::string::npos) << out;
   out.clear();
   ASSERT_EQ(run(command + (dir / "clothes").string(), out), 0) << out;
   const Image im = read_png((dir / "frame_00002.png").string());
@@ -157,6 +155,11 @@ TEST(Viewer, HeadlessDrawsAScenariosOwnMotionCaptureClips) {
   std::filesystem::remove_all(dir);
 }
 
+// Without a window: a scenario simulated and animated, written as PNG
+// frames under its camera set in motion; the formation of throng animate
+// as a screenshot. Each is drawn twice, in joint-LOD colours and in
+// clothing colours, so the pixels that differ are the characters': a
+// picture of the ground alone, or a cleared one, fails.
 TEST(Viewer, HeadlessWritesFramesOfAScenarioAndScreenshotsOfTheFormation) {
   const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_headless";
   std::filesystem::remove_all(dir);
