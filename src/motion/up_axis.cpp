@@ -24,11 +24,15 @@ std::optional<glm::vec3> body_by_roles(const Skeleton& skeleton, const Clip& cli
   std::int32_t top = skeleton.role(Role::Head);
   if (top < 0) top = skeleton.role(Role::Neck);
   if (left < 0 || right < 0 || top < 0 || clip.frame_count < 1) return std::nullopt;
-  Clip first = clip;
+  // Frame 0 alone (not a copy of the whole clip).
+  const auto J = static_cast<std::ptrdiff_t>(clip.joint_count);
+  Clip first;
+  first.joint_count = clip.joint_count;
   first.frame_count = 1;
-  first.rotations.resize(static_cast<std::size_t>(clip.joint_count));
-  first.root_positions.resize(1);
-  if (!first.translations.empty()) first.translations.resize(static_cast<std::size_t>(clip.joint_count));
+  first.frame_time = clip.frame_time;
+  first.rotations.assign(clip.rotations.begin(), clip.rotations.begin() + J);
+  first.root_positions.assign(clip.root_positions.begin(), clip.root_positions.begin() + 1);
+  if (!clip.translations.empty()) first.translations.assign(clip.translations.begin(), clip.translations.begin() + J);
   const ModelSpaceClip posed = forward_kinematics(skeleton, first);
   return posed.position(0, top) - 0.5f * (posed.position(0, left) + posed.position(0, right));
 }
