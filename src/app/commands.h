@@ -63,6 +63,7 @@ void add_export_command(CLI::App& app, const GlobalOptions& g);
 void add_export_crowd_command(CLI::App& app, const GlobalOptions& g);
 void add_match_command(CLI::App& app, const GlobalOptions& g);
 void add_route_command(CLI::App& app, const GlobalOptions& g);
+void add_verify_command(CLI::App& app, const GlobalOptions& g);
 void add_view_command(CLI::App& app, const GlobalOptions& g);
 void add_version_command(CLI::App& app);
 

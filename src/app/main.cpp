@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
   add_export_crowd_command(app, g);
   add_match_command(app, g);
   add_route_command(app, g);
+  add_verify_command(app, g);
   add_view_command(app, g);
   add_version_command(app);
   // The same options after the command's name: `throng run circle --threads 1`.

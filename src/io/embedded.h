@@ -36,5 +36,6 @@ struct EmbeddedSet {
 extern const EmbeddedSet kBuiltinScenarios;         // examples/*.yaml
 extern const EmbeddedSet kBuiltinAnimateScenarios;  // examples/animate/*.yaml
 extern const EmbeddedSet kBuiltinMotionData;        // data/motion/*.yaml
+extern const EmbeddedSet kBuiltinVerification;      // examples/verification/*.yaml (throng verify)
 
 }  // namespace throng::io

@@ -1,0 +1,216 @@
+// Running one verification scenario and recording what the RiMEA tests
+// judge: per agent its start, first movement, arrival, last position and
+// line crossings; per measurement area a sample a second; the deepest
+// overlap and the agents in walls.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "app/verification.h"
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "io/embedded.h"
+#include "sim/simulation.h"
+
+namespace throng::app {
+
+io::LoadedScenario load_verification_scenario(const std::string& name, const VerifyOptions& o) {
+  const std::optional<std::string_view> text = io::kBuiltinVerification.find(name);
+  if (!text) throw Error("no verification scenario named '" + name + "' in this build");
+  io::LoadedScenario loaded = io::parse_scenario(*text, "examples/verification/" + name + ".yaml");
+  if (o.model) loaded.spec.model.kind = *o.model;
+  return loaded;
+}
+
+std::vector<double> ScenarioObservation::arrivals() const {
+  std::vector<double> out;
+  for (float t : arrival_time)
+    if (t >= 0) out.push_back(t);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+double ScenarioObservation::evacuation_time() const {
+  const std::vector<double> a = arrivals();
+  if (a.size() < arrival_time.size() || a.empty()) return std::numeric_limits<double>::infinity();
+  return a.back();
+}
+
+std::vector<double> ScenarioObservation::crossing_times(std::int32_t line, std::optional<Index> agent) const {
+  std::vector<double> out;
+  for (const sim::LineCrossing& x : crossings)
+    if (x.line == line && (!agent || x.agent == *agent)) out.push_back(x.time);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+namespace {
+
+constexpr float kMovedM = 0.01f;      // an agent has started walking once 1 cm from its spawn point
+constexpr double kTrackEveryS = 0.5;  // track point spacing
+constexpr float kInWallM = 1e-3f;     // a disc entering a wall by more than this counts
+
+// The per-step bookkeeping of observe(): host copies of the state before
+// and after each step.
+class Recorder {
+ public:
+  Recorder(const sim::Simulation& sim, const ObserveOptions& options, ScenarioObservation& out)
+      : options_(options), out_(out), spawn_(sim.positions()), before_(spawn_), flags_before_(sim.flags()) {
+    const std::size_t n = spawn_.size();
+    out_.first_move.assign(n, -1.0f);
+    out_.last_seen = spawn_;
+    if (options_.tracks) out_.tracks.assign(n, {});
+    out_.area_samples.assign(sim.spec().measurement.areas.size(), {});
+    track(sim);
+  }
+
+  void after_step(const sim::Simulation& sim) {
+    const std::vector<glm::vec2> after = sim.positions();
+    const std::vector<std::uint8_t> flags = sim.flags();
+    const double t1 = sim.time(), t0 = t1 - sim.spec().dt;
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      const bool was_in = (flags_before_[i] & sim::kAgentActive) != 0, is_in = (flags[i] & sim::kAgentActive) != 0;
+      if (is_in) out_.last_seen[i] = after[i];
+      if (is_in && out_.first_move[i] < 0 && glm::length(after[i] - spawn_[i]) > kMovedM)
+        out_.first_move[i] = static_cast<float>(t1);
+      if (was_in && is_in) cross(sim.spec().measurement, before_[i], after[i], static_cast<Index>(i), t0, t1);
+    }
+    before_ = after;
+    flags_before_ = flags;
+    const sim::CrowdState& c = sim.crowd();
+    out_.most_in_walls = std::max(
+        out_.most_in_walls,
+        sim::count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), kInWallM));
+    if (every(sim, 1.0)) sample(sim);
+    if (options_.tracks && every(sim, kTrackEveryS)) track(sim);
+  }
+
+ private:
+  // True on the step that ends a whole multiple of `period` seconds.
+  static bool every(const sim::Simulation& sim, double period) {
+    const auto per = std::max<std::int64_t>(1, std::llround(period / sim.spec().dt));
+    return sim.steps_done() % per == 0;
+  }
+  void cross(const sim::MeasurementSpec& m, glm::vec2 p0, glm::vec2 p1, Index agent, double t0, double t1) {
+    for (std::size_t k = 0; k < m.lines.size(); ++k) {
+      double s = 0;
+      const int direction = sim::step_crossing(p0, p1, m.lines[k].from, m.lines[k].to, &s);
+      if (direction != 0)
+        out_.crossings.push_back({t0 + s * (t1 - t0), agent, static_cast<std::int32_t>(k), direction});
+    }
+  }
+  void sample(const sim::Simulation& sim) {
+    const sim::CrowdState& c = sim.crowd();
+    const sim::OverlapStats o =
+        sim::measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, sim.contact_cell());
+    out_.deepest_overlap = std::max(out_.deepest_overlap, o.max_depth);
+    if (sim.time() + 1e-6 < options_.sample_from_s) return;
+    const auto& areas = sim.spec().measurement.areas;
+    for (std::size_t k = 0; k < areas.size(); ++k)
+      out_.area_samples[k].push_back(
+          sim::measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), areas[k].rect));
+  }
+  void track(const sim::Simulation& sim) {
+    if (!options_.tracks) return;
+    const std::vector<glm::vec2> p = sim.positions();
+    const std::vector<std::uint8_t> f = sim.flags();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (f[i] & sim::kAgentActive) out_.tracks[i].push_back(p[i]);
+  }
+
+  ObserveOptions options_;
+  ScenarioObservation& out_;
+  std::vector<glm::vec2> spawn_, before_;
+  std::vector<std::uint8_t> flags_before_;
+};
+
+}  // namespace
+
+ScenarioObservation observe(const io::LoadedScenario& scenario, const ObserveOptions& options) {
+  io::LoadedScenario loaded = scenario;
+  if (options.agents) sim::scale_agent_counts(loaded.spec, *options.agents);
+  ScenarioObservation out;
+  out.spec = loaded.spec;
+  const std::unique_ptr<sim::Simulation> sim = io::build_simulation(loaded);
+  Recorder recorder(*sim, options, out);
+  const std::int64_t steps = loaded.spec.step_count();
+  for (std::int64_t k = 0; k < steps; ++k) {
+    sim->step();
+    recorder.after_step(*sim);
+    if (loaded.spec.stop_when_arrived && sim->all_arrived()) break;
+  }
+  const sim::CrowdState& c = sim->crowd();
+  out.end_time = sim->time();
+  out.agents = sim->agent_count();
+  out.group = c.group.to_vector();
+  out.pref_speed = c.pref_speed.to_vector();
+  out.start_time = c.start_time.to_vector();
+  out.arrival_time = sim->arrival_times();
+  return out;
+}
+
+}  // namespace throng::app
+
+namespace throng::app {
+
+const char* to_string(VerifyStatus s) {
+  switch (s) {
+    case VerifyStatus::pass: return "pass";
+    case VerifyStatus::fail: return "fail";
+    case VerifyStatus::not_applicable: return "not applicable";
+  }
+  return "?";
+}
+
+namespace {
+
+void check_selection(const std::vector<int>& only) {
+  const std::vector<VerifyTest>& tests = verification_tests();
+  for (int n : only)
+    if (std::none_of(tests.begin(), tests.end(), [n](const VerifyTest& t) { return t.number == n; }))
+      throw Error(fmt::format("no RiMEA 3.0 test {}: the tests are 1 to 15", n), at_field("--only"));
+}
+
+VerifyResult run_one(const VerifyTest& t, const VerifyOptions& o) {
+  if (!t.run) {
+    VerifyResult r;
+    r.number = t.number;
+    r.title = t.title;
+    r.status = VerifyStatus::not_applicable;
+    r.reason = t.not_applicable;
+    return r;
+  }
+  std::fprintf(stderr, "throng verify: test %d: %s\n", t.number, t.title.c_str());
+  const auto t0 = std::chrono::steady_clock::now();
+  VerifyResult r = t.run(o);
+  r.number = t.number;
+  r.title = t.title;
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const bool all =
+      !r.checks.empty() && std::all_of(r.checks.begin(), r.checks.end(), [](const VerifyCheck& c) { return c.pass; });
+  r.status = all ? VerifyStatus::pass : VerifyStatus::fail;
+  for (const VerifyCheck& c : r.checks)
+    std::fprintf(stderr, "  %s  %s: %s\n", c.pass ? "pass" : "FAIL", c.criterion.c_str(), c.measured.c_str());
+  std::fprintf(stderr, "throng verify: test %d: %s (%.1f s)\n", t.number, to_string(r.status), r.wall_s);
+  return r;
+}
+
+}  // namespace
+
+std::vector<VerifyResult> run_verification(const VerifyOptions& o) {
+  check_selection(o.only);
+  std::vector<VerifyResult> results;
+  for (const VerifyTest& t : verification_tests()) {
+    if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), t.number) == o.only.end()) continue;
+    check_interrupt("verifying");
+    results.push_back(run_one(t, o));
+  }
+  return results;
+}
+
+}  // namespace throng::app
