@@ -604,10 +604,11 @@ class Reader : public YamlReader {
       s.scheduler = sim::parse_scheduler(
           word(root["scheduler"], "scheduler", {"double_buffer", "four_colour", "four_color"}), "scheduler");
     if (root["planning"]) {
-      const std::string p = word(root["planning"], "planning", {"roadmap", "field", "none"});
-      s.planning = p == "none"    ? sim::PlanningKind::None
-                   : p == "field" ? sim::PlanningKind::Field
-                                  : sim::PlanningKind::Roadmap;
+      const std::string p = word(root["planning"], "planning", {"roadmap", "field", "quickest", "none"});
+      s.planning = p == "none"       ? sim::PlanningKind::None
+                   : p == "field"    ? sim::PlanningKind::Field
+                   : p == "quickest" ? sim::PlanningKind::Quickest
+                                     : sim::PlanningKind::Roadmap;
     }
     if (root["dt"]) s.dt = real_in(root["dt"], "dt", 1e-4, 10.0);
     if (root["duration"]) s.duration = real_in(root["duration"], "duration", 1e-3, 1e9);
@@ -759,13 +760,13 @@ std::unique_ptr<sim::Simulation> build_simulation(const LoadedScenario& scenario
       straight.planner = nullptr;
       return std::make_unique<sim::Simulation>(scenario.spec, straight);
     }
-    // `planning: field`: a navigation field per target, no routes.
-    if (scenario.spec.planning == sim::PlanningKind::Field) {
-      const path::FastMarchingFieldBuilder builder;
+    // `planning: field`: a navigation field per target, no routes
+    // (`quickest`: weighed again by the crowd's density as it walks).
+    if (scenario.spec.planning == sim::PlanningKind::Field || scenario.spec.planning == sim::PlanningKind::Quickest) {
       sim::SimulationOptions fields = options;
       fields.planner = nullptr;
       fields.replanner = nullptr;
-      if (fields.fields == nullptr) fields.fields = &builder;
+      if (fields.fields == nullptr) fields.fields = std::make_shared<const path::FastMarchingFieldBuilder>();
       const auto t0 = std::chrono::steady_clock::now();
       auto simulation = std::make_unique<sim::Simulation>(scenario.spec, fields);
       const sim::NavigationFields& f = simulation->fields();

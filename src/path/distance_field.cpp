@@ -158,27 +158,70 @@ void march(std::vector<float>& t, const std::vector<float>& slow, const sim::Fie
   }
 }
 
+// What a field's march starts from: its grid, the slowness of every node
+// (walls only) and the seeds round the target.
+struct PreparedField {
+  sim::FieldGrid grid;
+  std::vector<float> slowness;
+  std::vector<std::pair<float, std::int64_t>> seeds;
+};
+
+PreparedField prepare_field(const FreeSpace& space, glm::vec2 target, float radius, const DistanceFieldOptions& o) {
+  o.validate();
+  if (!(std::isfinite(target.x) && std::isfinite(target.y))) throw Error("the field's target is not finite");
+  sim::Aabb bounds = space.bounds();
+  bounds.add(target);
+  PreparedField p;
+  p.grid = grid_over(bounds, target, o);
+  p.slowness = node_slowness(space, p.grid, radius, o);
+  p.seeds = seeds(space, p.slowness, p.grid);
+  return p;
+}
+
+// The march from the prepared seeds; with `crowd`, every node's slowness
+// (and each seed's value) times the congestion at the node.
+sim::FieldData march_field(const PreparedField& p, const sim::CrowdDensity* crowd) {
+  sim::FieldData field;
+  field.grid = p.grid;
+  field.distance.assign(p.slowness.size(), INFINITY);
+  if (crowd == nullptr) {
+    march(field.distance, p.slowness, field.grid, p.seeds);
+    return field;
+  }
+  std::vector<float> slow = p.slowness;
+  for (std::int32_t j = 0; j < p.grid.ny; ++j)
+    for (std::int32_t i = 0; i < p.grid.nx; ++i)
+      slow[node(p.grid, i, j)] *= sim::congestion_slowness(crowd->at(node_point(p.grid, i, j)));
+  std::vector<std::pair<float, std::int64_t>> start = p.seeds;
+  for (auto& [value, k] : start) {
+    const auto i = static_cast<std::int32_t>(k % p.grid.nx), j = static_cast<std::int32_t>(k / p.grid.nx);
+    value *= sim::congestion_slowness(crowd->at(node_point(p.grid, i, j)));
+  }
+  march(field.distance, slow, field.grid, start);
+  return field;
+}
+
 }  // namespace
 
 sim::FieldData build_distance_field(const FreeSpace& space, glm::vec2 target, float radius,
                                     const DistanceFieldOptions& options) {
-  options.validate();
-  if (!(std::isfinite(target.x) && std::isfinite(target.y))) throw Error("the field's target is not finite");
-  sim::Aabb bounds = space.bounds();
-  bounds.add(target);
-  sim::FieldData field;
-  field.grid = grid_over(bounds, target, options);
-  const std::vector<float> slow = node_slowness(space, field.grid, radius, options);
-  field.distance.assign(slow.size(), INFINITY);
-  march(field.distance, slow, field.grid, seeds(space, slow, field.grid));
-  return field;
+  return march_field(prepare_field(space, target, radius, options), nullptr);
 }
+
+struct FastMarchingFieldBuilder::Prepared {
+  glm::vec2 target{0.0f};
+  float radius = 0.0f;
+  PreparedField field;
+};
 
 FastMarchingFieldBuilder::FastMarchingFieldBuilder(DistanceFieldOptions options) : options_(options) {
   options_.validate();
 }
 
-sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec2 target, float radius) const {
+FastMarchingFieldBuilder::~FastMarchingFieldBuilder() = default;
+
+sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec2 target, float radius,
+                                               const sim::CrowdDensity* crowd) const {
   if (!world_has_obstacles(world)) return {};  // straight lines are the shortest ways
   std::lock_guard lock(mutex_);
   // Without a walkable region the free space is the obstacles' box grown by
@@ -193,8 +236,15 @@ sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec
     }
     space_ = std::make_unique<FreeSpace>(FreeSpace::build(world, o));
     world_ = &world;
+    prepared_.clear();
   }
-  return build_distance_field(*space_, target, radius, options_);
+  if (crowd == nullptr) return build_distance_field(*space_, target, radius, options_);
+  // Congestion-weighted fields are asked for again and again: their walls
+  // and seeds are kept.
+  for (const Prepared& p : prepared_)
+    if (p.target == target && p.radius == radius) return march_field(p.field, crowd);
+  prepared_.push_back({target, radius, prepare_field(*space_, target, radius, options_)});
+  return march_field(prepared_.back().field, crowd);
 }
 
 }  // namespace throng::path

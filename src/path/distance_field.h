@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "path/free_space.h"
 #include "sim/navigation_field.h"
@@ -38,19 +39,28 @@ struct DistanceFieldOptions {
 sim::FieldData build_distance_field(const FreeSpace& space, glm::vec2 target, float radius,
                                     const DistanceFieldOptions& options = {});
 
-// The builder `throng run` uses for `planning: field`: the world's free
-// space built once (at the first field), each field by fast marching.
+// The builder `throng run` uses for `planning: field` and `planning:
+// quickest`: the world's free space built once (at the first field), each
+// field by fast marching. With a crowd's density every node is slowed by
+// sim::congestion_slowness there (the eikonal equation of Hughes 2002, "A
+// continuum theory for the flow of pedestrians", Transp. Res. B 36, with
+// Weidmann's speed-density relation); the walls' slowness and the seeds of
+// such fields are kept for the next time the same field is asked for.
 class FastMarchingFieldBuilder final : public sim::FieldBuilder {
  public:
   explicit FastMarchingFieldBuilder(DistanceFieldOptions options = {});
-  sim::FieldData build(const sim::World& world, glm::vec2 target, float radius) const override;
+  ~FastMarchingFieldBuilder() override;
+  sim::FieldData build(const sim::World& world, glm::vec2 target, float radius,
+                       const sim::CrowdDensity* crowd = nullptr) const override;
 
  private:
+  struct Prepared;
   DistanceFieldOptions options_;
   mutable std::mutex mutex_;
   mutable const sim::World* world_ = nullptr;
   mutable std::unique_ptr<FreeSpace> space_;
-  mutable sim::Aabb extent_;  // targets so far (a world without a walkable region)
+  mutable sim::Aabb extent_;                // targets so far (a world without a walkable region)
+  mutable std::vector<Prepared> prepared_;  // congestion-weighted fields' walls and seeds
 };
 
 }  // namespace throng::path

@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "core/error.h"
+#include "sim/crowd.h"
 
 namespace throng::sim {
 
@@ -22,6 +25,53 @@ std::int32_t NavigationFields::add(FieldData field) {
 void NavigationFields::upload() {
   grids_ = Buffer<FieldGrid>(std::span<const FieldGrid>(host_grids_), current_memory());
   distance_ = Buffer<float>(std::span<const float>(host_distance_), current_memory());
+}
+
+void NavigationFields::replace(std::int32_t k, std::span<const float> distance) {
+  const FieldGrid& g = grid(k);
+  if (distance.size() != static_cast<std::size_t>(g.nx) * static_cast<std::size_t>(g.ny))
+    throw Error(fmt::format("navigation field {} has {} x {} nodes, not {}", k, g.nx, g.ny, distance.size()));
+  std::copy(distance.begin(), distance.end(), host_distance_.begin() + static_cast<std::ptrdiff_t>(g.offset));
+}
+
+float CrowdDensity::at(glm::vec2 p) const {
+  const float gx = (p.x - origin.x) / cell, gy = (p.y - origin.y) / cell;
+  if (!(gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(nx) && gy < static_cast<float>(ny))) return 0.0f;
+  return density[static_cast<std::size_t>(static_cast<std::int32_t>(gy)) * static_cast<std::size_t>(nx) +
+                 static_cast<std::size_t>(static_cast<std::int32_t>(gx))];
+}
+
+CrowdDensity crowd_density(std::span<const glm::vec2> positions, std::span<const std::uint8_t> flags,
+                           const Aabb& bounds, float cell) {
+  CrowdDensity d;
+  d.cell = cell;
+  d.origin = bounds.min;
+  d.nx = std::max(1, static_cast<std::int32_t>(std::ceil(bounds.size().x / cell)));
+  d.ny = std::max(1, static_cast<std::int32_t>(std::ceil(bounds.size().y / cell)));
+  const auto nx = static_cast<std::size_t>(d.nx);
+  std::vector<float> count(nx * static_cast<std::size_t>(d.ny), 0.0f);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    if ((flags[i] & kAgentActive) == 0) continue;
+    const float gx = (positions[i].x - d.origin.x) / cell, gy = (positions[i].y - d.origin.y) / cell;
+    if (gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(d.nx) && gy < static_cast<float>(d.ny))
+      count[static_cast<std::size_t>(gy) * nx + static_cast<std::size_t>(gx)] += 1.0f;
+  }
+  d.density.assign(count.size(), 0.0f);
+  for (std::int32_t j = 0; j < d.ny; ++j)
+    for (std::int32_t i = 0; i < d.nx; ++i) {
+      float sum = 0.0f;
+      for (std::int32_t y = std::max(0, j - 1); y <= std::min(d.ny - 1, j + 1); ++y)
+        for (std::int32_t x = std::max(0, i - 1); x <= std::min(d.nx - 1, i + 1); ++x)
+          sum += count[static_cast<std::size_t>(y) * nx + static_cast<std::size_t>(x)];
+      d.density[static_cast<std::size_t>(j) * nx + static_cast<std::size_t>(i)] = sum / (9.0f * cell * cell);
+    }
+  return d;
+}
+
+float congestion_slowness(float density) {
+  if (!(density > 0.0f)) return 1.0f;
+  const float v = 1.34f * (1.0f - std::exp(-1.913f * (1.0f / density - 1.0f / 5.4f)));
+  return std::min(kMaxCongestion, 1.34f / std::max(v, 1.34f / kMaxCongestion));
 }
 
 std::span<const float> NavigationFields::distances(std::int32_t k) const {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/vec2.hpp>
+#include <span>
 #include <vector>
 
 #include "core/buffer.h"
@@ -125,6 +126,9 @@ class NavigationFields {
   FieldsView host_view() const;  // the host copies (outputs and tests)
   std::int32_t count() const { return static_cast<std::int32_t>(host_grids_.size()); }
   const FieldGrid& grid(std::int32_t k) const { return host_grids_[static_cast<std::size_t>(k)]; }
+  // Replaces the distances of field k (as many as its grid has nodes) on
+  // the host; upload() copies them on.
+  void replace(std::int32_t k, std::span<const float> distance);
   // The distances of field k, host copy (outputs and tests).
   std::span<const float> distances(std::int32_t k) const;
   std::size_t bytes() const { return host_distance_.size() * sizeof(float); }
@@ -146,15 +150,40 @@ class NavigationFields {
 std::vector<glm::vec2> trace_field(const FieldsView& f, std::int32_t k, glm::vec2 start, float step = 0.1f,
                                    std::int32_t max_points = 200000, float tolerance = 0.1f);
 
+// The crowd's density over a grid of square cells (host), for fields that
+// weigh congestion (`planning: quickest`): agents per m^2 of each cell,
+// averaged over the cell and its eight neighbours, so that an agent's own
+// presence weighs a ninth of a lone cell's and the map changes smoothly.
+struct CrowdDensity {
+  glm::vec2 origin{0.0f};
+  float cell = 1.0f;  // m
+  std::int32_t nx = 0, ny = 0;
+  std::vector<float> density;  // agents / m^2, row by row
+  // The density of the cell holding p; 0 outside the grid.
+  float at(glm::vec2 p) const;
+};
+// The density of the active agents over `bounds` in cells of side `cell`.
+CrowdDensity crowd_density(std::span<const glm::vec2> positions, std::span<const std::uint8_t> flags,
+                           const Aabb& bounds, float cell = 1.0f);
+
+// How much slower walking is at `density` than in the open: the free speed
+// over Weidmann's speed at that density (Weidmann 1993: v0 1.34 m/s, gamma
+// 1.913 /m^2, rho_max 5.4 /m^2), at most kMaxCongestion. 1 in the open.
+inline constexpr float kMaxCongestion = 10.0f;
+float congestion_slowness(float density);
+
 class World;
 
 // The hook a run's navigation plugs into (path/distance_field.h has the
-// fast-marching builder `throng run` uses for `planning: field`): the field
-// of walking distances to `target` for discs of `radius`.
+// fast-marching builder `throng run` uses for `planning: field` and
+// `planning: quickest`): the field of walking distances to `target` for
+// discs of `radius`; with `crowd`, of walking times at its density
+// (congestion_slowness), in seconds at the free speed of 1 m/s.
 class FieldBuilder {
  public:
   virtual ~FieldBuilder() = default;
-  virtual FieldData build(const World& world, glm::vec2 target, float radius) const = 0;
+  virtual FieldData build(const World& world, glm::vec2 target, float radius,
+                          const CrowdDensity* crowd = nullptr) const = 0;
 };
 
 }  // namespace throng::sim

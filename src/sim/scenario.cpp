@@ -93,6 +93,7 @@ const char* to_string(PlanningKind p) {
   switch (p) {
     case PlanningKind::None: return "none";
     case PlanningKind::Field: return "field";
+    case PlanningKind::Quickest: return "quickest";
     case PlanningKind::Roadmap: break;
   }
   return "roadmap";

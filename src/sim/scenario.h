@@ -133,9 +133,12 @@ enum class SchedulerKind : std::uint8_t { DoubleBuffer, FourColour };
 // How groups with a goal and no waypoints find their way: routes planned on
 // the roadmap of free space (path/route_planner.h; io::build_simulation
 // supplies the planner), navigation fields shared by every agent heading
-// to the same target (sim/navigation_field.h, path/distance_field.h), or
-// straight to the goal.
-enum class PlanningKind : std::uint8_t { Roadmap, None, Field };
+// to the same target (sim/navigation_field.h, path/distance_field.h), the
+// same fields weighed again every kQuickestRefreshS seconds by the crowd's
+// density (the quickest way rather than the shortest), or straight to the
+// goal.
+enum class PlanningKind : std::uint8_t { Roadmap, None, Field, Quickest };
+inline constexpr double kQuickestRefreshS = 2.0;
 const char* to_string(ArrivalBehaviour a);
 const char* to_string(SchedulerKind s);
 const char* to_string(PlanningKind p);

@@ -31,6 +31,8 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   exits_ = ExitChooser(spec_, host);
   replan_ = Replanner(spec_, host, options.replanner);
   if (options.fields != nullptr) build_fields(*options.fields);
+  if (options.fields != nullptr && spec_.planning == PlanningKind::Quickest && fields_.count() > 0)
+    quickest_builder_ = options.fields;
   exits_.use_fields(fields_.host_view());
   bins_ = AgentGrid(spec_.model.query_radius());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
@@ -79,13 +81,40 @@ void Simulation::build_fields(const FieldBuilder& builder) {
   }
   for (const auto& [target, radius] : targets) {
     FieldData f = builder.build(world_, target, radius);
-    if (f.grid.nx > 0) fields_.add(std::move(f));  // none: nothing in the way
+    if (f.grid.nx == 0) continue;  // none: nothing in the way
+    fields_.add(std::move(f));
+    field_targets_.emplace_back(target, radius);
   }
   fields_.upload();
 }
 
+// The density map covers the first field's grid (every field of a run
+// spans the same free space), in 1 m cells.
+void Simulation::reweigh_fields() {
+  const FieldGrid& g = fields_.grid(0);
+  Aabb extent;
+  extent.add(g.origin);
+  extent.add(g.origin + glm::vec2(static_cast<float>(g.nx - 1), static_cast<float>(g.ny - 1)) * g.cell);
+  const std::vector<glm::vec2> p = positions();
+  const std::vector<std::uint8_t> f = flags();
+  const CrowdDensity density = crowd_density(p, f, extent);
+  for (std::size_t k = 0; k < field_targets_.size(); ++k) {
+    const FieldData d = quickest_builder_->build(world_, field_targets_[k].first, field_targets_[k].second, &density);
+    fields_.replace(static_cast<std::int32_t>(k), d.distance);
+  }
+  fields_.upload();
+  fields_weighed_at_ = steps_done_;
+}
+
 void Simulation::step() {
   ScopedTimer timer("sim.step");
+  if (quickest_builder_) {
+    const auto every = std::max<std::int64_t>(1, std::llround(kQuickestRefreshS / spec_.dt));
+    if (fields_weighed_at_ < 0 || steps_done_ - fields_weighed_at_ >= every) {
+      ScopedTimer weigh("sim.quickest_fields");
+      reweigh_fields();
+    }
+  }
   if (!exits_.empty()) {
     ScopedTimer choose("sim.exit_choice");
     exits_.update(time(), crowd_);

@@ -153,8 +153,10 @@ struct SimulationOptions {
   std::shared_ptr<const RoutePlanner> replanner;
   // Navigation fields (sim/navigation_field.h) for the groups with a goal
   // and no waypoints whose goal is one point or a set of exits: one field
-  // per target, for the largest radius heading there. Null: none.
-  const FieldBuilder* fields = nullptr;
+  // per target, for the largest radius heading there; with `planning:
+  // quickest` built again every kQuickestRefreshS s at the crowd's density
+  // (the simulation keeps the builder). Null: none.
+  std::shared_ptr<const FieldBuilder> fields;
   NeighbourSearch neighbours = NeighbourSearch::Bins;
 };
 
@@ -204,6 +206,8 @@ class Simulation {
   void bin();
   bool admit_entries();
   void build_fields(const FieldBuilder& builder);
+  // planning: quickest: every field built again at the crowd's density.
+  void reweigh_fields();
   void sense_and_steer(const StepContext& ctx);
   void move(const StepContext& ctx);
   StepContext context() const;
@@ -225,6 +229,10 @@ class Simulation {
   ExitChooser exits_;                  // groups choosing the quickest exit
   Replanner replan_;                   // planned routes, planned again for agents pushed off them
   NavigationFields fields_;
+  // planning: quickest: the builder and each field's target and radius.
+  std::shared_ptr<const FieldBuilder> quickest_builder_;
+  std::vector<std::pair<glm::vec2, float>> field_targets_;
+  std::int64_t fields_weighed_at_ = -1;  // the step they were last weighed at
 };
 
 }  // namespace throng::sim

@@ -117,12 +117,12 @@ TEST_F(Verify, CollisionFreeSpeedPassesTheRoomTests) {
   EXPECT_NE(text.find("**6 passed, 0 failed, 1 not applicable.**"), std::string::npos) << text;
 }
 
-// The crowd-sized tests (1000 agents leaving rooms; the fundamental
-// diagram over seven densities, some 2 minutes). Under the sanitizers only
-// test 9.
+// The crowd-sized tests (1000 agents leaving rooms, 500 round a corner;
+// the fundamental diagram over seven densities, some 2 minutes). Under the
+// sanitizers only test 9.
 TEST_F(Verify, CollisionFreeSpeedPassesTheCrowdTests) {
   const nlohmann::json report =
-      verify(std::string("--model collision_free_speed --only ") + (sanitized() ? "9" : "4,9,11"), 0);
+      verify(std::string("--model collision_free_speed --only ") + (sanitized() ? "9" : "4,9,11,15"), 0);
   const nlohmann::json& t9 = test(report, 9);
   expect_pass(t9);
   expect_png(t9);
@@ -137,6 +137,12 @@ TEST_F(Verify, CollisionFreeSpeedPassesTheCrowdTests) {
     EXPECT_NEAR(p.at("speed_m_s").get<double>(), p.at("weidmann_m_s").get<double>(), 0.3) << p.dump();
   }
   EXPECT_GT(test(report, 11).at("figures").at("exit_2").get<int>(), 0);
+  const nlohmann::json& t15 = test(report, 15);
+  expect_pass(t15);
+  expect_png(t15);
+  const double corner = t15.at("figures").at("corner").at("last_arrival_s");
+  EXPECT_LT(corner, t15.at("figures").at("long").at("last_arrival_s").get<double>());
+  EXPECT_GT(corner, t15.at("figures").at("short").at("last_arrival_s").get<double>());
 }
 
 // Without --model the files run as written (the engine's default model).
