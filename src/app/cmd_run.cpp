@@ -24,6 +24,7 @@
 #include "core/memory_budget.h"
 #include "core/exec.h"
 #include "core/timing.h"
+#include "io/routes_output.h"
 #include "io/run_outputs.h"
 #include "io/scenario_yaml.h"
 #include "io/walkable_area.h"
@@ -95,6 +96,7 @@ struct RunOptions {
   double render_seconds = 0.0;  // simulated seconds rendered; 0 = the whole run
   std::string camera;           // fixed | orbit | flyover; empty = the scenario's, else orbit
   double camera_period = 0.0;   // video seconds per orbit or fly-over; 0 = the scenario's, else 40
+  Index routes = 0;             // agents whose routes are drawn on the ground (io::sample_routes)
   bool demo = false;            // no scenario named: the built-in demo
 };
 
@@ -433,8 +435,12 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
   lo.fps = static_cast<double>(per_video) / frame_time;
   const double until = o.render_seconds > 0.0 ? o.render_seconds : std::numeric_limits<double>::infinity();
   auto recorder = std::make_shared<std::unique_ptr<render::Recorder>>();
-  lo.on_frame = [recorder, record, per_video, until, simulation, character_px = hooks.character_px, anim_fps = lo.fps](
-                    double t, const Camera* camera, SimulationLocomotion& moved) {
+  // Where --routes agents will walk, as `throng route` traces them.
+  std::vector<render::MapPolyline> routes;
+  if (o.routes > 0)
+    for (io::AgentRoute& r : io::sample_routes(sim, o.routes)) routes.push_back(std::move(r.points));
+  lo.on_frame = [recorder, record, per_video, until, simulation, routes, character_px = hooks.character_px,
+                 anim_fps = lo.fps](double t, const Camera* camera, SimulationLocomotion& moved) {
     if (std::llround(t * anim_fps) % per_video != 0 || t > until + 1e-9) return;
     ScopedTimer timer("render.frame");
     character_px->push_back(median_character_px(*camera, *simulation));
@@ -442,6 +448,7 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
       *recorder = std::make_unique<render::Recorder>(
           record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
       (*recorder)->set_world(simulation->world());
+      (*recorder)->set_routes(routes);
     }
     (*recorder)->add_frame(*camera, render::poses_of(moved.animator(), simulation->crowd()));
   };
@@ -642,6 +649,10 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
   cmd->add_option("--camera-period", o.camera_period,
                   "Video seconds per orbit or fly-over (default: the scenario's, else 40)")
       ->check(greater_than(0));
+  cmd->add_option("--routes", o.routes,
+                  "Draw on the ground the routes of this many agents (spread over the crowd), as `throng route` "
+                  "traces them")
+      ->check(at_least(1));
   cmd->callback([&g, cmd, speed] {
     // The built-in demo (no scenario named) writes a short time-lapse video.
     // (A build without the renderer runs it without a video.)
@@ -656,7 +667,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
     // rather than ignored (the demo renders unless --no-render).
     refuse_unless(*cmd, !o.render.empty(),
                   {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera",
-                   "--camera-period", "--lod-colours"},
+                   "--camera-period", "--lod-colours", "--routes"},
                   "--render video|frames");
     refuse_unless(*cmd, !o.no_lod, {"--lod-thresholds"}, "joint LOD (it has no effect with --no-lod)");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");

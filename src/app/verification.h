@@ -61,7 +61,7 @@ struct ScenarioObservation {
   std::vector<float> arrival_time;             // s, -1 if never arrived
   std::vector<float> first_move;               // s: when the agent first stood 1 cm from its spawn point; -1 never
   std::vector<glm::vec2> last_seen;            // last position while in the scene
-  std::vector<sim::LineCrossing> crossings;    // of spec.measurement.lines, in time order per step
+  std::vector<sim::LineCrossing> crossings;    // of spec.measurement.lines, step by step (agent order in a step)
   std::vector<std::vector<glm::vec2>> tracks;  // every 0.5 s, when asked for
   std::vector<std::vector<sim::AreaSample>> area_samples;  // per measurement area, one per simulated second
   Index most_in_walls = 0;                                 // most agents at once whose disc entered a wall by over 1 mm
@@ -71,8 +71,9 @@ struct ScenarioObservation {
   std::vector<double> arrivals() const;
   // Last arrival (s), or +inf when someone never arrived.
   double evacuation_time() const;
-  // Crossing times of measurement line `line` (either direction), in order;
-  // of agent `agent` only when given.
+  // Times of the crossings of measurement line `line` in its positive
+  // direction (to the left walking from `from` to `to`), in order; of agent
+  // `agent` only when given.
   std::vector<double> crossing_times(std::int32_t line, std::optional<Index> agent = {}) const;
 };
 

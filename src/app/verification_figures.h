@@ -13,9 +13,10 @@
 
 namespace throng::app {
 
-// Okabe and Ito's colour-blind-safe colours, for series that must match.
-inline constexpr render::Rgb kBlue{0, 114, 178}, kOrange{230, 159, 0}, kGreen{0, 158, 115}, kVermillion{213, 94, 0},
-    kGrey{90, 90, 90}, kBlack{0, 0, 0};
+// Series whose colours must match (a group's points and its range lines)
+// take the chart palette's k-th colour (render::palette_colour); reference
+// curves are grey and walls black.
+inline constexpr render::Rgb kGrey{90, 90, 90}, kBlack{0, 0, 0};
 
 // "12.3 s", or "never" for +inf.
 std::string seconds_text(double t);

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "app/verification.h"
+#include "core/buffer.h"
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "io/embedded.h"
@@ -44,7 +45,7 @@ double ScenarioObservation::evacuation_time() const {
 std::vector<double> ScenarioObservation::crossing_times(std::int32_t line, std::optional<Index> agent) const {
   std::vector<double> out;
   for (const sim::LineCrossing& x : crossings)
-    if (x.line == line && (!agent || x.agent == *agent)) out.push_back(x.time);
+    if (x.line == line && x.direction > 0 && (!agent || x.agent == *agent)) out.push_back(x.time);
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -60,8 +61,16 @@ constexpr float kInWallM = 1e-3f;     // a disc entering a wall by more than thi
 class Recorder {
  public:
   Recorder(const sim::Simulation& sim, const ObserveOptions& options, ScenarioObservation& out)
-      : options_(options), out_(out), spawn_(sim.positions()), before_(spawn_), flags_before_(sim.flags()) {
+      : options_(options), out_(out), spawn_(sim.positions()) {
     const std::size_t n = spawn_.size();
+    std::vector<sim::Segment> lines;
+    for (const sim::MeasurementLine& l : sim.spec().measurement.lines) {
+      lines.push_back({l.from, l.to});
+      line_bounds_.add(l.from);
+      line_bounds_.add(l.to);
+    }
+    lines_ = Buffer<sim::Segment>(std::span<const sim::Segment>(lines), current_memory());
+    remember(sim);
     out_.first_move.assign(n, -1.0f);
     out_.last_seen = spawn_;
     if (options_.tracks) out_.tracks.assign(n, {});
@@ -72,17 +81,21 @@ class Recorder {
   void after_step(const sim::Simulation& sim) {
     const std::vector<glm::vec2> after = sim.positions();
     const std::vector<std::uint8_t> flags = sim.flags();
-    const double t1 = sim.time(), t0 = t1 - sim.spec().dt;
+    const double t1 = sim.time();
     for (std::size_t i = 0; i < after.size(); ++i) {
-      const bool was_in = (flags_before_[i] & sim::kAgentActive) != 0, is_in = (flags[i] & sim::kAgentActive) != 0;
-      if (is_in) out_.last_seen[i] = after[i];
-      if (is_in && out_.first_move[i] < 0 && glm::length(after[i] - spawn_[i]) > kMovedM)
+      if ((flags[i] & sim::kAgentActive) == 0) continue;
+      out_.last_seen[i] = after[i];
+      if (out_.first_move[i] < 0 && glm::length(after[i] - spawn_[i]) > kMovedM)
         out_.first_move[i] = static_cast<float>(t1);
-      if (was_in && is_in) cross(sim.spec().measurement, before_[i], after[i], static_cast<Index>(i), t0, t1);
     }
-    before_ = after;
-    flags_before_ = flags;
     const sim::CrowdState& c = sim.crowd();
+    if (lines_.size() > 0) {
+      const std::vector<sim::LineCrossing> found =
+          sim::line_crossings(before_.span(), flags_before_.span(), c.position.span(), c.flags.span(), lines_.span(),
+                              line_bounds_, t1 - sim.spec().dt, t1);
+      out_.crossings.insert(out_.crossings.end(), found.begin(), found.end());
+    }
+    remember(sim);
     out_.most_in_walls = std::max(
         out_.most_in_walls,
         sim::count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(), kInWallM));
@@ -96,13 +109,12 @@ class Recorder {
     const auto per = std::max<std::int64_t>(1, std::llround(period / sim.spec().dt));
     return sim.steps_done() % per == 0;
   }
-  void cross(const sim::MeasurementSpec& m, glm::vec2 p0, glm::vec2 p1, Index agent, double t0, double t1) {
-    for (std::size_t k = 0; k < m.lines.size(); ++k) {
-      double s = 0;
-      const int direction = sim::step_crossing(p0, p1, m.lines[k].from, m.lines[k].to, &s);
-      if (direction != 0)
-        out_.crossings.push_back({t0 + s * (t1 - t0), agent, static_cast<std::int32_t>(k), direction});
-    }
+  // The state before the next step, in the crowd's memory (line_crossings
+  // runs on the backend).
+  void remember(const sim::Simulation& sim) {
+    if (lines_.size() == 0) return;
+    before_ = sim.crowd().position.to(sim.crowd().position.memory());
+    flags_before_ = sim.crowd().flags.to(sim.crowd().flags.memory());
   }
   void sample(const sim::Simulation& sim) {
     const sim::CrowdState& c = sim.crowd();
@@ -125,8 +137,11 @@ class Recorder {
 
   ObserveOptions options_;
   ScenarioObservation& out_;
-  std::vector<glm::vec2> spawn_, before_;
-  std::vector<std::uint8_t> flags_before_;
+  std::vector<glm::vec2> spawn_;
+  Buffer<sim::Segment> lines_;
+  sim::Aabb line_bounds_;
+  Buffer<glm::vec2> before_;
+  Buffer<std::uint8_t> flags_before_;
 };
 
 }  // namespace
@@ -153,10 +168,6 @@ ScenarioObservation observe(const io::LoadedScenario& scenario, const ObserveOpt
   out.arrival_time = sim->arrival_times();
   return out;
 }
-
-}  // namespace throng::app
-
-namespace throng::app {
 
 const char* to_string(VerifyStatus s) {
   switch (s) {

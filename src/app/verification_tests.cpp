@@ -11,6 +11,7 @@
 
 #include "app/verification.h"
 #include "app/verification_figures.h"
+#include "sim/navigation_field.h"
 #include "core/error.h"
 
 namespace throng::app {
@@ -44,7 +45,7 @@ VerifyResult corridor_speed(const VerifyOptions& o) {
     time.push_back(0.5 * static_cast<double>(k));
     x.push_back(obs.tracks[0][k].x);
   }
-  c.series.push_back(make_series("walker", time, x, PlotSeries::Style::Line, kBlue));
+  c.series.push_back(make_series("walker", time, x, PlotSeries::Style::Line, render::palette_colour(0)));
   if (!start.empty())
     c.bands.push_back({true, start.front() + 26.0, start.front() + 34.0, "x = 40 reached in time", {}});
   r.chart = std::move(c);
@@ -52,8 +53,6 @@ VerifyResult corridor_speed(const VerifyOptions& o) {
 }
 
 // ---- Test 4: the fundamental diagram
-
-double weidmann(double rho) { return std::max(0.0, 1.34 * (1.0 - std::exp(-1.913 * (1.0 / rho - 1.0 / 5.4)))); }
 
 struct DiagramPoint {
   double target = 0, density = 0, speed = 0;
@@ -86,14 +85,16 @@ DiagramPoint measure_density(const io::LoadedScenario& s, double rho) {
 void add_diagram_checks(VerifyResult& r, const std::vector<DiagramPoint>& points) {
   double squares = 0, worst_fill = 0, worst_rise = -kInf, slowest = kInf;
   int n = 0;
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    const DiagramPoint& p = points[k];
+  const DiagramPoint* previous = nullptr;  // the last density measured
+  for (const DiagramPoint& p : points) {
     if (p.target > 5.0 || !p.error.empty()) continue;
-    squares += (p.speed - weidmann(p.density)) * (p.speed - weidmann(p.density));
+    const double w = sim::weidmann_speed(static_cast<float>(p.density));
+    squares += (p.speed - w) * (p.speed - w);
     ++n;
     worst_fill = std::max(worst_fill, std::abs(p.density - p.target) / p.target);
-    if (k > 0) worst_rise = std::max(worst_rise, p.speed - points[k - 1].speed);
+    if (previous != nullptr) worst_rise = std::max(worst_rise, p.speed - previous->speed);
     if (p.density < 4.5) slowest = std::min(slowest, p.speed);
+    previous = &p;
   }
   const double rms = n > 0 ? std::sqrt(squares / n) : kInf;
   r.checks.push_back({"the measuring area holds the density asked, 0.5-5 P/m^2 (within 15 %)",
@@ -119,13 +120,15 @@ VerifyResult fundamental_diagram(const VerifyOptions& o) {
   std::vector<double> wx, wy, px, py;
   for (double rho = 0.3; rho <= 5.4; rho += 0.05) {
     wx.push_back(rho);
-    wy.push_back(weidmann(rho));
+    wy.push_back(sim::weidmann_speed(static_cast<float>(rho)));
   }
   r.figures["points"] = nlohmann::json::array();
   for (const DiagramPoint& p : points) {
     nlohmann::json j = {{"target_p_m2", p.target}};
     if (p.error.empty()) {
-      j.update({{"density_p_m2", p.density}, {"speed_m_s", p.speed}, {"weidmann_m_s", weidmann(p.density)}});
+      j.update({{"density_p_m2", p.density},
+                {"speed_m_s", p.speed},
+                {"weidmann_m_s", sim::weidmann_speed(static_cast<float>(p.density))}});
       px.push_back(p.density);
       py.push_back(p.speed);
     } else {
@@ -135,7 +138,8 @@ VerifyResult fundamental_diagram(const VerifyOptions& o) {
   }
   c.series.push_back(make_series("Weidmann 1993", wx, wy, PlotSeries::Style::Line, kGrey));
   c.series.back().dashed = true;
-  c.series.push_back(make_series(sim::to_string(s.spec.model.kind), px, py, PlotSeries::Style::Points, kBlue));
+  c.series.push_back(
+      make_series(sim::to_string(s.spec.model.kind), px, py, PlotSeries::Style::Points, render::palette_colour(0)));
   c.series.back().width = 3.0f;
   c.x_min = 0.0;
   c.y_min = 0.0;
@@ -180,7 +184,7 @@ VerifyResult premovement(const VerifyOptions& o) {
   r.figures = {{"premovement_s", x}, {"first_move_s", y}, {"run", run_figures(obs)}};
   c.series.push_back(make_series("starts at its time", {0, 110}, {0, 110}, PlotSeries::Style::Line, kGrey));
   c.series.back().dashed = true;
-  c.series.push_back(make_series("persons", x, y, PlotSeries::Style::Points, kBlue));
+  c.series.push_back(make_series("persons", x, y, PlotSeries::Style::Points, render::palette_colour(0)));
   c.series.back().width = 3.0f;
   c.x_min = c.y_min = 0.0;
   c.x_max = c.y_max = 110.0;
@@ -200,7 +204,8 @@ VerifyResult corner(const VerifyOptions& o) {
   r.figures = {{"run", run_figures(obs)}};
   render::Chart c = make_chart("RiMEA 6: twenty persons round a left-hand corner", "x (m)", "y (m)");
   c.series.push_back(walls_series(obs.spec.world));
-  add_tracks(c, obs, [](std::size_t) { return std::pair<std::string, Rgb>("trajectories", kBlue); });
+  add_tracks(c, obs,
+             [](std::size_t) { return std::pair<std::string, Rgb>("trajectories", render::palette_colour(0)); });
   c.width = c.height = 700;
   r.chart = std::move(c);
   return r;

@@ -101,6 +101,11 @@ void Recorder::set_world(const sim::World& world, const ObstacleStyle& style) {
   show_world(s_->renderer, world, style);
 }
 
+void Recorder::set_routes(const std::vector<MapPolyline>& routes) {
+  s_->context.make_current();
+  s_->renderer.set_routes(routes);
+}
+
 RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses) {
   return add_frame(camera, poses, s_->spec.options);
 }

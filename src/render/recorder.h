@@ -55,6 +55,8 @@ class Recorder {
   const HeadlessContext& context() const;
   // The simulation's world (show_world).
   void set_world(const sim::World& world, const ObstacleStyle& style = {});
+  // Routes of agents drawn on the ground (Renderer::set_routes).
+  void set_routes(const std::vector<MapPolyline>& routes);
   // Renders one frame with `camera` (its viewport is set to the spec's
   // size) and appends it. The picture stays available in last_frame().
   RenderStats add_frame(const Camera& camera, const CharacterPoses& poses);  // spec.options

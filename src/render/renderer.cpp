@@ -230,10 +230,17 @@ struct Renderer::State {
   GLsizei cap_vertices = 0;
   bool has_obstacles = false;
 
-  GlVertexArray paths_vao;
-  GlBuffer paths_vbo;
-  std::vector<GLint> path_first;
-  std::vector<GLsizei> path_count;
+  // Line strips just above the ground: the map's paths (the walkable
+  // boundary, planned paths) and the routes of sampled agents.
+  struct Polylines {
+    GlVertexArray vao;
+    GlBuffer vbo;
+    std::vector<GLint> first;
+    std::vector<GLsizei> count;
+    void upload(const std::vector<MapPolyline>& lines, const char* field);
+    void draw(const GlProgram& flat, const FrameView& view, glm::vec4 colour) const;
+  };
+  Polylines paths, routes;
 
   GlTexture bins_texture;
   BinsOverlay bins_meta;
@@ -519,31 +526,34 @@ void Renderer::set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::
   check_gl("render.obstacles");
 }
 
-void Renderer::set_paths(const std::vector<MapPolyline>& paths) {
+void Renderer::State::Polylines::upload(const std::vector<MapPolyline>& lines, const char* field) {
   std::vector<glm::vec3> vertices;
-  s_->path_first.clear();
-  s_->path_count.clear();
-  for (const MapPolyline& p : paths) {
+  first.clear();
+  count.clear();
+  for (const MapPolyline& p : lines) {
     if (p.size() < 2) continue;
-    s_->path_first.push_back(static_cast<GLint>(vertices.size()));
-    s_->path_count.push_back(static_cast<GLsizei>(p.size()));
+    first.push_back(static_cast<GLint>(vertices.size()));
+    count.push_back(static_cast<GLsizei>(p.size()));
     for (const glm::vec2& q : p) {
-      if (!std::isfinite(q.x) || !std::isfinite(q.y))
-        throw Error("path points must be finite", at_field("render.paths"));
+      if (!std::isfinite(q.x) || !std::isfinite(q.y)) throw Error("path points must be finite", at_field(field));
       vertices.push_back(world_from_ground(q, 0.03f));
     }
   }
-  s_->paths_vao = make_vertex_array();
-  s_->paths_vbo = make_buffer();
-  glBindVertexArray(s_->paths_vao.get());
-  glBindBuffer(GL_ARRAY_BUFFER, s_->paths_vbo.get());
+  vao = make_vertex_array();
+  vbo = make_buffer();
+  glBindVertexArray(vao.get());
+  glBindBuffer(GL_ARRAY_BUFFER, vbo.get());
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(glm::vec3)), vertices.data(),
                GL_STATIC_DRAW);
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
   glBindVertexArray(0);
-  check_gl("render.paths");
+  check_gl(field);
 }
+
+void Renderer::set_paths(const std::vector<MapPolyline>& paths) { s_->paths.upload(paths, "render.paths"); }
+
+void Renderer::set_routes(const std::vector<MapPolyline>& routes) { s_->routes.upload(routes, "render.routes"); }
 
 void Renderer::set_bins(const BinsOverlay& bins) {
   bins.validate();
@@ -618,12 +628,18 @@ void Renderer::State::draw_bins(const FrameView& view) {
   glDisable(GL_BLEND);
 }
 
-void Renderer::State::draw_paths(const FrameView& view) {
+void Renderer::State::Polylines::draw(const GlProgram& flat, const FrameView& view, glm::vec4 colour) const {
+  if (first.empty()) return;
   glUseProgram(flat.get());
   glUniformMatrix4fv(uniform(flat, "u_view_projection"), 1, GL_FALSE, glm::value_ptr(view.view_projection));
-  glUniform4f(uniform(flat, "u_colour"), 0.95f, 0.95f, 0.25f, 1.0f);
-  glBindVertexArray(paths_vao.get());
-  glMultiDrawArrays(GL_LINE_STRIP, path_first.data(), path_count.data(), static_cast<GLsizei>(path_first.size()));
+  glUniform4f(uniform(flat, "u_colour"), colour.r, colour.g, colour.b, colour.a);
+  glBindVertexArray(vao.get());
+  glMultiDrawArrays(GL_LINE_STRIP, first.data(), count.data(), static_cast<GLsizei>(first.size()));
+}
+
+void Renderer::State::draw_paths(const FrameView& view) {
+  paths.draw(flat, view, kPathColour);
+  routes.draw(flat, view, kRouteColour);
 }
 
 void Renderer::State::draw_joint_characters(const FrameView& view, const DrawGroups& groups, bool lod_colours,
@@ -735,7 +751,7 @@ RenderStats Renderer::render(const Camera& camera, const CharacterPoses& poses, 
   clear_frame(camera, options);
   if (options.ground) s.draw_ground(view, options.grid);
   if (options.bins && s.has_bins) s.draw_bins(view);
-  if (options.paths && !s.path_first.empty()) s.draw_paths(view);
+  if (options.paths) s.draw_paths(view);
   if (!skinned && stats.visible > 0) s.draw_joint_characters(view, groups, options.lod_colours, stats);
   if (skinned && stats.visible > 0) s.draw_skinned_characters(view, groups, options.lod_colours, stats);
   if (options.obstacles && s.has_obstacles) s.draw_obstacles(view);

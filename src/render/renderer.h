@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 #include <memory>
 #include <vector>
 
@@ -28,13 +29,18 @@
 
 namespace throng::render {
 
+// The colours of the map's paths (the walkable boundary) and of agents'
+// routes (`--routes`), drawn just above the ground.
+inline const glm::vec4 kPathColour(0.95f, 0.95f, 0.25f, 1.0f);
+inline const glm::vec4 kRouteColour(0.2f, 0.85f, 0.95f, 1.0f);
+
 struct RenderOptions {
   RenderMode mode = RenderMode::Joints;
   bool lod_colours = false;  // colour by joint-LOD level (paper Fig. 8, a debug view); else by character
   bool ground = true;
   bool grid = true;
   bool obstacles = true;
-  bool paths = true;  // when set_paths gave any
+  bool paths = true;  // when set_paths or set_routes gave any
   bool bins = false;  // when set_bins gave any
   bool cull = true;   // skip characters whose bounding sphere is outside the view
   // Characters whose bounding sphere is at least this many pixels in
@@ -88,8 +94,10 @@ class Renderer {
   // Static scene: obstacles of the simulation's map, uploaded once.
   void set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::Circle> circles,
                      const ObstacleStyle& style = {});
-  // Paths drawn when options.paths; an empty list clears them.
+  // Paths (kPathColour) and agents' routes (kRouteColour) drawn when
+  // options.paths; an empty list clears them.
   void set_paths(const std::vector<MapPolyline>& paths);
+  void set_routes(const std::vector<MapPolyline>& routes);
   // Bins drawn when options.bins (counts copied; call again to update).
   void set_bins(const BinsOverlay& bins);
 

@@ -27,11 +27,15 @@ void NavigationFields::upload() {
   distance_ = Buffer<float>(std::span<const float>(host_distance_), current_memory());
 }
 
-void NavigationFields::replace(std::int32_t k, std::span<const float> distance) {
+void NavigationFields::replace(std::int32_t k, const FieldData& field) {
   const FieldGrid& g = grid(k);
-  if (distance.size() != static_cast<std::size_t>(g.nx) * static_cast<std::size_t>(g.ny))
-    throw Error(fmt::format("navigation field {} has {} x {} nodes, not {}", k, g.nx, g.ny, distance.size()));
-  std::copy(distance.begin(), distance.end(), host_distance_.begin() + static_cast<std::ptrdiff_t>(g.offset));
+  const FieldGrid& f = field.grid;
+  if (f.origin != g.origin || f.cell != g.cell || f.nx != g.nx || f.ny != g.ny ||
+      field.distance.size() != static_cast<std::size_t>(g.nx) * static_cast<std::size_t>(g.ny))
+    throw Error(fmt::format("navigation field {} ({} x {} nodes of {} m) replaced by one of {} x {} nodes of {} m", k,
+                            g.nx, g.ny, g.cell, f.nx, f.ny, f.cell));
+  std::copy(field.distance.begin(), field.distance.end(),
+            host_distance_.begin() + static_cast<std::ptrdiff_t>(g.offset));
 }
 
 float CrowdDensity::at(glm::vec2 p) const {
@@ -41,37 +45,59 @@ float CrowdDensity::at(glm::vec2 p) const {
                  static_cast<std::size_t>(static_cast<std::int32_t>(gx))];
 }
 
-CrowdDensity crowd_density(std::span<const glm::vec2> positions, std::span<const std::uint8_t> flags,
-                           const Aabb& bounds, float cell) {
+CrowdDensity density_cells(const Aabb& bounds, float cell) {
   CrowdDensity d;
   d.cell = cell;
   d.origin = bounds.min;
   d.nx = std::max(1, static_cast<std::int32_t>(std::ceil(bounds.size().x / cell)));
   d.ny = std::max(1, static_cast<std::int32_t>(std::ceil(bounds.size().y / cell)));
+  d.density.assign(static_cast<std::size_t>(d.nx) * static_cast<std::size_t>(d.ny), 0.0f);
+  return d;
+}
+
+void count_crowd(CrowdDensity& d, std::span<const glm::vec2> positions, std::span<const std::uint8_t> flags,
+                 std::span<const float> free_area) {
   const auto nx = static_cast<std::size_t>(d.nx);
-  std::vector<float> count(nx * static_cast<std::size_t>(d.ny), 0.0f);
+  std::vector<float> count(d.density.size(), 0.0f);
+  if (!free_area.empty() && free_area.size() != count.size())
+    throw Error(fmt::format("crowd density: {} free areas for {} cells", free_area.size(), count.size()));
   for (std::size_t i = 0; i < positions.size(); ++i) {
     if ((flags[i] & kAgentActive) == 0) continue;
-    const float gx = (positions[i].x - d.origin.x) / cell, gy = (positions[i].y - d.origin.y) / cell;
+    const float gx = (positions[i].x - d.origin.x) / d.cell, gy = (positions[i].y - d.origin.y) / d.cell;
     if (gx >= 0.0f && gy >= 0.0f && gx < static_cast<float>(d.nx) && gy < static_cast<float>(d.ny))
       count[static_cast<std::size_t>(gy) * nx + static_cast<std::size_t>(gx)] += 1.0f;
   }
-  d.density.assign(count.size(), 0.0f);
+  const float cell_area = d.cell * d.cell;
   for (std::int32_t j = 0; j < d.ny; ++j)
     for (std::int32_t i = 0; i < d.nx; ++i) {
-      float sum = 0.0f;
+      float agents = 0.0f, area = 0.0f;
       for (std::int32_t y = std::max(0, j - 1); y <= std::min(d.ny - 1, j + 1); ++y)
-        for (std::int32_t x = std::max(0, i - 1); x <= std::min(d.nx - 1, i + 1); ++x)
-          sum += count[static_cast<std::size_t>(y) * nx + static_cast<std::size_t>(x)];
-      d.density[static_cast<std::size_t>(j) * nx + static_cast<std::size_t>(i)] = sum / (9.0f * cell * cell);
+        for (std::int32_t x = std::max(0, i - 1); x <= std::min(d.nx - 1, i + 1); ++x) {
+          const std::size_t k = static_cast<std::size_t>(y) * nx + static_cast<std::size_t>(x);
+          agents += count[k];
+          area += free_area.empty() ? cell_area : free_area[k];
+        }
+      if (free_area.empty()) area = 9.0f * cell_area;  // as if the grid went on beyond its edges
+      d.density[static_cast<std::size_t>(j) * nx + static_cast<std::size_t>(i)] =
+          area >= 0.25f * cell_area ? agents / area : 0.0f;
     }
+}
+
+CrowdDensity crowd_density(std::span<const glm::vec2> positions, std::span<const std::uint8_t> flags,
+                           const Aabb& bounds, float cell, std::span<const float> free_area) {
+  CrowdDensity d = density_cells(bounds, cell);
+  count_crowd(d, positions, flags, free_area);
   return d;
+}
+
+float weidmann_speed(float density) {
+  if (!(density > 0.0f)) return 1.34f;
+  return std::max(0.0f, 1.34f * (1.0f - std::exp(-1.913f * (1.0f / density - 1.0f / 5.4f))));
 }
 
 float congestion_slowness(float density) {
   if (!(density > 0.0f)) return 1.0f;
-  const float v = 1.34f * (1.0f - std::exp(-1.913f * (1.0f / density - 1.0f / 5.4f)));
-  return std::min(kMaxCongestion, 1.34f / std::max(v, 1.34f / kMaxCongestion));
+  return std::min(kMaxCongestion, 1.34f / std::max(weidmann_speed(density), 1.34f / kMaxCongestion));
 }
 
 std::span<const float> NavigationFields::distances(std::int32_t k) const {

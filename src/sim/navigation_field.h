@@ -126,9 +126,10 @@ class NavigationFields {
   FieldsView host_view() const;  // the host copies (outputs and tests)
   std::int32_t count() const { return static_cast<std::int32_t>(host_grids_.size()); }
   const FieldGrid& grid(std::int32_t k) const { return host_grids_[static_cast<std::size_t>(k)]; }
-  // Replaces the distances of field k (as many as its grid has nodes) on
-  // the host; upload() copies them on.
-  void replace(std::int32_t k, std::span<const float> distance);
+  // Replaces the distances of field k with those of `field`, which must lie
+  // on the same grid (origin, cell and size; else an Error), on the host;
+  // upload() copies them on.
+  void replace(std::int32_t k, const FieldData& field);
   // The distances of field k, host copy (outputs and tests).
   std::span<const float> distances(std::int32_t k) const;
   std::size_t bytes() const { return host_distance_.size() * sizeof(float); }
@@ -163,12 +164,24 @@ struct CrowdDensity {
   float at(glm::vec2 p) const;
 };
 // The density of the active agents over `bounds` in cells of side `cell`.
+// `free_area` (m^2 per cell, row by row; empty: every cell wholly free)
+// is the walkable part of each cell: the agents of a 3x3 window are divided
+// by the window's free area (0 where it has less than a quarter of a cell),
+// so a crowd along a wall or in a narrow corridor reads its true density.
 CrowdDensity crowd_density(std::span<const glm::vec2> positions, std::span<const std::uint8_t> flags,
-                           const Aabb& bounds, float cell = 1.0f);
+                           const Aabb& bounds, float cell = 1.0f, std::span<const float> free_area = {});
+// Its two halves: the cells over `bounds` (densities 0), and the densities
+// of the active agents in them.
+CrowdDensity density_cells(const Aabb& bounds, float cell);
+void count_crowd(CrowdDensity& d, std::span<const glm::vec2> positions, std::span<const std::uint8_t> flags,
+                 std::span<const float> free_area = {});
 
+// Weidmann's speed at `density` (agents / m^2): v0 (1 - exp(-gamma (1/rho
+// - 1/rho_max))) with v0 1.34 m/s, gamma 1.913 /m^2, rho_max 5.4 /m^2
+// (Weidmann 1993); v0 at 0 and below, 0 from rho_max on.
+float weidmann_speed(float density);
 // How much slower walking is at `density` than in the open: the free speed
-// over Weidmann's speed at that density (Weidmann 1993: v0 1.34 m/s, gamma
-// 1.913 /m^2, rho_max 5.4 /m^2), at most kMaxCongestion. 1 in the open.
+// over Weidmann's speed there, at most kMaxCongestion; 1 in the open.
 inline constexpr float kMaxCongestion = 10.0f;
 float congestion_slowness(float density);
 

@@ -1,6 +1,7 @@
 #include "sim/simulation.h"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "core/error.h"
@@ -60,6 +61,36 @@ StepContext Simulation::context() const {
   return ctx;
 }
 
+namespace {
+
+// The area of each density cell where field 0's disc fits (its nodes of
+// finite distance, a node's cell each); cells that hold none of its nodes
+// count wholly free.
+std::vector<float> free_area_of(const NavigationFields& fields, const CrowdDensity& cells) {
+  const FieldGrid& g = fields.grid(0);
+  const std::span<const float> distance = fields.distances(0);
+  std::vector<float> area(cells.density.size(), 0.0f);
+  std::vector<std::uint8_t> seen(cells.density.size(), 0);
+  for (std::int32_t j = 0; j < g.ny; ++j)
+    for (std::int32_t i = 0; i < g.nx; ++i) {
+      const glm::vec2 p = g.origin + glm::vec2(static_cast<float>(i), static_cast<float>(j)) * g.cell;
+      const float cx = (p.x - cells.origin.x) / cells.cell, cy = (p.y - cells.origin.y) / cells.cell;
+      if (!(cx >= 0.0f && cy >= 0.0f && cx < static_cast<float>(cells.nx) && cy < static_cast<float>(cells.ny)))
+        continue;
+      const std::size_t k =
+          static_cast<std::size_t>(cy) * static_cast<std::size_t>(cells.nx) + static_cast<std::size_t>(cx);
+      seen[k] = 1;
+      if (distance[static_cast<std::size_t>(j) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(i)] <
+          INFINITY)
+        area[k] += g.cell * g.cell;
+    }
+  for (std::size_t k = 0; k < area.size(); ++k)
+    area[k] = seen[k] != 0 ? std::min(area[k], cells.cell * cells.cell) : cells.cell * cells.cell;
+  return area;
+}
+
+}  // namespace
+
 // One field per target of the groups that walk to one point or choose among
 // exits (their own waypoints, or goals that differ per agent, keep the
 // straight legs), for the largest radius heading there, in group order.
@@ -79,29 +110,43 @@ void Simulation::build_fields(const FieldBuilder& builder) {
     if (g.goal.kind == GoalSpec::Kind::Exits)
       for (const ExitSpec& e : g.goal.exits) add(e.point, g.radius);
   }
-  for (const auto& [target, radius] : targets) {
-    FieldData f = builder.build(world_, target, radius);
-    if (f.grid.nx == 0) continue;  // none: nothing in the way
-    fields_.add(std::move(f));
-    field_targets_.emplace_back(target, radius);
+  // Weighed fields are built again on their first grid: where the free
+  // space grows with the targets (a world without a walkable region), the
+  // first pass grows it to hold them all and the second lays every field
+  // over it, at the density of nobody (the plain distances).
+  const bool weighed = spec_.planning == PlanningKind::Quickest;
+  const CrowdDensity nobody;
+  for (int pass = weighed ? 0 : 1; pass < 2; ++pass) {
+    for (const auto& [target, radius] : targets) {
+      FieldData f = builder.build(world_, target, radius, weighed ? &nobody : nullptr);
+      if (f.grid.nx == 0 || pass == 0) continue;  // none: nothing in the way
+      fields_.add(std::move(f));
+      field_targets_.emplace_back(target, radius);
+    }
   }
   fields_.upload();
 }
 
-// The density map covers the first field's grid (every field of a run
-// spans the same free space), in 1 m cells.
+// The density map: over every field's grid, in cells of 1 m (coarser past a
+// million cells), each cell's free area the nodes of field 0 where its disc
+// fits (the rest of the union counted free).
 void Simulation::reweigh_fields() {
-  const FieldGrid& g = fields_.grid(0);
-  Aabb extent;
-  extent.add(g.origin);
-  extent.add(g.origin + glm::vec2(static_cast<float>(g.nx - 1), static_cast<float>(g.ny - 1)) * g.cell);
-  const std::vector<glm::vec2> p = positions();
-  const std::vector<std::uint8_t> f = flags();
-  const CrowdDensity density = crowd_density(p, f, extent);
-  for (std::size_t k = 0; k < field_targets_.size(); ++k) {
-    const FieldData d = quickest_builder_->build(world_, field_targets_[k].first, field_targets_[k].second, &density);
-    fields_.replace(static_cast<std::int32_t>(k), d.distance);
+  if (density_cells_.nx == 0) {
+    Aabb extent;
+    for (std::int32_t k = 0; k < fields_.count(); ++k) {
+      const FieldGrid& g = fields_.grid(k);
+      extent.add(g.origin);
+      extent.add(g.origin + glm::vec2(static_cast<float>(g.nx - 1), static_cast<float>(g.ny - 1)) * g.cell);
+    }
+    const float cell = std::max(1.0f, std::sqrt(extent.size().x * extent.size().y / 1e6f));
+    density_cells_ = density_cells(extent, cell);
+    density_free_area_ = free_area_of(fields_, density_cells_);
   }
+  CrowdDensity density = density_cells_;
+  count_crowd(density, positions(), flags(), density_free_area_);
+  for (std::size_t k = 0; k < field_targets_.size(); ++k)
+    fields_.replace(static_cast<std::int32_t>(k),
+                    quickest_builder_->build(world_, field_targets_[k].first, field_targets_[k].second, &density));
   fields_.upload();
   fields_weighed_at_ = steps_done_;
 }

@@ -20,6 +20,7 @@
 #include "render/image.h"
 #include "render/recorder.h"
 #include "sim/world.h"
+#include "tests/render/overlay_pixels.h"
 #include "tests/render/video_probe.h"
 
 namespace throng::render {
@@ -309,6 +310,35 @@ TEST(ThrongRunCamera, FollowKeepsTheCrowdInTheMiddleOfTheFrame) {
     // The scenario camera sees the group off to the side.
     EXPECT_GT(std::abs(fixed.x - 0.5 * w), 0.15 * w) << "frame " << f << ": the crowd's centre at x " << fixed.x;
   }
+  std::filesystem::remove_all(dir);
+}
+
+// `throng run --render frames --routes K`: the routes K agents will walk,
+// drawn on the ground in kRouteColour. The maze under a fixed camera with
+// and without them: the frames differ, and nearly every differing pixel
+// turned towards the routes' colour.
+TEST(ThrongRunRoutes, DrawsTheRoutesOfASampleOfAgents) {
+  const std::string dir = temp_dir("routes");
+  const auto first_frame = [&](const std::string& routes) {
+    const std::string out_dir = dir + "/" + (routes.empty() ? "plain" : "routes");
+    std::string out;
+    const int code = run_throng(
+        "--backend cpu --threads 2 run maze --seconds 1 --render frames --width 320 "
+        "--height 180 --fps 1 --camera fixed --no-trajectories --quiet " +
+            routes + " --out '" + out_dir + "'",
+        out);
+    EXPECT_EQ(code, 0) << out;
+    return read_png(out_dir + "/frame_00000.png");
+  };
+  const Image plain = first_frame(""), routed = first_frame("--routes 12");
+  const testing::OverlayPixels o = testing::overlay_pixels(routed, plain, kRouteColour);
+  std::printf("  %lld pixels differ, %lld of them towards the routes' colour\n", static_cast<long long>(o.differing),
+              static_cast<long long>(o.towards));
+  EXPECT_GT(o.towards, 100);
+  EXPECT_GT(o.towards, o.differing * 9 / 10);
+  std::string out;
+  EXPECT_NE(run_throng("run maze --routes 3 --seconds 1 --no-trajectories --quiet --out '" + dir + "/x'", out), 0);
+  EXPECT_NE(out.find("--routes: needs --render"), std::string::npos) << out;
   std::filesystem::remove_all(dir);
 }
 

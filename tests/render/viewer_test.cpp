@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "render/image.h"
+#include "render/renderer.h"
+#include "tests/render/overlay_pixels.h"
 #include "tests/shared_data.h"
 
 extern char** environ;
@@ -227,6 +229,32 @@ TEST(Viewer, BadOptionsAreErrors) {
   EXPECT_EQ(code, 1) << out;
   EXPECT_NE(out.find("--lod-thresholds"), std::string::npos) << out;
   EXPECT_NE(out.find("thresholds must decrease"), std::string::npos) << out;
+}
+
+// --routes K: the routes of K agents drawn on the ground of the scene, as
+// `throng run --render --routes` draws them: the maze's screenshot with and
+// without them differs, every differing pixel nearer the routes' colour.
+TEST(Viewer, HeadlessDrawsTheRoutesOfASampleOfAgents) {
+  const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_routes";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string view =
+      std::string(THRONG_EXE) + " --threads 2 view maze --headless --frames 1 --width 320 --height 180 --camera fixed ";
+  std::string out;
+  ASSERT_EQ(run(view + "--screenshot " + (dir / "plain.png").string(), out), 0) << out;
+  ASSERT_EQ(run(view + "--routes 12 --screenshot " + (dir / "routes.png").string(), out), 0) << out;
+  const Image plain = read_png((dir / "plain.png").string()), routed = read_png((dir / "routes.png").string());
+  ASSERT_EQ(plain.width, routed.width);
+  const testing::OverlayPixels o = testing::overlay_pixels(routed, plain, kRouteColour);
+  EXPECT_GT(o.towards, 100) << o.differing;
+  EXPECT_GT(o.towards, o.differing * 9 / 10);
+  out.clear();
+  EXPECT_NE(run(std::string(THRONG_EXE) + " view formation --headless --frames 1 --routes 3 --screenshot " +
+                    (dir / "x.png").string(),
+                out),
+            0);
+  EXPECT_NE(out.find("--routes is for scenarios"), std::string::npos) << out;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
