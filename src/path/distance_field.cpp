@@ -220,10 +220,8 @@ FastMarchingFieldBuilder::FastMarchingFieldBuilder(DistanceFieldOptions options)
 
 FastMarchingFieldBuilder::~FastMarchingFieldBuilder() = default;
 
-sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec2 target, float radius,
-                                               const sim::CrowdDensity* crowd) const {
-  if (!world_has_obstacles(world)) return {};  // straight lines are the shortest ways
-  std::lock_guard lock(mutex_);
+sim::FieldData FastMarchingFieldBuilder::build_locked(const sim::World& world, glm::vec2 target, float radius,
+                                                      const sim::CrowdDensity* crowd) const {
   // Without a walkable region the free space is the obstacles' box grown by
   // a margin: grown again to hold every target asked for.
   const bool outside = space_ && !world.has_walkable() && !space_->bounds().contains(target);
@@ -239,12 +237,38 @@ sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec
     prepared_.clear();
   }
   if (crowd == nullptr) return build_distance_field(*space_, target, radius, options_);
-  // Congestion-weighted fields are asked for again and again: their walls
-  // and seeds are kept.
-  for (const Prepared& p : prepared_)
-    if (p.target == target && p.radius == radius) return march_field(p.field, crowd);
-  prepared_.push_back({target, radius, prepare_field(*space_, target, radius, options_)});
-  return march_field(prepared_.back().field, crowd);
+  return march_field(prepared(target, radius).field, crowd);
+}
+
+sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec2 target, float radius,
+                                               const sim::CrowdDensity* crowd) const {
+  if (!world_has_obstacles(world)) return {};  // straight lines are the shortest ways
+  const Prepared* p = nullptr;
+  {
+    std::lock_guard lock(mutex_);
+    if (crowd == nullptr || !space_ || world_ != &world) return build_locked(world, target, radius, crowd);
+    p = find_prepared(target, radius);
+    if (p == nullptr) return build_locked(world, target, radius, crowd);
+  }
+  // A weighed field asked for again: marched outside the lock, so that a
+  // run's fields are weighed in parallel.
+  return march_field(p->field, crowd);
+}
+
+const FastMarchingFieldBuilder::Prepared* FastMarchingFieldBuilder::find_prepared(glm::vec2 target,
+                                                                                  float radius) const {
+  for (const std::unique_ptr<Prepared>& p : prepared_)
+    if (p->target == target && p->radius == radius) return p.get();
+  return nullptr;
+}
+
+// Congestion-weighted fields are asked for again and again: their walls and
+// seeds are kept (the entries stay where they are while the world does).
+const FastMarchingFieldBuilder::Prepared& FastMarchingFieldBuilder::prepared(glm::vec2 target, float radius) const {
+  if (const Prepared* p = find_prepared(target, radius)) return *p;
+  prepared_.push_back(
+      std::make_unique<Prepared>(Prepared{target, radius, prepare_field(*space_, target, radius, options_)}));
+  return *prepared_.back();
 }
 
 }  // namespace throng::path

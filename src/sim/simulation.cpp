@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/timing.h"
 
 namespace throng::sim {
@@ -144,9 +145,14 @@ void Simulation::reweigh_fields() {
   }
   CrowdDensity density = density_cells_;
   count_crowd(density, positions(), flags(), density_free_area_);
-  for (std::size_t k = 0; k < field_targets_.size(); ++k)
-    fields_.replace(static_cast<std::int32_t>(k),
-                    quickest_builder_->build(world_, field_targets_[k].first, field_targets_[k].second, &density));
+  // Each field is marched on its own (fast marching is serial): in
+  // parallel over the fields, the same fields on any thread count.
+  std::vector<FieldData> weighed(field_targets_.size());
+  host_parallel_for("sim.quickest_fields.march", static_cast<Index>(weighed.size()), [&](Index k) {
+    const auto i = static_cast<std::size_t>(k);
+    weighed[i] = quickest_builder_->build(world_, field_targets_[i].first, field_targets_[i].second, &density);
+  });
+  for (std::size_t k = 0; k < weighed.size(); ++k) fields_.replace(static_cast<std::int32_t>(k), weighed[k]);
   fields_.upload();
   fields_weighed_at_ = steps_done_;
 }
