@@ -75,6 +75,9 @@ struct ScenarioObservation {
   // direction (to the left walking from `from` to `to`), in order; of agent
   // `agent` only when given.
   std::vector<double> crossing_times(std::int32_t line, std::optional<Index> agent = {}) const;
+  // Each agent's first positive crossing of line `line`, in order (people,
+  // not crossings: one who steps back and across again counts once).
+  std::vector<double> first_crossings(std::int32_t line) const;
 };
 
 struct ObserveOptions {

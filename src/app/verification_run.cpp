@@ -50,6 +50,19 @@ std::vector<double> ScenarioObservation::crossing_times(std::int32_t line, std::
   return out;
 }
 
+std::vector<double> ScenarioObservation::first_crossings(std::int32_t line) const {
+  std::vector<double> first(static_cast<std::size_t>(agents), -1.0);
+  for (const sim::LineCrossing& x : crossings) {
+    double& t = first.at(static_cast<std::size_t>(x.agent));
+    if (x.line == line && x.direction > 0 && (t < 0 || x.time < t)) t = x.time;
+  }
+  std::vector<double> out;
+  for (double t : first)
+    if (t >= 0) out.push_back(t);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 namespace {
 
 constexpr float kMovedM = 0.01f;      // an agent has started walking once 1 cm from its spawn point

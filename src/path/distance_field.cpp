@@ -237,38 +237,37 @@ sim::FieldData FastMarchingFieldBuilder::build_locked(const sim::World& world, g
     prepared_.clear();
   }
   if (crowd == nullptr) return build_distance_field(*space_, target, radius, options_);
-  return march_field(prepared(target, radius).field, crowd);
+  std::shared_ptr<const Prepared> p = find_prepared(target, radius);
+  if (!p) {
+    p = std::make_shared<const Prepared>(Prepared{target, radius, prepare_field(*space_, target, radius, options_)});
+    prepared_.push_back(p);
+  }
+  return march_field(p->field, crowd);
 }
 
 sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec2 target, float radius,
                                                const sim::CrowdDensity* crowd) const {
   if (!world_has_obstacles(world)) return {};  // straight lines are the shortest ways
-  const Prepared* p = nullptr;
+  std::shared_ptr<const Prepared> p;
   {
     std::lock_guard lock(mutex_);
     if (crowd == nullptr || !space_ || world_ != &world) return build_locked(world, target, radius, crowd);
     p = find_prepared(target, radius);
-    if (p == nullptr) return build_locked(world, target, radius, crowd);
+    if (!p) return build_locked(world, target, radius, crowd);
   }
-  // A weighed field asked for again: marched outside the lock, so that a
-  // run's fields are weighed in parallel.
+  // A weighed field asked for again: marched outside the lock (on a copy of
+  // the pointer, which keeps it alive whatever else the builder is asked),
+  // so that a run's fields are weighed in parallel.
   return march_field(p->field, crowd);
 }
 
-const FastMarchingFieldBuilder::Prepared* FastMarchingFieldBuilder::find_prepared(glm::vec2 target,
-                                                                                  float radius) const {
-  for (const std::unique_ptr<Prepared>& p : prepared_)
-    if (p->target == target && p->radius == radius) return p.get();
-  return nullptr;
-}
-
 // Congestion-weighted fields are asked for again and again: their walls and
-// seeds are kept (the entries stay where they are while the world does).
-const FastMarchingFieldBuilder::Prepared& FastMarchingFieldBuilder::prepared(glm::vec2 target, float radius) const {
-  if (const Prepared* p = find_prepared(target, radius)) return *p;
-  prepared_.push_back(
-      std::make_unique<Prepared>(Prepared{target, radius, prepare_field(*space_, target, radius, options_)}));
-  return *prepared_.back();
+// seeds are kept.
+std::shared_ptr<const FastMarchingFieldBuilder::Prepared> FastMarchingFieldBuilder::find_prepared(glm::vec2 target,
+                                                                                                  float radius) const {
+  for (const std::shared_ptr<const Prepared>& p : prepared_)
+    if (p->target == target && p->radius == radius) return p;
+  return nullptr;
 }
 
 }  // namespace throng::path

@@ -47,7 +47,9 @@ sim::FieldData build_distance_field(const FreeSpace& space, glm::vec2 target, fl
 // Weidmann's speed-density relation); the walls' slowness and the seeds of
 // such fields are kept for the next time the same field is asked for, and
 // such a field asked for again is marched outside the builder's lock (a
-// run weighs its fields in parallel; one world at a time per builder).
+// run weighs its fields in parallel). build() may be called from several
+// threads at once; give each world its own builder (the free space is kept
+// for the last world asked about).
 class FastMarchingFieldBuilder final : public sim::FieldBuilder {
  public:
   explicit FastMarchingFieldBuilder(DistanceFieldOptions options = {});
@@ -60,14 +62,13 @@ class FastMarchingFieldBuilder final : public sim::FieldBuilder {
   // build() under the lock: the free space made or grown, then the field.
   sim::FieldData build_locked(const sim::World& world, glm::vec2 target, float radius,
                               const sim::CrowdDensity* crowd) const;
-  const Prepared* find_prepared(glm::vec2 target, float radius) const;
-  const Prepared& prepared(glm::vec2 target, float radius) const;  // found, else made
+  std::shared_ptr<const Prepared> find_prepared(glm::vec2 target, float radius) const;
   DistanceFieldOptions options_;
   mutable std::mutex mutex_;
   mutable const sim::World* world_ = nullptr;
   mutable std::unique_ptr<FreeSpace> space_;
-  mutable sim::Aabb extent_;                                 // targets so far (a world without a walkable region)
-  mutable std::vector<std::unique_ptr<Prepared>> prepared_;  // congestion-weighted fields' walls and seeds
+  mutable sim::Aabb extent_;                                       // targets so far (a world without a walkable region)
+  mutable std::vector<std::shared_ptr<const Prepared>> prepared_;  // congestion-weighted fields' walls and seeds
 };
 
 }  // namespace throng::path

@@ -527,18 +527,21 @@ void Renderer::set_obstacles(Span<const sim::Polygon> polygons, Span<const sim::
 }
 
 void Renderer::State::Polylines::upload(const std::vector<MapPolyline>& lines, const char* field) {
+  // Checked whole before anything drawn is replaced.
   std::vector<glm::vec3> vertices;
-  first.clear();
-  count.clear();
+  std::vector<GLint> new_first;
+  std::vector<GLsizei> new_count;
   for (const MapPolyline& p : lines) {
     if (p.size() < 2) continue;
-    first.push_back(static_cast<GLint>(vertices.size()));
-    count.push_back(static_cast<GLsizei>(p.size()));
+    new_first.push_back(static_cast<GLint>(vertices.size()));
+    new_count.push_back(static_cast<GLsizei>(p.size()));
     for (const glm::vec2& q : p) {
       if (!std::isfinite(q.x) || !std::isfinite(q.y)) throw Error("path points must be finite", at_field(field));
       vertices.push_back(world_from_ground(q, 0.03f));
     }
   }
+  first = std::move(new_first);
+  count = std::move(new_count);
   vao = make_vertex_array();
   vbo = make_buffer();
   glBindVertexArray(vao.get());

@@ -191,7 +191,9 @@ class World;
 // fast-marching builder `throng run` uses for `planning: field` and
 // `planning: quickest`): the field of walking distances to `target` for
 // discs of `radius`; with `crowd`, of walking times at its density
-// (congestion_slowness), in seconds at the free speed of 1 m/s.
+// (congestion_slowness), in seconds at the free speed of 1 m/s. build()
+// may be called from several threads at once (planning: quickest weighs a
+// run's fields in parallel).
 class FieldBuilder {
  public:
   virtual ~FieldBuilder() = default;

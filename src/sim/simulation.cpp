@@ -64,29 +64,24 @@ StepContext Simulation::context() const {
 
 namespace {
 
-// The area of each density cell where field 0's disc fits (its nodes of
-// finite distance, a node's cell each); cells that hold none of its nodes
-// count wholly free.
-std::vector<float> free_area_of(const NavigationFields& fields, const CrowdDensity& cells) {
-  const FieldGrid& g = fields.grid(0);
-  const std::span<const float> distance = fields.distances(0);
+// The walkable area of each density cell: the cell's area times the share
+// of a 5 x 5 lattice of points in it that lie in free space.
+std::vector<float> free_area_of(const World& world, const CrowdDensity& cells) {
+  constexpr int kSamples = 5;
   std::vector<float> area(cells.density.size(), 0.0f);
-  std::vector<std::uint8_t> seen(cells.density.size(), 0);
-  for (std::int32_t j = 0; j < g.ny; ++j)
-    for (std::int32_t i = 0; i < g.nx; ++i) {
-      const glm::vec2 p = g.origin + glm::vec2(static_cast<float>(i), static_cast<float>(j)) * g.cell;
-      const float cx = (p.x - cells.origin.x) / cells.cell, cy = (p.y - cells.origin.y) / cells.cell;
-      if (!(cx >= 0.0f && cy >= 0.0f && cx < static_cast<float>(cells.nx) && cy < static_cast<float>(cells.ny)))
-        continue;
-      const std::size_t k =
-          static_cast<std::size_t>(cy) * static_cast<std::size_t>(cells.nx) + static_cast<std::size_t>(cx);
-      seen[k] = 1;
-      if (distance[static_cast<std::size_t>(j) * static_cast<std::size_t>(g.nx) + static_cast<std::size_t>(i)] <
-          INFINITY)
-        area[k] += g.cell * g.cell;
+  host_parallel_for("sim.quickest_fields.free_area", cells.ny, [&](Index j) {
+    for (std::int32_t i = 0; i < cells.nx; ++i) {
+      int free = 0;
+      for (int v = 0; v < kSamples; ++v)
+        for (int u = 0; u < kSamples; ++u) {
+          const glm::vec2 q(static_cast<float>(i) + (static_cast<float>(u) + 0.5f) / kSamples,
+                            static_cast<float>(j) + (static_cast<float>(v) + 0.5f) / kSamples);
+          free += world.in_free_space(cells.origin + q * cells.cell) ? 1 : 0;
+        }
+      area[static_cast<std::size_t>(j) * static_cast<std::size_t>(cells.nx) + static_cast<std::size_t>(i)] =
+          cells.cell * cells.cell * static_cast<float>(free) / (kSamples * kSamples);
     }
-  for (std::size_t k = 0; k < area.size(); ++k)
-    area[k] = seen[k] != 0 ? std::min(area[k], cells.cell * cells.cell) : cells.cell * cells.cell;
+  });
   return area;
 }
 
@@ -117,7 +112,7 @@ void Simulation::build_fields(const FieldBuilder& builder) {
   // over it, at the density of nobody (the plain distances).
   const bool weighed = spec_.planning == PlanningKind::Quickest;
   const CrowdDensity nobody;
-  for (int pass = weighed ? 0 : 1; pass < 2; ++pass) {
+  for (int pass = weighed && !world_.has_walkable() ? 0 : 1; pass < 2; ++pass) {
     for (const auto& [target, radius] : targets) {
       FieldData f = builder.build(world_, target, radius, weighed ? &nobody : nullptr);
       if (f.grid.nx == 0 || pass == 0) continue;  // none: nothing in the way
@@ -129,8 +124,7 @@ void Simulation::build_fields(const FieldBuilder& builder) {
 }
 
 // The density map: over every field's grid, in cells of 1 m (coarser past a
-// million cells), each cell's free area the nodes of field 0 where its disc
-// fits (the rest of the union counted free).
+// million cells), each cell's walkable area measured once.
 void Simulation::reweigh_fields() {
   if (density_cells_.nx == 0) {
     Aabb extent;
@@ -141,7 +135,7 @@ void Simulation::reweigh_fields() {
     }
     const float cell = std::max(1.0f, std::sqrt(extent.size().x * extent.size().y / 1e6f));
     density_cells_ = density_cells(extent, cell);
-    density_free_area_ = free_area_of(fields_, density_cells_);
+    density_free_area_ = free_area_of(world_, density_cells_);
   }
   CrowdDensity density = density_cells_;
   count_crowd(density, positions(), flags(), density_free_area_);

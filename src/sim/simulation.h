@@ -234,7 +234,7 @@ class Simulation {
   std::vector<std::pair<glm::vec2, float>> field_targets_;
   std::int64_t fields_weighed_at_ = -1;   // the step they were last weighed at
   CrowdDensity density_cells_;            // the density map's cells (no densities)
-  std::vector<float> density_free_area_;  // m^2 of each cell where field 0's disc fits
+  std::vector<float> density_free_area_;  // m^2 of each cell in free space
 };
 
 }  // namespace throng::sim
