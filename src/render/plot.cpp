@@ -14,9 +14,6 @@
 namespace throng::render {
 namespace {
 
-// Okabe and Ito: blue, vermillion, bluish green, reddish purple, orange, sky blue, black.
-constexpr std::array<Rgb, 7> kPalette{
-    {{0, 114, 178}, {213, 94, 0}, {0, 158, 115}, {204, 121, 167}, {230, 159, 0}, {86, 180, 233}, {0, 0, 0}}};
 constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kText{32, 32, 32};
 constexpr Rgb kAxis{64, 64, 64};
@@ -564,9 +561,6 @@ void draw_labels(Image& im, const Chart& c, const ChartFrame& f) {
 }
 
 }  // namespace
-
-Rgb palette_colour(std::size_t i) { return kPalette[i % kPalette.size()]; }
-std::size_t palette_size() { return kPalette.size(); }
 
 glm::vec2 ChartFrame::to_pixel(double x, double y) const {
   return {static_cast<float>(left + (x - x_min) / (x_max - x_min) * (right - left)),

@@ -5,6 +5,7 @@
 // time, error against step size) written as PNG next to their numbers.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -22,10 +23,15 @@ struct Rgb {
   friend bool operator==(const Rgb&, const Rgb&) = default;
 };
 
-// The i-th colour of the fixed, colour-blind-safe palette (Okabe and Ito's,
-// yellow left out: too faint on white); it repeats after palette_size().
-Rgb palette_colour(std::size_t i);
-std::size_t palette_size();
+// The fixed, colour-blind-safe palette (Okabe and Ito's, yellow left out:
+// too faint on white): blue, vermillion, bluish green, reddish purple,
+// orange, sky blue, black. Here rather than in plot.cpp so that code
+// describing charts needs no renderer (builds with -DTHRONG_RENDER=OFF).
+inline constexpr std::array<Rgb, 7> kPalette{
+    {{0, 114, 178}, {213, 94, 0}, {0, 158, 115}, {204, 121, 167}, {230, 159, 0}, {86, 180, 233}, {0, 0, 0}}};
+// The i-th colour of the palette; it repeats after palette_size().
+inline Rgb palette_colour(std::size_t i) { return kPalette[i % kPalette.size()]; }
+inline std::size_t palette_size() { return kPalette.size(); }
 
 struct PlotSeries {
   // Line: a polyline through the points, broken at non-finite ones.
