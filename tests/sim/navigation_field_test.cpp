@@ -18,6 +18,7 @@
 #include "path/distance_field.h"
 #include "sim/metrics.h"
 #include "sim/simulation.h"
+#include "tests/sim/same_bits_on_threads.h"
 #include "tests/sim/test_scenarios.h"
 
 namespace throng::sim {
@@ -137,18 +138,7 @@ TEST(NavigationField, TwentyRoundACornerAllArrive) {
 
 TEST(NavigationField, SameBitsOnAnyThreadCount) {
   const io::LoadedScenario l = io::parse_scenario(corner_yaml("collision_free_speed"), "corner.yaml");
-  auto snapshot = [&](int threads) {
-    ScopedExecution exec(Backend::Cpu, threads);
-    const auto sim = io::build_simulation(l);
-    sim->run(300);
-    return std::pair{sim->positions(), sim->velocities()};
-  };
-  const auto one = snapshot(1);
-  for (int t : {2, 4}) {
-    const auto other = snapshot(t);
-    EXPECT_TRUE(test::same_bits(one.first, other.first)) << t << " threads";
-    EXPECT_TRUE(test::same_bits(one.second, other.second)) << t << " threads";
-  }
+  test::expect_same_bits_on_threads(l, 300);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "sim/crowd.h"
 #include "sim/navigation_field.h"
 #include "sim/simulation.h"
+#include "tests/sim/same_bits_on_threads.h"
 #include "tests/sim/test_scenarios.h"
 
 namespace throng::sim {
@@ -142,18 +143,7 @@ TEST(QuickestFields, SameBitsOnAnyThreadCount) {
   io::LoadedScenario l = io::parse_scenario(yaml, "rimea_15_corner.yaml");
   ASSERT_EQ(l.spec.planning, PlanningKind::Quickest);
   scale_agent_counts(l.spec, 150);
-  auto snapshot = [&](int threads) {
-    ScopedExecution exec(Backend::Cpu, threads);
-    const auto sim = io::build_simulation(l);
-    sim->run(600);  // 30 s: the fields are weighed again 15 times
-    return std::pair{sim->positions(), sim->velocities()};
-  };
-  const auto one = snapshot(1);
-  for (int t : {2, 4}) {
-    const auto other = snapshot(t);
-    EXPECT_TRUE(test::same_bits(one.first, other.first)) << t << " threads";
-    EXPECT_TRUE(test::same_bits(one.second, other.second)) << t << " threads";
-  }
+  test::expect_same_bits_on_threads(l, 600);  // 30 s: the fields are weighed again 15 times
 }
 
 }  // namespace
