@@ -129,6 +129,10 @@ THRONG_HOST_DEVICE inline float cfs_gap_ahead(glm::vec2 p, float ri, glm::vec2 e
   return length_of(d) - l;
 }
 
+// Below this speed (m/s) an agent counts as held at rest by its neighbours
+// (collision_free_velocity, sim/sense.h).
+constexpr float kCfsBlockedSpeed = 0.05f;
+
 // The optimal-velocity function: the speed that keeps time gap T to the gap
 // s ahead, within [0, v0].
 THRONG_HOST_DEVICE inline float cfs_speed(float gap, float v0, float time_gap) {

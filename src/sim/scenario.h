@@ -87,7 +87,7 @@ struct SocialForceParams {
 
 // The steering model and its parameters, and those of the move stage.
 struct ModelParams {
-  ModelKind kind = ModelKind::Priority;
+  ModelKind kind = ModelKind::CollisionFreeSpeed;
   CollisionFreeSpeedParams cfs;
   TtcParams ttc;
   SocialForceParams sf;

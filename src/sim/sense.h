@@ -149,15 +149,26 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   // The time gap is kept to where neighbours will be in anticipation_time
   // (one crossing the agent's path will have left it), to those within the
   // lane; no step may end in a body where it is now.
-  float gap = INFINITY, gap_now = INFINITY;
-  for_each_candidate([&](Index j) {
-    if (!is_neighbour(j)) return;
-    const glm::vec2 q = n.position[j];
-    gap = fminf(gap,
-                cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j], c.lane_width));
-    gap_now = fminf(gap_now, cfs_gap_ahead(me.p, me.radius, e, q, n.radius[j]));
-  });
-  return e * fminf(cfs_speed(gap, v0, c.time_gap), fmaxf(gap_now, 0.0f) / dt);
+  auto speed_past = [&](bool all) {
+    float gap = INFINITY, gap_now = INFINITY;
+    for_each_candidate([&](Index j) {
+      if (!is_neighbour(j)) return;
+      const glm::vec2 q = n.position[j];
+      if (!all && dot2(q - me.p, me.e0) < 0.0f) return;
+      gap = fminf(
+          gap, cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j], c.lane_width));
+      gap_now = fminf(gap_now, cfs_gap_ahead(me.p, me.radius, e, q, n.radius[j]));
+    });
+    return fminf(cfs_speed(gap, v0, c.time_gap), fmaxf(gap_now, 0.0f) / dt);
+  };
+  const float speed = speed_past(true);
+  // Held at rest by a neighbour that is behind the agent on the way to its
+  // goal (beside it at a door's jamb, say) while walking on would take it
+  // forward: that neighbour waits instead. Two agents pressed together at a
+  // door each stand in the other's corridor and would both wait for ever;
+  // the one further along goes first, as people do.
+  if (speed < kCfsBlockedSpeed && dot2(e, me.e0) > 0.0f) return e * speed_past(false);
+  return e * speed;
 }
 
 // ---- time to collision -------------------------------------------------------

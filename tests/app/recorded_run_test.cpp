@@ -183,7 +183,10 @@ class RecordedRun : public ::testing::Test {
 TEST_F(RecordedRun, RunsExportsAndAnimationsMatchTheRecording) {
   Record now;
   // The four models, both schedulers, animated (locomotion, LOD, cache).
-  run("corridor_priority", {"corridor", "--agents", "60", "--seconds", "20", "--seed", "5"}, now);
+  run("corridor_priority",
+      {example_with_model("corridor.yaml", "model: {type: priority}", dir_).string(), "--agents", "60", "--seconds",
+       "20", "--seed", "5"},
+      now);
   run("bottleneck_cfs",
       {example_with_model("bottleneck.yaml", "model: {type: collision_free_speed}", dir_).string(), "--agents", "80",
        "--seconds", "30", "--seed", "2", "--scheduler", "four_colour"},

@@ -122,6 +122,7 @@ dt: 0.05
 steps: 120
 stop_when_arrived: false
 model:
+  type: priority
   pred_time: 1.5
   max_speed: 1.8
   max_force: 5
@@ -259,11 +260,11 @@ outputs:
   EXPECT_EQ(s.outputs.every, 4);
   EXPECT_FALSE(s.outputs.trajectories);
   // Every key's position is known.
-  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 43);
-  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 52);
-  EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").line, 58);  // each point, though not recorded as a key
+  EXPECT_EQ(l.source.locate("groups[0].waypoints[1]").line, 44);
+  EXPECT_EQ(l.source.locate("groups[2].spawn.polygon[1]").line, 53);
+  EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").line, 59);  // each point, though not recorded as a key
   EXPECT_EQ(l.source.locate("groups[3].spawn.points[1]").column, 11);
-  EXPECT_EQ(l.source.locate("groups[3].spawn.points[7]").line, 57);  // beyond the list: where the list starts
+  EXPECT_EQ(l.source.locate("groups[3].spawn.points[7]").line, 58);  // beyond the list: where the list starts
   // And it all builds and runs.
   const auto sim = build_simulation(l);
   EXPECT_EQ(sim->agent_count(), 26);

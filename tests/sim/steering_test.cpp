@@ -24,7 +24,13 @@ void expect_vec(glm::vec2 got, glm::vec2 want, float eps = kEps) {
 
 // Agent at the origin walking +x at 1 m/s, radius 0.25; pred_time 1 s,
 // probe_margin 0.1: probe length 0.25 + 1 * 1 = 1.25 m, half-width 0.35 m.
-ModelParams model() { return ModelParams{}; }
+// The priority model's parameters (the collision-free speed model is the
+// default).
+ModelParams model() {
+  ModelParams m;
+  m.kind = ModelKind::Priority;
+  return m;
+}
 Probe probe_east() { return make_probe({0.0f, 0.0f}, {1.0f, 0.0f}, 0.0f, 0.25f, model()); }
 
 TEST(ObstacleAvoidance, ProbeSize) {
@@ -206,7 +212,7 @@ struct Scene {
   World world;
   CrowdState crowd;
   AgentGrid bins;
-  ModelParams m;
+  ModelParams m = model();
   StepContext ctx;
 
   Scene(std::vector<glm::vec2> positions, std::vector<glm::vec2> velocities, std::vector<glm::vec2> goals,

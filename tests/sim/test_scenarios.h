@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstring>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -13,6 +14,7 @@
 #include "io/scenario_yaml.h"
 #include "sim/crowd.h"
 #include "sim/scenario.h"
+#include "sim/simulation.h"
 #include "sim/world.h"
 
 namespace throng::sim::test {
@@ -22,6 +24,14 @@ inline ScenarioSpec builtin(std::string_view name, std::int64_t agents = 0) {
   ScenarioSpec s = io::load_builtin_scenario(name).spec;
   if (agents > 0) scale_agent_counts(s, agents);
   return s;
+}
+
+// The simulation `throng run` builds for `spec` (io::build_simulation: the
+// route planner or navigation fields its `planning` asks for).
+inline std::unique_ptr<Simulation> as_run(const ScenarioSpec& spec, const SimulationOptions& options = {}) {
+  io::LoadedScenario l;
+  l.spec = spec;
+  return io::build_simulation(l, options);
 }
 
 // One group of `count` agents in a rect walking by `offset`, in an empty world.

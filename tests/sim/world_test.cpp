@@ -182,7 +182,8 @@ TEST(Spawn, ClearErrorsForSpawnRegionsGoalsAndParameters) {
   EXPECT_TRUE(contains(spawn_error(in_wall), "inside obstacle world.obstacles[2]")) << spawn_error(in_wall);
 
   ScenarioSpec goal_in_wall = test::builtin("crossing", 20);
-  goal_in_wall.groups[1].goal.value = {30, 70};  // offset into a block
+  goal_in_wall.groups[1].goal.kind = GoalSpec::Kind::Offset;
+  goal_in_wall.groups[1].goal.value = {30, 70};  // into a block
   EXPECT_TRUE(contains(spawn_error(goal_in_wall), "groups[1].goal")) << spawn_error(goal_in_wall);
   EXPECT_TRUE(contains(spawn_error(goal_in_wall), "lies inside obstacle")) << spawn_error(goal_in_wall);
 
