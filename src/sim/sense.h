@@ -139,10 +139,29 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   };
   for_each_wall_point(w, me.p, wall_point);
   glm::vec2 sum = e0 + walls;
+  // Only neighbours within `hold` can keep the agent below v0 (a gap of v0 T
+  // or more allows v0; where a neighbour will be moves by at most max_speed
+  // t_a): the pushes' pass keeps them for the gap passes, which then need
+  // not walk the bins again (the same speeds, far fewer neighbours). Past
+  // kCfsHolders of them (a crush) the gap passes walk the bins.
+  const float hold = me.radius + ModelParams::kCfsMaxRadius + v0 * c.time_gap + m.max_speed * c.anticipation_time;
+  Index holders[kCfsHolders];
+  int held = 0;
   for_each_candidate([&](Index j) {
-    if (is_neighbour(j))
-      sum += cfs_neighbour_push(me, n.position[j], n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
+    if (!is_neighbour(j)) return;
+    const glm::vec2 q = n.position[j];
+    sum += cfs_neighbour_push(me, q, n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
+    if (length2(q - me.p) >= hold * hold) return;
+    if (held < kCfsHolders) holders[held] = j;
+    ++held;
   });
+  auto for_each_holder = [&](const auto& fn) {
+    if (held > kCfsHolders)
+      return for_each_candidate([&](Index j) {
+        if (is_neighbour(j)) fn(j);
+      });
+    for (int k = 0; k < held; ++k) fn(holders[k]);
+  };
   const glm::vec2 e =
       cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
   if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
@@ -151,8 +170,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   // lane; no step may end in a body where it is now.
   auto speed_past = [&](bool all) {
     float gap = INFINITY, gap_now = INFINITY;
-    for_each_candidate([&](Index j) {
-      if (!is_neighbour(j)) return;
+    for_each_holder([&](Index j) {
       const glm::vec2 q = n.position[j];
       if (!all && dot2(q - me.p, me.e0) < 0.0f) return;
       gap = fminf(
@@ -165,8 +183,8 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   // Held at rest by a neighbour that is behind the agent on the way to its
   // goal (beside it at a door's jamb, say) while walking on would take it
   // forward: that neighbour waits instead. Two agents pressed together at a
-  // door each stand in the other's corridor and would both wait for ever;
-  // the one further along goes first, as people do.
+  // door each stand in the other's corridor and both stood still until the
+  // crowd shifted; the one further along goes first, as people do.
   if (speed < kCfsBlockedSpeed && dot2(e, me.e0) > 0.0f) return e * speed_past(false);
   return e * speed;
 }

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "encounters.h"
+#include "sim/sense.h"
+#include "sim/world.h"
 
 namespace throng::sim {
 namespace {
@@ -105,6 +107,58 @@ TEST(CollisionFreeSpeed, WallsSlideTheGoalDirectionAndTurnsTakeTime) {
   EXPECT_NEAR(t.x, std::sqrt(0.5f), kEps);
   EXPECT_NEAR(t.y, std::sqrt(0.5f), kEps);
   EXPECT_NEAR(cfs_turn({0.0f, 0.0f}, {0.0f, 1.0f}, 0.1f, 0.3f).y, 1.0f, kEps);  // from rest: at once
+}
+
+// The gap passes read only the neighbours that the pushes' pass kept as
+// close enough to hold the agent's speed (and walk every candidate again
+// past kCfsHolders of them). Either way the speed must be the time-gap
+// speed over every neighbour: in a light lattice (a few kept) and in a
+// dense one of small bodies (far more than kCfsHolders within reach), the
+// velocity's length against cfs_speed over all neighbours along its
+// direction.
+TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
+  ModelParams m;
+  m.kind = ModelKind::CollisionFreeSpeed;
+  const World world = World::build(WorldSpec{}, m.query_radius());
+  struct Lattice {
+    float spacing, radius;
+    bool overflows;
+  };
+  for (const Lattice l : {Lattice{0.6f, 0.25f, false}, Lattice{0.2f, 0.05f, true}}) {
+    SCOPED_TRACE(l.spacing);
+    std::vector<glm::vec2> p{{0.0f, 0.0f}}, v{{1.0f, 0.0f}};
+    std::vector<float> r{0.1f};
+    for (int i = -12; i <= 12; ++i)
+      for (int j = -12; j <= 12; ++j)
+        if (i != 0 || j != 0) {
+          p.emplace_back(l.spacing * (static_cast<float>(i) + 0.07f * static_cast<float>(j)),
+                         l.spacing * static_cast<float>(j));
+          v.emplace_back(-0.2f, 0.05f * static_cast<float>(i % 3));
+          r.push_back(l.radius);
+        }
+    const std::vector<std::uint8_t> f(p.size(), kAgentActive);
+    const NeighbourArrays n{Span<const glm::vec2>(p), Span<const glm::vec2>(v), Span<const float>(r),
+                            Span<const std::uint8_t>(f)};
+    const float v0 = 1.3f, dt = 0.1f;
+    const float hold = r[0] + ModelParams::kCfsMaxRadius + v0 * m.cfs.time_gap;
+    Index near = 0;
+    for (const glm::vec2 q : p) near += glm::length(q) < hold ? 1 : 0;
+    EXPECT_EQ(near - 1 > kCfsHolders, l.overflows) << near - 1 << " neighbours within " << hold << " m";
+    auto all = [&](const auto& fn) {
+      for (Index j = 0; j < static_cast<Index>(p.size()); ++j) fn(j);
+    };
+    const CfsAgent me{p[0], v[0], r[0], {1.0f, 0.0f}};
+    const glm::vec2 got = collision_free_velocity(world.view(), 0, me, v0, dt, n, m, all);
+    const float speed = glm::length(got);
+    ASSERT_GT(speed, kCfsBlockedSpeed);  // walking: no fallback, so the direction is known
+    const glm::vec2 e = got / speed;
+    float gap = INFINITY;
+    for (std::size_t j = 1; j < p.size(); ++j) gap = std::min(gap, cfs_gap_ahead(p[0], r[0], e, p[j], r[j]));
+    std::printf("  lattice %.2f m: %lld neighbours within %.2f m, speed %.4f m/s (gap %.4f m)\n", l.spacing,
+                static_cast<long long>(near - 1), hold, speed, gap);
+    EXPECT_NEAR(speed, std::min(cfs_speed(gap, v0, m.cfs.time_gap), gap / dt), 1e-5f);
+    EXPECT_LT(speed, v0);  // someone holds it
+  }
 }
 
 // ---- encounters -------------------------------------------------------------------
