@@ -313,8 +313,9 @@ class Reader : public YamlReader {
         const std::vector<std::string_view>& keys = keys_of_model(owner);
         if (owner == m.kind || std::find(keys.begin(), keys.end(), key.Scalar()) == keys.end()) continue;
         fail_at(key.Mark(), child(path, key.Scalar()),
-                fmt::format("'{}' is a parameter of the {} model, and this scenario's model.type is {}", key.Scalar(),
-                            to_string(owner), to_string(m.kind)));
+                fmt::format("'{}' is a parameter of the {} model, and this scenario's model.type is {}{}", key.Scalar(),
+                            to_string(owner), to_string(m.kind),
+                            n["type"] ? "" : fmt::format(" (the default; add 'type: {}')", to_string(owner))));
       }
     }
     keys_of(n, path, allowed);

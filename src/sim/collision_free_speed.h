@@ -131,11 +131,11 @@ THRONG_HOST_DEVICE inline float cfs_gap_ahead(glm::vec2 p, float ri, glm::vec2 e
 
 // Below this speed (m/s) an agent counts as held at rest by its neighbours
 // (collision_free_velocity, sim/sense.h).
-constexpr float kCfsBlockedSpeed = 0.05f;
+inline constexpr float kCfsBlockedSpeed = 0.05f;
 // Neighbours close enough to hold an agent's speed that the pushes' pass
 // keeps for the gap passes (collision_free_velocity): a disc of 1.7 m holds
 // about 50 at 6 P/m^2.
-constexpr int kCfsHolders = 64;
+inline constexpr int kCfsHolders = 64;
 
 // The optimal-velocity function: the speed that keeps time gap T to the gap
 // s ahead, within [0, v0].

@@ -139,20 +139,22 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   };
   for_each_wall_point(w, me.p, wall_point);
   glm::vec2 sum = e0 + walls;
-  // Only neighbours within `hold` can keep the agent below v0 (a gap of v0 T
-  // or more allows v0; where a neighbour will be moves by at most max_speed
-  // t_a): the pushes' pass keeps them for the gap passes, which then need
-  // not walk the bins again (the same speeds, far fewer neighbours). Past
-  // kCfsHolders of them (a crush) the gap passes walk the bins.
-  const float hold = me.radius + ModelParams::kCfsMaxRadius + v0 * c.time_gap + m.max_speed * c.anticipation_time;
-  Index holders[kCfsHolders];
+  // Only neighbours within `hold` can keep the agent below v0 (a gap of
+  // v0 max(T, dt) or more allows v0 under both caps; where a neighbour will
+  // be moves by at most max_speed t_a; 1 mm for rounding): the pushes' pass
+  // keeps them for the gap passes, which then need not walk the bins again
+  // (the same speeds, far fewer neighbours). Past kCfsHolders of them (a
+  // crush) the gap passes walk the bins.
+  const float hold =
+      me.radius + ModelParams::kCfsMaxRadius + v0 * fmaxf(c.time_gap, dt) + m.max_speed * c.anticipation_time + 1e-3f;
+  std::int32_t holders[kCfsHolders];
   int held = 0;
   for_each_candidate([&](Index j) {
     if (!is_neighbour(j)) return;
     const glm::vec2 q = n.position[j];
     sum += cfs_neighbour_push(me, q, n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
     if (length2(q - me.p) >= hold * hold) return;
-    if (held < kCfsHolders) holders[held] = j;
+    if (held < kCfsHolders) holders[held] = static_cast<std::int32_t>(j);
     ++held;
   });
   auto for_each_holder = [&](const auto& fn) {
@@ -160,7 +162,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
       return for_each_candidate([&](Index j) {
         if (is_neighbour(j)) fn(j);
       });
-    for (int k = 0; k < held; ++k) fn(holders[k]);
+    for (int k = 0; k < held; ++k) fn(static_cast<Index>(holders[k]));
   };
   const glm::vec2 e =
       cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
@@ -184,7 +186,9 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   // goal (beside it at a door's jamb, say) while walking on would take it
   // forward: that neighbour waits instead. Two agents pressed together at a
   // door each stand in the other's corridor and both stood still until the
-  // crowd shifted; the one further along goes first, as people do.
+  // crowd shifted; the one further along goes first, as people do. The
+  // neighbours behind are left out of the no-step-into-a-body cap too: the
+  // agent may press into them, and the contact passes part the pair.
   if (speed < kCfsBlockedSpeed && dot2(e, me.e0) > 0.0f) return e * speed_past(false);
   return e * speed;
 }

@@ -456,6 +456,9 @@ TEST(ScenarioYaml, TtcModelKeys) {
   // A parameter of another model names its owner, either way round.
   expect_owner_named("{type: ttc, time_gap: 1}", "'time_gap' is a parameter of the collision_free_speed model");
   expect_owner_named("{type: priority, ttc_strength: 1}", "'ttc_strength' is a parameter of the ttc model");
+  // Without a type (the collision-free speed model by default) the error
+  // says how to keep the priority model's parameters.
+  expect_owner_named("{pred_time: 1}", "model.type is collision_free_speed (the default; add 'type: priority')");
 }
 
 TEST(ScenarioYaml, SocialForceModelKeys) {

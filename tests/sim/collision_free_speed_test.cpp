@@ -112,10 +112,10 @@ TEST(CollisionFreeSpeed, WallsSlideTheGoalDirectionAndTurnsTakeTime) {
 // The gap passes read only the neighbours that the pushes' pass kept as
 // close enough to hold the agent's speed (and walk every candidate again
 // past kCfsHolders of them). Either way the speed must be the time-gap
-// speed over every neighbour: in a light lattice (a few kept) and in a
-// dense one of small bodies (far more than kCfsHolders within reach), the
-// velocity's length against cfs_speed over all neighbours along its
-// direction.
+// speed over every neighbour: in a light lattice (a few kept), in a dense
+// one of small bodies (far more than kCfsHolders within reach) and in a
+// light one with an anticipated gap and narrower lanes; the velocity's
+// length against cfs_speed over all neighbours along its direction.
 TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
   ModelParams m;
   m.kind = ModelKind::CollisionFreeSpeed;
@@ -123,9 +123,13 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
   struct Lattice {
     float spacing, radius;
     bool overflows;
+    float anticipation, lane_width;
   };
-  for (const Lattice l : {Lattice{0.6f, 0.25f, false}, Lattice{0.2f, 0.05f, true}}) {
+  for (const Lattice l : {Lattice{0.6f, 0.25f, false, 0.0f, 1.0f}, Lattice{0.2f, 0.05f, true, 0.0f, 1.0f},
+                          Lattice{0.6f, 0.25f, false, 0.5f, 0.8f}}) {
     SCOPED_TRACE(l.spacing);
+    m.cfs.anticipation_time = l.anticipation;
+    m.cfs.lane_width = l.lane_width;
     std::vector<glm::vec2> p{{0.0f, 0.0f}}, v{{1.0f, 0.0f}};
     std::vector<float> r{0.1f};
     for (int i = -12; i <= 12; ++i)
@@ -140,7 +144,7 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
     const NeighbourArrays n{Span<const glm::vec2>(p), Span<const glm::vec2>(v), Span<const float>(r),
                             Span<const std::uint8_t>(f)};
     const float v0 = 1.3f, dt = 0.1f;
-    const float hold = r[0] + ModelParams::kCfsMaxRadius + v0 * m.cfs.time_gap;
+    const float hold = r[0] + ModelParams::kCfsMaxRadius + v0 * m.cfs.time_gap + m.max_speed * l.anticipation;
     Index near = 0;
     for (const glm::vec2 q : p) near += glm::length(q) < hold ? 1 : 0;
     EXPECT_EQ(near - 1 > kCfsHolders, l.overflows) << near - 1 << " neighbours within " << hold << " m";
@@ -152,11 +156,16 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
     const float speed = glm::length(got);
     ASSERT_GT(speed, kCfsBlockedSpeed);  // walking: no fallback, so the direction is known
     const glm::vec2 e = got / speed;
-    float gap = INFINITY;
-    for (std::size_t j = 1; j < p.size(); ++j) gap = std::min(gap, cfs_gap_ahead(p[0], r[0], e, p[j], r[j]));
-    std::printf("  lattice %.2f m: %lld neighbours within %.2f m, speed %.4f m/s (gap %.4f m)\n", l.spacing,
-                static_cast<long long>(near - 1), hold, speed, gap);
-    EXPECT_NEAR(speed, std::min(cfs_speed(gap, v0, m.cfs.time_gap), gap / dt), 1e-5f);
+    float gap = INFINITY, gap_now = INFINITY;
+    for (std::size_t j = 1; j < p.size(); ++j) {
+      gap = std::min(gap, cfs_gap_ahead(p[0], r[0], e, p[j] + v[j] * l.anticipation, r[j], l.lane_width));
+      gap_now = std::min(gap_now, cfs_gap_ahead(p[0], r[0], e, p[j], r[j]));
+    }
+    std::printf(
+        "  lattice %.2f m, t_a %.1f s, lane width %.1f: %lld neighbours within %.2f m, speed %.4f m/s (gap %.4f "
+        "m)\n",
+        l.spacing, l.anticipation, l.lane_width, static_cast<long long>(near - 1), hold, speed, gap);
+    EXPECT_NEAR(speed, std::min(cfs_speed(gap, v0, m.cfs.time_gap), gap_now / dt), 1e-5f);
     EXPECT_LT(speed, v0);  // someone holds it
   }
 }
