@@ -5,6 +5,7 @@
 #include "io/run_outputs.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cctype>
 #include <filesystem>
@@ -24,7 +25,13 @@ using namespace throng::io::testing;
 
 class TrajectoryFormats : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { run_ = run_room(fs::temp_directory_path() / "throng_run_outputs_test"); }
+  // One folder per process: ctest runs each test of the suite in a process
+  // of its own, two at a time, and two runs writing one SQLite file clash
+  // ("attempt to write a readonly database").
+  static void SetUpTestSuite() {
+    run_ = run_room(fs::temp_directory_path() / ("throng_run_outputs_test_" + std::to_string(::getpid())));
+  }
+  static void TearDownTestSuite() { fs::remove_all(run_.dir); }
   static std::string path(TrajectoryFormat f) { return run_.path(f); }
   static inline RoomRun run_;
 };
