@@ -175,33 +175,80 @@ class Reader : public YamlReader {
       g.value = point(n, path);
       return g;
     }
-    const std::string k = one_of(n, path, {"point", "offset", "mirror", "random", "exits"}, {"choice", "reconsider"});
+    const std::string k =
+        one_of(n, path, {"point", "offset", "mirror", "random", "exits", "gate"}, {"choice", "reconsider", "wait"});
     const std::string sub = child(path, k);
-    if (k == "exits") return exits(n, path);
+    if (k == "exits") {
+      if (n["wait"]) fail(n["wait"], child(path, "wait"), "agents leave by an exit: it takes no wait");
+      return exits(n, path);
+    }
     if (n["choice"] || n["reconsider"])
       fail(n["choice"] ? n["choice"] : n["reconsider"], child(path, n["choice"] ? "choice" : "reconsider"),
            "only a goal of exits takes a choice");
+    if (n["wait"]) g.wait_s = real(n["wait"], child(path, "wait"));
     if (k == "random") {
       g.kind = GoalSpec::Kind::Random;
       g.region = region(n[k], sub);
-      return g;
+    } else if (k == "gate") {  // [[x, y], [x, y]]: its two ends
+      g.kind = GoalSpec::Kind::Gate;
+      expect_list(n[k], sub, 2, 2, "ends [x, y] (a gate is two points)");
+      const std::vector<glm::vec2> ends = points(n[k], sub);
+      g.value = ends[0];
+      g.gate_to = ends[1];
+    } else {
+      g.kind = k == "point" ? GoalSpec::Kind::Point : (k == "offset" ? GoalSpec::Kind::Offset : GoalSpec::Kind::Mirror);
+      g.value = point(n[k], sub);
     }
-    g.kind = k == "point" ? GoalSpec::Kind::Point : (k == "offset" ? GoalSpec::Kind::Offset : GoalSpec::Kind::Mirror);
-    g.value = point(n[k], sub);
     return g;
   }
 
-  // {exits: [{point: [x, y], width: m}, ...], choice: nearest | quickest,
-  // reconsider: s}.
+  // One exit: {point: [x, y], width: m} or a door line {from: [x, y], to:
+  // [x, y]} (its middle and length), with a `name` where `named`.
+  sim::ExitSpec exit(const YAML::Node& x, const std::string& xp, bool named) {
+    if (named)
+      expect_map(x, xp, {"name", "point", "width", "from", "to"});
+    else
+      expect_map(x, xp, {"point", "width", "from", "to"});
+    sim::ExitSpec e;
+    if (named) e.name = text(required(x, xp, "name"), child(xp, "name"));
+    if (x["from"] || x["to"]) {
+      if (x["point"] || x["width"])
+        fail(x["point"] ? x["point"] : x["width"], child(xp, x["point"] ? "point" : "width"),
+             "give an exit as 'point' and 'width' or as a line 'from' and 'to', not both");
+      const glm::vec2 from = point(required(x, xp, "from"), child(xp, "from"));
+      const glm::vec2 to = point(required(x, xp, "to"), child(xp, "to"));
+      e.point = 0.5f * (from + to);
+      e.half = 0.5f * (to - from);
+      e.width = glm::length(to - from);
+      if (!(e.width > 0)) fail(x["to"], child(xp, "to"), "a door line needs two different ends");
+      return e;
+    }
+    e.point = point(required(x, xp, "point"), child(xp, "point"));
+    if (x["width"]) e.width = real(x["width"], child(xp, "width"));
+    return e;
+  }
+
+  // {exits: [EXIT | name of one of the scenario's exits, ...], choice:
+  // nearest | quickest, reconsider: s}.
   GoalSpec exits(const YAML::Node& n, const std::string& path) {
     GoalSpec g;
     g.kind = GoalSpec::Kind::Exits;
     each_item(n["exits"], child(path, "exits"), 1, 1000, "exits", [&](const YAML::Node& x, const std::string& xp) {
-      expect_map(x, xp, {"point", "width"});
-      sim::ExitSpec e;
-      e.point = point(required(x, xp, "point"), child(xp, "point"));
-      if (x["width"]) e.width = real(x["width"], child(xp, "width"));
-      g.exits.push_back(e);
+      if (!x.IsScalar()) {
+        g.exits.push_back(exit(x, xp, false));
+        return;
+      }
+      const std::string name = text(x, xp);
+      const auto found = std::find_if(named_exits_.begin(), named_exits_.end(),
+                                      [&](const sim::ExitSpec& e) { return e.name == name; });
+      if (found == named_exits_.end()) {
+        std::string known;
+        for (const sim::ExitSpec& e : named_exits_) known += (known.empty() ? "" : ", ") + e.name;
+        fail(x, xp,
+             fmt::format("no exit named {} (the scenario's exits: {})", shown(name),
+                         known.empty() ? "none; name them in the top-level 'exits'" : known));
+      }
+      g.exits.push_back(*found);
     });
     if (n["choice"])
       g.choice = word(n["choice"], child(path, "choice"), {"nearest", "quickest"}) == "quickest"
@@ -592,11 +639,22 @@ class Reader : public YamlReader {
     return o;
   }
 
+  // The scenario's named exits, which groups' goals name.
+  void named_exits(const YAML::Node& n, const std::string& path) {
+    each_item(n, path, 1, 1000, "exits", [&](const YAML::Node& x, const std::string& xp) {
+      sim::ExitSpec e = exit(x, xp, true);
+      if (e.name.empty()) fail(x["name"], child(xp, "name"), "must not be empty");
+      for (const sim::ExitSpec& other : named_exits_)
+        if (other.name == e.name) fail(x["name"], child(xp, "name"), fmt::format("duplicate name {}", shown(e.name)));
+      named_exits_.push_back(std::move(e));
+    });
+  }
+
   sim::ScenarioSpec scenario(const YAML::Node& root, const std::string& default_name, TrajectoryFormat& format,
                              MotionSetSpec& motion) {
     expect_map(root, "",
                {"name", "description", "seed", "scheduler", "planning", "dt", "duration", "steps", "stop_when_arrived",
-                "model", "world", "groups", "camera", "measurement", "outputs", "motion"});
+                "model", "world", "exits", "groups", "camera", "measurement", "outputs", "motion"});
     sim::ScenarioSpec s;
     s.name = root["name"] ? text(root["name"], "name") : default_name;
     if (root["description"]) s.description = text(root["description"], "description");
@@ -620,6 +678,7 @@ class Reader : public YamlReader {
     if (root["stop_when_arrived"]) s.stop_when_arrived = boolean(root["stop_when_arrived"], "stop_when_arrived");
     if (root["model"]) s.model = model(root["model"], "model");
     if (root["world"]) world(root["world"], "world", s.world);
+    if (root["exits"]) named_exits(root["exits"], "exits");
     const YAML::Node groups = required(root, "", "groups");
     expect_list(groups, "groups", 1, static_cast<std::size_t>(limits_.max_groups), "groups");
     std::int64_t agents = 0;
@@ -647,6 +706,7 @@ class Reader : public YamlReader {
 
   ScenarioReadLimits limits_;
   ScenarioSource& source_;
+  std::vector<sim::ExitSpec> named_exits_;  // the top-level `exits`, read before the groups
   std::int64_t vertices_ = 0;
 };
 

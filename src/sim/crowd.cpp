@@ -187,6 +187,19 @@ void check_goal(const GoalSpec& goal, const std::string& gf, const ScenarioLimit
     if (!std::isfinite(goal.reconsider_s) || !(goal.reconsider_s > 0))
       throw Error(fmt::format("reconsider must be > 0 s (got {})", goal.reconsider_s), at_field(gf + ".reconsider"));
   }
+  if (goal.kind == GoalSpec::Kind::Gate) {
+    const glm::vec2 to = goal.gate_to;
+    if (!std::isfinite(to.x) || !std::isfinite(to.y) || std::fabs(to.x) > limits.max_extent ||
+        std::fabs(to.y) > limits.max_extent)
+      throw Error("gate coordinates must be finite numbers within the extent limit", at_field(gf + ".gate"));
+    if (length_of(to - goal.value) < kMinGateLength)
+      throw Error(fmt::format("a gate needs two ends at least {} m apart (got {:.3g} m)", kMinGateLength,
+                              length_of(to - goal.value)),
+                  at_field(gf + ".gate"));
+  }
+  if (!std::isfinite(goal.wait_s) || goal.wait_s < 0)
+    throw Error(fmt::format("wait must be a finite number of seconds >= 0 (got {})", goal.wait_s),
+                at_field(gf + ".wait"));
   if (goal.kind == GoalSpec::Kind::Random) {
     check_region(goal.region, gf + ".random", limits.max_extent);
     if (goal.region.kind == Region::Kind::ring)
@@ -319,6 +332,10 @@ void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string
     if (G.waypoints[w].kind == GoalSpec::Kind::Exits) throw Error("exits can only be a group's goal", at_field(wf));
     check_goal(G.waypoints[w], wf, limits);
   }
+  if (G.goal.kind == GoalSpec::Kind::Gate)
+    throw Error("a gate is a waypoint: the goal is a point, a region or exits", at_field(field + ".goal"));
+  if (G.goal.wait_s > 0)
+    throw Error("the goal takes no wait (on_arrival: stop keeps agents there)", at_field(field + ".goal.wait"));
   check_goal(G.goal, field + ".goal", limits);
   if (G.goal.kind == GoalSpec::Kind::Exits && G.arrival == ArrivalBehaviour::Loop)
     throw Error("agents leave by an exit: on_arrival stop or despawn, not loop", at_field(field + ".on_arrival"));
@@ -372,6 +389,10 @@ void add_group_extent(const GroupSpec& G, Aabb& extent) {
         extent.add(2.0f * goal.value - sb.max);
         break;
       case GoalSpec::Kind::Random: extent.add(region_bounds(goal.region)); break;
+      case GoalSpec::Kind::Gate:
+        extent.add(goal.value);
+        extent.add(goal.gate_to);
+        break;
       case GoalSpec::Kind::Exits:
         for (const ExitSpec& x : goal.exits) extent.add(x.point);
         break;
@@ -624,12 +645,13 @@ void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std
 // from `from`: a point, or one drawn from a region with arng (free for a
 // disc of radius r and reachable from `from`).
 glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std::string& gf, glm::vec2 p,
-                       glm::vec2 from, std::int64_t agent, Rng& arng) {
+                       glm::vec2 from, std::int64_t agent, Rng& arng, Occupancy* spots) {
   glm::vec2 q(0.0f);
   switch (goal.kind) {
     case GoalSpec::Kind::Point: q = goal.value; break;
     case GoalSpec::Kind::Offset: q = p + goal.value; break;
     case GoalSpec::Kind::Mirror: q = 2.0f * goal.value - p; break;
+    case GoalSpec::Kind::Gate: q = 0.5f * (goal.value + goal.gate_to); break;  // its middle
     case GoalSpec::Kind::Exits: {
       // Every exit must be reachable (a quickest choice may switch to any);
       // the agent starts towards the nearest in a straight line.
@@ -651,12 +673,19 @@ glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std:
         q = glm::vec2(static_cast<float>(arng.uniform(rb.min.x, rb.max.x)),
                       static_cast<float>(arng.uniform(rb.min.y, rb.max.y)));
         found = region_contains(goal.region, q) && ctx.world.disc_fits(q, ctx.r) &&
+                (spots == nullptr || !spots->overlaps(q, ctx.r, 0.1f * ctx.r)) &&
                 (!ctx.reach || ctx.reach->connected(from, q));
       }
+      if (!found && spots != nullptr)
+        throw Error(fmt::format("found no free spot for agent {} in the waiting area: each agent waiting there "
+                                "stands on a spot of its own; make the area larger",
+                                agent),
+                    at_field(gf + ".random"));
       if (!found)
         throw Error(fmt::format("found no free place reachable from {} for agent {} in the goal region",
                                 point_text(from), agent),
                     at_field(gf + ".random"));
+      if (spots != nullptr) spots->add(q, ctx.r, agent);
       break;
     }
   }
@@ -693,6 +722,8 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
   const auto first_agent = static_cast<std::int64_t>(out.position.size());
   const std::size_t W = G.waypoints.size();
   std::vector<glm::vec2> resolved(chosen.size() * (W + 1));
+  // A waiting area gives each agent a spot of its own (not one another's).
+  std::vector<Occupancy> spots(W, Occupancy(std::max(2.0f * ctx.r * 1.2f, 0.1f)));
   for (std::size_t k = 0; k < chosen.size(); ++k) {
     const glm::vec2 p = chosen[k];
     const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);
@@ -718,7 +749,8 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
     for (std::size_t w = 0; w <= W; ++w) {
       const GoalSpec& goal = w < W ? G.waypoints[w] : G.goal;
       const std::string gf = w < W ? fmt::format("{}.waypoints[{}]", field, w) : field + ".goal";
-      const glm::vec2 q = resolve_goal(ctx, goal, gf, p, from, agent, arng);
+      const bool waiting_area = w < W && goal.kind == GoalSpec::Kind::Random && goal.wait_s > 0.0f;
+      const glm::vec2 q = resolve_goal(ctx, goal, gf, p, from, agent, arng, waiting_area ? &spots[w] : nullptr);
       check_route_point(ctx, q, from, agent, gf);
       resolved[k * (W + 1) + w] = q;
       from = q;
@@ -727,12 +759,36 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
   return resolved;
 }
 
+// Appends to out.stages what group G's waypoints ask beyond being reached
+// (a gate's extent, a wait) and its exits given as door lines (gates), and
+// to out.exit_stages the group's exits' stages; returns each waypoint's
+// index there, -1 for a plain point.
+std::vector<std::int32_t> add_stages(const GroupSpec& G, CrowdHost& out) {
+  auto add = [&](glm::vec2 half, float wait_s) {
+    out.stages.push_back({half, wait_s});
+    return static_cast<std::int32_t>(out.stages.size()) - 1;
+  };
+  std::vector<std::int32_t> ids(G.waypoints.size(), -1);
+  for (std::size_t w = 0; w < G.waypoints.size(); ++w) {
+    const GoalSpec& goal = G.waypoints[w];
+    if (goal.kind == GoalSpec::Kind::Gate)
+      ids[w] = add(0.5f * (goal.gate_to - goal.value), goal.wait_s);
+    else if (goal.wait_s > 0.0f)
+      ids[w] = add(glm::vec2(0.0f), goal.wait_s);
+  }
+  std::vector<std::int32_t>& exits = out.exit_stages.emplace_back();
+  if (G.goal.kind == GoalSpec::Kind::Exits)
+    for (const ExitSpec& x : G.goal.exits) exits.push_back(length2(x.half) > 0.0f ? add(x.half, 0.0f) : -1);
+  return ids;
+}
+
 // Appends the routes of the agents at `chosen` (group G, field) to `out`:
 // their waypoints (or, for a goal without waypoints, the planner's points
 // in between, when there is a planner), the goal, the way back for a loop,
 // and the heading towards the first point.
 void add_routes(const GroupSpec& G, const std::string& field, const std::vector<glm::vec2>& chosen,
-                const std::vector<glm::vec2>& resolved, const World& world, const RoutePlanner* planner,
+                const std::vector<glm::vec2>& resolved, const std::vector<std::int32_t>& stage_ids,
+                const std::vector<std::int32_t>& exit_stages, const World& world, const RoutePlanner* planner,
                 const ScenarioLimits& limits, float r, CrowdHost& out) {
   const std::size_t W = G.waypoints.size();
   std::vector<std::vector<glm::vec2>> planned;
@@ -753,13 +809,26 @@ void add_routes(const GroupSpec& G, const std::string& field, const std::vector<
     if (static_cast<std::int64_t>(via.size()) > limits.max_waypoints)
       throw Error(fmt::format("a planned route has {} points, more than {}", via.size(), limits.max_waypoints),
                   at_field(field + ".goal"));
+    // (Planned points are plain; the group's own waypoints carry their stages.)
+    auto stage = [&](std::size_t v) { return planned.empty() ? stage_ids[v] : -1; };
     out.waypoints.insert(out.waypoints.end(), via.begin(), via.end());
-    out.waypoints.push_back(resolved[k * (W + 1) + W]);
+    for (std::size_t v = 0; v < via.size(); ++v) out.waypoint_stage.push_back(stage(v));
+    // (An exit goal: the stage of the exit spawning chose, a door line's gate.)
+    const glm::vec2 goal = resolved[k * (W + 1) + W];
+    std::int32_t goal_stage = -1;
+    for (std::size_t e = 0; e < exit_stages.size(); ++e)
+      if (G.goal.exits[e].point == goal && goal_stage < 0) goal_stage = exit_stages[e];
+    out.waypoints.push_back(goal);
+    out.waypoint_stage.push_back(goal_stage);
     out.waypoint_goal.push_back(static_cast<std::int32_t>(out.waypoints.size()) - 1 - begin);
     // A loop walks back along the route to where the agent started.
     if (G.arrival == ArrivalBehaviour::Loop) {
-      for (std::size_t v = via.size(); v-- > 0;) out.waypoints.push_back(via[v]);
+      for (std::size_t v = via.size(); v-- > 0;) {
+        out.waypoints.push_back(via[v]);
+        out.waypoint_stage.push_back(stage(v));
+      }
       out.waypoints.push_back(p);
+      out.waypoint_stage.push_back(-1);
     }
     out.waypoint_count.push_back(static_cast<std::int32_t>(out.waypoints.size()) - begin);
     const glm::vec2 to = out.waypoints[static_cast<std::size_t>(begin)] - p;
@@ -789,7 +858,8 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
     out.groups.push_back(rt);
     const RouteContext ctx{world, reach.get(), limits, r};
     const std::vector<glm::vec2> resolved = add_agents(ctx, spec, g, chosen, placed, out);
-    add_routes(G, field, chosen, resolved, world, planner, limits, r, out);
+    const std::vector<std::int32_t> stage_ids = add_stages(G, out);
+    add_routes(G, field, chosen, resolved, stage_ids, out.exit_stages.back(), world, planner, limits, r, out);
   }
   return out;
 }
@@ -821,6 +891,10 @@ CrowdState upload_crowd(const CrowdHost& h, Memory m) {
   c.start_time = up(h.start_time.empty() ? std::vector<float>(h.position.size(), 0.0f) : h.start_time);
   c.arrival_time = up(std::vector<float>(h.position.size(), -1.0f));
   c.waypoints = up(h.waypoints);
+  c.waypoint_stage =
+      up(h.waypoint_stage.empty() ? std::vector<std::int32_t>(h.waypoints.size(), -1) : h.waypoint_stage);
+  // (One entry at least: a device span of a null buffer is no table.)
+  c.stages = up(h.stages.empty() ? std::vector<StageRuntime>(1) : h.stages);
   c.groups = up(h.groups);
   return c;
 }

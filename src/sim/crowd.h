@@ -25,6 +25,15 @@ struct GroupRuntime {
   float arrival_radius = 0.5f;
 };
 
+// What a waypoint asks beyond being reached (a stage of the journey): a
+// gate's half extent (from its middle, the waypoint, to one end; zero for a
+// point) and how long the agent stands once there.
+struct StageRuntime {
+  glm::vec2 gate_half{0.0f};  // m
+  float wait_s = 0.0f;        // s
+};
+inline constexpr float kMinGateLength = 0.1f;  // m: a gate's two ends lie at least this far apart
+
 struct CrowdState {
   Index count = 0;
   Buffer<glm::vec2> position;
@@ -40,9 +49,11 @@ struct CrowdState {
   Buffer<std::int32_t> waypoint_goal;    // the waypoint whose arrival counts as arriving
   Buffer<std::int32_t> group;
   Buffer<std::uint8_t> flags;
-  Buffer<float> arrival_time;   // s, -1 until arrived
-  Buffer<float> start_time;     // s: stands (kAgentWaiting) or stays out (kAgentPending) until then
-  Buffer<glm::vec2> waypoints;  // every agent's waypoint list, flattened
+  Buffer<float> arrival_time;           // s, -1 until arrived
+  Buffer<float> start_time;             // s: stands (kAgentWaiting) or stays out (kAgentPending) until then
+  Buffer<glm::vec2> waypoints;          // every agent's waypoint list, flattened
+  Buffer<std::int32_t> waypoint_stage;  // per entry of waypoints: into stages, -1 = a plain point
+  Buffer<StageRuntime> stages;
   Buffer<GroupRuntime> groups;
 };
 
@@ -54,6 +65,11 @@ struct CrowdHost {
   std::vector<std::uint8_t> flags;  // initial flags; empty = every agent active
   std::vector<std::int32_t> group, waypoint_begin, waypoint_count, waypoint_goal;
   std::vector<glm::vec2> waypoints;
+  std::vector<std::int32_t> waypoint_stage;  // per entry of waypoints; empty = every one a plain point
+  std::vector<StageRuntime> stages;
+  // Per group, per exit of its goal: into stages (a door line), -1 for an
+  // exit given as a point; empty for a group without exits.
+  std::vector<std::vector<std::int32_t>> exit_stages;
   std::vector<GroupRuntime> groups;
 };
 

@@ -9,6 +9,8 @@ namespace throng::sim {
 
 ExitChooser::ExitChooser(const ScenarioSpec& spec, const CrowdHost& host) {
   exits_.resize(spec.groups.size());
+  exit_stage_ = host.exit_stages;
+  exit_stage_.resize(spec.groups.size());
   std::vector<std::size_t> first_exit(spec.groups.size(), 0);
   bool any = false;
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
@@ -69,6 +71,7 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
   const std::vector<std::int32_t> cursor = crowd.waypoint_cursor.to_vector();
   std::vector<glm::vec2> waypoints = crowd.waypoints.to_vector(), goal = crowd.goal.to_vector(),
                          path_start = crowd.path_start.to_vector();
+  std::vector<std::int32_t> stage = crowd.waypoint_stage.to_vector();
   // Those in the scene still to leave, nearest an exit first (one yet to
   // enter chooses at the first round after it entered).
   std::vector<std::pair<float, std::size_t>> order;
@@ -104,6 +107,8 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
     ++switched;
     const glm::vec2 to = exits_[static_cast<std::size_t>(c.group)][best].point;
     waypoints[static_cast<std::size_t>(c.goal_slot)] = to;
+    const std::vector<std::int32_t>& stages = exit_stage_[static_cast<std::size_t>(c.group)];
+    stage[static_cast<std::size_t>(c.goal_slot)] = best < stages.size() ? stages[best] : -1;
     if (cursor[i] == c.goal_index) {  // on its last leg: a new leg from where it stands
       goal[i] = to;
       path_start[i] = position[i];
@@ -111,6 +116,7 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
   }
   if (switched > 0) {
     crowd.waypoints.write(0, std::span<const glm::vec2>(waypoints));
+    crowd.waypoint_stage.write(0, std::span<const std::int32_t>(stage));
     crowd.goal.write(0, std::span<const glm::vec2>(goal));
     crowd.path_start.write(0, std::span<const glm::vec2>(path_start));
   }

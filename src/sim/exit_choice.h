@@ -43,7 +43,8 @@ class ExitChooser {
   void use_fields(FieldsView host_fields);
   // At the first call and then every reconsider_s seconds of `time`: the
   // exits weighed again and the goals of agents that switch rewritten in
-  // `crowd` (the flattened waypoint and, on its last leg, the current goal).
+  // `crowd` (the flattened waypoint and its stage and, on its last leg, the
+  // current goal).
   // Returns the number of agents that switched.
   Index update(double time, CrowdState& crowd);
 
@@ -63,6 +64,7 @@ class ExitChooser {
 
   std::vector<std::vector<ExitSpec>> exits_;           // per group (empty where the group does not choose)
   std::vector<std::vector<std::int32_t>> exit_field_;  // per group and exit: its navigation field, or -1
+  std::vector<std::vector<std::int32_t>> exit_stage_;  // per group and exit: its gate's stage, or -1 (CrowdHost)
   FieldsView fields_;
   std::size_t exit_count_ = 0;  // exits of all choosing groups (the flat queue counts)
   std::vector<Chooser> agents_;

@@ -70,8 +70,12 @@ Index Replanner::update(double time, const World& world, CrowdState& crowd) {
     last_distance_[k] = INFINITY;
     last_cursor_[k] = -1;
   }
+  // (Re-planned routes are plain points: agents on journeys of stages are not re-planned.)
+  std::vector<std::int32_t> stage = crowd.waypoint_stage.to_vector();
+  stage.resize(waypoints.size(), -1);
   const Memory m = current_memory();
   crowd.waypoints = Buffer<glm::vec2>(std::span<const glm::vec2>(waypoints), m);
+  crowd.waypoint_stage = Buffer<std::int32_t>(std::span<const std::int32_t>(stage), m);
   crowd.waypoint_begin.write(0, std::span<const std::int32_t>(begin));
   crowd.waypoint_count.write(0, std::span<const std::int32_t>(count));
   crowd.waypoint_goal.write(0, std::span<const std::int32_t>(goal_index));

@@ -160,9 +160,15 @@ struct Region {
 
 // A way out: agents heading for it aim at `point` (the middle of the door,
 // say) and leave through `width` metres, which sizes its capacity.
+// A scenario's `exits` list names exits that groups then refer to by name.
+// An exit given as a door line is passed by crossing it anywhere along it
+// (as a gate); one given as a point and width, within arrival_radius of
+// the point.
 struct ExitSpec {
   glm::vec2 point{0.0f};
-  float width = 1.0f;  // m
+  float width = 1.0f;    // m
+  std::string name;      // empty when given inline in a group's goal
+  glm::vec2 half{0.0f};  // m: from point to the line's `to` end; zero for a point and width
 };
 // How an agent picks among its group's exits: the nearest in a straight
 // line (once, at the start), or the quickest (sim/exit_choice.h: walking
@@ -178,13 +184,18 @@ struct GoalSpec {
     Mirror,  // 2 * value - spawn position (the antipode through value)
     Random,  // a random free point of `region` per agent
     Exits,   // one of `exits` per agent, chosen by `choice` (a group's goal only)
+    Gate,    // the line from value to gate_to, passed when crossed anywhere along it (waypoints only)
   };
   Kind kind = Kind::Point;
   glm::vec2 value{0.0f};
+  glm::vec2 gate_to{0.0f};      // Gate
   Region region;                // Random
   std::vector<ExitSpec> exits;  // Exits
   ExitChoice choice = ExitChoice::Nearest;
   float reconsider_s = 2.0f;  // Exits, quickest: how often each agent weighs the exits again
+  // s: a waypoint where the agent stands this long once it reaches it (a
+  // waiting area: a `random` waypoint with a wait; not on the goal).
+  float wait_s = 0.0f;
   static GoalSpec at(glm::vec2 p) {
     GoalSpec g;
     g.value = p;

@@ -14,8 +14,8 @@ AgentArrays arrays_of(CrowdState& c) {
   return {c.position.span(),       c.velocity.span(),        c.heading.span(),       c.radius.span(),
           c.pref_speed.span(),     c.path_start.span(),      c.goal.span(),          c.waypoint_begin.span(),
           c.waypoint_count.span(), c.waypoint_cursor.span(), c.waypoint_goal.span(), c.group.span(),
-          c.flags.span(),          c.arrival_time.span(),    c.waypoints.span(),     c.groups.span(),
-          c.start_time.span()};
+          c.flags.span(),          c.arrival_time.span(),    c.waypoints.span(),     c.waypoint_stage.span(),
+          c.stages.span(),         c.groups.span(),          c.start_time.span()};
 }
 
 Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& options)

@@ -68,8 +68,10 @@ struct AgentArrays {
   Span<std::uint8_t> flags;
   Span<float> arrival_time;
   Span<const glm::vec2> waypoints;
+  Span<const std::int32_t> waypoint_stage;
+  Span<const StageRuntime> stages;
   Span<const GroupRuntime> groups;
-  Span<const float> start_time;
+  Span<float> start_time;  // written when an agent stops to wait at a waypoint
 };
 AgentArrays arrays_of(CrowdState& c);
 

@@ -60,6 +60,49 @@ THRONG_HOST_DEVICE inline bool waypoint_in_view(const WorldView& w, glm::vec2 p,
   return !blocked;
 }
 
+// A gate of the journey (a waypoint with an extent, sim/crowd.h): every
+// model heads for the nearest point of it kept a body and kGateEndMargin
+// from each end, kGateLead past the line so that agents cross it rather
+// than stop on it; it is passed once the agent is across the line, seen
+// from where its leg started, anywhere along it (within a body of its ends).
+constexpr float kGateEndMargin = 0.1f;  // m
+constexpr float kGateLead = 1.0f;       // m
+// Its middle; unit vectors along it and across it, away from the leg's
+// start; half its length (m).
+struct Gate {
+  glm::vec2 mid{0.0f}, along{0.0f}, ahead{0.0f};
+  float half = 0.0f;
+};
+// Agent i's current waypoint as a gate; false for a point (with or without a wait).
+THRONG_HOST_DEVICE inline bool current_gate(const AgentArrays& a, Index i, Gate& g) {
+  const std::int32_t s = a.waypoint_stage[a.waypoint_begin[i] + a.waypoint_cursor[i]];
+  if (s < 0 || length2(a.stages[s].gate_half) == 0.0f) return false;
+  g.mid = a.goal[i];
+  g.half = length_of(a.stages[s].gate_half);
+  g.along = a.stages[s].gate_half * (1.0f / g.half);
+  g.ahead = perp_left(g.along);
+  if (dot2(a.path_start[i] - g.mid, g.ahead) > 0.0f) g.ahead = -g.ahead;
+  return true;
+}
+// True when agent i's current waypoint asks it to wait there: it walks to
+// the point itself (not to a gate through it, as the collision-free speed
+// model's other waypoints).
+THRONG_HOST_DEVICE inline bool waits_at_waypoint(const AgentArrays& a, Index i) {
+  const std::int32_t s = a.waypoint_stage[a.waypoint_begin[i] + a.waypoint_cursor[i]];
+  return s >= 0 && a.stages[s].wait_s > 0.0f;
+}
+// (An agent beyond an end heads for the line itself and takes the lead
+// once in line with the gate: led from beyond the end it would cut past it.)
+THRONG_HOST_DEVICE inline glm::vec2 gate_aim(const Gate& g, glm::vec2 p, float r) {
+  const float reach = fmaxf(g.half - r - kGateEndMargin, 0.0f);
+  const float offset = dot2(p - g.mid, g.along);
+  const float t = fminf(fmaxf(offset, -reach), reach);
+  return g.mid + g.along * t + g.ahead * (t == offset ? kGateLead : 0.0f);
+}
+THRONG_HOST_DEVICE inline bool crossed_gate(const Gate& g, glm::vec2 p, float r) {
+  return dot2(p - g.mid, g.ahead) > 0.0f && fabsf(dot2(p - g.mid, g.along)) <= g.half + r;
+}
+
 // Where a navigation field leads agent i (its current waypoint is the
 // field's target): the point the field aims at (sim/navigation_field.h).
 // False when no field leads to its waypoint.
@@ -69,6 +112,23 @@ THRONG_HOST_DEVICE inline bool field_target(const StepContext& ctx, const AgentA
   if (f < 0) return false;
   out = field_aim(ctx.fields, f, a.position[i]);
   return true;
+}
+
+// Where a navigation field or a gate leads agent i: the field's aim (taken
+// kGateLead past the line where it ends at the gate of an exit, so that the
+// agent crosses it), else the gate's aim; false for neither.
+THRONG_HOST_DEVICE inline bool led_target(const StepContext& ctx, const AgentArrays& a, Index i, glm::vec2& out) {
+  Gate gate;
+  const bool is_gate = current_gate(a, i, gate);
+  if (field_target(ctx, a, i, out)) {
+    if (!is_gate) return true;
+    const float past = dot2(out - gate.mid, gate.ahead);
+    if (fabsf(past) < kGateLead && fabsf(dot2(out - gate.mid, gate.along)) <= gate.half)
+      out += gate.ahead * (kGateLead - past);
+    return true;
+  }
+  if (is_gate) out = gate_aim(gate, a.position[i], a.radius[i]);
+  return is_gate;
 }
 
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
@@ -100,9 +160,9 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx,
   const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
   const glm::vec2 p = a.position[i];
   glm::vec2 aim;
-  if (!field_target(ctx, a, i, aim)) {
-    const bool final_goal = a.waypoint_cursor[i] == a.waypoint_goal[i];
-    aim = final_goal ? a.goal[i] : waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
+  if (!led_target(ctx, a, i, aim)) {
+    const bool to_point = a.waypoint_cursor[i] == a.waypoint_goal[i] || waits_at_waypoint(a, i);
+    aim = to_point ? a.goal[i] : waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
   }
   const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f))};
   return collision_free_velocity(ctx.world, i, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
@@ -113,7 +173,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx,
 THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const AgentArrays& a, Index i) {
   const glm::vec2 p = a.position[i];
   glm::vec2 aim = a.goal[i];
-  field_target(ctx, a, i, aim);
+  led_target(ctx, a, i, aim);
   return {p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f)), a.pref_speed[i]};
 }
 
@@ -182,10 +242,11 @@ THRONG_HOST_DEVICE inline void steer_agent(const StepContext& ctx, const AgentAr
     out_v = clamp_length(v + sensed * ctx.dt, m.max_speed);
   } else {
     // Priority: path following only when no avoidance force was sensed; a
-    // field's aim is followed from where the agent stands (its leg's lane
-    // may run through the walls the field leads round).
+    // field's aim or a gate's is followed from where the agent stands (its
+    // leg's lane may run through the walls the field leads round; it ends
+    // at the gate's middle).
     glm::vec2 start = a.path_start[i], goal = a.goal[i];
-    if (field_target(ctx, a, i, goal)) start = p;
+    if (led_target(ctx, a, i, goal)) start = p;
     const glm::vec2 force =
         force_applies(sensed) ? sensed : path_following_force(p, v, a.pref_speed[i], start, goal, m);
     // Forces turn and brake; none makes an agent walk faster than it prefers.
@@ -365,12 +426,23 @@ struct Finalize {
       const GroupRuntime g = a.groups[a.group[i]];
       const glm::vec2 goal = a.goal[i];
       const std::int32_t cursor = a.waypoint_cursor[i];
+      Gate gate;
+      const bool is_gate = current_gate(a, i, gate);
       // (The priority model keeps the paper's point waypoints.)
-      const bool through = ctx.model.kind == ModelKind::CollisionFreeSpeed && cursor != a.waypoint_goal[i] &&
-                           passed_waypoint(p, a.path_start[i], goal, g.arrival_radius) &&
-                           waypoint_in_view(ctx.world, p, goal);
-      if (through || length2(goal - p) <= g.arrival_radius * g.arrival_radius) {
+      const bool through = is_gate ? crossed_gate(gate, p, r)
+                                   : ctx.model.kind == ModelKind::CollisionFreeSpeed && cursor != a.waypoint_goal[i] &&
+                                         !waits_at_waypoint(a, i) &&
+                                         passed_waypoint(p, a.path_start[i], goal, g.arrival_radius) &&
+                                         waypoint_in_view(ctx.world, p, goal);
+      if (through || (!is_gate && length2(goal - p) <= g.arrival_radius * g.arrival_radius)) {
         const std::int32_t begin = a.waypoint_begin[i], count = a.waypoint_count[i];
+        const std::int32_t stage = a.waypoint_stage[begin + cursor];
+        // A waiting area: the agent stands here (sensed) until then, as before its pre-movement ends.
+        if (stage >= 0 && a.stages[stage].wait_s > 0.0f) {
+          flags |= kAgentWaiting;
+          a.start_time[i] = ctx.time_after + a.stages[stage].wait_s;
+          v = glm::vec2(0.0f);
+        }
         if (cursor == a.waypoint_goal[i] && a.arrival_time[i] < 0.0f) {
           a.arrival_time[i] = ctx.time_after;
           flags |= kAgentArrived;

@@ -436,6 +436,49 @@ TEST(ScenarioYaml, ExitsGoal) {
   EXPECT_FLOAT_EQ(quickest.reconsider_s, 5.0f);
 }
 
+// Named exits (a point and width, or a door line: its middle and length)
+// that goals name; gates and waits on waypoints.
+TEST(ScenarioYaml, NamedExitsGatesAndWaits) {
+  const std::string text = R"(exits:
+  - {name: east, point: [30, 2], width: 1.2}
+  - {name: north, from: [10, 20], to: [13, 24]}
+groups:
+  - count: 4
+    spawn: {rect: {min: [0, 0], max: [5, 5]}}
+    waypoints:
+      - {gate: [[8, -1], [8, 6]]}
+      - {random: {rect: {min: [12, 0], max: [16, 4]}}, wait: 7.5}
+      - {point: [18, 2], wait: 2}
+    goal: {exits: [north, {from: [30, 8], to: [30, 10]}, east], choice: quickest}
+)";
+  const sim::GroupSpec g = parse_scenario(text, "j.yaml").spec.groups[0];
+  ASSERT_EQ(g.waypoints.size(), 3u);
+  EXPECT_EQ(g.waypoints[0].kind, sim::GoalSpec::Kind::Gate);
+  EXPECT_EQ(g.waypoints[0].value, glm::vec2(8, -1));
+  EXPECT_EQ(g.waypoints[0].gate_to, glm::vec2(8, 6));
+  EXPECT_EQ(g.waypoints[0].wait_s, 0.0f);
+  EXPECT_EQ(g.waypoints[1].kind, sim::GoalSpec::Kind::Random);
+  EXPECT_FLOAT_EQ(g.waypoints[1].wait_s, 7.5f);
+  EXPECT_FLOAT_EQ(g.waypoints[2].wait_s, 2.0f);
+  ASSERT_EQ(g.goal.exits.size(), 3u);
+  EXPECT_EQ(g.goal.exits[0].name, "north");
+  EXPECT_EQ(g.goal.exits[0].point, glm::vec2(11.5f, 22.0f));
+  EXPECT_FLOAT_EQ(g.goal.exits[0].width, 5.0f);
+  EXPECT_EQ(g.goal.exits[1].point, glm::vec2(30, 9));
+  EXPECT_FLOAT_EQ(g.goal.exits[1].width, 2.0f);
+  EXPECT_EQ(g.goal.exits[2].name, "east");
+  EXPECT_FLOAT_EQ(g.goal.exits[2].width, 1.2f);
+  EXPECT_EQ(g.goal.choice, sim::ExitChoice::Quickest);
+  // An exit named before any are given says where to name them.
+  try {
+    parse_scenario("groups:\n  - count: 4\n    spawn: {rect: {min: [0, 0], max: [5, 5]}}\n    goal: {exits: [east]}\n",
+                   "n.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("none; name them in the top-level 'exits'"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ScenarioYaml, TtcModelKeys) {
   const std::string text = std::string(kOneGroup) + R"(model:
   type: ttc

@@ -18,6 +18,13 @@
 namespace throng::sim {
 namespace {
 
+ExitSpec door(glm::vec2 point, float width) {
+  ExitSpec e;
+  e.point = point;
+  e.width = width;
+  return e;
+}
+
 GoalSpec two_exits(ExitSpec a, ExitSpec b, ExitChoice choice) {
   GoalSpec g;
   g.kind = GoalSpec::Kind::Exits;
@@ -39,7 +46,7 @@ TEST(ExitChoice, QuickestWeighsTheQueueAhead) {
   g.spawn.points = {{4, 0}, {2, 0}, {3, 0}};
   g.count = 3;
   g.speed = {1.3f, 0.0f, 1.3f, 1.3f};
-  g.goal = two_exits({{0, 0}, 0.1f}, {{20, 0}, 2.0f}, ExitChoice::Quickest);
+  g.goal = two_exits(door({0, 0}, 0.1f), door({20, 0}, 2.0f), ExitChoice::Quickest);
   Simulation sim(s);
   // Spawning aims everyone at the nearest exit; the first step chooses.
   for (glm::vec2 goal : sim.crowd().goal.to_vector()) EXPECT_EQ(goal, glm::vec2(0, 0));
@@ -75,12 +82,7 @@ TEST(ExitChoice, QuickestWeighsTheWalkWithNavigationFields) {
 // (16, 10): 10 m from the south door, 14 m from the north one, and every
 // agent nearer the south door.
 ScenarioSpec room(ExitChoice choice, ModelKind model) {
-  ScenarioSpec s;
-  s.name = "two_exits";
-  s.model.kind = model;
-  s.planning = PlanningKind::None;
-  s.dt = 0.1f;
-  s.duration = 900.0f;
+  ScenarioSpec s = test::straight_spec("two_exits", model, 0.1f, 900.0f);
   s.world.has_walkable = true;
   s.world.walkable.outer = {{-2, 0},  {15.4f, 0},  {15.4f, -2}, {16.6f, -2}, {16.6f, 0},  {34, 0},
                             {34, 24}, {16.6f, 24}, {16.6f, 26}, {15.4f, 26}, {15.4f, 24}, {-2, 24}};
@@ -91,7 +93,7 @@ ScenarioSpec room(ExitChoice choice, ModelKind model) {
   g.spawn.kind = Region::Kind::rect;
   g.spawn.min = {0.0f, 8.1f};
   g.spawn.max = {32.0f, 11.9f};
-  g.goal = two_exits({{16, 0}, 1.2f}, {{16, 24}, 1.2f}, choice);
+  g.goal = two_exits(door({16, 0}, 1.2f), door({16, 24}, 1.2f), choice);
   g.arrival = ArrivalBehaviour::Despawn;
   s.groups = {g};
   return s;
@@ -132,6 +134,29 @@ TEST(ExitChoice, QuickestUsesBothDoorsAndEmptiesTheRoomSooner) {
     EXPECT_GE(quickest.south, quickest.agents / 4);
     EXPECT_LE(quickest.last, 0.8f * nearest.last);
   }
+}
+
+// The same doors given as door lines: each agent leaves once across its
+// door's line (not within arrival_radius of its middle), whichever door it
+// switched to.
+TEST(ExitChoice, DoorLinesAreLeftByCrossingThem) {
+  ScenarioSpec s = room(ExitChoice::Quickest, ModelKind::CollisionFreeSpeed);
+  for (ExitSpec& x : s.groups[0].goal.exits) x.half = {0.6f, 0.0f};
+  Simulation sim(s);
+  while (!sim.all_arrived() && sim.time() < s.duration) sim.step();
+  EXPECT_EQ(sim.arrived_count(), sim.agent_count());
+  Index south = 0, north = 0;
+  for (glm::vec2 p : sim.positions()) {
+    EXPECT_TRUE(p.y <= 0.0f || p.y >= 24.0f) << p.x << ", " << p.y << ": left before the line";
+    EXPECT_LE(std::fabs(p.x - 16.0f), 0.6f + s.groups[0].radius);
+    (p.y < 12.0f ? south : north) += 1;
+  }
+  float last = 0.0f;
+  for (float t : sim.arrival_times()) last = std::max(last, t);
+  std::printf("  door lines: %lld south / %lld north, out by %.1f s\n", static_cast<long long>(south),
+              static_cast<long long>(north), last);
+  EXPECT_GE(north, sim.agent_count() / 4);
+  EXPECT_GE(south, sim.agent_count() / 4);
 }
 
 TEST(ExitChoice, BadExitsAreLocatedErrors) {

@@ -49,16 +49,23 @@ inline ScenarioSpec open_field(std::int64_t count, glm::vec2 min, glm::vec2 max,
   return s;
 }
 
+// An empty scenario under `model` without route planning (groups walk
+// straight at their goals).
+inline ScenarioSpec straight_spec(const char* name, ModelKind model, float dt, float duration) {
+  ScenarioSpec s;
+  s.name = name;
+  s.model.kind = model;
+  s.planning = PlanningKind::None;
+  s.dt = dt;
+  s.duration = duration;
+  return s;
+}
+
 // An empty scenario for the validation runs: the collision-free speed
 // model, no route planning (groups walk straight at their goals), and the
 // walkable region `outer`.
 inline ScenarioSpec collision_free_spec(const char* name, float dt, float duration, Ring outer) {
-  ScenarioSpec s;
-  s.name = name;
-  s.model.kind = ModelKind::CollisionFreeSpeed;
-  s.planning = PlanningKind::None;
-  s.dt = dt;
-  s.duration = duration;
+  ScenarioSpec s = straight_spec(name, ModelKind::CollisionFreeSpeed, dt, duration);
   s.world.has_walkable = true;
   s.world.walkable.outer = std::move(outer);
   return s;
