@@ -165,6 +165,8 @@ ScenarioObservation observe(const io::LoadedScenario& scenario, const ObserveOpt
   ScenarioObservation out;
   out.spec = loaded.spec;
   const std::unique_ptr<sim::Simulation> sim = io::build_simulation(loaded);
+  // (Read now: a wait at a waypoint rewrites an agent's start time.)
+  out.start_time = sim->crowd().start_time.to_vector();
   Recorder recorder(*sim, options, out);
   const std::int64_t steps = loaded.spec.step_count();
   for (std::int64_t k = 0; k < steps; ++k) {
@@ -177,7 +179,6 @@ ScenarioObservation observe(const io::LoadedScenario& scenario, const ObserveOpt
   out.agents = sim->agent_count();
   out.group = c.group.to_vector();
   out.pref_speed = c.pref_speed.to_vector();
-  out.start_time = c.start_time.to_vector();
   out.arrival_time = sim->arrival_times();
   return out;
 }

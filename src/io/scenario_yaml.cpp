@@ -225,6 +225,7 @@ class Reader : public YamlReader {
     }
     e.point = point(required(x, xp, "point"), child(xp, "point"));
     if (x["width"]) e.width = real(x["width"], child(xp, "width"));
+    if (!(e.width > 0)) fail(x["width"], child(xp, "width"), fmt::format("must be > 0 m (got {})", e.width));
     return e;
   }
 

@@ -641,6 +641,11 @@ void check_route_point(const RouteContext& ctx, glm::vec2 q, glm::vec2 from, std
         at_field(gf));
 }
 
+// Space kept between the bodies of agents waiting in one waiting area: at
+// r = 0.25 m the spots are at least 0.75 m apart, about 2 persons per m^2
+// where they are packed, so that those standing leave ways to the others.
+constexpr float kWaitingSpotGap = 0.25f;  // m
+
 // Route point `goal` (field gf) of an agent that spawned at p and comes
 // from `from`: a point, or one drawn from a region with arng (free for a
 // disc of radius r and reachable from `from`).
@@ -668,15 +673,18 @@ glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std:
     }
     case GoalSpec::Kind::Random: {
       const Aabb rb = region_bounds(goal.region);
-      bool found = false;
+      bool found = false, taken = false;  // taken: a free, reachable place was another's spot
       for (int attempt = 0; attempt < 200 && !found; ++attempt) {
         q = glm::vec2(static_cast<float>(arng.uniform(rb.min.x, rb.max.x)),
                       static_cast<float>(arng.uniform(rb.min.y, rb.max.y)));
         found = region_contains(goal.region, q) && ctx.world.disc_fits(q, ctx.r) &&
-                (spots == nullptr || !spots->overlaps(q, ctx.r, 0.1f * ctx.r)) &&
                 (!ctx.reach || ctx.reach->connected(from, q));
+        if (found && spots != nullptr && spots->overlaps(q, ctx.r, kWaitingSpotGap)) {
+          found = false;
+          taken = true;
+        }
       }
-      if (!found && spots != nullptr)
+      if (!found && taken)
         throw Error(fmt::format("found no free spot for agent {} in the waiting area: each agent waiting there "
                                 "stands on a spot of its own; make the area larger",
                                 agent),
@@ -723,7 +731,7 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
   const std::size_t W = G.waypoints.size();
   std::vector<glm::vec2> resolved(chosen.size() * (W + 1));
   // A waiting area gives each agent a spot of its own (not one another's).
-  std::vector<Occupancy> spots(W, Occupancy(std::max(2.0f * ctx.r * 1.2f, 0.1f)));
+  std::vector<Occupancy> spots(W, Occupancy(2.0f * ctx.r + kWaitingSpotGap));  // (a cell reaches every conflict)
   for (std::size_t k = 0; k < chosen.size(); ++k) {
     const glm::vec2 p = chosen[k];
     const std::int64_t agent = first_agent + static_cast<std::int64_t>(k);

@@ -62,13 +62,14 @@ THRONG_HOST_DEVICE inline bool waypoint_in_view(const WorldView& w, glm::vec2 p,
 
 // A gate of the journey (a waypoint with an extent, sim/crowd.h): every
 // model heads for the nearest point of it kept a body and kGateEndMargin
-// from each end, kGateLead past the line so that agents cross it rather
-// than stop on it; it is passed once the agent is across the line, seen
-// from where its leg started, anywhere along it (within a body of its ends).
+// from each end, led kGateLead past the line so that agents cross it
+// rather than stop on it; it is passed by a step that crosses the line, in
+// either direction, within a body of its ends.
 constexpr float kGateEndMargin = 0.1f;  // m
 constexpr float kGateLead = 1.0f;       // m
-// Its middle; unit vectors along it and across it, away from the leg's
-// start; half its length (m).
+// Its middle; unit vectors along it and across it, away from the side the
+// agent is on (from where its leg started while on the line); half its
+// length (m).
 struct Gate {
   glm::vec2 mid{0.0f}, along{0.0f}, ahead{0.0f};
   float half = 0.0f;
@@ -81,8 +82,18 @@ THRONG_HOST_DEVICE inline bool current_gate(const AgentArrays& a, Index i, Gate&
   g.half = length_of(a.stages[s].gate_half);
   g.along = a.stages[s].gate_half * (1.0f / g.half);
   g.ahead = perp_left(g.along);
-  if (dot2(a.path_start[i] - g.mid, g.ahead) > 0.0f) g.ahead = -g.ahead;
+  const float side = dot2(a.position[i] - g.mid, g.ahead);
+  if (side > 0.0f || (side == 0.0f && dot2(a.path_start[i] - g.mid, g.ahead) > 0.0f)) g.ahead = -g.ahead;
   return true;
+}
+// True when the step from `from` to `p` crosses the gate's line within a
+// body (r) of its ends.
+THRONG_HOST_DEVICE inline bool crossed_gate(const Gate& g, glm::vec2 from, glm::vec2 p, float r) {
+  const glm::vec2 n = perp_left(g.along);
+  const float s0 = dot2(from - g.mid, n), s1 = dot2(p - g.mid, n);
+  if ((s0 > 0.0f) == (s1 > 0.0f) || s0 == s1) return false;
+  const glm::vec2 at = from + (p - from) * (s0 / (s0 - s1));
+  return fabsf(dot2(at - g.mid, g.along)) <= g.half + r;
 }
 // True when agent i's current waypoint asks it to wait there: it walks to
 // the point itself (not to a gate through it, as the collision-free speed
@@ -91,16 +102,15 @@ THRONG_HOST_DEVICE inline bool waits_at_waypoint(const AgentArrays& a, Index i) 
   const std::int32_t s = a.waypoint_stage[a.waypoint_begin[i] + a.waypoint_cursor[i]];
   return s >= 0 && a.stages[s].wait_s > 0.0f;
 }
-// (An agent beyond an end heads for the line itself and takes the lead
-// once in line with the gate: led from beyond the end it would cut past it.)
+// (An agent beyond the aimed-at part heads for the line itself and takes
+// the lead once in line with that part: led from beyond it, it would cut
+// past the gate's end. A gate narrower than a body and its margins, a
+// turnstile, leads those within half its half-length of its middle.)
 THRONG_HOST_DEVICE inline glm::vec2 gate_aim(const Gate& g, glm::vec2 p, float r) {
   const float reach = fmaxf(g.half - r - kGateEndMargin, 0.0f);
   const float offset = dot2(p - g.mid, g.along);
   const float t = fminf(fmaxf(offset, -reach), reach);
-  return g.mid + g.along * t + g.ahead * (t == offset ? kGateLead : 0.0f);
-}
-THRONG_HOST_DEVICE inline bool crossed_gate(const Gate& g, glm::vec2 p, float r) {
-  return dot2(p - g.mid, g.ahead) > 0.0f && fabsf(dot2(p - g.mid, g.along)) <= g.half + r;
+  return g.mid + g.along * t + g.ahead * (fabsf(offset) <= fmaxf(reach, 0.5f * g.half) ? kGateLead : 0.0f);
 }
 
 // Where a navigation field leads agent i (its current waypoint is the
@@ -429,7 +439,7 @@ struct Finalize {
       Gate gate;
       const bool is_gate = current_gate(a, i, gate);
       // (The priority model keeps the paper's point waypoints.)
-      const bool through = is_gate ? crossed_gate(gate, p, r)
+      const bool through = is_gate ? crossed_gate(gate, from, p, r)
                                    : ctx.model.kind == ModelKind::CollisionFreeSpeed && cursor != a.waypoint_goal[i] &&
                                          !waits_at_waypoint(a, i) &&
                                          passed_waypoint(p, a.path_start[i], goal, g.arrival_radius) &&
