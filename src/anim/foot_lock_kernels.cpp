@@ -101,6 +101,14 @@ THRONG_HOST_DEVICE inline glm::vec2 carried_correction(const FootLockJob& job, f
 }
 
 inline constexpr float kTouchdownHeight = 0.005f;
+// A foot low (within kHoldHeight of its ground, m at scale 1) whose posed
+// ankle moves slower than kHoldSpeed is held too, though its clip has it in
+// the air: creeping in a jam, the clips keep their cadence and shorten the
+// stride, so a swing drags a few centimetres over the ground at a few
+// centimetres a second, and held it lifts and sets down instead (a held
+// foot left far behind takes a step of its own, as a planted one).
+inline constexpr float kHoldHeight = 0.05f;
+inline constexpr float kHoldSpeed = 1.0f;  // m/s
 
 // One leg: the correction carried on (FootLock), then the leg moved by it.
 THRONG_HOST_DEVICE inline void lock_leg(const FootLockJob& job, Index c, int leg, const motion::BlendPoint& point,
@@ -126,7 +134,9 @@ THRONG_HOST_DEVICE inline void lock_leg(const FootLockJob& job, Index c, int leg
   const float ground =
       motion::mix_weight(v.clips[point.a].ankle_ground[leg], v.clips[point.b].ankle_ground[leg], point.w);
   const float height = (a.y - job.positions[c].y) / scale - ground;
-  bool down = foot_down_in_blend(v, point, phases, leg) || height < kTouchdownHeight;
+  const bool low_and_slow = lock.seen && job.dt > 0.0f && height < kHoldHeight &&
+                            glm::length(ground_xz(a) - lock.ankle) < kHoldSpeed * job.dt * scale;
+  bool down = foot_down_in_blend(v, point, phases, leg) || height < kTouchdownHeight || low_and_slow;
   if (!lock.seen) lock = FootLock{};
   glm::vec2 correction = lock.correction;
   float lift = 0.0f;

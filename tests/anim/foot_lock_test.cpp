@@ -260,6 +260,35 @@ TEST(FootLock, AStraightWalkIsBarelyCorrected) {
   }
 }
 
+// Creeping in a jam, as the collision-free speed model's agents do: 0.1 to
+// 0.3 m/s, stop and go, the heading drifting 0.2 rad a step, at the
+// simulation's 10 frames a second. The clips' cadence stays and their
+// stride shrinks, so the swinging foot drags low over the ground; locked,
+// low slow feet are held: p95 under 2 cm per contact (measured 1.51; 0.29
+// cm mean). Without the hold the lock left p95 about 4 cm per contact in
+// the circle's crowd.
+MapState creep(float t) {
+  MapState s;
+  const float speed = 0.2f + 0.1f * std::sin(2.1f * t);
+  s.heading = kPi / 2.0f + 0.6f * std::sin(0.9f * t);
+  s.velocity = speed * glm::vec2(std::cos(s.heading), std::sin(s.heading));
+  // (Position: the integral of the velocity, by small steps.)
+  for (float u = 0.0f; u < t; u += 0.01f) {
+    const float h = kPi / 2.0f + 0.6f * std::sin(0.9f * u);
+    s.position += 0.01f * (0.2f + 0.1f * std::sin(2.1f * u)) * glm::vec2(std::cos(h), std::sin(h));
+  }
+  return s;
+}
+
+TEST(FootLock, CreepingInAJamHoldsTheLowFeet) {
+  const Drive free = drive(creep, 12.0f, false, 0.1f), locked = drive(creep, 12.0f, true, 0.1f);
+  std::printf("creeping: without locking %s; locked %s (max %.2f cm)\n", motion::describe(free.skating).c_str(),
+              motion::describe(locked.skating).c_str(), locked.skating.max_cm);
+  ASSERT_GE(locked.skating.contacts, 10);
+  EXPECT_LT(locked.skating.p95_cm, 2.0);
+  EXPECT_LT(locked.skating.mean_cm, 0.5);
+}
+
 // A crowd walking noisily (200 characters: several blocks of the kernel):
 // every joint sits where its parent's world rotation puts its rest offset
 // (bones keep their lengths, rotations agree with positions), and locking
