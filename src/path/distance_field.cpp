@@ -35,10 +35,12 @@ glm::vec2 node_point(const sim::FieldGrid& g, std::int32_t x, std::int32_t y) {
 // The grid over `bounds` with a cell round it: `cell` or coarser, so that
 // it holds at most max_nodes nodes (the cell grows until it does: the grid
 // always covers the bounds).
-sim::FieldGrid grid_over(const sim::Aabb& bounds, glm::vec2 target, const DistanceFieldOptions& o) {
+sim::FieldGrid grid_over(const sim::Aabb& bounds, glm::vec2 target, glm::vec2 target_half,
+                         const DistanceFieldOptions& o) {
   const glm::vec2 size = bounds.size();
   sim::FieldGrid g;
   g.target = target;
+  g.target_half = target_half;
   double cell = o.cell;
   for (;;) {
     const double nx = std::ceil(static_cast<double>(size.x) / cell + 2.0) + 1.0;
@@ -99,25 +101,34 @@ float upwind(const std::vector<float>& t, const std::vector<std::uint8_t>& settl
 // The nodes the march starts from, with their values: the four round the
 // target (whether the disc fits there or not: a goal against a wall is
 // reached by walking up to it), and every free node within kSeedCells of
-// it that sees it (no wall in between), at the straight distance times its
-// slowness: the front is a circle there, which the upwind differences
-// resolve badly at a handful of cells.
+// it (of a door line: of its nearest point) that sees it (no wall in
+// between), at the straight distance times its slowness: the front is a
+// circle there, which the upwind differences resolve badly at a handful of
+// cells.
 std::vector<std::pair<float, std::int64_t>> seeds(const FreeSpace& space, const std::vector<float>& slow,
                                                   const sim::FieldGrid& g) {
   constexpr std::int32_t kSeedCells = 3;
-  const float fx = (g.target.x - g.origin.x) / g.cell, fy = (g.target.y - g.origin.y) / g.cell;
-  const auto ti = std::clamp(static_cast<std::int32_t>(std::floor(fx)), 0, g.nx - 2);
-  const auto tj = std::clamp(static_cast<std::int32_t>(std::floor(fy)), 0, g.ny - 2);
+  auto cell_x = [&](float x) {
+    return std::clamp(static_cast<std::int32_t>(std::floor((x - g.origin.x) / g.cell)), 0, g.nx - 2);
+  };
+  auto cell_y = [&](float y) {
+    return std::clamp(static_cast<std::int32_t>(std::floor((y - g.origin.y) / g.cell)), 0, g.ny - 2);
+  };
+  const std::int32_t ti = cell_x(g.target.x), tj = cell_y(g.target.y);
+  const glm::vec2 a = g.target - g.target_half, b = g.target + g.target_half;
+  const std::int32_t x0 = std::min(cell_x(a.x), cell_x(b.x)), x1 = std::max(cell_x(a.x), cell_x(b.x));
+  const std::int32_t y0 = std::min(cell_y(a.y), cell_y(b.y)), y1 = std::max(cell_y(a.y), cell_y(b.y));
   std::vector<std::pair<float, std::int64_t>> out;
-  for (std::int32_t y = std::max(0, tj - kSeedCells); y <= std::min(g.ny - 1, tj + 1 + kSeedCells); ++y)
-    for (std::int32_t x = std::max(0, ti - kSeedCells); x <= std::min(g.nx - 1, ti + 1 + kSeedCells); ++x) {
+  for (std::int32_t y = std::max(0, y0 - kSeedCells); y <= std::min(g.ny - 1, y1 + 1 + kSeedCells); ++y)
+    for (std::int32_t x = std::max(0, x0 - kSeedCells); x <= std::min(g.nx - 1, x1 + 1 + kSeedCells); ++x) {
       const std::size_t k = node(g, x, y);
       const bool corner = (x == ti || x == ti + 1) && (y == tj || y == tj + 1);
       const glm::vec2 p = node_point(g, x, y);
-      const float d = sim::length_of(p - g.target);
+      const glm::vec2 near = sim::field_target_near(g, p);
+      const float d = sim::length_of(p - near);
       const bool free = slow[k] < INFINITY;
       if (!corner &&
-          !(free && d <= static_cast<float>(kSeedCells) * g.cell && space.segment_clear(p, g.target, 0.0f, true)))
+          !(free && d <= static_cast<float>(kSeedCells) * g.cell && space.segment_clear(p, near, 0.0f, true)))
         continue;
       out.emplace_back(d * (free ? slow[k] : 1.0f), static_cast<std::int64_t>(k));
     }
@@ -166,13 +177,17 @@ struct PreparedField {
   std::vector<std::pair<float, std::int64_t>> seeds;
 };
 
-PreparedField prepare_field(const FreeSpace& space, glm::vec2 target, float radius, const DistanceFieldOptions& o) {
+PreparedField prepare_field(const FreeSpace& space, glm::vec2 target, glm::vec2 target_half, float radius,
+                            const DistanceFieldOptions& o) {
   o.validate();
-  if (!(std::isfinite(target.x) && std::isfinite(target.y))) throw Error("the field's target is not finite");
+  if (!(std::isfinite(target.x) && std::isfinite(target.y) && std::isfinite(target_half.x) &&
+        std::isfinite(target_half.y)))
+    throw Error("the field's target is not finite");
   sim::Aabb bounds = space.bounds();
-  bounds.add(target);
+  bounds.add(target - target_half);
+  bounds.add(target + target_half);
   PreparedField p;
-  p.grid = grid_over(bounds, target, o);
+  p.grid = grid_over(bounds, target, target_half, o);
   p.slowness = node_slowness(space, p.grid, radius, o);
   p.seeds = seeds(space, p.slowness, p.grid);
   return p;
@@ -204,12 +219,12 @@ sim::FieldData march_field(const PreparedField& p, const sim::CrowdDensity* crow
 }  // namespace
 
 sim::FieldData build_distance_field(const FreeSpace& space, glm::vec2 target, float radius,
-                                    const DistanceFieldOptions& options) {
-  return march_field(prepare_field(space, target, radius, options), nullptr);
+                                    const DistanceFieldOptions& options, glm::vec2 target_half) {
+  return march_field(prepare_field(space, target, target_half, radius, options), nullptr);
 }
 
 struct FastMarchingFieldBuilder::Prepared {
-  glm::vec2 target{0.0f};
+  glm::vec2 target{0.0f}, target_half{0.0f};
   float radius = 0.0f;
   PreparedField field;
 };
@@ -221,39 +236,43 @@ FastMarchingFieldBuilder::FastMarchingFieldBuilder(DistanceFieldOptions options)
 FastMarchingFieldBuilder::~FastMarchingFieldBuilder() = default;
 
 sim::FieldData FastMarchingFieldBuilder::build_locked(const sim::World& world, glm::vec2 target, float radius,
-                                                      const sim::CrowdDensity* crowd) const {
+                                                      const sim::CrowdDensity* crowd, glm::vec2 target_half) const {
   // Without a walkable region the free space is the obstacles' box grown by
   // a margin: grown again to hold every target asked for.
-  const bool outside = space_ && !world.has_walkable() && !space_->bounds().contains(target);
+  const bool outside =
+      space_ && !world.has_walkable() &&
+      !(space_->bounds().contains(target - target_half) && space_->bounds().contains(target + target_half));
   if (world_ != &world || !space_ || outside) {
     FreeSpaceOptions o;
     if (!world.has_walkable()) {
       o.extent = space_ && world_ == &world ? extent_ : sim::Aabb{};
-      o.extent.add(target);
+      o.extent.add(target - target_half);
+      o.extent.add(target + target_half);
       extent_ = o.extent;
     }
     space_ = std::make_unique<FreeSpace>(FreeSpace::build(world, o));
     world_ = &world;
     prepared_.clear();
   }
-  if (crowd == nullptr) return build_distance_field(*space_, target, radius, options_);
-  std::shared_ptr<const Prepared> p = find_prepared(target, radius);
+  if (crowd == nullptr) return build_distance_field(*space_, target, radius, options_, target_half);
+  std::shared_ptr<const Prepared> p = find_prepared(target, radius, target_half);
   if (!p) {
-    p = std::make_shared<const Prepared>(Prepared{target, radius, prepare_field(*space_, target, radius, options_)});
+    p = std::make_shared<const Prepared>(
+        Prepared{target, target_half, radius, prepare_field(*space_, target, target_half, radius, options_)});
     prepared_.push_back(p);
   }
   return march_field(p->field, crowd);
 }
 
 sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec2 target, float radius,
-                                               const sim::CrowdDensity* crowd) const {
+                                               const sim::CrowdDensity* crowd, glm::vec2 target_half) const {
   if (!world_has_obstacles(world)) return {};  // straight lines are the shortest ways
   std::shared_ptr<const Prepared> p;
   {
     std::lock_guard lock(mutex_);
-    if (crowd == nullptr || !space_ || world_ != &world) return build_locked(world, target, radius, crowd);
-    p = find_prepared(target, radius);
-    if (!p) return build_locked(world, target, radius, crowd);
+    if (crowd == nullptr || !space_ || world_ != &world) return build_locked(world, target, radius, crowd, target_half);
+    p = find_prepared(target, radius, target_half);
+    if (!p) return build_locked(world, target, radius, crowd, target_half);
   }
   // A weighed field asked for again: marched outside the lock (on a copy of
   // the pointer, which keeps it alive whatever else the builder is asked),
@@ -263,10 +282,10 @@ sim::FieldData FastMarchingFieldBuilder::build(const sim::World& world, glm::vec
 
 // Congestion-weighted fields are asked for again and again: their walls and
 // seeds are kept.
-std::shared_ptr<const FastMarchingFieldBuilder::Prepared> FastMarchingFieldBuilder::find_prepared(glm::vec2 target,
-                                                                                                  float radius) const {
+std::shared_ptr<const FastMarchingFieldBuilder::Prepared> FastMarchingFieldBuilder::find_prepared(
+    glm::vec2 target, float radius, glm::vec2 target_half) const {
   for (const std::shared_ptr<const Prepared>& p : prepared_)
-    if (p->target == target && p->radius == radius) return p;
+    if (p->target == target && p->radius == radius && p->target_half == target_half) return p;
   return nullptr;
 }
 

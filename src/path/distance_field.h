@@ -33,11 +33,13 @@ struct DistanceFieldOptions {
   void validate() const;               // throws Error naming the field ("field.cell", ...)
 };
 
-// The field of `target` over the bounds of `space` for discs of `radius`.
-// A target without room for the disc still seeds the nodes round it (a goal
-// against a wall is reached by walking up to the wall).
+// The field of `target` over the bounds of `space` for discs of `radius`
+// (of the door line target +- target_half where that is not zero: the
+// distance to its nearest point). A target without room for the disc
+// still seeds the nodes round it (a goal against a wall is reached by
+// walking up to the wall).
 sim::FieldData build_distance_field(const FreeSpace& space, glm::vec2 target, float radius,
-                                    const DistanceFieldOptions& options = {});
+                                    const DistanceFieldOptions& options = {}, glm::vec2 target_half = glm::vec2(0.0f));
 
 // The builder `throng run` uses for `planning: field` and `planning:
 // quickest`: the world's free space built once (at the first field), each
@@ -55,14 +57,15 @@ class FastMarchingFieldBuilder final : public sim::FieldBuilder {
   explicit FastMarchingFieldBuilder(DistanceFieldOptions options = {});
   ~FastMarchingFieldBuilder() override;
   sim::FieldData build(const sim::World& world, glm::vec2 target, float radius,
-                       const sim::CrowdDensity* crowd = nullptr) const override;
+                       const sim::CrowdDensity* crowd = nullptr,
+                       glm::vec2 target_half = glm::vec2(0.0f)) const override;
 
  private:
   struct Prepared;
   // build() under the lock: the free space made or grown, then the field.
-  sim::FieldData build_locked(const sim::World& world, glm::vec2 target, float radius,
-                              const sim::CrowdDensity* crowd) const;
-  std::shared_ptr<const Prepared> find_prepared(glm::vec2 target, float radius) const;
+  sim::FieldData build_locked(const sim::World& world, glm::vec2 target, float radius, const sim::CrowdDensity* crowd,
+                              glm::vec2 target_half) const;
+  std::shared_ptr<const Prepared> find_prepared(glm::vec2 target, float radius, glm::vec2 target_half) const;
   DistanceFieldOptions options_;
   mutable std::mutex mutex_;
   mutable const sim::World* world_ = nullptr;

@@ -30,7 +30,16 @@ struct FieldGrid {
   std::int32_t nx = 0, ny = 0;
   std::int64_t offset = 0;
   glm::vec2 target{0.0f};
+  glm::vec2 target_half{0.0f};  // m: a door line's target, target +- this (seeded along it); zero for a point
 };
+
+// The point of the field's target (a point, or a door line) nearest p.
+THRONG_HOST_DEVICE inline glm::vec2 field_target_near(const FieldGrid& g, glm::vec2 p) {
+  const float h2 = dot2(g.target_half, g.target_half);
+  if (h2 == 0.0f) return g.target;
+  const float t = fminf(fmaxf(dot2(p - g.target, g.target_half) / h2, -1.0f), 1.0f);
+  return g.target + g.target_half * t;
+}
 
 // A field as the builder returns it, before it joins the run's fields.
 struct FieldData {
@@ -74,7 +83,7 @@ THRONG_HOST_DEVICE inline bool field_cell(const FieldsView& f, std::int32_t fiel
 }
 
 // Where an agent at p heading for the field's target steers: the target
-// itself within two cells of it, else a point a metre down the field's
+// itself within two cells of it (of a door line: its nearest point), else a point a metre down the field's
 // gradient (bilinear over the four nodes round p; a node where the disc
 // does not fit counts as a cell farther than the farthest of the others, so
 // the gradient also leads away from walls). Outside the grid, or with every
@@ -83,19 +92,20 @@ THRONG_HOST_DEVICE inline bool field_cell(const FieldsView& f, std::int32_t fiel
 // lengthens it by centimetres, the grid's own error by per cent.)
 THRONG_HOST_DEVICE inline glm::vec2 field_aim(const FieldsView& f, std::int32_t field, glm::vec2 p) {
   const FieldGrid& g = f.grids[field];
+  const glm::vec2 near = field_target_near(g, p);
   FieldCell c;
-  if (length_of(g.target - p) <= 2.0f * g.cell || !field_cell(f, field, p, c)) return g.target;
+  if (length_of(near - p) <= 2.0f * g.cell || !field_cell(f, field, p, c)) return near;
   float worst = -1.0f;
   for (float x : c.v)
     if (x < INFINITY) worst = fmaxf(worst, x);
-  if (worst < 0.0f) return g.target;
+  if (worst < 0.0f) return near;
   for (float& x : c.v)
     if (!(x < INFINITY)) x = worst + g.cell;
   const float* v = c.v;
   const float tx = c.tx, ty = c.ty;
   const glm::vec2 grad((v[1] - v[0]) * (1 - ty) + (v[3] - v[2]) * ty, (v[2] - v[0]) * (1 - tx) + (v[3] - v[1]) * tx);
   const float len = length_of(grad);
-  if (!(len > 0.0f)) return g.target;
+  if (!(len > 0.0f)) return near;
   return p - grad * (1.0f / len);
 }
 
@@ -189,16 +199,17 @@ class World;
 
 // The hook a run's navigation plugs into (path/distance_field.h has the
 // fast-marching builder `throng run` uses for `planning: field` and
-// `planning: quickest`): the field of walking distances to `target` for
-// discs of `radius`; with `crowd`, of walking times at its density
+// `planning: quickest`): the field of walking distances to `target` (to
+// the door line target +- target_half, where that is not zero) for discs
+// of `radius`; with `crowd`, of walking times at its density
 // (congestion_slowness), in seconds at the free speed of 1 m/s. build()
 // may be called from several threads at once (planning: quickest weighs a
 // run's fields in parallel).
 class FieldBuilder {
  public:
   virtual ~FieldBuilder() = default;
-  virtual FieldData build(const World& world, glm::vec2 target, float radius,
-                          const CrowdDensity* crowd = nullptr) const = 0;
+  virtual FieldData build(const World& world, glm::vec2 target, float radius, const CrowdDensity* crowd = nullptr,
+                          glm::vec2 target_half = glm::vec2(0.0f)) const = 0;
 };
 
 }  // namespace throng::sim

@@ -91,20 +91,22 @@ std::vector<float> free_area_of(const World& world, const CrowdDensity& cells) {
 // exits (their own waypoints, or goals that differ per agent, keep the
 // straight legs), for the largest radius heading there, in group order.
 void Simulation::build_fields(const FieldBuilder& builder) {
-  std::vector<std::pair<glm::vec2, float>> targets;
-  auto add = [&](glm::vec2 t, float radius) {
-    for (auto& [target, r] : targets)
-      if (target == t) {
-        r = std::max(r, radius);
+  std::vector<FieldTarget> targets;
+  // (A door line's field is seeded along it; fields are found by their
+  // middle, so the first target at a point decides its extent.)
+  auto add = [&](glm::vec2 t, glm::vec2 half, float radius) {
+    for (FieldTarget& known : targets)
+      if (known.point == t) {
+        known.radius = std::max(known.radius, radius);
         return;
       }
-    targets.emplace_back(t, radius);
+    targets.push_back({t, half, radius});
   };
   for (const GroupSpec& g : spec_.groups) {
     if (!g.waypoints.empty() || g.count == 0) continue;
-    if (g.goal.kind == GoalSpec::Kind::Point) add(g.goal.value, g.radius);
+    if (g.goal.kind == GoalSpec::Kind::Point) add(g.goal.value, glm::vec2(0.0f), g.radius);
     if (g.goal.kind == GoalSpec::Kind::Exits)
-      for (const ExitSpec& e : g.goal.exits) add(e.point, g.radius);
+      for (const ExitSpec& e : g.goal.exits) add(e.point, e.half, g.radius);
   }
   // Weighed fields are built again on their first grid: where the free
   // space grows with the targets (a world without a walkable region), the
@@ -113,11 +115,11 @@ void Simulation::build_fields(const FieldBuilder& builder) {
   const bool weighed = spec_.planning == PlanningKind::Quickest;
   const CrowdDensity nobody;
   for (int pass = weighed && !world_.has_walkable() ? 0 : 1; pass < 2; ++pass) {
-    for (const auto& [target, radius] : targets) {
-      FieldData f = builder.build(world_, target, radius, weighed ? &nobody : nullptr);
+    for (const FieldTarget& t : targets) {
+      FieldData f = builder.build(world_, t.point, t.radius, weighed ? &nobody : nullptr, t.half);
       if (f.grid.nx == 0 || pass == 0) continue;  // none: nothing in the way
       fields_.add(std::move(f));
-      field_targets_.emplace_back(target, radius);
+      field_targets_.push_back(t);
     }
   }
   fields_.upload();
@@ -144,7 +146,8 @@ void Simulation::reweigh_fields() {
   std::vector<FieldData> weighed(field_targets_.size());
   host_parallel_for("sim.quickest_fields.march", static_cast<Index>(weighed.size()), [&](Index k) {
     const auto i = static_cast<std::size_t>(k);
-    weighed[i] = quickest_builder_->build(world_, field_targets_[i].first, field_targets_[i].second, &density);
+    const FieldTarget& t = field_targets_[i];
+    weighed[i] = quickest_builder_->build(world_, t.point, t.radius, &density, t.half);
   });
   for (std::size_t k = 0; k < weighed.size(); ++k) fields_.replace(static_cast<std::int32_t>(k), weighed[k]);
   fields_.upload();

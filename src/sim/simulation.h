@@ -233,7 +233,11 @@ class Simulation {
   NavigationFields fields_;
   // planning: quickest: the builder and each field's target and radius.
   std::shared_ptr<const FieldBuilder> quickest_builder_;
-  std::vector<std::pair<glm::vec2, float>> field_targets_;
+  struct FieldTarget {
+    glm::vec2 point{0.0f}, half{0.0f};  // a point, or a door line point +- half
+    float radius = 0.0f;                // the largest agent heading there
+  };
+  std::vector<FieldTarget> field_targets_;
   std::int64_t fields_weighed_at_ = -1;   // the step they were last weighed at
   CrowdDensity density_cells_;            // the density map's cells (no densities)
   std::vector<float> density_free_area_;  // m^2 of each cell in free space

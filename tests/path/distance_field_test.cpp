@@ -65,6 +65,39 @@ TEST(DistanceField, OpenRoomIsTheStraightLineDistance) {
               100.0 * static_cast<double>(worst));
 }
 
+// A door line 6 m long across the open room (x = 14, y from 2 to 8): every
+// node the disc fits at is as far as the nearest point of the line (closed
+// form: the distance to a segment), within first order's diagonal error;
+// in front of the line that is the distance to the line itself, not to its
+// middle.
+TEST(DistanceField, ADoorLineIsTheDistanceToItsNearestPoint) {
+  Shapes s;
+  s.walkable.outer = sim::rect_ring({0, 0}, {20, 10});
+  const float r = 0.25f;
+  const glm::vec2 middle(14.0f, 5.0f), half(0.0f, 3.0f);
+  const sim::FieldData f = build_distance_field(space_of(s), middle, r, plain(), half);
+  EXPECT_EQ(f.grid.target_half, half);
+  float worst = 0;
+  for (std::int32_t j = 0; j < f.grid.ny; ++j)
+    for (std::int32_t i = 0; i < f.grid.nx; ++i) {
+      const glm::vec2 p = node_point(f, i, j);
+      if (!(p.x >= r + 0.01f && p.x <= 20 - r - 0.01f && p.y >= r + 0.01f && p.y <= 10 - r - 0.01f)) continue;
+      const glm::vec2 near = middle + half * std::clamp((p.y - middle.y) / half.y, -1.0f, 1.0f);
+      const float straight = sim::length_of(p - near), d = node_distance(f, i, j);
+      ASSERT_LT(d, INFINITY) << p.x << ", " << p.y;
+      worst = std::max(worst, std::fabs(d - straight) / std::max(straight, 1.0f));
+      EXPECT_GE(d, straight - 1e-3f) << p.x << ", " << p.y;
+      EXPECT_LE(d, 1.05f * straight + f.grid.cell) << p.x << ", " << p.y;
+    }
+  std::printf("  door line: worst error %.2f %% of the distance\n", 100.0 * static_cast<double>(worst));
+  // 4 m in front of the line, 2.6 m off its middle: 4 m, where the middle is 4.8 m away.
+  const sim::FieldGrid grids[] = {f.grid};
+  const sim::FieldsView view{{grids, 1}, {f.distance.data(), static_cast<Index>(f.distance.size())}};
+  EXPECT_NEAR(sim::field_distance(view, 0, {10.0f, 7.6f}), 4.0f, 0.15f);
+  // Within two cells of the line the aim is its nearest point, not its middle.
+  EXPECT_EQ(sim::field_aim(view, 0, {13.8f, 7.0f}), glm::vec2(14.0f, 7.0f));
+}
+
 // A 14 m wall across a room with the target behind it: the distance from
 // the far side is the shortest way round the wall's end, kept a radius off
 // it (closed form: start to the rounded corner, the arc, on to the target),
