@@ -823,9 +823,8 @@ void add_routes(const GroupSpec& G, const std::string& field, const std::vector<
     for (std::size_t v = 0; v < via.size(); ++v) out.waypoint_stage.push_back(stage(v));
     // (An exit goal: the stage of the exit spawning chose, a door line's gate.)
     const glm::vec2 goal = resolved[k * (W + 1) + W];
-    std::int32_t goal_stage = -1;
-    for (std::size_t e = 0; e < exit_stages.size(); ++e)
-      if (G.goal.exits[e].point == goal && goal_stage < 0) goal_stage = exit_stages[e];
+    const std::int32_t chosen_exit = exit_stages.empty() ? -1 : G.goal.exit_at(goal);
+    const std::int32_t goal_stage = chosen_exit < 0 ? -1 : exit_stages[static_cast<std::size_t>(chosen_exit)];
     out.waypoints.push_back(goal);
     out.waypoint_stage.push_back(goal_stage);
     out.waypoint_goal.push_back(static_cast<std::int32_t>(out.waypoints.size()) - 1 - begin);

@@ -33,9 +33,8 @@ ExitChooser::ExitChooser(const ScenarioSpec& spec, const CrowdHost& host) {
     c.speed = std::max(host.pref_speed[i], 0.1f);
     c.queue_base = first_exit[g];
     // Spawning aimed the agent at its nearest exit: find which it is.
-    const glm::vec2 aim = host.waypoints[static_cast<std::size_t>(c.goal_slot)];
-    for (std::uint32_t e = 0; e < exits_[g].size(); ++e)
-      if (exits_[g][e].point == aim) c.exit = e;
+    const std::int32_t e = spec.groups[g].goal.exit_at(host.waypoints[static_cast<std::size_t>(c.goal_slot)]);
+    if (e >= 0) c.exit = static_cast<std::uint32_t>(e);
     c.tie = Rng(spec.seed, (std::uint64_t{5} << 60) + static_cast<std::uint64_t>(i)).next();
     agents_.push_back(c);
   }

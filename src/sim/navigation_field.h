@@ -83,8 +83,9 @@ THRONG_HOST_DEVICE inline bool field_cell(const FieldsView& f, std::int32_t fiel
 }
 
 // Where an agent at p heading for the field's target steers: the target
-// itself within two cells of it (of a door line: its nearest point), else a point a metre down the field's
-// gradient (bilinear over the four nodes round p; a node where the disc
+// itself within two cells of it (of a door line: its nearest point), else
+// a point a metre down the field's gradient (bilinear over the four nodes
+// round p; a node where the disc
 // does not fit counts as a cell farther than the farthest of the others, so
 // the gradient also leads away from walls). Outside the grid, or with every
 // node blocked: the target. (Comparing the field's distance with the

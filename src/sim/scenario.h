@@ -196,6 +196,13 @@ struct GoalSpec {
   // s: a waypoint where the agent stands this long once it reaches it (a
   // waiting area: a `random` waypoint with a wait; not on the goal).
   float wait_s = 0.0f;
+  // The first of `exits` whose point is `point`, or -1 (Exits: which exit
+  // an agent aiming at `point` heads for).
+  std::int32_t exit_at(glm::vec2 point) const {
+    for (std::size_t e = 0; e < exits.size(); ++e)
+      if (exits[e].point == point) return static_cast<std::int32_t>(e);
+    return -1;
+  }
   static GoalSpec at(glm::vec2 p) {
     GoalSpec g;
     g.value = p;

@@ -74,9 +74,13 @@ struct Gate {
   glm::vec2 mid{0.0f}, along{0.0f}, ahead{0.0f};
   float half = 0.0f;
 };
+// The stage of agent i's current waypoint (into a.stages), -1 for a plain point.
+THRONG_HOST_DEVICE inline std::int32_t current_stage(const AgentArrays& a, Index i) {
+  return a.waypoint_stage[a.waypoint_begin[i] + a.waypoint_cursor[i]];
+}
 // Agent i's current waypoint as a gate; false for a point (with or without a wait).
 THRONG_HOST_DEVICE inline bool current_gate(const AgentArrays& a, Index i, Gate& g) {
-  const std::int32_t s = a.waypoint_stage[a.waypoint_begin[i] + a.waypoint_cursor[i]];
+  const std::int32_t s = current_stage(a, i);
   if (s < 0 || length2(a.stages[s].gate_half) == 0.0f) return false;
   g.mid = a.goal[i];
   g.half = length_of(a.stages[s].gate_half);
@@ -89,8 +93,7 @@ THRONG_HOST_DEVICE inline bool current_gate(const AgentArrays& a, Index i, Gate&
 // True when the step from `from` to `p` crosses the gate's line within a
 // body (r) of its ends.
 THRONG_HOST_DEVICE inline bool crossed_gate(const Gate& g, glm::vec2 from, glm::vec2 p, float r) {
-  const glm::vec2 n = perp_left(g.along);
-  const float s0 = dot2(from - g.mid, n), s1 = dot2(p - g.mid, n);
+  const float s0 = dot2(from - g.mid, g.ahead), s1 = dot2(p - g.mid, g.ahead);
   if ((s0 > 0.0f) == (s1 > 0.0f) || s0 == s1) return false;
   const glm::vec2 at = from + (p - from) * (s0 / (s0 - s1));
   return fabsf(dot2(at - g.mid, g.along)) <= g.half + r;
@@ -99,7 +102,7 @@ THRONG_HOST_DEVICE inline bool crossed_gate(const Gate& g, glm::vec2 from, glm::
 // the point itself (not to a gate through it, as the collision-free speed
 // model's other waypoints).
 THRONG_HOST_DEVICE inline bool waits_at_waypoint(const AgentArrays& a, Index i) {
-  const std::int32_t s = a.waypoint_stage[a.waypoint_begin[i] + a.waypoint_cursor[i]];
+  const std::int32_t s = current_stage(a, i);
   return s >= 0 && a.stages[s].wait_s > 0.0f;
 }
 // (An agent beyond the aimed-at part heads for the line itself and takes
@@ -446,11 +449,10 @@ struct Finalize {
                                          waypoint_in_view(ctx.world, p, goal);
       if (through || (!is_gate && length2(goal - p) <= g.arrival_radius * g.arrival_radius)) {
         const std::int32_t begin = a.waypoint_begin[i], count = a.waypoint_count[i];
-        const std::int32_t stage = a.waypoint_stage[begin + cursor];
         // A waiting area: the agent stands here (sensed) until then, as before its pre-movement ends.
-        if (stage >= 0 && a.stages[stage].wait_s > 0.0f) {
+        if (waits_at_waypoint(a, i)) {
           flags |= kAgentWaiting;
-          a.start_time[i] = ctx.time_after + a.stages[stage].wait_s;
+          a.start_time[i] = ctx.time_after + a.stages[current_stage(a, i)].wait_s;
           v = glm::vec2(0.0f);
         }
         if (cursor == a.waypoint_goal[i] && a.arrival_time[i] < 0.0f) {
