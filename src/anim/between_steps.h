@@ -9,6 +9,7 @@
 
 #include <glm/vec2.hpp>
 
+#include "core/periodic.h"
 #include "core/span.h"
 
 namespace throng::anim {
@@ -27,6 +28,10 @@ struct InterpolateAgentsJob {
   // velocity; animating this one keeps the stride matched to the motion.
   float step_seconds = 0.0f;
   Span<glm::vec2> out_velocities;
+  // Over a periodic area: an agent that crossed the seam in the step walks
+  // on from the previous position's copy nearest the current one, drawn
+  // back in the area once past the seam.
+  Periodic periodic;
 
   Index agent_count() const { return positions.size(); }
   void validate() const;  // Error naming the span or alpha

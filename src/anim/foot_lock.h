@@ -24,8 +24,9 @@
 // comes down vertically in the second; one foot at a time.
 //
 // Per-leg state lives in FootLock (two per character); a leg that LOD does
-// not synthesise, and every leg after CrowdAnimator::place(), starts again
-// from no correction. A frame with dt = 0 (a paused viewer) moves nothing on.
+// not synthesise, every leg after CrowdAnimator::place(), and a leg whose
+// character was moved farther in a frame than it can walk (across a
+// periodic seam) starts again from no correction. A frame with dt = 0 (a paused viewer) moves nothing on.
 #pragma once
 
 #include <cstdint>

@@ -109,6 +109,12 @@ inline constexpr float kTouchdownHeight = 0.005f;
 // foot left far behind takes a step of its own, as a planted one).
 inline constexpr float kHoldHeight = 0.05f;
 inline constexpr float kHoldSpeed = 1.0f;  // m/s
+// A foot whose posed ankle moved farther in a frame than any walk takes it
+// (kJumpM plus kJumpSpeed for each second of the frame) was moved with its
+// character: across a periodic seam, or placed anew. Its leg starts again
+// from no correction, as after CrowdAnimator::place().
+inline constexpr float kJumpM = 1.0f;
+inline constexpr float kJumpSpeed = 5.0f;  // m/s
 
 // One leg: the correction carried on (FootLock), then the leg moved by it.
 THRONG_HOST_DEVICE inline void lock_leg(const FootLockJob& job, Index c, int leg, const motion::BlendPoint& point,
@@ -137,7 +143,8 @@ THRONG_HOST_DEVICE inline void lock_leg(const FootLockJob& job, Index c, int leg
   const bool low_and_slow = lock.seen && job.dt > 0.0f && height < kHoldHeight &&
                             glm::length(ground_xz(a) - lock.ankle) < kHoldSpeed * job.dt * scale;
   bool down = foot_down_in_blend(v, point, phases, leg) || height < kTouchdownHeight || low_and_slow;
-  if (!lock.seen) lock = FootLock{};
+  const bool jumped = glm::length(ground_xz(a) - lock.ankle) > (kJumpM + kJumpSpeed * job.dt) * scale;
+  if (!lock.seen || jumped) lock = FootLock{};
   glm::vec2 correction = lock.correction;
   float lift = 0.0f;
   if (lock.step_left > 0.0f) {

@@ -97,6 +97,7 @@ struct RunOptions {
   std::string camera;           // fixed | orbit | flyover; empty = the scenario's, else orbit
   double camera_period = 0.0;   // video seconds per orbit or fly-over; 0 = the scenario's, else 40
   Index routes = 0;             // agents whose routes are drawn on the ground (io::sample_routes)
+  float field_lines = 0.0f;     // m between the drawn lines of equal walking distance; 0: none
   bool demo = false;            // no scenario named: the built-in demo
 };
 
@@ -439,7 +440,9 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
   std::vector<render::MapPolyline> routes;
   if (o.routes > 0)
     for (io::AgentRoute& r : io::sample_routes(sim, o.routes)) routes.push_back(std::move(r.points));
-  lo.on_frame = [recorder, record, per_video, until, simulation, routes, character_px = hooks.character_px,
+  std::vector<render::MapPolyline> field_lines;
+  if (o.field_lines > 0.0f) field_lines = io::field_lines(sim, o.field_lines);
+  lo.on_frame = [recorder, record, per_video, until, simulation, routes, field_lines, character_px = hooks.character_px,
                  anim_fps = lo.fps](double t, const Camera* camera, SimulationLocomotion& moved) {
     if (std::llround(t * anim_fps) % per_video != 0 || t > until + 1e-9) return;
     ScopedTimer timer("render.frame");
@@ -449,6 +452,7 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
           record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
       (*recorder)->set_world(simulation->world());
       (*recorder)->set_routes(routes);
+      (*recorder)->set_field_lines(field_lines);
     }
     (*recorder)->add_frame(*camera, render::poses_of(moved.animator(), simulation->crowd()));
   };
@@ -653,6 +657,10 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
                   "Draw on the ground the routes of this many agents (spread over the crowd), as `throng route` "
                   "traces them")
       ->check(at_least(1));
+  cmd->add_option("--field-lines", o.field_lines,
+                  "Draw on the ground the navigation fields' lines of equal walking distance, this many metres apart "
+                  "(planning: field or quickest)")
+      ->check(greater_than(0));
   cmd->callback([&g, cmd, speed] {
     // The built-in demo (no scenario named) writes a short time-lapse video.
     // (A build without the renderer runs it without a video.)
@@ -667,7 +675,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
     // rather than ignored (the demo renders unless --no-render).
     refuse_unless(*cmd, !o.render.empty(),
                   {"--render-mode", "--width", "--height", "--fps", "--render-speed", "--render-seconds", "--camera",
-                   "--camera-period", "--lod-colours", "--routes"},
+                   "--camera-period", "--lod-colours", "--routes", "--field-lines"},
                   "--render video|frames");
     refuse_unless(*cmd, !o.no_lod, {"--lod-thresholds"}, "joint LOD (it has no effect with --no-lod)");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");

@@ -80,13 +80,15 @@ class FormationScene final : public render::ViewerScene {
 // the locomotion stage as `throng run` animates them (app/sim_locomotion.h).
 class SimulationScene final : public render::ViewerScene {
  public:
-  SimulationScene(const io::LoadedScenario& loaded, const std::vector<float>& lod_thresholds, Index routes)
+  SimulationScene(const io::LoadedScenario& loaded, const std::vector<float>& lod_thresholds, Index routes,
+                  float field_lines)
       : sim_(io::build_simulation(loaded)),
         locomotion_(*sim_, locomotion_options(loaded, lod_thresholds)),
         camera_(scenario_camera(*sim_)) {
     // Where `routes` agents will walk, as `throng route` traces them.
     if (routes > 0)
       for (io::AgentRoute& r : io::sample_routes(*sim_, routes)) routes_.push_back(std::move(r.points));
+    if (field_lines > 0.0f) field_lines_ = io::field_lines(*sim_, field_lines);
     max_steps_ = sim_->spec().step_count();
     sim::Aabb box = sim_->world().bounds();
     for (const glm::vec2& p : sim_->positions()) box.add(p);
@@ -108,6 +110,7 @@ class SimulationScene final : public render::ViewerScene {
   void decorate(render::Renderer& renderer) const override {
     render::show_world(renderer, sim_->world());
     renderer.set_routes(routes_);
+    renderer.set_field_lines(field_lines_);
   }
   void advance(double dt, const Camera& camera) override {
     const double step = static_cast<double>(sim_->spec().dt);
@@ -135,7 +138,7 @@ class SimulationScene final : public render::ViewerScene {
   std::unique_ptr<sim::Simulation> sim_;
   SimulationLocomotion locomotion_;
   Camera camera_;
-  std::vector<render::MapPolyline> routes_;
+  std::vector<render::MapPolyline> routes_, field_lines_;
   std::int64_t max_steps_ = 0;
   bool finished_ = false;
   double shown_ = 0.0;  // simulated seconds on screen
@@ -169,7 +172,8 @@ struct ViewArgs {
   double fps = 30.0;
   std::string camera_kind;  // empty: the scenario's camera.motion, else orbit
   float camera_period = 0.0f;
-  Index routes = 0;  // agents whose routes are drawn (scenarios)
+  Index routes = 0;          // agents whose routes are drawn (scenarios)
+  float field_lines = 0.0f;  // m between the navigation fields' drawn lines (scenarios); 0: none
 };
 
 // Adds the command's options to cmd, bound to a.
@@ -188,6 +192,10 @@ void add_view_options(CLI::App* cmd, ViewArgs& a) {
                   "Draw on the ground the routes of this many agents (spread over the crowd), as `throng route` "
                   "traces them")
       ->check(at_least(1));
+  cmd->add_option("--field-lines", a.field_lines,
+                  "Draw on the ground the navigation fields' lines of equal walking distance, this many metres apart "
+                  "(planning: field or quickest)")
+      ->check(greater_than(0));
   cmd->add_option("--mode", a.mode, "Render mode: skinned (the mannequin) or joints (a sphere per bone)")
       ->check(CLI::IsMember({"skinned", "joints"}));
   cmd->add_flag("--lod-colours", o.lod_colours, "Joint-LOD level colours instead of clothes, a debug view (L toggles)");
@@ -250,13 +258,16 @@ std::unique_ptr<render::ViewerScene> make_scene(ViewArgs& a, const GlobalOptions
     if (!a.thresholds.empty()) spec.lod_thresholds = a.thresholds;
     apply_global_options(g);
     if (a.routes > 0) throw Error("--routes is for scenarios, not the formation", at_field("--routes"));
+    if (a.field_lines > 0.0f)
+      throw Error("--field-lines is for scenarios, not the formation", at_field("--field-lines"));
     return std::make_unique<FormationScene>(std::move(spec), folder);
   }
   if (!a.layout.empty()) throw Error("--layout is for the formation", at_field("--layout"));
   io::LoadedScenario loaded = io::load_scenario(a.scenario);
   if (a.agents > 0) sim::scale_agent_counts(loaded.spec, a.agents);
   apply_global_options(g);
-  std::unique_ptr<render::ViewerScene> scene = std::make_unique<SimulationScene>(loaded, a.thresholds, a.routes);
+  std::unique_ptr<render::ViewerScene> scene =
+      std::make_unique<SimulationScene>(loaded, a.thresholds, a.routes, a.field_lines);
   if (a.camera_kind.empty()) a.camera_kind = loaded.spec.camera_motion;
   if (!(a.camera_period > 0.0f)) a.camera_period = loaded.spec.camera_period_s;
   return scene;

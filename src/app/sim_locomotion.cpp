@@ -97,6 +97,7 @@ const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim
   between.out_headings = shown_headings_.span();
   between.step_seconds = sim.spec().dt;
   between.out_velocities = moved_.span();
+  between.periodic = sim.world().periodic();
   between.run();
   crowd_->drive_from_map(shown_positions_.span(), moving ? moved_.span() : still_.span(), shown_headings_.span());
   const anim::FrameStats& s = crowd_->animate({dt, camera, false});

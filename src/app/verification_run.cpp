@@ -105,7 +105,7 @@ class Recorder {
     if (lines_.size() > 0) {
       const std::vector<sim::LineCrossing> found =
           sim::line_crossings(before_.span(), flags_before_.span(), c.position.span(), c.flags.span(), lines_.span(),
-                              line_bounds_, t1 - sim.spec().dt, t1);
+                              line_bounds_, t1 - sim.spec().dt, t1, sim.world().periodic());
       out_.crossings.insert(out_.crossings.end(), found.begin(), found.end());
     }
     remember(sim);
@@ -131,8 +131,8 @@ class Recorder {
   }
   void sample(const sim::Simulation& sim) {
     const sim::CrowdState& c = sim.crowd();
-    const sim::OverlapStats o =
-        sim::measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, sim.contact_cell());
+    const sim::OverlapStats o = sim::measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f,
+                                                      sim.contact_cell(), sim.world().periodic());
     out_.deepest_overlap = std::max(out_.deepest_overlap, o.max_depth);
     if (sim.time() + 1e-6 < options_.sample_from_s) return;
     const auto& areas = sim.spec().measurement.areas;

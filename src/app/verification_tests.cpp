@@ -62,8 +62,9 @@ struct DiagramPoint {
 DiagramPoint measure_density(const io::LoadedScenario& s, double rho) {
   DiagramPoint p;
   p.target = rho;
-  const sim::Region& spawn = s.spec.groups.at(0).spawn;
-  const double area = static_cast<double>((spawn.max.x - spawn.min.x) * (spawn.max.y - spawn.min.y));
+  // The periodic corridor: the density over all of it.
+  const sim::Aabb corridor = sim::bounds(s.spec.world.walkable);
+  const double area = static_cast<double>(corridor.size().x) * static_cast<double>(corridor.size().y);
   const auto count = static_cast<std::int64_t>(std::llround(rho * area));
   std::fprintf(stderr, "throng verify: test 4: %.1f P/m^2 (%lld agents)\n", rho, static_cast<long long>(count));
   ObserveOptions sampled;
@@ -115,7 +116,7 @@ VerifyResult fundamental_diagram(const VerifyOptions& o) {
   std::vector<DiagramPoint> points;
   for (double rho : {0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0}) points.push_back(measure_density(s, rho));
   add_diagram_checks(r, points);
-  render::Chart c = make_chart("RiMEA 4: speed against density in a 10 m corridor", "density (P/m^2)",
+  render::Chart c = make_chart("RiMEA 4: speed against density, periodic corridor", "density (P/m^2)",
                                "speed along the corridor (m/s)");
   std::vector<double> wx, wy, px, py;
   for (double rho = 0.3; rho <= 5.4; rho += 0.05) {

@@ -26,6 +26,16 @@ std::string csv_field(const std::string& text) {
   return out + "\"";
 }
 
+// Where the ray from p (inside `box`) in direction d leaves the box.
+glm::vec2 edge_ahead(const sim::Aabb& box, glm::vec2 p, glm::vec2 d) {
+  float t = INFINITY;
+  if (d.x > 0.0f) t = std::min(t, (box.max.x - p.x) / d.x);
+  if (d.x < 0.0f) t = std::min(t, (box.min.x - p.x) / d.x);
+  if (d.y > 0.0f) t = std::min(t, (box.max.y - p.y) / d.y);
+  if (d.y < 0.0f) t = std::min(t, (box.min.y - p.y) / d.y);
+  return std::isfinite(t) ? p + d * std::max(t, 0.0f) : p;
+}
+
 }  // namespace
 
 std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
@@ -47,7 +57,11 @@ std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
     const auto first = waypoints.begin() + begin[i];
     // A goal reached over a navigation field: the way down the field.
     const std::int32_t field = goal[i] == 0 ? sim::field_of(fields, *first) : -1;
-    if (field >= 0) {
+    const sim::GoalSpec& group_goal = sim.spec().groups[g].goal;
+    if (group_goal.kind == sim::GoalSpec::Kind::Direction) {
+      // Walking on for ever: the way across the area, to its edge.
+      r.points = {position[i], edge_ahead(sim.world().bounds(), position[i], group_goal.value)};
+    } else if (field >= 0) {
       r.points = sim::trace_field(fields, field, position[i]);
     } else {
       r.points.push_back(position[i]);
@@ -56,6 +70,16 @@ std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count) {
     r.length_m = path_length(r.points);
     r.straight_m = static_cast<double>(sim::length_of(r.points.back() - r.points.front()));
     out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::vector<std::vector<glm::vec2>> field_lines(const sim::Simulation& sim, float spacing) {
+  const sim::FieldsView fields = sim.fields().host_view();
+  std::vector<std::vector<glm::vec2>> out;
+  for (std::int32_t k = 0; k < sim.fields().count(); ++k) {
+    std::vector<std::vector<glm::vec2>> lines = sim::field_contours(fields, k, spacing);
+    out.insert(out.end(), std::make_move_iterator(lines.begin()), std::make_move_iterator(lines.end()));
   }
   return out;
 }

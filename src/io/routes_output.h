@@ -25,7 +25,13 @@ struct AgentRoute {
 // A loop's way back is left out; an agent yet to enter starts where it will.
 // An agent whose goal has a navigation field (`planning: field`) gets the
 // way down the field (sim::trace_field), its bends as waypoints.
+// An agent walking in a direction (a periodic world) gets the way straight
+// on to the edge of the area.
 std::vector<AgentRoute> sample_routes(const sim::Simulation& sim, Index count);
+
+// The lines of equal walking distance of every navigation field of the run
+// (sim::field_contours), every `spacing` m; none without fields.
+std::vector<std::vector<glm::vec2>> field_lines(const sim::Simulation& sim, float spacing);
 
 // A GeoJSON FeatureCollection (RFC 7946) of LineStrings, one per route, with
 // properties agent, group, length_m, straight_m and waypoints (points - 2).

@@ -175,8 +175,8 @@ class Reader : public YamlReader {
       g.value = point(n, path);
       return g;
     }
-    const std::string k =
-        one_of(n, path, {"point", "offset", "mirror", "random", "exits", "gate"}, {"choice", "reconsider", "wait"});
+    const std::string k = one_of(n, path, {"point", "offset", "mirror", "random", "exits", "gate", "direction"},
+                                 {"choice", "reconsider", "wait"});
     const std::string sub = child(path, k);
     if (k == "exits") {
       if (n["wait"]) fail(n["wait"], child(path, "wait"), "agents leave by an exit: it takes no wait");
@@ -195,6 +195,12 @@ class Reader : public YamlReader {
       const std::vector<glm::vec2> ends = points(n[k], sub);
       g.value = ends[0];
       g.gate_to = ends[1];
+    } else if (k == "direction") {  // [x, y]: any length but zero
+      g.kind = GoalSpec::Kind::Direction;
+      const glm::vec2 d = point(n[k], sub);
+      const float length = std::sqrt(d.x * d.x + d.y * d.y);
+      if (!(length > 0.0f) || !std::isfinite(length)) fail(n[k], sub, "a direction needs a vector that is not zero");
+      g.value = d / length;
     } else {
       g.kind = k == "point" ? GoalSpec::Kind::Point : (k == "offset" ? GoalSpec::Kind::Offset : GoalSpec::Kind::Mirror);
       g.value = point(n[k], sub);
@@ -414,12 +420,28 @@ class Reader : public YamlReader {
     return m;
   }
 
+  // periodic: x, y, or a list of them ([x], [x, y]): the axes that wrap.
+  void periodic(const YAML::Node& n, const std::string& path, sim::WorldSpec& w) {
+    if (n.IsSequence()) expect_list(n, path, 1, 2, "axes x, y");
+    const std::size_t count = n.IsSequence() ? n.size() : 1;
+    for (std::size_t k = 0; k < count; ++k) {
+      const YAML::Node a = n.IsSequence() ? n[k] : n;
+      const std::string ap = n.IsSequence() ? item(path, k) : path;
+      const std::string axis = text(a, ap);
+      if (axis != "x" && axis != "y") fail(a, ap, fmt::format("an axis is x or y (got '{}')", axis));
+      bool& wraps = axis == "x" ? w.periodic_x : w.periodic_y;
+      if (wraps) fail(a, ap, fmt::format("axis {} is named twice", axis));
+      wraps = true;
+    }
+  }
+
   void world(const YAML::Node& n, const std::string& path, sim::WorldSpec& w) {
-    expect_map(n, path, {"walkable", "obstacles", "scatter"});
+    expect_map(n, path, {"walkable", "periodic", "obstacles", "scatter"});
     if (n["walkable"]) {
       w.has_walkable = true;
       w.walkable = area(n["walkable"], child(path, "walkable"));
     }
+    if (const YAML::Node p = n["periodic"]) periodic(p, child(path, "periodic"), w);
     std::int64_t obstacles = 0;
     if (const YAML::Node list = n["obstacles"]) {
       const std::string lp = child(path, "obstacles");

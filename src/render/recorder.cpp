@@ -89,11 +89,23 @@ Index Recorder::frames() const { return s_->frames; }
 
 void show_world(Renderer& renderer, const sim::World& world, const ObstacleStyle& style) {
   renderer.set_obstacles(world.polygons(), world.circles(), style);
-  if (world.has_walkable()) {
-    MapPolyline boundary(world.walkable().outer.begin(), world.walkable().outer.end());
+  if (!world.has_walkable()) return;
+  const sim::Ring& ring = world.walkable().outer;
+  const Periodic& periodic = world.periodic();
+  if (!periodic.wraps()) {
+    MapPolyline boundary(ring.begin(), ring.end());
     if (!boundary.empty()) boundary.push_back(boundary.front());
     renderer.set_paths({boundary});
+    return;
   }
+  // A periodic area's sides at its seams are no walls: only the others are drawn.
+  std::vector<MapPolyline> walls;
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const glm::vec2 a = ring[k], b = ring[(k + 1) % ring.size()];
+    const bool seam = (periodic.period.x > 0.0f && a.x == b.x) || (periodic.period.y > 0.0f && a.y == b.y);
+    if (!seam) walls.push_back({a, b});
+  }
+  renderer.set_paths(walls);
 }
 
 void Recorder::set_world(const sim::World& world, const ObstacleStyle& style) {
@@ -104,6 +116,11 @@ void Recorder::set_world(const sim::World& world, const ObstacleStyle& style) {
 void Recorder::set_routes(const std::vector<MapPolyline>& routes) {
   s_->context.make_current();
   s_->renderer.set_routes(routes);
+}
+
+void Recorder::set_field_lines(const std::vector<MapPolyline>& lines) {
+  s_->context.make_current();
+  s_->renderer.set_field_lines(lines);
 }
 
 RenderStats Recorder::add_frame(const Camera& camera, const CharacterPoses& poses) {

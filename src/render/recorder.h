@@ -57,6 +57,8 @@ class Recorder {
   void set_world(const sim::World& world, const ObstacleStyle& style = {});
   // Routes of agents drawn on the ground (Renderer::set_routes).
   void set_routes(const std::vector<MapPolyline>& routes);
+  // Lines of equal walking distance of the navigation fields (Renderer::set_field_lines).
+  void set_field_lines(const std::vector<MapPolyline>& lines);
   // Renders one frame with `camera` (its viewport is set to the spec's
   // size) and appends it. The picture stays available in last_frame().
   RenderStats add_frame(const Camera& camera, const CharacterPoses& poses);  // spec.options

@@ -240,7 +240,7 @@ struct Renderer::State {
     void upload(const std::vector<MapPolyline>& lines, const char* field);
     void draw(const GlProgram& flat, const FrameView& view, glm::vec4 colour) const;
   };
-  Polylines paths, routes;
+  Polylines paths, routes, field_lines;
 
   GlTexture bins_texture;
   BinsOverlay bins_meta;
@@ -558,6 +558,10 @@ void Renderer::set_paths(const std::vector<MapPolyline>& paths) { s_->paths.uplo
 
 void Renderer::set_routes(const std::vector<MapPolyline>& routes) { s_->routes.upload(routes, "render.routes"); }
 
+void Renderer::set_field_lines(const std::vector<MapPolyline>& lines) {
+  s_->field_lines.upload(lines, "render.field_lines");
+}
+
 void Renderer::set_bins(const BinsOverlay& bins) {
   bins.validate();
   s_->bins_meta = bins;
@@ -642,6 +646,7 @@ void Renderer::State::Polylines::draw(const GlProgram& flat, const FrameView& vi
 
 void Renderer::State::draw_paths(const FrameView& view) {
   paths.draw(flat, view, kPathColour);
+  field_lines.draw(flat, view, kFieldColour);
   routes.draw(flat, view, kRouteColour);
 }
 

@@ -29,10 +29,12 @@
 
 namespace throng::render {
 
-// The colours of the map's paths (the walkable boundary) and of agents'
-// routes (`--routes`), drawn just above the ground.
+// The colours of the map's paths (the walkable boundary), of agents'
+// routes (`--routes`) and of the navigation fields' lines of equal walking
+// distance (`--field-lines`), drawn just above the ground.
 inline const glm::vec4 kPathColour(0.95f, 0.95f, 0.25f, 1.0f);
 inline const glm::vec4 kRouteColour(0.2f, 0.85f, 0.95f, 1.0f);
+inline const glm::vec4 kFieldColour(0.85f, 0.45f, 0.9f, 1.0f);
 
 struct RenderOptions {
   RenderMode mode = RenderMode::Joints;
@@ -98,6 +100,7 @@ class Renderer {
   // options.paths; an empty list clears them.
   void set_paths(const std::vector<MapPolyline>& paths);
   void set_routes(const std::vector<MapPolyline>& routes);
+  void set_field_lines(const std::vector<MapPolyline>& lines);  // kFieldColour, with the paths
   // Bins drawn when options.bins (counts copied; call again to update).
   void set_bins(const BinsOverlay& bins);
 

@@ -197,6 +197,8 @@ void check_goal(const GoalSpec& goal, const std::string& gf, const ScenarioLimit
                               length_of(to - goal.value)),
                   at_field(gf + ".gate"));
   }
+  if (goal.kind == GoalSpec::Kind::Direction && std::fabs(length_of(goal.value) - 1.0f) > 1e-3f)
+    throw Error("a direction must be a unit vector", at_field(gf + ".direction"));
   if (!std::isfinite(goal.wait_s) || goal.wait_s < 0)
     throw Error(fmt::format("wait must be a finite number of seconds >= 0 (got {})", goal.wait_s),
                 at_field(gf + ".wait"));
@@ -334,6 +336,15 @@ void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string
   }
   if (G.goal.kind == GoalSpec::Kind::Gate)
     throw Error("a gate is a waypoint: the goal is a point, a region or exits", at_field(field + ".goal"));
+  const bool periodic = spec.world.periodic_x || spec.world.periodic_y;
+  if (G.goal.kind == GoalSpec::Kind::Direction && !periodic)
+    throw Error("a direction goal needs a periodic world (world.periodic): elsewhere give a point to walk to",
+                at_field(field + ".goal.direction"));
+  if (periodic && G.goal.kind != GoalSpec::Kind::Direction)
+    throw Error("in a periodic world agents walk in a direction: give goal: {direction: [x, y]}",
+                at_field(field + ".goal"));
+  if (periodic && !G.waypoints.empty())
+    throw Error("in a periodic world agents walk in a direction, without waypoints", at_field(field + ".waypoints"));
   if (G.goal.wait_s > 0)
     throw Error("the goal takes no wait (on_arrival: stop keeps agents there)", at_field(field + ".goal.wait"));
   check_goal(G.goal, field + ".goal", limits);
@@ -396,6 +407,7 @@ void add_group_extent(const GroupSpec& G, Aabb& extent) {
       case GoalSpec::Kind::Exits:
         for (const ExitSpec& x : goal.exits) extent.add(x.point);
         break;
+      case GoalSpec::Kind::Direction: break;  // no place: the agent walks on
     }
   }
 }
@@ -657,6 +669,7 @@ glm::vec2 resolve_goal(const RouteContext& ctx, const GoalSpec& goal, const std:
     case GoalSpec::Kind::Offset: q = p + goal.value; break;
     case GoalSpec::Kind::Mirror: q = 2.0f * goal.value - p; break;
     case GoalSpec::Kind::Gate: q = 0.5f * (goal.value + goal.gate_to); break;  // its middle
+    case GoalSpec::Kind::Direction: q = p + goal.value * kDirectionReach; break;
     case GoalSpec::Kind::Exits: {
       // Every exit must be reachable (a quickest choice may switch to any);
       // the agent starts towards the nearest in a straight line.
@@ -759,7 +772,7 @@ std::vector<glm::vec2> add_agents(const RouteContext& ctx, const ScenarioSpec& s
       const std::string gf = w < W ? fmt::format("{}.waypoints[{}]", field, w) : field + ".goal";
       const bool waiting_area = w < W && goal.kind == GoalSpec::Kind::Random && goal.wait_s > 0.0f;
       const glm::vec2 q = resolve_goal(ctx, goal, gf, p, from, agent, arng, waiting_area ? &spots[w] : nullptr);
-      check_route_point(ctx, q, from, agent, gf);
+      if (goal.kind != GoalSpec::Kind::Direction) check_route_point(ctx, q, from, agent, gf);
       resolved[k * (W + 1) + w] = q;
       from = q;
     }
@@ -802,7 +815,8 @@ void add_routes(const GroupSpec& G, const std::string& field, const std::vector<
   std::vector<std::vector<glm::vec2>> planned;
   // (Agents choosing among exits walk straight: a planned route would hold
   // them to the exit they started towards.)
-  if (planner != nullptr && W == 0 && !chosen.empty() && G.goal.kind != GoalSpec::Kind::Exits) {
+  if (planner != nullptr && W == 0 && !chosen.empty() && G.goal.kind != GoalSpec::Kind::Exits &&
+      G.goal.kind != GoalSpec::Kind::Direction) {
     planned = planner->plan(world, chosen, resolved, r);
     if (planned.size() != chosen.size())
       throw Error(fmt::format("the route planner returned {} routes for {} agents", planned.size(), chosen.size()),

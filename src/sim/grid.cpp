@@ -1,5 +1,8 @@
 #include <algorithm>
 
+#include <cmath>
+#include <fmt/format.h>
+
 #include "core/error.h"
 #include "sim/grid.h"
 
@@ -44,21 +47,68 @@ StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std
 }
 
 GridView StaticGrid::view() const {
-  return {cell_size_, mask_, keys_.span(), start_.span(), count_.span(), items_.span()};
+  GridView v;
+  v.cell_size = v.cell_size_y = cell_size_;
+  v.mask = mask_;
+  v.keys = keys_.span();
+  v.start = start_.span();
+  v.count = count_.span();
+  v.items = items_.span();
+  return v;
 }
 
 GridView StaticGrid::host_view() const {
-  return {cell_size_,
-          mask_,
-          Span<const std::uint64_t>(host_keys_.data(), static_cast<Index>(host_keys_.size())),
-          Span<const std::int32_t>(host_start_.data(), static_cast<Index>(host_start_.size())),
-          Span<const std::int32_t>(host_count_.data(), static_cast<Index>(host_count_.size())),
-          Span<const std::int32_t>(host_items_.data(), static_cast<Index>(host_items_.size()))};
+  GridView v;
+  v.cell_size = v.cell_size_y = cell_size_;
+  v.mask = mask_;
+  v.keys = Span<const std::uint64_t>(host_keys_.data(), static_cast<Index>(host_keys_.size()));
+  v.start = Span<const std::int32_t>(host_start_.data(), static_cast<Index>(host_start_.size()));
+  v.count = Span<const std::int32_t>(host_count_.data(), static_cast<Index>(host_count_.size()));
+  v.items = Span<const std::int32_t>(host_items_.data(), static_cast<Index>(host_items_.size()));
+  return v;
+}
+
+namespace {
+// Cells along one wrapping axis: an even number, at least four, each at
+// least `side` wide.
+std::int32_t cells_per_period(float period, float side, const char* axis) {
+  const double fit = std::floor(static_cast<double>(period) / static_cast<double>(side));
+  if (!(fit >= 4.0))
+    throw Error(fmt::format("the period along {} ({:.3g} m) must be at least four neighbour cells long ({:.3g} m): "
+                            "lengthen the walkable area or lower model.max_speed",
+                            axis, period, 4.0 * side),
+                at_field("world.periodic"));
+  const auto n = static_cast<std::int32_t>(std::min(fit, 1.0e6));
+  return n - (n & 1);
+}
+}  // namespace
+
+AgentGrid::AgentGrid(float cell_size, const Periodic& periodic)
+    : cell_size_(cell_size), cell_size_y_(cell_size), periodic_(periodic) {
+  if (periodic.period.x > 0.0f) {
+    wrap_x_ = cells_per_period(periodic.period.x, cell_size, "x");
+    cell_size_ = periodic.period.x / static_cast<float>(wrap_x_);
+  }
+  if (periodic.period.y > 0.0f) {
+    wrap_y_ = cells_per_period(periodic.period.y, cell_size, "y");
+    cell_size_y_ = periodic.period.y / static_cast<float>(wrap_y_);
+  }
 }
 
 GridView AgentGrid::view() const {
+  GridView v;
+  v.cell_size = cell_size_;
+  v.cell_size_y = cell_size_y_;
+  if (periodic_.wraps()) v.origin = periodic_.origin;
+  v.wrap_x = wrap_x_;
+  v.wrap_y = wrap_y_;
+  v.mask = mask_;
+  v.keys = keys_.span();
+  v.start = start_.span();
+  v.count = count_.span();
   // Only the first binned_ items are agents (inactive ones are not binned).
-  return {cell_size_, mask_, keys_.span(), start_.span(), count_.span(), items_.span().subspan(0, binned_)};
+  v.items = items_.span().subspan(0, binned_);
+  return v;
 }
 
 Index AgentGrid::occupied_cells() const {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/buffer.h"
+#include "core/periodic.h"
 #include "core/span.h"
 
 namespace throng::sim {
@@ -71,22 +72,44 @@ THRONG_HOST_DEVICE inline std::uint64_t home_slot(std::uint64_t key, std::uint64
 }
 
 // What kernels see: the table (keys per slot, kEmptyCell when free), the run
-// of each slot in `items`, and the cell side. `items` holds every binned
+// of each slot in `items`, and the cell sides. `items` holds every binned
 // item grouped by cell: iterating it visits agents cell by cell, which keeps
 // the lookups of neighbouring agents in the same part of memory.
+//
+// Over a periodic area (core/periodic.h) the cells of a wrapping axis tile the
+// period exactly, `wrap_x` (or `wrap_y`) of them, an even number so that the
+// four colours stay two cells apart across the seam, and cell coordinates
+// are taken modulo that count: the cell beyond the last is the first.
+// Elsewhere cells are squares of side cell_size from the origin (0, 0).
 struct GridView {
-  float cell_size = 1.0f;
-  std::uint64_t mask = 0;  // capacity - 1 (capacity is a power of two)
+  float cell_size = 1.0f;               // m: the side along x
+  float cell_size_y = 1.0f;             // m: the side along y (differs from cell_size only on a periodic grid)
+  glm::vec2 origin{0.0f};               // m: where cell (0, 0) starts
+  std::int32_t wrap_x = 0, wrap_y = 0;  // cells per period along a wrapping axis; 0 elsewhere
+  std::uint64_t mask = 0;               // capacity - 1 (capacity is a power of two)
   Span<const std::uint64_t> keys;
   Span<const std::int32_t> start;
   Span<const std::int32_t> count;
   Span<const std::int32_t> items;
 
   THRONG_HOST_DEVICE Index capacity() const { return keys.size(); }
+  THRONG_HOST_DEVICE std::int32_t cell_x(float x) const { return cell_coord(x - origin.x, cell_size); }
+  THRONG_HOST_DEVICE std::int32_t cell_y(float y) const { return cell_coord(y - origin.y, cell_size_y); }
+  // Where cell (cx, cy) starts, unwrapped: the cell before the first lies
+  // before the origin, where the images of the last cell's items are.
+  THRONG_HOST_DEVICE glm::vec2 cell_min(std::int32_t cx, std::int32_t cy) const {
+    return origin + glm::vec2(static_cast<float>(cx) * cell_size, static_cast<float>(cy) * cell_size_y);
+  }
+  // The key of cell (cx, cy), wrapped along the periodic axes.
+  THRONG_HOST_DEVICE std::uint64_t key_of(std::int32_t cx, std::int32_t cy) const {
+    if (wrap_x > 0) cx = ((cx % wrap_x) + wrap_x) % wrap_x;
+    if (wrap_y > 0) cy = ((cy % wrap_y) + wrap_y) % wrap_y;
+    return cell_key(cx, cy);
+  }
   // Slot holding the cell, or -1.
   THRONG_HOST_DEVICE Index find(std::int32_t cx, std::int32_t cy) const {
     if (items.size() == 0) return -1;  // nothing binned (e.g. a world without walls)
-    const std::uint64_t key = cell_key(cx, cy);
+    const std::uint64_t key = key_of(cx, cy);
     std::uint64_t s = home_slot(key, mask);
     for (;;) {
       const std::uint64_t k = keys[static_cast<Index>(s)];
@@ -138,13 +161,13 @@ THRONG_HOST_DEVICE inline void for_each_in_3x3(const GridView& g, std::int32_t c
 // The same around the cell containing p.
 template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_in_3x3(const GridView& g, glm::vec2 p, Fn&& fn) {
-  for_each_in_3x3(g, cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size), fn);
+  for_each_in_3x3(g, g.cell_x(p.x), g.cell_y(p.y), fn);
 }
 // The same for the one cell containing p. On the world's halo grids (walls,
 // circles: see world.h) this finds everything within one cell side of p.
 template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_in_cell(const GridView& g, glm::vec2 p, Fn&& fn) {
-  const Index s = g.find(cell_coord(p.x, g.cell_size), cell_coord(p.y, g.cell_size));
+  const Index s = g.find(g.cell_x(p.x), g.cell_y(p.y));
   if (s < 0) return;
   const std::int32_t b = g.start[s], n = g.count[s];
   for (std::int32_t k = 0; k < n; ++k) fn(g.items[b + k]);
@@ -178,19 +201,26 @@ class StaticGrid {
 class AgentGrid {
  public:
   AgentGrid() = default;
-  explicit AgentGrid(float cell_size) : cell_size_(cell_size) {}
+  explicit AgentGrid(float cell_size) : cell_size_(cell_size), cell_size_y_(cell_size) {}
+  // Over a periodic area: cells at least cell_size wide, tiling each
+  // wrapping period in an even number of them (at least four: throws
+  // Error when the period is shorter than four cell sides).
+  AgentGrid(float cell_size, const Periodic& periodic);
   // Bins every agent whose flags[i] has bit 0 (active) set, by positions[i].
   // Spans in current_memory().
   void rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags);
   GridView view() const;
   float cell_size() const { return cell_size_; }
+  const Periodic& periodic() const { return periodic_; }
   Index binned_agents() const { return binned_; }
   Index occupied_cells() const;  // counts on the host (for tests and stats)
   // Memory held by the tables, bytes.
   std::size_t bytes() const;
 
  private:
-  float cell_size_ = 1.0f;
+  float cell_size_ = 1.0f, cell_size_y_ = 1.0f;
+  Periodic periodic_;
+  std::int32_t wrap_x_ = 0, wrap_y_ = 0;
   std::uint64_t mask_ = 0;
   Index binned_ = 0;
   Buffer<std::uint64_t> keys_;

@@ -60,7 +60,12 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
   }
   mask_ = static_cast<std::uint64_t>(cap - 1);
   const std::uint64_t mask = mask_;
-  const float cell = cell_size_;
+  GridView cells;  // the cell geometry only (its tables are being built)
+  cells.cell_size = cell_size_;
+  cells.cell_size_y = cell_size_y_;
+  if (periodic_.wraps()) cells.origin = periodic_.origin;
+  cells.wrap_x = wrap_x_;
+  cells.wrap_y = wrap_y_;
   auto keys = keys_.span();
   auto start = start_.span();
   auto count = count_.span();
@@ -81,7 +86,7 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
           slot_of[i] = -1;
           return;
         }
-        const std::uint64_t key = cell_key(cell_coord(positions[i].x, cell), cell_coord(positions[i].y, cell));
+        const std::uint64_t key = cells.key_of(cells.cell_x(positions[i].x), cells.cell_y(positions[i].y));
         std::uint64_t s = home_slot(key, mask);
         for (;;) {
           std::uint64_t found = atomic_load(&keys[static_cast<Index>(s)]);

@@ -30,8 +30,9 @@ struct OverlapStats {
       INFINITY;  // smallest gap between discs, m (negative = overlap); inf when no two agents are within the bins' reach
 };
 // Active agents only; `reach` (>= twice the largest radius) sizes the bins.
+// Over a periodic area, pairs across the seam count too.
 OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags,
-                              float tolerance, float reach);
+                              float tolerance, float reach, const Periodic& periodic = {});
 
 // The deepest pair overlap the steering models keep to, m: a third of the
 // 0.25 m radius (docs/simulation.md, "Acceptance", where the acceptance
@@ -98,7 +99,7 @@ struct VoronoiSample {
 };
 VoronoiSample measure_area_voronoi(std::span<const glm::vec2> positions, std::span<const glm::vec2> velocities,
                                    std::span<const glm::vec2> goals, std::span<const std::uint8_t> flags,
-                                   const Aabb& area, float cutoff);
+                                   const Aabb& area, float cutoff, const Periodic& periodic = {});
 
 // The Voronoi cell of every point among `points` (host), cut to the disc of
 // radius `cutoff`, as a convex polygon counter-clockwise; the building block
@@ -144,7 +145,8 @@ THRONG_HOST_DEVICE inline int step_crossing(glm::vec2 p0, glm::vec2 p1, glm::vec
 // whose step stays outside it are skipped).
 std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before,
                                          Span<const glm::vec2> after, Span<const std::uint8_t> flags_after,
-                                         Span<const Segment> lines, const Aabb& bounds, double t0, double t1);
+                                         Span<const Segment> lines, const Aabb& bounds, double t0, double t1,
+                                         const Periodic& periodic = {});
 
 // Flow through a line by the N-t curve (method A of Liao et al. 2014): of
 // `times`, one direction's crossing times in increasing order, the mean flow
@@ -174,8 +176,10 @@ struct LaneOrder {
   double order = 0;   // mean phi_j (0 when no agent has neighbours in its band)
   Index counted = 0;  // agents with at least one neighbour in their band
 };
+// Over a periodic area, neighbours across the seam count at their nearest copy.
 LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<glm::vec2>& goals,
-                     const std::vector<std::uint8_t>& flags, glm::vec2 axis, float band, float reach);
+                     const std::vector<std::uint8_t>& flags, glm::vec2 axis, float band, float reach,
+                     const Periodic& periodic = {});
 
 // Mean speed of active agents.
 double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> flags);
@@ -246,6 +250,7 @@ class StuckTracker {
  private:
   StuckOptions options_;
   AgentGrid bins_;
+  float bins_reach_ = 0.0f;     // the reach bins_ was made for
   Buffer<std::int32_t> rest_;   // steps in a row at rest with the way free
   Buffer<std::uint8_t> state_;  // kStuck* bits (metrics_stuck.cpp)
   StuckStats stats_;

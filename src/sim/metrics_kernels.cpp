@@ -28,12 +28,13 @@ struct OverlapOf {
   Span<const float> r;
   Span<const std::uint8_t> flags;
   float tolerance;
+  Periodic periodic;
   THRONG_HOST_DEVICE OverlapAcc operator()(Index i) const {
     OverlapAcc acc{0, 0, 0.0f, INFINITY};
     if ((flags[i] & kAgentActive) == 0) return acc;
     for_each_in_3x3(bins, p[i], [&](std::int32_t j) {
       if (j <= i || (flags[j] & kAgentActive) == 0) return;  // each pair once
-      const float gap = length_of(p[i] - p[j]) - r[i] - r[j];
+      const float gap = length_of(p[i] - periodic.near(p[j], p[i])) - r[i] - r[j];
       acc.min_separation = gap < acc.min_separation ? gap : acc.min_separation;
       if (gap < 0.0f) ++acc.touching;
       if (-gap > tolerance) ++acc.pairs;
@@ -80,11 +81,12 @@ struct CombineHistogram {
 }  // namespace
 
 OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float> radii, Span<const std::uint8_t> flags,
-                              float tolerance, float reach) {
-  AgentGrid grid(reach);
+                              float tolerance, float reach, const Periodic& periodic) {
+  AgentGrid grid(reach, periodic);
   grid.rebuild(positions, flags);
-  const OverlapAcc acc = parallel_reduce("sim.metrics.overlaps", positions.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
-                                         OverlapOf{grid.view(), positions, radii, flags, tolerance}, CombineOverlap{});
+  const OverlapAcc acc =
+      parallel_reduce("sim.metrics.overlaps", positions.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
+                      OverlapOf{grid.view(), positions, radii, flags, tolerance, periodic}, CombineOverlap{});
   return {acc.touching, acc.pairs, acc.max_depth, acc.min_separation};
 }
 
@@ -143,18 +145,31 @@ struct CrossingRecord {
 // the step's box meets the lines' box (most agents are far from every line).
 THRONG_HOST_DEVICE inline bool may_cross(Index i, Span<const glm::vec2> before, Span<const std::uint8_t> flags_before,
                                          Span<const glm::vec2> after, Span<const std::uint8_t> flags_after,
-                                         glm::vec2 lo, glm::vec2 hi) {
+                                         glm::vec2 lo, glm::vec2 hi, bool wraps) {
   if ((flags_before[i] & kAgentActive) == 0 || (flags_after[i] & kAgentActive) == 0) return false;
+  if (wraps) return true;  // (a step across the seam spans the area)
   const glm::vec2 p0 = before[i], p1 = after[i];
   return !((p0.x < lo.x && p1.x < lo.x) || (p0.x > hi.x && p1.x > hi.x) || (p0.y < lo.y && p1.y < lo.y) ||
            (p0.y > hi.y && p1.y > hi.y));
+}
+// The crossing of line (a, b) by the step from p0 to p1 (step_crossing);
+// over a periodic area the step is the shorter one across the seam, seen
+// from either end (a line near one side of the seam is crossed by the copy
+// of the step on that side).
+THRONG_HOST_DEVICE inline int crossing_of(glm::vec2 p0, glm::vec2 p1, glm::vec2 a, glm::vec2 b,
+                                          const Periodic& periodic, double* s) {
+  if (!periodic.wraps()) return step_crossing(p0, p1, a, b, s);
+  const int d = step_crossing(periodic.near(p0, p1), p1, a, b, s);
+  return d != 0 ? d : step_crossing(p0, periodic.near(p1, p0), a, b, s);
 }
 }  // namespace
 
 std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<const std::uint8_t> flags_before,
                                          Span<const glm::vec2> after, Span<const std::uint8_t> flags_after,
-                                         Span<const Segment> lines, const Aabb& bounds, double t0, double t1) {
+                                         Span<const Segment> lines, const Aabb& bounds, double t0, double t1,
+                                         const Periodic& periodic) {
   const Index n = after.size();
+  const bool wraps = periodic.wraps();
   if (n == 0 || lines.size() == 0 || bounds.empty()) return {};
   const glm::vec2 lo = bounds.min, hi = bounds.max;
   const Index line_count = lines.size();
@@ -165,10 +180,10 @@ std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<cons
   parallel_for(
       "sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
         Index c = 0;
-        if (may_cross(i, before, flags_before, after, flags_after, lo, hi)) {
+        if (may_cross(i, before, flags_before, after, flags_after, lo, hi, wraps)) {
           double s = 0;
           for (Index k = 0; k < line_count; ++k)
-            c += step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s) != 0 ? 1 : 0;
+            c += crossing_of(before[i], after[i], lines[k].a, lines[k].b, periodic, &s) != 0 ? 1 : 0;
         }
         count[i] = c;
       });
@@ -179,11 +194,11 @@ std::vector<LineCrossing> line_crossings(Span<const glm::vec2> before, Span<cons
   const Span<const Index> first = offsets.span();
   parallel_for(
       "sim.metrics.line_crossings", n, THRONG_LAMBDA(Index i) {
-        if (!may_cross(i, before, flags_before, after, flags_after, lo, hi)) return;
+        if (!may_cross(i, before, flags_before, after, flags_after, lo, hi, wraps)) return;
         Index at = first[i];
         for (Index k = 0; k < line_count; ++k) {
           double s = 0;
-          const int d = step_crossing(before[i], after[i], lines[k].a, lines[k].b, &s);
+          const int d = crossing_of(before[i], after[i], lines[k].a, lines[k].b, periodic, &s);
           if (d != 0) out[at++] = CrossingRecord{s, i, static_cast<std::int32_t>(k), d};
         }
       });

@@ -8,7 +8,8 @@
 namespace throng::sim {
 
 LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<glm::vec2>& goals,
-                     const std::vector<std::uint8_t>& flags, glm::vec2 axis, float band, float reach) {
+                     const std::vector<std::uint8_t>& flags, glm::vec2 axis, float band, float reach,
+                     const Periodic& periodic) {
   const glm::vec2 across = perp_left(axis);
   auto heading_sign = [&](std::size_t i) { return dot2(goals[i] - positions[i], axis) >= 0.0f ? 1 : -1; };
   LaneOrder out;
@@ -19,7 +20,7 @@ LaneOrder lane_order(const std::vector<glm::vec2>& positions, const std::vector<
     double same = 0, other = 0;
     for (std::size_t k = 0; k < positions.size(); ++k) {
       if (k == j || (flags[k] & kAgentActive) == 0) continue;
-      const glm::vec2 d = positions[k] - positions[j];
+      const glm::vec2 d = periodic.near(positions[k], positions[j]) - positions[j];
       if (std::fabs(dot2(d, across)) >= band || std::fabs(dot2(d, axis)) >= reach) continue;
       (heading_sign(k) == mine ? same : other) += 1.0;
     }

@@ -56,7 +56,7 @@ void CrowdMetricsStage::record_crossings(const Simulation& sim, const FrameInfo&
     const Index n = std::min(previous_position_.size(), c.position.size());
     const std::vector<LineCrossing> found = line_crossings(
         previous_position_.span().subspan(0, n), previous_flags_.span().subspan(0, n), c.position.span().subspan(0, n),
-        c.flags.span().subspan(0, n), lines_.span(), line_bounds_, previous_time_, frame.time);
+        c.flags.span().subspan(0, n), lines_.span(), line_bounds_, previous_time_, frame.time, sim.world().periodic());
     // The list is in agent order; sorted by time within the step, every
     // N-t curve only climbs.
     std::vector<LineTimes> step(line_times_.size());
@@ -91,7 +91,7 @@ void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame
   Sample s;
   s.time = frame.time;
   s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_tolerance,
-                                sim.contact_cell());
+                                sim.contact_cell(), sim.world().periodic());
   s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(),
                                                options_.penetration_tolerance);
   s.mean_speed = mean_speed(c.velocity.span(), c.flags.span());
@@ -99,9 +99,9 @@ void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame
                                goal = c.goal.to_vector();
   const std::vector<std::uint8_t> flags = c.flags.to_vector();
   for (const MeasurementArea& a : options_.measurement.areas)
-    s.areas.push_back(
-        {measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), a.rect),
-         measure_area_voronoi(position, velocity, goal, flags, a.rect, options_.measurement.voronoi_cutoff)});
+    s.areas.push_back({measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), a.rect),
+                       measure_area_voronoi(position, velocity, goal, flags, a.rect,
+                                            options_.measurement.voronoi_cutoff, sim.world().periodic())});
   const DensityHistogram h = density_histogram(c.position.span(), c.flags.span());
   density_.cell = h.cell;
   density_.bin_width = h.bin_width;

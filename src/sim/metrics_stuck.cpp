@@ -24,6 +24,7 @@ struct AtRestInFreeSpace {
   Span<const glm::vec2> goal;
   Span<const std::uint8_t> flags;
   float speed_below, gap;
+  Periodic periodic;
   THRONG_HOST_DEVICE bool operator()(Index i) const {
     const std::uint8_t f = flags[i];
     if ((f & kAgentActive) == 0 || (f & (kAgentStopped | kAgentWaiting)) != 0) return false;
@@ -38,7 +39,7 @@ struct AtRestInFreeSpace {
     for_each_in_3x3(bins, probe, [&](std::int32_t j) {
       if (j == i || (flags[j] & kAgentActive) == 0) return;
       const float reach = ri + r[j];
-      if (length2(p[j] - probe) < reach * reach) free = false;
+      if (length2(periodic.near(p[j], probe) - probe) < reach * reach) free = false;
     });
     return free;
   }
@@ -76,7 +77,10 @@ void StuckTracker::update(const World& world, Span<const glm::vec2> positions, S
     rest_ = grown(rest_, n);
     state_ = grown(state_, n);
   }
-  if (bins_.cell_size() != reach) bins_ = AgentGrid(reach);
+  if (bins_reach_ != reach || bins_.periodic().period != world.periodic().period) {
+    bins_ = AgentGrid(reach, world.periodic());
+    bins_reach_ = reach;
+  }
   bins_.rebuild(positions, flags);
   const AtRestInFreeSpace at_rest{bins_.view(),
                                   world.view(),
@@ -86,7 +90,8 @@ void StuckTracker::update(const World& world, Span<const glm::vec2> positions, S
                                   goals,
                                   flags,
                                   static_cast<float>(options_.speed_below),
-                                  static_cast<float>(options_.gap)};
+                                  static_cast<float>(options_.gap),
+                                  world.periodic()};
   const std::int32_t threshold = threshold_steps(dt);
   const Span<std::int32_t> rest = rest_.span();
   const Span<std::uint8_t> state = state_.span();

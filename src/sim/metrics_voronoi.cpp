@@ -155,7 +155,26 @@ std::vector<ConvexPolygon> voronoi_cells(std::span<const glm::vec2> points, floa
 
 VoronoiSample measure_area_voronoi(std::span<const glm::vec2> positions, std::span<const glm::vec2> velocities,
                                    std::span<const glm::vec2> goals, std::span<const std::uint8_t> flags,
-                                   const Aabb& area, float cutoff) {
+                                   const Aabb& area, float cutoff, const Periodic& periodic) {
+  if (periodic.wraps()) {
+    // The agents and their copies one period away on every wrapping side:
+    // a cell by the seam is cut by the neighbours across it.
+    std::vector<glm::vec2> p, v, g;
+    std::vector<std::uint8_t> f;
+    const glm::vec2 L = periodic.period;
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) {
+        if ((i != 0 && L.x == 0.0f) || (j != 0 && L.y == 0.0f)) continue;
+        const glm::vec2 shift(static_cast<float>(i) * L.x, static_cast<float>(j) * L.y);
+        for (std::size_t k = 0; k < positions.size(); ++k) {
+          p.push_back(positions[k] + shift);
+          v.push_back(velocities[k]);
+          g.push_back(goals[k] + shift);
+          f.push_back(flags[k]);
+        }
+      }
+    return measure_area_voronoi(p, v, g, f, area, cutoff);
+  }
   VoronoiSample s;
   // In double like the cells: float differences would put the area's size
   // off the sum of the cell parts by a float rounding.

@@ -156,3 +156,59 @@ std::vector<glm::vec2> trace_field(const FieldsView& f, std::int32_t k, glm::vec
 }
 
 }  // namespace throng::sim
+
+namespace throng::sim {
+
+namespace {
+// Where the level `d` crosses the edge from node a (value va) to node b.
+glm::vec2 level_point(glm::vec2 a, glm::vec2 b, float va, float vb, float d) {
+  return a + (b - a) * ((d - va) / (vb - va));
+}
+}  // namespace
+
+std::vector<std::vector<glm::vec2>> field_contours(const FieldsView& f, std::int32_t k, float spacing,
+                                                   std::size_t max_segments) {
+  if (!(spacing > 0.0f) || !std::isfinite(spacing))
+    throw Error(fmt::format("the spacing of a field's lines must be a positive number of metres (got {})", spacing));
+  std::vector<std::vector<glm::vec2>> out;
+  const FieldGrid& g = f.grids[k];
+  const float* d = f.distance.data() + g.offset;
+  auto node = [&](std::int32_t i, std::int32_t j) {
+    return g.origin + glm::vec2(static_cast<float>(i) * g.cell, static_cast<float>(j) * g.cell);
+  };
+  for (std::int32_t j = 0; j + 1 < g.ny; ++j)
+    for (std::int32_t i = 0; i + 1 < g.nx; ++i) {
+      // Corners counter-clockwise: (i, j), (i+1, j), (i+1, j+1), (i, j+1).
+      const float v[4] = {d[static_cast<std::int64_t>(j) * g.nx + i], d[static_cast<std::int64_t>(j) * g.nx + i + 1],
+                          d[static_cast<std::int64_t>(j + 1) * g.nx + i + 1],
+                          d[static_cast<std::int64_t>(j + 1) * g.nx + i]};
+      const glm::vec2 p[4] = {node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)};
+      if (!(v[0] < INFINITY && v[1] < INFINITY && v[2] < INFINITY && v[3] < INFINITY)) continue;  // by a wall
+      const float lo = std::min({v[0], v[1], v[2], v[3]}), hi = std::max({v[0], v[1], v[2], v[3]});
+      for (float level = std::ceil(lo / spacing) * spacing; level < hi; level += spacing) {
+        if (level <= lo) continue;  // a corner on the level: the neighbouring cell draws it
+        glm::vec2 cross[4];
+        int n = 0;
+        for (int e = 0; e < 4; ++e) {
+          const float va = v[e], vb = v[(e + 1) % 4];
+          if ((va < level) != (vb < level)) cross[n++] = level_point(p[e], p[(e + 1) % 4], va, vb, level);
+        }
+        if (n == 2) out.push_back({cross[0], cross[1]});
+        if (n == 4) {  // a saddle: pair the crossings by the level of the cell's middle
+          const bool middle_below = 0.25f * (v[0] + v[1] + v[2] + v[3]) < level;
+          const bool first_below = v[0] < level;
+          if (middle_below == first_below) {
+            out.push_back({cross[0], cross[1]});
+            out.push_back({cross[2], cross[3]});
+          } else {
+            out.push_back({cross[3], cross[0]});
+            out.push_back({cross[1], cross[2]});
+          }
+        }
+        if (out.size() >= max_segments) return out;
+      }
+    }
+  return out;
+}
+
+}  // namespace throng::sim

@@ -162,6 +162,13 @@ class NavigationFields {
 std::vector<glm::vec2> trace_field(const FieldsView& f, std::int32_t k, glm::vec2 start, float step = 0.1f,
                                    std::int32_t max_points = 200000, float tolerance = 0.1f);
 
+// The lines of equal walking distance of field k, every `spacing` m (or s
+// for a weighed field), as segments across the grid's cells (marching
+// squares, the distance linear along each cell edge; cells with a blocked
+// node are left out), at most max_segments of them. For drawing the field.
+std::vector<std::vector<glm::vec2>> field_contours(const FieldsView& f, std::int32_t k, float spacing,
+                                                   std::size_t max_segments = 1'000'000);
+
 // The crowd's density over a grid of square cells (host), for fields that
 // weigh congestion (`planning: quickest`): agents per m^2 of each cell,
 // averaged over the cell and its eight neighbours, so that an agent's own

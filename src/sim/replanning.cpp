@@ -23,7 +23,9 @@ Replanner::Replanner(const ScenarioSpec& spec, const CrowdHost& host, std::share
   if (!planner_) return;
   for (std::size_t i = 0; i < host.group.size(); ++i) {
     const GroupSpec& G = spec.groups[static_cast<std::size_t>(host.group[i])];
-    if (!G.waypoints.empty() || G.goal.kind == GoalSpec::Kind::Exits || G.arrival == ArrivalBehaviour::Loop) continue;
+    if (!G.waypoints.empty() || G.goal.kind == GoalSpec::Kind::Exits || G.goal.kind == GoalSpec::Kind::Direction ||
+        G.arrival == ArrivalBehaviour::Loop)
+      continue;
     agents_.push_back(static_cast<Index>(i));
     radius_.push_back(host.radius[i]);
   }

@@ -176,6 +176,11 @@ struct ExitSpec {
 // reconsider_s seconds).
 enum class ExitChoice : std::uint8_t { Nearest, Quickest };
 
+// How far ahead of an agent a direction goal lies (m): beyond any walk a
+// run can take at walking speed (a day at 1.2 m/s), close enough for
+// float precision (a few mm there).
+inline constexpr float kDirectionReach = 1.0e5f;
+
 // One waypoint of a group: the same for every agent, or per agent.
 struct GoalSpec {
   enum class Kind : std::uint8_t {
@@ -185,6 +190,10 @@ struct GoalSpec {
     Random,  // a random free point of `region` per agent
     Exits,   // one of `exits` per agent, chosen by `choice` (a group's goal only)
     Gate,    // the line from value to gate_to, passed when crossed anywhere along it (waypoints only)
+    // Walk on in the unit direction `value`, never arriving (a group's goal
+    // in a periodic world only): the goal lies kDirectionReach ahead of
+    // where the agent spawned and moves with it across the seam.
+    Direction,
   };
   Kind kind = Kind::Point;
   glm::vec2 value{0.0f};
@@ -284,6 +293,9 @@ struct ScatterSpec {
 
 struct WorldSpec {
   bool has_walkable = false;
+  // Periodic boundaries (core/periodic.h): the rectangular walkable area's
+  // opposite sides joined along x and/or y.
+  bool periodic_x = false, periodic_y = false;
   Polygon walkable;                         // outer boundary and holes
   std::vector<Polygon> polygons;            // obstacle polygons
   std::vector<std::string> polygon_fields;  // "world.obstacles[3]" per polygon

@@ -33,12 +33,15 @@ THRONG_HOST_DEVICE inline ObstacleSense sense_obstacles(const WorldView& w, cons
   return best;
 }
 
-// Read-only view of the neighbours' state.
+// Read-only view of the neighbours' state. Models read a neighbour's
+// position through at(j, p): over a periodic area, the image nearest p.
 struct NeighbourArrays {
   Span<const glm::vec2> position;
   Span<const glm::vec2> velocity;
   Span<const float> radius;
   Span<const std::uint8_t> flags;
+  Periodic periodic;
+  THRONG_HOST_DEVICE glm::vec2 at(Index j, glm::vec2 p) const { return periodic.near(position[j], p); }
 };
 
 // Neighbour j as a candidate threat of the agent at p: kept in `best` when
@@ -46,7 +49,7 @@ struct NeighbourArrays {
 THRONG_HOST_DEVICE inline void consider_neighbour(Threat& best, Index j, Index self, glm::vec2 p, glm::vec2 v,
                                                   glm::vec2 forward, float radius, const NeighbourArrays& n,
                                                   const ModelParams& m, float query2) {
-  const glm::vec2 q = n.position[j];
+  const glm::vec2 q = n.at(j, p);
   if (length2(q - p) >= query2 || j == self || (n.flags[j] & kAgentActive) == 0) return;
   // An agent standing at its goal is passed like a post: no personal space,
   // so arriving agents can still reach goals next to those already there.
@@ -66,11 +69,10 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
   Threat best;
   const float query = m.query_radius();
   const float query2 = query * query;
-  const float side = bins.cell_size;
   for (std::int32_t dy = -1; dy <= 1; ++dy)
     for (std::int32_t dx = -1; dx <= 1; ++dx) {
-      const glm::vec2 lo(static_cast<float>(cx + dx) * side - slack, static_cast<float>(cy + dy) * side - slack);
-      const glm::vec2 hi = lo + glm::vec2(side + 2.0f * slack);
+      const glm::vec2 lo = bins.cell_min(cx + dx, cy + dy) - glm::vec2(slack);
+      const glm::vec2 hi = lo + glm::vec2(bins.cell_size, bins.cell_size_y) + glm::vec2(2.0f * slack);
       const glm::vec2 nearest(fminf(fmaxf(p.x, lo.x), hi.x), fminf(fmaxf(p.y, lo.y), hi.y));
       if (length2(nearest - p) >= query2) continue;
       // The corner of the cell furthest along `forward`.
@@ -125,7 +127,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   const CollisionFreeSpeedParams& c = m.cfs;
   const float query2 = m.query_radius() * m.query_radius();
   auto is_neighbour = [&](Index j) {
-    return j != self && (n.flags[j] & kAgentActive) != 0 && length2(n.position[j] - me.p) < query2;
+    return j != self && (n.flags[j] & kAgentActive) != 0 && length2(n.at(j, me.p) - me.p) < query2;
   };
   // Walls first: they may slide e0 along them before the pushes are summed.
   const float reach = me.radius + cfs_wall_reach(c);
@@ -151,7 +153,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   int held = 0;
   for_each_candidate([&](Index j) {
     if (!is_neighbour(j)) return;
-    const glm::vec2 q = n.position[j];
+    const glm::vec2 q = n.at(j, me.p);
     sum += cfs_neighbour_push(me, q, n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
     if (length2(q - me.p) >= hold * hold) return;
     if (held < kCfsHolders) holders[held] = static_cast<std::int32_t>(j);
@@ -173,7 +175,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   auto speed_past = [&](bool all) {
     float gap = INFINITY, gap_now = INFINITY;
     for_each_holder([&](Index j) {
-      const glm::vec2 q = n.position[j];
+      const glm::vec2 q = n.at(j, me.p);
       if (!all && dot2(q - me.p, me.e0) < 0.0f) return;
       gap = fminf(
           gap, cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j], c.lane_width));
@@ -225,7 +227,7 @@ THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, co
   for_each_wall_point(w, me.p, wall_point);
   for_each_candidate([&](Index j) {
     if (j == self || (n.flags[j] & kAgentActive) == 0) return;
-    const glm::vec2 x = me.p - n.position[j];
+    const glm::vec2 x = me.p - n.at(j, me.p);
     if (length2(x) >= sense2) return;
     f += ttc_avoidance(x, me.v - n.velocity[j], me.radius + n.radius[j], t);
   });
@@ -252,7 +254,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index sel
   const glm::vec2 heading = normalize_or(me.v, me.e0);
   for_each_candidate([&](Index j) {
     if (j == self || (n.flags[j] & kAgentActive) == 0) return;
-    const glm::vec2 x = me.p - (n.position[j] + n.velocity[j] * t);
+    const glm::vec2 x = me.p - (n.at(j, me.p) + n.velocity[j] * t);
     if (length2(x) < sense2) f += sf_neighbour_force(x, me.v, n.velocity[j], me.radius + n.radius[j], heading, s, h);
   });
   return f;
@@ -291,15 +293,17 @@ THRONG_HOST_DEVICE inline glm::vec2 tie_direction(Index i, Index j) {
 // Contact constraint (the addition to the paper's model): each overlapping
 // pair is pushed apart, this agent taking half of the overlap. `deepest`
 // becomes the deepest of those overlaps (m; 0 when none).
-// Candidates: the contact bins' cells `cells` (the 3x3 around the agent's).
+// Candidates: the contact bins' cells `cells` (the 3x3 around the agent's);
+// over a periodic area, each at its image nearest p.
 THRONG_HOST_DEVICE inline glm::vec2 contact_push(const GridView& bins, const Cells3x3& cells, Index self, glm::vec2 p,
                                                  float radius, Span<const glm::vec2> positions, Span<const float> radii,
-                                                 Span<const std::uint8_t> flags, float& deepest) {
+                                                 Span<const std::uint8_t> flags, const Periodic& periodic,
+                                                 float& deepest) {
   glm::vec2 push(0.0f);
   deepest = 0.0f;
   for_each_in_cells(bins, cells, [&](std::int32_t j) {
     if (j == self || (flags[j] & kAgentActive) == 0) return;
-    const glm::vec2 d = p - positions[j];
+    const glm::vec2 d = p - periodic.near(positions[j], p);
     const float reach = radius + radii[j];
     const float d2 = length2(d);
     if (d2 >= reach * reach) return;

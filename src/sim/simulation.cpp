@@ -36,9 +36,9 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   if (options.fields != nullptr && spec_.planning == PlanningKind::Quickest && fields_.count() > 0)
     quickest_builder_ = options.fields;
   exits_.use_fields(fields_.host_view());
-  bins_ = AgentGrid(spec_.model.query_radius());
+  bins_ = AgentGrid(spec_.model.query_radius(), world_.periodic());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
-  contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()));
+  contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()), world_.periodic());
   const Memory m = current_memory();
   anchor_ = Buffer<glm::vec2>(crowd_.count, m);
   candidate_ = Buffer<glm::vec2>(crowd_.count, m);
@@ -59,6 +59,7 @@ StepContext Simulation::context() const {
   // The move stage accepts at most 0.95 radius per step (simulation_kernels.cpp).
   ctx.bin_slack = scheduler_ == SchedulerKind::FourColour ? max_radius_ : 0.0f;
   ctx.fields = fields_.view();
+  ctx.periodic = world_.periodic();
   return ctx;
 }
 
@@ -204,8 +205,8 @@ bool Simulation::admit_entries() {
   const Buffer<glm::vec2> spot_buffer(std::span<const glm::vec2>(spots), m);
   const Buffer<float> radius_buffer(std::span<const float>(radii), m);
   Buffer<float> clearance = Buffer<float>::zeros(static_cast<Index>(due), m);
-  entry_clearance(contact_bins_.view(), crowd_.position.span(), crowd_.radius.span(), crowd_.flags.span(),
-                  spot_buffer.span(), radius_buffer.span(), clearance.span());
+  entry_clearance(contact_bins_.view(), world_.periodic(), crowd_.position.span(), crowd_.radius.span(),
+                  crowd_.flags.span(), spot_buffer.span(), radius_buffer.span(), clearance.span());
   const std::vector<float> gap = clearance.to_vector();
   std::vector<PendingEntry> waiting, entered;
   for (std::size_t k = 0; k < due; ++k) {

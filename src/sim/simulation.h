@@ -94,6 +94,7 @@ struct StepContext {
   // 0 for the double buffer, one step's largest move for the four colours.
   float bin_slack = 0.0f;
   FieldsView fields;  // navigation fields (none: every agent steers at its waypoint)
+  Periodic periodic;  // the world's periodic boundaries (none: periods 0)
 };
 
 // Stages (each one or more parallel_for launches named "sim.<stage>...").
@@ -131,9 +132,9 @@ Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit);
 // Per spot k: the smallest gap (m) between a disc of spot_radius[k] there
 // and any active agent binned in the 3x3 cells of `bins` around it (cells
 // at least as wide as two radii); +inf when none is near.
-void entry_clearance(const GridView& bins, Span<const glm::vec2> position, Span<const float> radius,
-                     Span<const std::uint8_t> flags, Span<const glm::vec2> spots, Span<const float> spot_radius,
-                     Span<float> clearance);
+void entry_clearance(const GridView& bins, const Periodic& periodic, Span<const glm::vec2> position,
+                     Span<const float> radius, Span<const std::uint8_t> flags, Span<const glm::vec2> spots,
+                     Span<const float> spot_radius, Span<float> clearance);
 
 // An agent arriving over time (kAgentPending): when and where it enters.
 struct PendingEntry {

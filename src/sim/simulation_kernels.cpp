@@ -144,6 +144,11 @@ THRONG_HOST_DEVICE inline bool led_target(const StepContext& ctx, const AgentArr
   return is_gate;
 }
 
+// The agents as the models read their neighbours.
+THRONG_HOST_DEVICE inline NeighbourArrays neighbours_of(const StepContext& ctx, const AgentArrays& a) {
+  return {a.position, a.velocity, a.radius, a.flags, ctx.periodic};
+}
+
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
   return (flags & kAgentActive) != 0 && (flags & (kAgentStopped | kAgentWaiting)) == 0;
 }
@@ -170,7 +175,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_priority(const StepContext& ctx, const
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx, const AgentArrays& a, Index i,
                                                          const ForEachCandidate& for_each_candidate) {
-  const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+  const NeighbourArrays n = neighbours_of(ctx, a);
   const glm::vec2 p = a.position[i];
   glm::vec2 aim;
   if (!led_target(ctx, a, i, aim)) {
@@ -194,7 +199,7 @@ THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const A
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i,
                                               const ForEachCandidate& for_each_candidate) {
-  const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+  const NeighbourArrays n = neighbours_of(ctx, a);
   return ttc_force(ctx.world, i, force_agent(ctx, a, i), n, ctx.model, for_each_candidate);
 }
 
@@ -202,7 +207,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const Agen
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a, Index i,
                                                        const ForEachCandidate& for_each_candidate) {
-  const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+  const NeighbourArrays n = neighbours_of(ctx, a);
   return social_force_velocity(ctx.world, i, force_agent(ctx, a, i), ctx.dt, n, ctx.model, for_each_candidate);
 }
 
@@ -229,7 +234,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
     auto candidates = [&](const auto& fn) { for_each_in_cells(ctx.bins, cells, fn); };
     return sense_candidates(ctx, a, i, candidates);
   }
-  const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+  const NeighbourArrays n = neighbours_of(ctx, a);
   return sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
     return sense_neighbours(ctx.bins, cx, cy, i, p, v, forward, r, n, ctx.model, ctx.bin_slack);
   });
@@ -286,7 +291,8 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const 
   deepest = 0.0f;
   if ((a.flags[i] & kAgentActive) == 0) return p;
   const float r = a.radius[i];
-  p += clamp_length(contact_push(ctx.contact_bins, cells.agents, i, p, r, P, a.radius, a.flags, deepest), 0.5f * r);
+  p += clamp_length(contact_push(ctx.contact_bins, cells.agents, i, p, r, P, a.radius, a.flags, ctx.periodic, deepest),
+                    0.5f * r);
   p = anchor + clamp_length(p - anchor, kMaxStepFraction * r);
   bool clear = false;
   p = project_out_of_obstacles(ctx.world, cells.obstacles, p, r, anchor, clear);
@@ -306,7 +312,7 @@ struct Sense {
   THRONG_HOST_DEVICE void operator()(Index i) const {
     if ((a.flags[i] & kAgentActive) == 0) return;
     const glm::vec2 p = a.position[i];
-    sensed[i] = sense_binned(ctx, a, i, cell_coord(p.x, ctx.bins.cell_size), cell_coord(p.y, ctx.bins.cell_size));
+    sensed[i] = sense_binned(ctx, a, i, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
   }
 };
 
@@ -329,7 +335,7 @@ struct SenseAllPairs {
       sensed[i] = sense_candidates(ctx, a, i, candidates);
       return;
     }
-    const NeighbourArrays n{a.position, a.velocity, a.radius, a.flags};
+    const NeighbourArrays n = neighbours_of(ctx, a);
     const ModelParams m = ctx.model;
     sensed[i] = sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
       return sense_neighbours_all_pairs(i, p, v, forward, r, n, m);
@@ -357,8 +363,8 @@ struct FindMoveCells {
   Span<MoveCells> cells;
   THRONG_HOST_DEVICE void operator()(Index i) const {
     const glm::vec2 b = anchor[i];
-    const float side = ctx.contact_bins.cell_size;
-    cells[i] = {cells_3x3(ctx.contact_bins, cell_coord(b.x, side), cell_coord(b.y, side)), obstacle_cell(ctx.world, b)};
+    const GridView& g = ctx.contact_bins;
+    cells[i] = {cells_3x3(g, g.cell_x(b.x), g.cell_y(b.y)), obstacle_cell(ctx.world, b)};
   }
 };
 
@@ -429,6 +435,14 @@ struct Finalize {
     if (!acceptable_move(ctx, cells[i], from, p, r)) p = from;
     glm::vec2 v = clamp_length((p - from) * (1.0f / ctx.dt), ctx.model.max_speed);
     if ((flags & kAgentStopped) != 0) v = glm::vec2(0.0f);
+    if (ctx.periodic.wraps()) {
+      // Back into the area across the seam, the route with it (a periodic
+      // area's agents head in a direction: their goal lies far ahead).
+      const glm::vec2 shift = ctx.periodic.wrap(p) - p;
+      p += shift;
+      a.path_start[i] += shift;
+      a.goal[i] += shift;
+    }
     a.position[i] = p;
     if (length2(v) > 0.05f * 0.05f && (flags & kAgentWaiting) == 0) a.heading[i] = atan2f(v.y, v.x);
     // A waiting agent starts walking in the step that begins at its start time.
@@ -538,15 +552,16 @@ void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to) {
       "sim.move.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
 }
 
-void entry_clearance(const GridView& bins, Span<const glm::vec2> position, Span<const float> radius,
-                     Span<const std::uint8_t> flags, Span<const glm::vec2> spots, Span<const float> spot_radius,
-                     Span<float> clearance) {
+void entry_clearance(const GridView& bins, const Periodic& periodic, Span<const glm::vec2> position,
+                     Span<const float> radius, Span<const std::uint8_t> flags, Span<const glm::vec2> spots,
+                     Span<const float> spot_radius, Span<float> clearance) {
   parallel_for(
       "sim.inflow.clearance", spots.size(), THRONG_LAMBDA(Index k) {
         const glm::vec2 q = spots[k];
         float gap = INFINITY;
         for_each_in_3x3(bins, q, [&](Index j) {
-          if ((flags[j] & kAgentActive) != 0) gap = fminf(gap, length_of(position[j] - q) - radius[j] - spot_radius[k]);
+          if ((flags[j] & kAgentActive) != 0)
+            gap = fminf(gap, length_of(periodic.near(position[j], q) - q) - radius[j] - spot_radius[k]);
         });
         clearance[k] = gap;
       });

@@ -55,7 +55,7 @@ SoakCheck SoakCheckStage::measure(const Simulation& sim, const FrameInfo& frame)
     s.penetrations = count_obstacle_penetrations(sim.world(), c.position.span(), c.radius.span(), c.flags.span(),
                                                  options_.penetration_tolerance);
     s.overlaps = measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), options_.overlap_bound,
-                                  sim.contact_cell());
+                                  sim.contact_cell(), sim.world().periodic());
   }
   s.rss_bytes = resident_memory_bytes();
   return s;

@@ -208,9 +208,54 @@ World World::build(const WorldSpec& spec, float cell_size, const ScenarioLimits&
     for (const Polygon& p : w.polygons_) w.bounds_.add(sim::bounds(p));
     for (const Circle& c : w.circles_) w.bounds_.add(sim::bounds(c));
   }
+  if (spec.periodic_x || spec.periodic_y) w.make_periodic(spec);
   w.index(limits, memory);
   return w;
 }
+
+void World::make_periodic(const WorldSpec& spec) {
+  const Ring& r = walkable_.outer;
+  bool rectangle = has_walkable_ && r.size() == 4;
+  for (std::size_t k = 0; rectangle && k < 4; ++k) {
+    const glm::vec2 a = r[k], b = r[(k + 1) % 4];
+    rectangle = (a.x == b.x) != (a.y == b.y);  // every side along an axis
+  }
+  if (!rectangle)
+    throw Error("periodic boundaries need a rectangular walkable area: world.walkable: {rect: {min, max}}",
+                at_field("world.periodic"));
+  const glm::vec2 size = bounds_.size();
+  periodic_.origin = bounds_.min;
+  periodic_.period = glm::vec2(spec.periodic_x ? size.x : 0.0f, spec.periodic_y ? size.y : 0.0f);
+}
+
+namespace {
+// What the kernels of a periodic world index besides the scenario's
+// shapes: their copies one period away (and the walkable rectangle grown by
+// a period on each wrapping side), appended in order so that copy k of n
+// shapes is shape k % n.
+void add_periodic_copies(const Periodic& periodic, Polygon& walkable, std::vector<Polygon>& polygons,
+                         std::vector<Circle>& circles) {
+  const glm::vec2 L = periodic.period;
+  Aabb grown = bounds(walkable);
+  grown.min -= L;
+  grown.max += L;
+  walkable.outer = {grown.min, {grown.max.x, grown.min.y}, grown.max, {grown.min.x, grown.max.y}};
+  const std::size_t np = polygons.size(), nc = circles.size();
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) {
+      const glm::vec2 shift(static_cast<float>(i) * L.x, static_cast<float>(j) * L.y);
+      if ((i != 0 && L.x == 0.0f) || (j != 0 && L.y == 0.0f) || (i == 0 && j == 0)) continue;
+      for (std::size_t k = 0; k < np; ++k) {
+        Polygon p = polygons[k];
+        for (glm::vec2& v : p.outer) v += shift;
+        for (Ring& h : p.holes)
+          for (glm::vec2& v : h) v += shift;
+        polygons.push_back(std::move(p));
+      }
+      for (std::size_t k = 0; k < nc; ++k) circles.push_back({circles[k].center + shift, circles[k].radius});
+    }
+}
+}  // namespace
 
 void World::index(const ScenarioLimits& limits, Memory memory) {
   check_interrupt("indexing the world");
@@ -219,12 +264,16 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
     rings_.push_back({static_cast<std::int32_t>(vertices_.size()), static_cast<std::int32_t>(r.size())});
     vertices_.insert(vertices_.end(), r.begin(), r.end());
   };
+  Polygon walkable = walkable_;
+  std::vector<Polygon> polygons = polygons_;
+  std::vector<Circle> circles = circles_;
+  if (periodic_.wraps()) add_periodic_copies(periodic_, walkable, polygons, circles);
   if (has_walkable_) {
-    walkable_outer_ = {static_cast<std::int32_t>(vertices_.size()), static_cast<std::int32_t>(walkable_.outer.size())};
-    vertices_.insert(vertices_.end(), walkable_.outer.begin(), walkable_.outer.end());
-    append_edges(walkable_, segments_);
+    walkable_outer_ = {static_cast<std::int32_t>(vertices_.size()), static_cast<std::int32_t>(walkable.outer.size())};
+    vertices_.insert(vertices_.end(), walkable.outer.begin(), walkable.outer.end());
+    append_edges(walkable, segments_);
   }
-  for (const Polygon& p : polygons_) {
+  for (const Polygon& p : polygons) {
     polygon_refs_.push_back({static_cast<std::int32_t>(rings_.size()), static_cast<std::int32_t>(1 + p.holes.size())});
     add_ring(p.outer);
     for (const Ring& h : p.holes) add_ring(h);
@@ -257,8 +306,8 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
   // (Halo registrations: 9 per cell before duplicates are merged.)
   for (std::size_t k = 0; k < segments_.size(); ++k)
     if (in_grid[k]) total += 9.0 * (2.0 * cells_crossed(segments_[k]) + 2.0);
-  for (const Circle& c : circles_) total += 9.0 * cells_in_box(sim::bounds(c), cell);
-  for (const Polygon& p : polygons_) total += cells_in_box(sim::bounds(p), cell);
+  for (const Circle& c : circles) total += 9.0 * cells_in_box(sim::bounds(c), cell);
+  for (const Polygon& p : polygons) total += cells_in_box(sim::bounds(p), cell);
   if (total > static_cast<double>(limits.max_grid_items))
     throw Error(
         fmt::format(
@@ -280,12 +329,12 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
     if (in_grid[k]) cells_of_segment(segments_[k], cell, with_halo(static_cast<std::int32_t>(k)));
   segment_grid_ = StaticGrid(cell, std::move(pairs), memory);
   pairs.clear();
-  for (std::size_t k = 0; k < circles_.size(); ++k)
-    cells_of_circle(circles_[k], cell, with_halo(static_cast<std::int32_t>(k)));
+  for (std::size_t k = 0; k < circles.size(); ++k)
+    cells_of_circle(circles[k], cell, with_halo(static_cast<std::int32_t>(k)));
   circle_grid_ = StaticGrid(cell, std::move(pairs), memory);
   pairs.clear();
-  for (std::size_t k = 0; k < polygons_.size(); ++k) {
-    const Aabb b = sim::bounds(polygons_[k]);
+  for (std::size_t k = 0; k < polygons.size(); ++k) {
+    const Aabb b = sim::bounds(polygons[k]);
     for (std::int32_t y = cell_coord(b.min.y, cell); y <= cell_coord(b.max.y, cell); ++y)
       for (std::int32_t x = cell_coord(b.min.x, cell); x <= cell_coord(b.max.x, cell); ++x)
         pairs.push_back({cell_key(x, y), static_cast<std::int32_t>(k)});
@@ -297,7 +346,8 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
   d_polygons_ = Buffer<PolygonRef>(std::span<const PolygonRef>(polygon_refs_), memory);
   d_segments_ = Buffer<Segment>(std::span<const Segment>(segments_), memory);
   d_long_walls_ = Buffer<std::int32_t>(std::span<const std::int32_t>(long_walls_), memory);
-  d_circles_ = Buffer<Circle>(std::span<const Circle>(circles_), memory);
+  indexed_circles_ = std::move(circles);
+  d_circles_ = Buffer<Circle>(std::span<const Circle>(indexed_circles_), memory);
 }
 
 WorldView World::view() const {
@@ -314,7 +364,7 @@ WorldView World::host_view() const {
           Span<const RingRef>(rings_.data(), static_cast<Index>(rings_.size())),
           Span<const PolygonRef>(polygon_refs_.data(), static_cast<Index>(polygon_refs_.size())),
           Span<const Segment>(segments_.data(), static_cast<Index>(segments_.size())),
-          Span<const Circle>(circles_.data(), static_cast<Index>(circles_.size())),
+          Span<const Circle>(indexed_circles_.data(), static_cast<Index>(indexed_circles_.size())),
           segment_grid_.host_view(),
           Span<const std::int32_t>(long_walls_.data(), static_cast<Index>(long_walls_.size())),
           circle_grid_.host_view(),
@@ -326,10 +376,8 @@ bool World::in_free_space(glm::vec2 p) const { return sim::in_free_space(host_vi
 std::string World::what_blocks(glm::vec2 p) const {
   const WorldView v = host_view();
   if (v.has_walkable && !point_in_ring(p, walkable_.outer)) return "outside the walkable region world.walkable";
-  if (const std::int32_t k = polygon_containing(v, p); k >= 0)
-    return "inside obstacle " + polygon_fields_[static_cast<std::size_t>(k)];
-  if (const std::int32_t k = circle_containing(v, p); k >= 0)
-    return "inside obstacle " + circle_fields_[static_cast<std::size_t>(k)];
+  if (const std::int32_t k = polygon_containing(v, p); k >= 0) return "inside obstacle " + polygon_field(k);
+  if (const std::int32_t k = circle_containing(v, p); k >= 0) return "inside obstacle " + circle_field(k);
   return {};
 }
 

@@ -11,6 +11,13 @@
 //   polygons: every cell of a polygon's bounding box (point containment).
 // Because of the ring ("halo"), the one cell containing a point lists every
 // wall and circle within one cell side of it: one lookup instead of nine.
+//
+// A periodic world (WorldSpec::periodic_x, periodic_y) has a rectangular
+// walkable area. What the kernels index is then its copies one period away
+// on every wrapping side as well, inside a walkable rectangle three periods
+// long: the sides at the seams are no walls, and an agent near a seam sees
+// the walls and obstacles across it. The host's shapes (polygons(),
+// circles(), walkable()) stay the scenario's own.
 #pragma once
 
 #include <cstdint>
@@ -170,12 +177,20 @@ class World {
   // All obstacle polygons (spec polygons, walkable holes, scattered shapes).
   const std::vector<Polygon>& polygons() const { return polygons_; }
   const std::vector<Circle>& circles() const { return circles_; }
+  // Every wall the kernels see (with a periodic world's copies).
   const std::vector<Segment>& segments() const { return segments_; }
-  // Field path of obstacle polygon / circle k, for messages.
-  const std::string& polygon_field(std::int32_t k) const { return polygon_fields_[static_cast<std::size_t>(k)]; }
-  const std::string& circle_field(std::int32_t k) const { return circle_fields_[static_cast<std::size_t>(k)]; }
+  // Field path of obstacle polygon / circle k of the view (a copy across a
+  // periodic seam is named as its original), for messages.
+  const std::string& polygon_field(std::int32_t k) const {
+    return polygon_fields_[static_cast<std::size_t>(k) % polygon_fields_.size()];
+  }
+  const std::string& circle_field(std::int32_t k) const {
+    return circle_fields_[static_cast<std::size_t>(k) % circle_fields_.size()];
+  }
   // Bounding box of the walkable region, or of all obstacles when unbounded.
   Aabb bounds() const { return bounds_; }
+  // The periodic boundaries (periods 0 when there are none).
+  const Periodic& periodic() const { return periodic_; }
 
   // Host queries.
   bool in_free_space(glm::vec2 p) const;
@@ -188,6 +203,7 @@ class World {
 
  private:
   void index(const ScenarioLimits& limits, Memory memory);
+  void make_periodic(const WorldSpec& spec);
 
   float cell_size_ = 4.0f;
   bool has_walkable_ = false;
@@ -198,6 +214,7 @@ class World {
   std::vector<std::string> circle_fields_;
   std::vector<Segment> segments_;
   Aabb bounds_;
+  Periodic periodic_;
 
   // Flattened host arrays and their device copies.
   RingRef walkable_outer_;
@@ -210,6 +227,7 @@ class World {
   Buffer<Segment> d_segments_;
   std::vector<std::int32_t> long_walls_;
   Buffer<std::int32_t> d_long_walls_;
+  std::vector<Circle> indexed_circles_;  // circles_ and a periodic world's copies
   Buffer<Circle> d_circles_;
   StaticGrid segment_grid_, circle_grid_, polygon_grid_;
 };

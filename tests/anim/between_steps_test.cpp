@@ -124,6 +124,27 @@ TEST(InterpolateAgents, TurnsAcrossTheSeamTheShortWay) {
   EXPECT_NEAR(o.p[0].x, 0.5f, 1e-6f);
 }
 
+// Over a periodic area an agent that stepped across the seam (from x =
+// 19.9 to 0.1 of a 20 m period) walks on from 19.9 through 20 = 0: drawn
+// at 19.95 a quarter of the way, at 0.05 three quarters, never in between.
+TEST(InterpolateAgents, AStepAcrossAPeriodicSeamGoesTheShortWay) {
+  Case c;
+  c.p0 = {glm::vec2(19.9f, 1.0f)};
+  c.p1 = {glm::vec2(0.1f, 1.0f)};
+  c.h0 = {0.0f};
+  c.h1 = {0.0f};
+  Arrays a(c);
+  InterpolateAgentsJob job = a.job(0.25f);
+  job.periodic = Periodic{{0.0f, 0.0f}, {20.0f, 0.0f}};
+  job.run();
+  EXPECT_NEAR(a.out_p.to_vector()[0].x, 19.95f, 1e-4f);
+  EXPECT_NEAR(a.out_v.to_vector()[0].x, 0.2f / kStep, 1e-3f);
+  job.alpha = 0.75f;
+  job.run();
+  EXPECT_NEAR(a.out_p.to_vector()[0].x, 0.05f, 1e-4f);
+  EXPECT_NEAR(a.out_p.to_vector()[0].y, 1.0f, 1e-6f);
+}
+
 TEST(InterpolateAgents, SameOnOneTwoAndSevenThreads) {
   const Case c = random_case(20000, 9);
   const auto run = [&](int threads) {

@@ -260,6 +260,23 @@ TEST(FootLock, AStraightWalkIsBarelyCorrected) {
   }
 }
 
+// Across a periodic seam the simulation moves an agent back by the period
+// within one frame: its feet start again from no correction, instead of
+// the lock pulling them a whole corridor back (to its cap, 30 cm) and
+// stepping them over.
+TEST(FootLock, AJumpAcrossAPeriodicSeamStartsTheFeetAgain) {
+  const Drive run = drive(
+      [](float t) {
+        MapState s;
+        s.position = {1.3f * t - (t >= 2.0f ? 20.0f : 0.0f), 0.0f};
+        s.velocity = {1.3f, 0.0f};
+        return s;
+      },
+      4.0f, true);
+  EXPECT_LT(run.largest_correction, 0.05f);
+  EXPECT_EQ(run.steps, 0);
+}
+
 // Creeping in a jam, as the collision-free speed model's agents do: 0.1 to
 // 0.3 m/s, stop and go, the heading drifting 0.2 rad a step, at the
 // simulation's 10 frames a second. The clips' cadence stays and their

@@ -52,6 +52,23 @@ TEST(RoutesOutput, FieldRoutesFollowTheFieldRoundTheCorner) {
   }
 }
 
+// In a periodic corridor agents walk in a direction for ever: a route is
+// the way straight on to the corridor's end, not to the goal 100 km ahead.
+TEST(RoutesOutput, ADirectionsRouteEndsAtTheAreasEdge) {
+  const LoadedScenario ring = parse_scenario(
+      "name: ring\nplanning: none\nworld:\n  walkable: {rect: {min: [0, 0], max: [30, 4]}}\n  periodic: [x]\n"
+      "groups:\n  - count: 10\n    spawn: {rect: {min: [1, 1], max: [20, 3]}}\n    goal: {direction: [-1, 0]}\n",
+      "ring.yaml");
+  const std::unique_ptr<sim::Simulation> sim = build_simulation(ring);
+  for (const AgentRoute& r : sample_routes(*sim, 4)) {
+    ASSERT_EQ(r.points.size(), 2u);
+    EXPECT_EQ(r.points.front(), sim->positions()[static_cast<std::size_t>(r.agent)]);
+    EXPECT_FLOAT_EQ(r.points.back().x, 0.0f);
+    EXPECT_FLOAT_EQ(r.points.back().y, r.points.front().y);
+    EXPECT_NEAR(r.length_m, r.points.front().x, 1e-4);
+  }
+}
+
 TEST(RoutesOutput, SampledRoutesRunThroughFreeSpaceFromStartToGoal) {
   LoadedScenario maze = load_builtin_scenario("maze");
   sim::scale_agent_counts(maze.spec, 40);

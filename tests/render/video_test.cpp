@@ -317,20 +317,25 @@ TEST(ThrongRunCamera, FollowKeepsTheCrowdInTheMiddleOfTheFrame) {
 // drawn on the ground in kRouteColour. The maze under a fixed camera with
 // and without them: the frames differ, and nearly every differing pixel
 // turned towards the routes' colour.
+// The first frame of `throng run SCENARIO --render frames` (320 x 180, a
+// fixed camera, one simulated second) with `extra` options, in dir/name.
+Image first_run_frame(const std::string& dir, const std::string& name, const std::string& scenario,
+                      const std::string& extra) {
+  const std::string out_dir = dir + "/" + name;
+  std::string out;
+  const int code = run_throng("--backend cpu --threads 2 run " + scenario +
+                                  " --seconds 1 --render frames --width 320 --height 180 --fps 1 --camera fixed "
+                                  "--no-trajectories --quiet " +
+                                  extra + " --out '" + out_dir + "'",
+                              out);
+  EXPECT_EQ(code, 0) << out;
+  return read_png(out_dir + "/frame_00000.png");
+}
+
 TEST(ThrongRunRoutes, DrawsTheRoutesOfASampleOfAgents) {
   const std::string dir = temp_dir("routes");
-  const auto first_frame = [&](const std::string& routes) {
-    const std::string out_dir = dir + "/" + (routes.empty() ? "plain" : "routes");
-    std::string out;
-    const int code = run_throng(
-        "--backend cpu --threads 2 run maze --seconds 1 --render frames --width 320 "
-        "--height 180 --fps 1 --camera fixed --no-trajectories --quiet " +
-            routes + " --out '" + out_dir + "'",
-        out);
-    EXPECT_EQ(code, 0) << out;
-    return read_png(out_dir + "/frame_00000.png");
-  };
-  const Image plain = first_frame(""), routed = first_frame("--routes 12");
+  const Image plain = first_run_frame(dir, "plain", "maze", ""),
+              routed = first_run_frame(dir, "routes", "maze", "--routes 12");
   const testing::OverlayPixels o = testing::overlay_pixels(routed, plain, kRouteColour);
   std::printf("  %lld pixels differ, %lld of them towards the routes' colour\n", static_cast<long long>(o.differing),
               static_cast<long long>(o.towards));
@@ -339,6 +344,25 @@ TEST(ThrongRunRoutes, DrawsTheRoutesOfASampleOfAgents) {
   std::string out;
   EXPECT_NE(run_throng("run maze --routes 3 --seconds 1 --no-trajectories --quiet --out '" + dir + "/x'", out), 0);
   EXPECT_NE(out.find("--routes: needs --render"), std::string::npos) << out;
+  std::filesystem::remove_all(dir);
+}
+
+// `throng run --render frames --field-lines M`: the navigation fields'
+// lines of equal walking distance, M m apart, drawn on the ground in
+// kFieldColour. The crossing (planning: field) with and without them.
+TEST(ThrongRunRoutes, DrawsTheFieldsLinesOfEqualDistance) {
+  const std::string dir = temp_dir("field_lines");
+  const Image plain = first_run_frame(dir, "plain", "crossing --agents 40", ""),
+              lined = first_run_frame(dir, "lines", "crossing --agents 40", "--field-lines 5");
+  const testing::OverlayPixels o = testing::overlay_pixels(lined, plain, kFieldColour);
+  std::printf("  %lld pixels differ, %lld of them towards the field lines' colour\n",
+              static_cast<long long>(o.differing), static_cast<long long>(o.towards));
+  EXPECT_GT(o.towards, 100);
+  EXPECT_GT(o.towards, o.differing * 9 / 10);
+  std::string out;
+  EXPECT_NE(run_throng("run crossing --field-lines 0 --render frames --seconds 1 --quiet --out '" + dir + "/x'", out),
+            0);
+  EXPECT_NE(out.find("--field-lines"), std::string::npos) << out;
   std::filesystem::remove_all(dir);
 }
 

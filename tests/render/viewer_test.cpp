@@ -234,27 +234,42 @@ TEST(Viewer, BadOptionsAreErrors) {
 // --routes K: the routes of K agents drawn on the ground of the scene, as
 // `throng run --render --routes` draws them: the maze's screenshot with and
 // without them differs, every differing pixel nearer the routes' colour.
-TEST(Viewer, HeadlessDrawsTheRoutesOfASampleOfAgents) {
-  const auto dir = std::filesystem::temp_directory_path() / "throng_viewer_routes";
+// The overlay that `extra` asks for, in a headless screenshot of
+// `scenario` (320 x 180, fixed camera, first frame) against the same
+// screenshot without it: over 100 pixels differ and nine in ten of them
+// turned towards `colour`.
+void expect_overlay_in_screenshot(const std::string& name, const std::string& scenario, const std::string& extra,
+                                  glm::vec4 colour) {
+  const auto dir = std::filesystem::temp_directory_path() / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  const std::string view =
-      std::string(THRONG_EXE) + " --threads 2 view maze --headless --frames 1 --width 320 --height 180 --camera fixed ";
+  const std::string view = std::string(THRONG_EXE) + " --threads 2 view " + scenario +
+                           " --headless --frames 1 --width 320 --height 180 --camera fixed ";
   std::string out;
   ASSERT_EQ(run(view + "--screenshot " + (dir / "plain.png").string(), out), 0) << out;
-  ASSERT_EQ(run(view + "--routes 12 --screenshot " + (dir / "routes.png").string(), out), 0) << out;
-  const Image plain = read_png((dir / "plain.png").string()), routed = read_png((dir / "routes.png").string());
-  ASSERT_EQ(plain.width, routed.width);
-  const testing::OverlayPixels o = testing::overlay_pixels(routed, plain, kRouteColour);
+  ASSERT_EQ(run(view + extra + " --screenshot " + (dir / "overlay.png").string(), out), 0) << out;
+  const Image plain = read_png((dir / "plain.png").string()), with = read_png((dir / "overlay.png").string());
+  ASSERT_EQ(plain.width, with.width);
+  const testing::OverlayPixels o = testing::overlay_pixels(with, plain, colour);
   EXPECT_GT(o.towards, 100) << o.differing;
   EXPECT_GT(o.towards, o.differing * 9 / 10);
-  out.clear();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Viewer, HeadlessDrawsTheRoutesOfASampleOfAgents) {
+  expect_overlay_in_screenshot("throng_viewer_routes", "maze", "--routes 12", kRouteColour);
+  std::string out;
   EXPECT_NE(run(std::string(THRONG_EXE) + " view formation --headless --frames 1 --routes 3 --screenshot " +
-                    (dir / "x.png").string(),
+                    (std::filesystem::temp_directory_path() / "throng_viewer_no_routes.png").string(),
                 out),
             0);
   EXPECT_NE(out.find("--routes is for scenarios"), std::string::npos) << out;
-  std::filesystem::remove_all(dir);
+}
+
+// --field-lines M: the navigation fields' lines of equal walking distance,
+// as `throng run --render --field-lines` draws them (the crossing's fields).
+TEST(Viewer, HeadlessDrawsTheFieldsLinesOfEqualDistance) {
+  expect_overlay_in_screenshot("throng_viewer_field_lines", "crossing --agents 40", "--field-lines 5", kFieldColour);
 }
 
 }  // namespace

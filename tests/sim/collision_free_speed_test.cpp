@@ -142,7 +142,7 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
         }
     const std::vector<std::uint8_t> f(p.size(), kAgentActive);
     const NeighbourArrays n{Span<const glm::vec2>(p), Span<const glm::vec2>(v), Span<const float>(r),
-                            Span<const std::uint8_t>(f)};
+                            Span<const std::uint8_t>(f), Periodic{}};
     const float v0 = 1.3f, dt = 0.1f;
     const float hold = r[0] + ModelParams::kCfsMaxRadius + v0 * m.cfs.time_gap + m.max_speed * l.anticipation;
     Index near = 0;

@@ -143,3 +143,49 @@ TEST(NavigationField, SameBitsOnAnyThreadCount) {
 
 }  // namespace
 }  // namespace throng::sim
+
+namespace throng::sim {
+namespace {
+
+// The lines of equal distance of a field that is the straight distance to
+// a point (closed form) are circles round it: every segment's ends lie on
+// a circle of a radius the spacing divides, and each circle's segments add
+// up to its circumference; no line crosses the blocked nodes.
+TEST(FieldContours, ThePointFieldsLinesAreCirclesRoundTheTarget) {
+  FieldData f;
+  f.grid.origin = {-10.0f, -10.0f};
+  f.grid.cell = 0.25f;
+  f.grid.nx = f.grid.ny = 81;
+  f.grid.target = {0.5f, -0.25f};
+  for (std::int32_t j = 0; j < f.grid.ny; ++j)
+    for (std::int32_t i = 0; i < f.grid.nx; ++i) {
+      const glm::vec2 p = f.grid.origin + f.grid.cell * glm::vec2(static_cast<float>(i), static_cast<float>(j));
+      // A blocked square (a pillar) at x 4-6, y 4-6.
+      const bool blocked = p.x >= 4.0f && p.x <= 6.0f && p.y >= 4.0f && p.y <= 6.0f;
+      f.distance.push_back(blocked ? INFINITY : length_of(p - f.grid.target));
+    }
+  NavigationFields fields;
+  fields.add(f);
+  fields.upload();
+  const std::vector<std::vector<glm::vec2>> lines = field_contours(fields.host_view(), 0, 2.0f);
+  double circumference[4] = {0, 0, 0, 0};  // radii 2, 4, 6, 8 (2 and 4 clear of the pillar, 5.5 m away)
+  for (const std::vector<glm::vec2>& s : lines) {
+    ASSERT_EQ(s.size(), 2u);
+    const float r0 = length_of(s[0] - f.grid.target), r1 = length_of(s[1] - f.grid.target);
+    const float level = 2.0f * std::round(r0 / 2.0f);
+    EXPECT_NEAR(r0, level, 0.01f);
+    EXPECT_NEAR(r1, level, 0.01f);
+    for (const glm::vec2 q : s)
+      EXPECT_FALSE(q.x > 4.0f && q.x < 6.0f && q.y > 4.0f && q.y < 6.0f) << q.x << ", " << q.y;
+    const int k = static_cast<int>(level / 2.0f) - 1;
+    if (k >= 0 && k < 4) circumference[k] += length_of(s[1] - s[0]);
+  }
+  for (int k = 0; k < 2; ++k)
+    EXPECT_NEAR(circumference[k], 2.0 * 3.14159265 * 2.0 * (k + 1), 0.01 * 2.0 * (k + 1) * 6.3);
+  EXPECT_THROW(field_contours(fields.host_view(), 0, 0.0f), Error);
+  EXPECT_THROW(field_contours(fields.host_view(), 0, NAN), Error);
+  EXPECT_EQ(field_contours(fields.host_view(), 0, 2.0f, 10).size(), 10u);  // capped
+}
+
+}  // namespace
+}  // namespace throng::sim

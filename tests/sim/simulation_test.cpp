@@ -367,19 +367,7 @@ TEST(Bins, SummingModelsStepMatchesTheAllPairsReference) {
       reference.neighbours = NeighbourSearch::AllPairs;
       Simulation binned(spec), all_pairs(spec, reference);
       binned.run(100);  // into the jam, then one step of each from the same state
-      CrowdState& to = all_pairs.crowd();
-      const CrowdState& from = binned.crowd();
-      auto copy = [](auto& dst, const auto& src) {
-        const auto host = src.to_vector();
-        dst.copy_from(host);
-      };
-      copy(to.position, from.position);
-      copy(to.velocity, from.velocity);
-      copy(to.heading, from.heading);
-      copy(to.flags, from.flags);
-      copy(to.goal, from.goal);
-      copy(to.path_start, from.path_start);
-      copy(to.waypoint_cursor, from.waypoint_cursor);
+      test::copy_step_state(all_pairs.crowd(), binned.crowd());
       binned.step();
       all_pairs.step();
       const auto a = binned.velocities(), b = all_pairs.velocities();

@@ -88,6 +88,20 @@ inline CrowdHost spawn(const ScenarioSpec& spec) {
   return spawn_crowd(spec, World::build(spec.world, spec.model.query_radius()));
 }
 
+// Copies the state one step reads (positions, velocities, headings, flags,
+// legs) from one simulation's crowd to another's of the same spec: both then
+// step from the same state.
+inline void copy_step_state(CrowdState& to, const CrowdState& from) {
+  auto copy = [](auto& dst, const auto& src) { dst.copy_from(src.to_vector()); };
+  copy(to.position, from.position);
+  copy(to.velocity, from.velocity);
+  copy(to.heading, from.heading);
+  copy(to.flags, from.flags);
+  copy(to.goal, from.goal);
+  copy(to.path_start, from.path_start);
+  copy(to.waypoint_cursor, from.waypoint_cursor);
+}
+
 // The message of the Error spawning `spec` throws, or "no error".
 inline std::string spawn_error(const ScenarioSpec& spec) {
   try {
