@@ -39,9 +39,9 @@ struct Periodic {
     if (!(L > 0.0f) || !(x == x)) return x;
     float u = x - o;
     u -= L * floorf(u / L);
-    // Rounding can leave u == L for x a hair below o.
-    if (!(u < L)) u = 0.0f;
-    return o + u;
+    // Rounding can leave u == L for x a hair below o, or o + u == o + L.
+    const float w = o + u;
+    return u < L && w < o + L ? w : o;
   }
 };
 

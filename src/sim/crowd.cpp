@@ -88,12 +88,30 @@ void check_region(const Region& r, const std::string& field, float max_extent) {
 }
 
 // Agents already placed, for overlap tests across groups. The cell must be
-// at least the largest r + rq + gap asked about.
+// at least the largest r + rq + gap asked about. Over a periodic area the
+// agents across the seam count too (at their copies one period away).
 class Occupancy {
  public:
-  explicit Occupancy(float cell) : cell_(cell) {}
+  explicit Occupancy(float cell, const Periodic& periodic = {}) : cell_(cell), periodic_(periodic) {}
   // The id of an agent closer than r + rq + gap to p, or -1.
   std::int64_t find(glm::vec2 p, float r, float gap) const {
+    const glm::vec2 L = periodic_.period;
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) {
+        if ((i != 0 && L.x == 0.0f) || (j != 0 && L.y == 0.0f)) continue;
+        const std::int64_t id =
+            find_near(p + glm::vec2(static_cast<float>(i) * L.x, static_cast<float>(j) * L.y), r, gap);
+        if (id >= 0) return id;
+      }
+    return -1;
+  }
+  bool overlaps(glm::vec2 p, float r, float gap) const { return find(p, r, gap) >= 0; }
+  void add(glm::vec2 p, float r, std::int64_t id) {
+    cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r, id});
+  }
+
+ private:
+  std::int64_t find_near(glm::vec2 p, float r, float gap) const {
     const std::int32_t cx = cell_coord(p.x, cell_), cy = cell_coord(p.y, cell_);
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
@@ -104,18 +122,13 @@ class Occupancy {
       }
     return -1;
   }
-  bool overlaps(glm::vec2 p, float r, float gap) const { return find(p, r, gap) >= 0; }
-  void add(glm::vec2 p, float r, std::int64_t id) {
-    cells_[cell_key(cell_coord(p.x, cell_), cell_coord(p.y, cell_))].push_back({p, r, id});
-  }
-
- private:
   struct Entry {
     glm::vec2 p;
     float r;
     std::int64_t id;
   };
   float cell_;
+  Periodic periodic_;
   std::unordered_map<std::uint64_t, std::vector<Entry>> cells_;
 };
 
@@ -343,6 +356,11 @@ void check_group(const ScenarioSpec& spec, const GroupSpec& G, const std::string
   if (periodic && G.goal.kind != GoalSpec::Kind::Direction)
     throw Error("in a periodic world agents walk in a direction: give goal: {direction: [x, y]}",
                 at_field(field + ".goal"));
+  const glm::vec2 d = G.goal.value;
+  if (periodic &&
+      (spec.world.periodic_x ? std::fabs(d.x) : 0.0f) + (spec.world.periodic_y ? std::fabs(d.y) : 0.0f) < 1e-3f)
+    throw Error("the direction runs along no periodic axis: the agents would walk into the wall",
+                at_field(field + ".goal.direction"));
   if (periodic && !G.waypoints.empty())
     throw Error("in a periodic world agents walk in a direction, without waypoints", at_field(field + ".waypoints"));
   if (G.goal.wait_s > 0)
@@ -476,7 +494,7 @@ std::vector<glm::vec2> place_on_ring(const Placement& at) {
 std::vector<glm::vec2> place_at_points(const Placement& at) {
   const GroupSpec& G = at.G;
   const float r = at.r;
-  Occupancy own(std::max(2.0f * r * 1.2f, 0.1f));
+  Occupancy own(std::max(2.0f * r * 1.2f, 0.1f), at.world.periodic());
   std::vector<glm::vec2> chosen;
   for (std::size_t k = 0; k < G.spawn.points.size(); ++k) {
     const glm::vec2 p = G.spawn.points[k];
@@ -531,11 +549,17 @@ std::vector<glm::vec2> lattice_candidates(const Placement& at, std::uint64_t see
     // on the same lattice has its sites exactly d from ours, which
     // rounding must not reject.
     std::int64_t visited = 0;
+    // Sites of the lattice are d apart but for those across a periodic
+    // seam: of two too close there, the first is kept.
+    const bool periodic = at.world.periodic().wraps();
+    Occupancy across(static_cast<float>(d) * 1.01f, at.world.periodic());
     const std::int64_t sites = hex_sites(b, a, (a - d) * 0.5, rng, [&](glm::vec2 p) {
       if ((++visited & 4095) == 0) setup_checkpoint("placing agents");
       if (region_contains(G.spawn, p) && at.world.disc_fits(p, at.wall_clearance) &&
-          !at.placed.overlaps(p, at.r, 0.99f * at.gap))
+          !at.placed.overlaps(p, at.r, 0.99f * at.gap) && !(periodic && across.overlaps(p, at.r, 0.99f * at.gap))) {
         candidates.push_back(p);
+        if (periodic) across.add(p, at.r, 0);
+      }
     });
     if (static_cast<std::int64_t>(candidates.size()) >= G.count || a <= d) break;
     // Free area as seen by this lattice; at least a 20 % denser lattice next.
@@ -865,7 +889,7 @@ CrowdHost spawn_crowd(const ScenarioSpec& spec, const World& world, const Scenar
   const std::unique_ptr<Reachability> reach = make_reachability(spec, world, limits);
   CrowdHost out;
   out.position.reserve(static_cast<std::size_t>(spec.total_agents()));
-  Occupancy placed(std::max(2.0f * max_radius * 1.2f, 0.1f));
+  Occupancy placed(std::max(2.0f * max_radius * 1.2f, 0.1f), world.periodic());
   for (std::size_t g = 0; g < spec.groups.size(); ++g) {
     check_interrupt("placing agents");
     const GroupSpec& G = spec.groups[g];

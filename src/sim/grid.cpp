@@ -84,7 +84,7 @@ std::int32_t cells_per_period(float period, float side, const char* axis) {
 }  // namespace
 
 AgentGrid::AgentGrid(float cell_size, const Periodic& periodic)
-    : cell_size_(cell_size), cell_size_y_(cell_size), periodic_(periodic) {
+    : asked_(cell_size), cell_size_(cell_size), cell_size_y_(cell_size), periodic_(periodic) {
   if (periodic.period.x > 0.0f) {
     wrap_x_ = cells_per_period(periodic.period.x, cell_size, "x");
     cell_size_ = periodic.period.x / static_cast<float>(wrap_x_);

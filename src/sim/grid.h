@@ -201,7 +201,7 @@ class StaticGrid {
 class AgentGrid {
  public:
   AgentGrid() = default;
-  explicit AgentGrid(float cell_size) : cell_size_(cell_size), cell_size_y_(cell_size) {}
+  explicit AgentGrid(float cell_size) : asked_(cell_size), cell_size_(cell_size), cell_size_y_(cell_size) {}
   // Over a periodic area: cells at least cell_size wide, tiling each
   // wrapping period in an even number of them (at least four: throws
   // Error when the period is shorter than four cell sides).
@@ -210,7 +210,9 @@ class AgentGrid {
   // Spans in current_memory().
   void rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags);
   GridView view() const;
-  float cell_size() const { return cell_size_; }
+  // The side asked for; the view's cells are at least as wide (wider along
+  // a periodic axis, to tile its period).
+  float cell_size() const { return asked_; }
   const Periodic& periodic() const { return periodic_; }
   Index binned_agents() const { return binned_; }
   Index occupied_cells() const;  // counts on the host (for tests and stats)
@@ -218,7 +220,7 @@ class AgentGrid {
   std::size_t bytes() const;
 
  private:
-  float cell_size_ = 1.0f, cell_size_y_ = 1.0f;
+  float asked_ = 1.0f, cell_size_ = 1.0f, cell_size_y_ = 1.0f;
   Periodic periodic_;
   std::int32_t wrap_x_ = 0, wrap_y_ = 0;
   std::uint64_t mask_ = 0;

@@ -186,7 +186,8 @@ double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> fla
 
 // How many agents stand at each local density: density of an agent = agents
 // in its square cell of side `cell` / cell^2; bins of `bin_width` agents/m^2,
-// the last one open-ended.
+// the last one open-ended. Over a periodic area (at least four cells along
+// each wrapping axis) the cells tile the period, the one by the seam whole.
 inline constexpr int kDensityBins = 16;
 struct DensityHistogram {
   float cell = 2.0f;
@@ -194,7 +195,7 @@ struct DensityHistogram {
   std::array<std::int64_t, kDensityBins> agents{};
 };
 DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, float cell = 2.0f,
-                                   float bin_width = 0.5f);
+                                   float bin_width = 0.5f, const Periodic& periodic = {});
 
 // Stuck agents. An agent is stuck when, for more than `threshold_s` of
 // simulated time in a row, it is active, still steering (not kAgentStopped),
@@ -250,7 +251,6 @@ class StuckTracker {
  private:
   StuckOptions options_;
   AgentGrid bins_;
-  float bins_reach_ = 0.0f;     // the reach bins_ was made for
   Buffer<std::int32_t> rest_;   // steps in a row at rest with the way free
   Buffer<std::uint8_t> state_;  // kStuck* bits (metrics_stuck.cpp)
   StuckStats stats_;

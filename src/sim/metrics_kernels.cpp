@@ -221,17 +221,19 @@ double mean_speed(Span<const glm::vec2> velocities, Span<const std::uint8_t> fla
 }
 
 DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, float cell,
-                                   float bin_width) {
-  AgentGrid grid(cell);
+                                   float bin_width, const Periodic& periodic) {
+  const bool tiles = (periodic.period.x == 0.0f || periodic.period.x >= 4.0f * cell) &&
+                     (periodic.period.y == 0.0f || periodic.period.y >= 4.0f * cell);
+  AgentGrid grid(cell, tiles ? periodic : Periodic{});
   grid.rebuild(positions, flags);
   const GridView g = grid.view();
-  const float inv_area = 1.0f / (cell * cell);
+  const float inv_area = 1.0f / (g.cell_size * g.cell_size_y);
   const Histogram h = parallel_reduce(
       "sim.metrics.density", positions.size(), Histogram{},
       THRONG_LAMBDA(Index i)->Histogram {
         Histogram one{};
         if ((flags[i] & kAgentActive) == 0) return one;
-        const Index s = g.find(cell_coord(positions[i].x, cell), cell_coord(positions[i].y, cell));
+        const Index s = g.find(g.cell_x(positions[i].x), g.cell_y(positions[i].y));
         const float density = static_cast<float>(g.count[s]) * inv_area;
         int b = static_cast<int>(density / bin_width);
         b = b < kDensityBins - 1 ? b : kDensityBins - 1;

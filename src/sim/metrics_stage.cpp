@@ -102,7 +102,9 @@ void CrowdMetricsStage::after_step(const Simulation& sim, const FrameInfo& frame
     s.areas.push_back({measure_area(c.position.span(), c.velocity.span(), c.goal.span(), c.flags.span(), a.rect),
                        measure_area_voronoi(position, velocity, goal, flags, a.rect,
                                             options_.measurement.voronoi_cutoff, sim.world().periodic())});
-  const DensityHistogram h = density_histogram(c.position.span(), c.flags.span());
+  const DensityHistogram defaults;
+  const DensityHistogram h =
+      density_histogram(c.position.span(), c.flags.span(), defaults.cell, defaults.bin_width, sim.world().periodic());
   density_.cell = h.cell;
   density_.bin_width = h.bin_width;
   for (int b = 0; b < kDensityBins; ++b)

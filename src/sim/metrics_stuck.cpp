@@ -77,10 +77,8 @@ void StuckTracker::update(const World& world, Span<const glm::vec2> positions, S
     rest_ = grown(rest_, n);
     state_ = grown(state_, n);
   }
-  if (bins_reach_ != reach || bins_.periodic().period != world.periodic().period) {
+  if (bins_.cell_size() != reach || bins_.periodic().period != world.periodic().period)
     bins_ = AgentGrid(reach, world.periodic());
-    bins_reach_ = reach;
-  }
   bins_.rebuild(positions, flags);
   const AtRestInFreeSpace at_rest{bins_.view(),
                                   world.view(),

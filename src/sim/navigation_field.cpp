@@ -168,10 +168,13 @@ glm::vec2 level_point(glm::vec2 a, glm::vec2 b, float va, float vb, float d) {
 
 std::vector<std::vector<glm::vec2>> field_contours(const FieldsView& f, std::int32_t k, float spacing,
                                                    std::size_t max_segments) {
-  if (!(spacing > 0.0f) || !std::isfinite(spacing))
-    throw Error(fmt::format("the spacing of a field's lines must be a positive number of metres (got {})", spacing));
-  std::vector<std::vector<glm::vec2>> out;
   const FieldGrid& g = f.grids[k];
+  // (At least a hundredth of a cell: finer lines would be a smear, and the
+  // levels of a cell stay few.)
+  if (!(spacing >= 0.01f * g.cell) || !std::isfinite(spacing))
+    throw Error(fmt::format("the spacing of a field's lines must be a number of metres of at least {:.3g} (got {})",
+                            0.01f * g.cell, spacing));
+  std::vector<std::vector<glm::vec2>> out;
   const float* d = f.distance.data() + g.offset;
   auto node = [&](std::int32_t i, std::int32_t j) {
     return g.origin + glm::vec2(static_cast<float>(i) * g.cell, static_cast<float>(j) * g.cell);
@@ -185,7 +188,9 @@ std::vector<std::vector<glm::vec2>> field_contours(const FieldsView& f, std::int
       const glm::vec2 p[4] = {node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)};
       if (!(v[0] < INFINITY && v[1] < INFINITY && v[2] < INFINITY && v[3] < INFINITY)) continue;  // by a wall
       const float lo = std::min({v[0], v[1], v[2], v[3]}), hi = std::max({v[0], v[1], v[2], v[3]});
-      for (float level = std::ceil(lo / spacing) * spacing; level < hi; level += spacing) {
+      for (auto m = static_cast<std::int64_t>(std::ceil(lo / spacing));; ++m) {
+        const float level = static_cast<float>(m) * spacing;
+        if (!(level < hi)) break;
         if (level <= lo) continue;  // a corner on the level: the neighbouring cell draws it
         glm::vec2 cross[4];
         int n = 0;

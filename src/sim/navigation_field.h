@@ -165,7 +165,8 @@ std::vector<glm::vec2> trace_field(const FieldsView& f, std::int32_t k, glm::vec
 // The lines of equal walking distance of field k, every `spacing` m (or s
 // for a weighed field), as segments across the grid's cells (marching
 // squares, the distance linear along each cell edge; cells with a blocked
-// node are left out), at most max_segments of them. For drawing the field.
+// node are left out), at most max_segments of them; spacing at least a
+// hundredth of the grid's cell (else an Error). For drawing the field.
 std::vector<std::vector<glm::vec2>> field_contours(const FieldsView& f, std::int32_t k, float spacing,
                                                    std::size_t max_segments = 1'000'000);
 

@@ -176,10 +176,10 @@ struct ExitSpec {
 // reconsider_s seconds).
 enum class ExitChoice : std::uint8_t { Nearest, Quickest };
 
-// How far ahead of an agent a direction goal lies (m): beyond any walk a
-// run can take at walking speed (a day at 1.2 m/s), close enough for
-// float precision (a few mm there).
-inline constexpr float kDirectionReach = 1.0e5f;
+// How far ahead of an agent a direction goal lies (m): the goal moves with
+// the agent, so this only needs to be far beyond any arrival radius, and
+// near enough that float rounding keeps it where it is (0.06 mm there).
+inline constexpr float kDirectionReach = 1.0e3f;
 
 // One waypoint of a group: the same for every agent, or per agent.
 struct GoalSpec {
@@ -192,7 +192,7 @@ struct GoalSpec {
     Gate,    // the line from value to gate_to, passed when crossed anywhere along it (waypoints only)
     // Walk on in the unit direction `value`, never arriving (a group's goal
     // in a periodic world only): the goal lies kDirectionReach ahead of
-    // where the agent spawned and moves with it across the seam.
+    // the agent and moves with it, step by step and across the seam.
     Direction,
   };
   Kind kind = Kind::Point;

@@ -436,12 +436,13 @@ struct Finalize {
     glm::vec2 v = clamp_length((p - from) * (1.0f / ctx.dt), ctx.model.max_speed);
     if ((flags & kAgentStopped) != 0) v = glm::vec2(0.0f);
     if (ctx.periodic.wraps()) {
-      // Back into the area across the seam, the route with it (a periodic
-      // area's agents head in a direction: their goal lies far ahead).
-      const glm::vec2 shift = ctx.periodic.wrap(p) - p;
-      p += shift;
-      a.path_start[i] += shift;
-      a.goal[i] += shift;
+      // Back into the area across the seam. A periodic area's agents head
+      // in a direction, a goal far ahead: it moves with them, step by step
+      // and across the seam, so they never reach it and their way stays
+      // parallel to the direction however they are pushed aside.
+      p = ctx.periodic.wrap(p);
+      a.path_start[i] = p + (a.path_start[i] - from);
+      a.goal[i] = p + (a.goal[i] - from);
     }
     a.position[i] = p;
     if (length2(v) > 0.05f * 0.05f && (flags & kAgentWaiting) == 0) a.heading[i] = atan2f(v.y, v.x);

@@ -220,10 +220,10 @@ void World::make_periodic(const WorldSpec& spec) {
     const glm::vec2 a = r[k], b = r[(k + 1) % 4];
     rectangle = (a.x == b.x) != (a.y == b.y);  // every side along an axis
   }
-  if (!rectangle)
+  const glm::vec2 size = bounds_.size();
+  if (!rectangle || !(size.x > 0.0f && size.y > 0.0f))
     throw Error("periodic boundaries need a rectangular walkable area: world.walkable: {rect: {min, max}}",
                 at_field("world.periodic"));
-  const glm::vec2 size = bounds_.size();
   periodic_.origin = bounds_.min;
   periodic_.period = glm::vec2(spec.periodic_x ? size.x : 0.0f, spec.periodic_y ? size.y : 0.0f);
 }
@@ -371,7 +371,11 @@ WorldView World::host_view() const {
           polygon_grid_.host_view()};
 }
 
-bool World::in_free_space(glm::vec2 p) const { return sim::in_free_space(host_view(), p); }
+// (A periodic world's kernels see a walkable area three periods long; the
+// host's queries, for spawning and validation, keep to the area itself.)
+bool World::in_free_space(glm::vec2 p) const {
+  return (!periodic_.wraps() || point_in_ring(p, walkable_.outer)) && sim::in_free_space(host_view(), p);
+}
 
 std::string World::what_blocks(glm::vec2 p) const {
   const WorldView v = host_view();
@@ -381,7 +385,9 @@ std::string World::what_blocks(glm::vec2 p) const {
   return {};
 }
 
-bool World::disc_fits(glm::vec2 p, float r) const { return disc_is_clear(host_view(), p, r, 0.0f); }
+bool World::disc_fits(glm::vec2 p, float r) const {
+  return (!periodic_.wraps() || point_in_ring(p, walkable_.outer)) && disc_is_clear(host_view(), p, r, 0.0f);
+}
 
 // ---- Reachability -------------------------------------------------------------
 

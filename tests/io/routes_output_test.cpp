@@ -53,7 +53,7 @@ TEST(RoutesOutput, FieldRoutesFollowTheFieldRoundTheCorner) {
 }
 
 // In a periodic corridor agents walk in a direction for ever: a route is
-// the way straight on to the corridor's end, not to the goal 100 km ahead.
+// the way straight on to the corridor's end, not to the goal 1 km ahead.
 TEST(RoutesOutput, ADirectionsRouteEndsAtTheAreasEdge) {
   const LoadedScenario ring = parse_scenario(
       "name: ring\nplanning: none\nworld:\n  walkable: {rect: {min: [0, 0], max: [30, 4]}}\n  periodic: [x]\n"

@@ -184,6 +184,7 @@ TEST(FieldContours, ThePointFieldsLinesAreCirclesRoundTheTarget) {
     EXPECT_NEAR(circumference[k], 2.0 * 3.14159265 * 2.0 * (k + 1), 0.01 * 2.0 * (k + 1) * 6.3);
   EXPECT_THROW(field_contours(fields.host_view(), 0, 0.0f), Error);
   EXPECT_THROW(field_contours(fields.host_view(), 0, NAN), Error);
+  EXPECT_THROW(field_contours(fields.host_view(), 0, 1e-4f), Error);       // under a hundredth of a cell
   EXPECT_EQ(field_contours(fields.host_view(), 0, 2.0f, 10).size(), 10u);  // capped
 }
 

@@ -73,10 +73,17 @@ TEST(Periodic, NearestImageAndWrapFollowTheClosedForm) {
   EXPECT_FLOAT_EQ(p.wrap({-15.5f, 9.0f}).x, 4.5f);
   EXPECT_FLOAT_EQ(p.wrap({-5.0f, 9.0f}).x, -5.0f);
   EXPECT_FLOAT_EQ(p.wrap({-5.0f, 9.0f}).y, 9.0f);
-  // A hair below the origin must land inside [origin, origin + period).
+  // A hair below the origin must land inside [origin, origin + period),
+  // also where origin + (period - a hair) rounds to origin + period.
   const float x = p.wrap({std::nextafter(-5.0f, -6.0f), 0.0f}).x;
   EXPECT_GE(x, -5.0f);
   EXPECT_LT(x, 5.0f);
+  for (const glm::vec2 o : {glm::vec2(60.0f, 10.0f), glm::vec2(100.0f, 30.0f), glm::vec2(3.0f, 2.0f)}) {
+    const Periodic q{{o.x, 0.0f}, {o.y, 0.0f}};
+    const float w = q.wrap({std::nextafter(o.x, 0.0f), 0.0f}).x;
+    EXPECT_GE(w, o.x) << o.x;
+    EXPECT_LT(w, o.x + o.y) << o.x;
+  }
 }
 
 TEST(Periodic, BinsTileThePeriodInAnEvenNumberOfCellsAndWrap) {
@@ -90,6 +97,7 @@ TEST(Periodic, BinsTileThePeriodInAnEvenNumberOfCellsAndWrap) {
   const GridView g = bins.view();
   EXPECT_EQ(g.wrap_x, 6);
   EXPECT_FLOAT_EQ(g.cell_size, 10.0f / 6.0f);
+  EXPECT_FLOAT_EQ(bins.cell_size(), 1.3f);  // the side asked for, which metrics pass on
   EXPECT_EQ(g.cell_x(1.1f), 0);
   EXPECT_EQ(g.cell_x(10.9f), 5);
   // The 3x3 around the first cell reaches the last one across the seam, not the middle.
@@ -110,7 +118,9 @@ TEST(Periodic, APairMeetingAcrossTheSeamMovesAsInTheMiddle) {
     SCOPED_TRACE(static_cast<int>(model));
     auto run = [&](float x0) {
       ScenarioSpec s = ring_corridor(model);
-      s.groups = {walkers({{x0 - 1.5f, 2.0f}}, {1.0f, 0.0f}), walkers({{x0 + 1.5f, 2.1f}}, {-1.0f, 0.0f})};
+      const Periodic ring{{0.0f, 0.0f}, {kLength, 0.0f}};
+      s.groups = {walkers({ring.wrap({x0 - 1.5f, 2.0f})}, {1.0f, 0.0f}),
+                  walkers({ring.wrap({x0 + 1.5f, 2.1f})}, {-1.0f, 0.0f})};
       Simulation sim(s);
       std::vector<std::vector<glm::vec2>> track;
       for (int k = 0; k < 60; ++k) {
@@ -285,6 +295,29 @@ TEST(Periodic, CounterflowInARingCorridorFormsLanes) {
   EXPECT_GT(speed, 0.6);
 }
 
+// Spawning sees across the seam: a crowd filling the whole period starts
+// with no two bodies overlapping there. A direction's goal moves with its
+// agent: after a minute it is still 100 km ahead, straight along the
+// direction, wherever the crowd pushed the agent.
+TEST(Periodic, SpawningAndGoalsRespectTheSeam) {
+  ScenarioSpec s = ring_corridor(ModelKind::CollisionFreeSpeed);
+  GroupSpec g = filling(2.5);
+  g.spawn.min.x = 0.0f;
+  g.spawn.max.x = kLength;
+  s.groups = {g};
+  Simulation sim(s);
+  const CrowdState& c = sim.crowd();
+  const OverlapStats start =
+      measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f, sim.world().periodic());
+  EXPECT_EQ(start.touching, 0) << "deepest " << start.max_depth;
+  sim.run(1200);
+  const std::vector<glm::vec2> p = sim.positions(), goal = sim.crowd().goal.to_vector();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_NEAR(goal[i].x - p[i].x, kDirectionReach, 0.01f) << i;
+    EXPECT_NEAR(goal[i].y - p[i].y, 0.0f, 1e-3f) << i;
+  }
+}
+
 TEST(Periodic, MetricsSeeAcrossTheSeam) {
   const Periodic p{{0.0f, 0.0f}, {kLength, 0.0f}};
   // Two discs of 0.2 m whose centres are 0.3 m apart across the seam.
@@ -348,6 +381,15 @@ TEST(Periodic, ScenarioErrorsNameTheField) {
   ScenarioSpec open = s;
   open.world.periodic_x = false;
   EXPECT_NE(test::spawn_error(open).find("goal.direction"), std::string::npos) << test::spawn_error(open);
+  // Spawning outside the rectangle (where the kernels see the copies).
+  ScenarioSpec outside = s;
+  outside.groups = {walkers({{kLength + 2.0f, 2.0f}}, {1.0f, 0.0f})};
+  EXPECT_NE(test::spawn_error(outside).find("walkable"), std::string::npos) << test::spawn_error(outside);
+  // A direction that runs along no periodic axis.
+  ScenarioSpec across = s;
+  across.groups[0].goal.value = {0.0f, 1.0f};
+  EXPECT_NE(test::spawn_error(across).find("runs along no periodic axis"), std::string::npos)
+      << test::spawn_error(across);
   // A period under four neighbour cells.
   ScenarioSpec short_ring = s;
   short_ring.world.walkable.outer = {{0, 0}, {3, 0}, {3, 4}, {0, 4}};
