@@ -22,6 +22,16 @@ struct Periodic {
   THRONG_HOST_DEVICE glm::vec2 near(glm::vec2 q, glm::vec2 p) const {
     return {near_axis(q.x, p.x, period.x), near_axis(q.y, p.y, period.y)};
   }
+  // Calls fn(shift) with the shift to each copy of the area that touches
+  // it, the area itself (0, 0) among them: 1, 3 or 9 shifts, rows of y,
+  // each from -period to +period. (Host code: spawning, indexing, metrics.)
+  template <class Fn>
+  void for_each_shift(Fn&& fn) const {
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i)
+        if ((i == 0 || period.x > 0.0f) && (j == 0 || period.y > 0.0f))
+          fn(glm::vec2(static_cast<float>(i) * period.x, static_cast<float>(j) * period.y));
+  }
   // p moved by whole periods into [origin, origin + period).
   THRONG_HOST_DEVICE glm::vec2 wrap(glm::vec2 p) const {
     return {wrap_axis(p.x, origin.x, period.x), wrap_axis(p.y, origin.y, period.y)};

@@ -95,15 +95,11 @@ class Occupancy {
   explicit Occupancy(float cell, const Periodic& periodic = {}) : cell_(cell), periodic_(periodic) {}
   // The id of an agent closer than r + rq + gap to p, or -1.
   std::int64_t find(glm::vec2 p, float r, float gap) const {
-    const glm::vec2 L = periodic_.period;
-    for (int j = -1; j <= 1; ++j)
-      for (int i = -1; i <= 1; ++i) {
-        if ((i != 0 && L.x == 0.0f) || (j != 0 && L.y == 0.0f)) continue;
-        const std::int64_t id =
-            find_near(p + glm::vec2(static_cast<float>(i) * L.x, static_cast<float>(j) * L.y), r, gap);
-        if (id >= 0) return id;
-      }
-    return -1;
+    std::int64_t id = -1;
+    periodic_.for_each_shift([&](glm::vec2 shift) {
+      if (id < 0) id = find_near(p + shift, r, gap);
+    });
+    return id;
   }
   bool overlaps(glm::vec2 p, float r, float gap) const { return find(p, r, gap) >= 0; }
   void add(glm::vec2 p, float r, std::int64_t id) {

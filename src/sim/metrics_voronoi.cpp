@@ -161,18 +161,14 @@ VoronoiSample measure_area_voronoi(std::span<const glm::vec2> positions, std::sp
     // a cell by the seam is cut by the neighbours across it.
     std::vector<glm::vec2> p, v, g;
     std::vector<std::uint8_t> f;
-    const glm::vec2 L = periodic.period;
-    for (int j = -1; j <= 1; ++j)
-      for (int i = -1; i <= 1; ++i) {
-        if ((i != 0 && L.x == 0.0f) || (j != 0 && L.y == 0.0f)) continue;
-        const glm::vec2 shift(static_cast<float>(i) * L.x, static_cast<float>(j) * L.y);
-        for (std::size_t k = 0; k < positions.size(); ++k) {
-          p.push_back(positions[k] + shift);
-          v.push_back(velocities[k]);
-          g.push_back(goals[k] + shift);
-          f.push_back(flags[k]);
-        }
+    periodic.for_each_shift([&](glm::vec2 shift) {
+      for (std::size_t k = 0; k < positions.size(); ++k) {
+        p.push_back(positions[k] + shift);
+        v.push_back(velocities[k]);
+        g.push_back(goals[k] + shift);
+        f.push_back(flags[k]);
       }
+    });
     return measure_area_voronoi(p, v, g, f, area, cutoff);
   }
   VoronoiSample s;

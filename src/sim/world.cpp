@@ -241,19 +241,17 @@ void add_periodic_copies(const Periodic& periodic, Polygon& walkable, std::vecto
   grown.max += L;
   walkable.outer = {grown.min, {grown.max.x, grown.min.y}, grown.max, {grown.min.x, grown.max.y}};
   const std::size_t np = polygons.size(), nc = circles.size();
-  for (int j = -1; j <= 1; ++j)
-    for (int i = -1; i <= 1; ++i) {
-      const glm::vec2 shift(static_cast<float>(i) * L.x, static_cast<float>(j) * L.y);
-      if ((i != 0 && L.x == 0.0f) || (j != 0 && L.y == 0.0f) || (i == 0 && j == 0)) continue;
-      for (std::size_t k = 0; k < np; ++k) {
-        Polygon p = polygons[k];
-        for (glm::vec2& v : p.outer) v += shift;
-        for (Ring& h : p.holes)
-          for (glm::vec2& v : h) v += shift;
-        polygons.push_back(std::move(p));
-      }
-      for (std::size_t k = 0; k < nc; ++k) circles.push_back({circles[k].center + shift, circles[k].radius});
+  periodic.for_each_shift([&](glm::vec2 shift) {
+    if (shift == glm::vec2(0.0f)) return;  // the shapes themselves
+    for (std::size_t k = 0; k < np; ++k) {
+      Polygon p = polygons[k];
+      for (glm::vec2& v : p.outer) v += shift;
+      for (Ring& h : p.holes)
+        for (glm::vec2& v : h) v += shift;
+      polygons.push_back(std::move(p));
     }
+    for (std::size_t k = 0; k < nc; ++k) circles.push_back({circles[k].center + shift, circles[k].radius});
+  });
 }
 }  // namespace
 
@@ -264,10 +262,18 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
     rings_.push_back({static_cast<std::int32_t>(vertices_.size()), static_cast<std::int32_t>(r.size())});
     vertices_.insert(vertices_.end(), r.begin(), r.end());
   };
-  Polygon walkable = walkable_;
-  std::vector<Polygon> polygons = polygons_;
-  std::vector<Circle> circles = circles_;
-  if (periodic_.wraps()) add_periodic_copies(periodic_, walkable, polygons, circles);
+  // A periodic world indexes its shapes and their copies; any other its shapes.
+  Polygon grown;
+  std::vector<Polygon> copies;
+  if (periodic_.wraps()) {
+    grown = walkable_;
+    copies = polygons_;
+    indexed_circles_ = circles_;
+    add_periodic_copies(periodic_, grown, copies, indexed_circles_);
+  }
+  const Polygon& walkable = periodic_.wraps() ? grown : walkable_;
+  const std::vector<Polygon>& polygons = periodic_.wraps() ? copies : polygons_;
+  const std::vector<Circle>& circles = indexed_circles();
   if (has_walkable_) {
     walkable_outer_ = {static_cast<std::int32_t>(vertices_.size()), static_cast<std::int32_t>(walkable.outer.size())};
     vertices_.insert(vertices_.end(), walkable.outer.begin(), walkable.outer.end());
@@ -346,8 +352,7 @@ void World::index(const ScenarioLimits& limits, Memory memory) {
   d_polygons_ = Buffer<PolygonRef>(std::span<const PolygonRef>(polygon_refs_), memory);
   d_segments_ = Buffer<Segment>(std::span<const Segment>(segments_), memory);
   d_long_walls_ = Buffer<std::int32_t>(std::span<const std::int32_t>(long_walls_), memory);
-  indexed_circles_ = std::move(circles);
-  d_circles_ = Buffer<Circle>(std::span<const Circle>(indexed_circles_), memory);
+  d_circles_ = Buffer<Circle>(std::span<const Circle>(circles), memory);
 }
 
 WorldView World::view() const {
@@ -364,7 +369,7 @@ WorldView World::host_view() const {
           Span<const RingRef>(rings_.data(), static_cast<Index>(rings_.size())),
           Span<const PolygonRef>(polygon_refs_.data(), static_cast<Index>(polygon_refs_.size())),
           Span<const Segment>(segments_.data(), static_cast<Index>(segments_.size())),
-          Span<const Circle>(indexed_circles_.data(), static_cast<Index>(indexed_circles_.size())),
+          Span<const Circle>(indexed_circles().data(), static_cast<Index>(indexed_circles().size())),
           segment_grid_.host_view(),
           Span<const std::int32_t>(long_walls_.data(), static_cast<Index>(long_walls_.size())),
           circle_grid_.host_view(),

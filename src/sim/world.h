@@ -204,6 +204,8 @@ class World {
  private:
   void index(const ScenarioLimits& limits, Memory memory);
   void make_periodic(const WorldSpec& spec);
+  // The circles the kernels index.
+  const std::vector<Circle>& indexed_circles() const { return periodic_.wraps() ? indexed_circles_ : circles_; }
 
   float cell_size_ = 4.0f;
   bool has_walkable_ = false;
@@ -227,7 +229,7 @@ class World {
   Buffer<Segment> d_segments_;
   std::vector<std::int32_t> long_walls_;
   Buffer<std::int32_t> d_long_walls_;
-  std::vector<Circle> indexed_circles_;  // circles_ and a periodic world's copies
+  std::vector<Circle> indexed_circles_;  // a periodic world's circles_ and their copies (empty elsewhere)
   Buffer<Circle> d_circles_;
   StaticGrid segment_grid_, circle_grid_, polygon_grid_;
 };
