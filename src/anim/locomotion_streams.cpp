@@ -33,7 +33,6 @@ void LocomotionStreamsConfig::validate() const {
     throw Error("must be positive square pixels", field("exact_coverage"));
   if (!(stop_after_seconds >= 0.0f && stop_after_seconds <= 1e6f))
     throw Error("must be in [0, 1e6] s", field("stop_after_seconds"));
-  if ((cluster_mask & 0xffu) == 0u) throw Error("must select at least one of the 8 clusters", field("cluster_mask"));
 }
 
 LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D> space, Index agents,
@@ -41,7 +40,7 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
     : space_(std::move(space)),
       config_(config),
       count_(agents),
-      crowd_(StreamCrowdConfig{config.frame_rate, config.seed}) {
+      crowd_(StreamCrowdConfig{config.frame_rate, config.seed, config.footstep_events}) {
   if (!space_) throw Error("needs a blend space", at_field("locomotion_streams.space"));
   config_.validate();
   if (agents < 0 || agents > (Index{1} << 31))
@@ -99,15 +98,10 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
   source_ = Buffer<std::int32_t>(count_, m);
   offset_ = Buffer<std::int32_t>(count_, m);
   exact_rank_ = Buffer<std::int32_t>(count_, m);
-  palettes_ = Buffer<Mat3x4>(crowd_.palette_size(), m);
+  refs_ = Buffer<PaletteRef>(count_, m);
   inverse_bind_ = Buffer<Mat3x4>(std::span<const Mat3x4>(crowd_.rig(rig).inverse_bind), m);
   bind_positions_ = Buffer<glm::vec3>(std::span<const glm::vec3>(crowd_.rig(rig).bind_positions), m);
-  if (config_.exact_near_camera) {
-    parts_ = make_body_parts(space_->skeleton());
-    lod_tables_.emplace(make_lod_config(*parts_, {config_.exact_coverage}), m);
-    levels_ = Buffer<std::uint8_t>(count_ * kBodyPartCount, m);
-    masks_ = Buffer<std::uint32_t>(count_ * lod_tables_->mask_words, m);
-  }
+  if (config_.exact_near_camera) part_spheres_ = make_body_parts(space_->skeleton()).rest_spheres;
 }
 
 void LocomotionStreams::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities,
@@ -151,14 +145,15 @@ const LocomotionStreamsStats& LocomotionStreams::animate(const Camera* camera) {
     key_phase_.copy_from(std::span<const float>(phases));
   }
   select(1.0f / config_.frame_rate);
-  stats_.retargeted = crowd_.retarget(source_.span(), offset_.span(), config_.blend_seconds, config_.cluster_mask);
-  crowd_.resolve(position_.span(), yaw_.span(), palettes_.span(), {}, exact_.span());
+  stats_.retargeted = crowd_.retarget(source_.span(), offset_.span(), config_.blend_seconds);
   synthesise_exact();
+  make_refs();
   record_tracks();
 
   const StreamMemory memory = crowd_.memory();
   stats_.pose_bytes = memory.stream_poses;
-  stats_.palette_bytes = memory.palettes;
+  stats_.palette_bytes = static_cast<std::size_t>(stats_.exact) * static_cast<std::size_t>(joints_) * sizeof(Mat3x4);
+  stats_.ref_bytes = static_cast<std::size_t>(count_) * sizeof(PaletteRef);
   stats_.agent_state_bytes =
       memory.agent_state + static_cast<std::size_t>(count_) * (sizeof(glm::vec3) + 3 * sizeof(float) +
                                                                sizeof(std::uint8_t) + 4 * sizeof(std::int32_t));
@@ -192,23 +187,39 @@ void LocomotionStreams::manage_streams(const std::vector<Index>& counts) {
 }
 
 std::vector<Index> LocomotionStreams::classify(const Camera* camera) {
-  const bool lod = config_.exact_near_camera && camera != nullptr && count_ > 0;
-  if (lod) {
-    make_lod_job(*camera, *lod_tables_, *parts_, {position_.span(), yaw_.span(), {}}, levels_.span(), masks_.span())
-        .run();
-  }
   StreamBucketJob buckets;
   buckets.blend = quantised_view(tables_.view(), config_.bucket_width, buckets_);
   buckets.bucket_width = config_.bucket_width;
   buckets.bucket_count = buckets_;
   buckets.speeds = speed_.span();
-  if (lod) buckets.levels = levels_.span();
+  buckets.near_camera = config_.exact_near_camera && camera != nullptr;
+  if (buckets.near_camera) {
+    buckets.camera = make_camera_view(*camera);
+    buckets.exact_coverage = config_.exact_coverage;
+    buckets.part_spheres = part_spheres_;
+    buckets.body_sphere = body_sphere(part_spheres_);
+    buckets.positions = position_.span();
+    buckets.yaws = yaw_.span();
+  }
   buckets.exact = exact_.span();
   buckets.exact_flags = exact_rank_.span();
   buckets.keys = key_.span();
   buckets.run();
-  stats_.exact = lod ? count_nonzero(exact_.span()) : 0;
+  stats_.exact = buckets.near_camera ? count_nonzero(exact_.span()) : 0;
   return histogram(key_.span(), keys_);
+}
+
+glm::vec4 body_sphere(const std::array<glm::vec4, kBodyPartCount>& parts) {
+  float low = parts[0].y - parts[0].w, high = parts[0].y + parts[0].w;
+  for (const glm::vec4& p : parts) {
+    low = std::min(low, p.y - p.w);
+    high = std::max(high, p.y + p.w);
+  }
+  const float y = 0.5f * (low + high);
+  float radius = 0.0f;
+  for (const glm::vec4& p : parts)
+    radius = std::max(radius, glm::length(glm::vec3(p) - glm::vec3(0.0f, y, 0.0f)) + p.w);
+  return glm::vec4(0.0f, y, 0.0f, radius);
 }
 
 void LocomotionStreams::select(float dt) {
@@ -224,8 +235,6 @@ void LocomotionStreams::select(float dt) {
   job.streams = crowd_.streams().views();
   job.clusters = crowd_.cluster_refs();
   job.cluster_stride = crowd_.cluster_stride();
-  for (std::int32_t c = kMaxClusters - 1; c >= 0; --c)
-    if (((config_.cluster_mask >> c) & 1u) != 0u && c < crowd_.cluster_stride()) job.cluster = c;
   job.phases = phase_.span();
   job.sources = source_.span();
   job.offsets = offset_.span();
@@ -246,6 +255,7 @@ void LocomotionStreams::synthesise_exact() {
     exact_speed_ = Buffer<float>(cap, m);
     joint_position_ = Buffer<glm::vec3>(cap * joints_, m);
     joint_rotation_ = Buffer<glm::quat>(cap * joints_, m);
+    exact_palettes_ = Buffer<Mat3x4>(cap * joints_, m);
   }
   const ExactGatherJob gather{.exact = exact_.span(),
                               .ranks = exact_rank_.span(),
@@ -273,10 +283,27 @@ void LocomotionStreams::synthesise_exact() {
   palettes.joint_positions = pose.joint_positions;
   palettes.joint_rotations = pose.joint_rotations;
   palettes.inverse_bind = inverse_bind_.span();
-  palettes.agents = exact_agents_.span().subspan(0, n);
-  palettes.palette_offsets = crowd_.palette_offsets();
-  palettes.palettes = palettes_.span();
+  palettes.palettes = exact_palettes_.span();  // densely, in the order of the exact agents
   palettes.run();
+}
+
+void LocomotionStreams::make_refs() {
+  const StreamRefsJob refs{.streams = crowd_.streams().views(),
+                           .clusters = crowd_.cluster_refs(),
+                           .cluster_stride = crowd_.cluster_stride(),
+                           .frame = crowd_.frame(),
+                           .joint_count = joints_,
+                           .exact = exact_.span(),
+                           .exact_ranks = exact_rank_.span(),
+                           .exact_palettes = exact_palettes_.span(),
+                           .refs = refs_.span()};
+  refs.run();
+}
+
+Span<const Mat3x4> LocomotionStreams::palettes() const {
+  if (palettes_.size() != count_ * joints_) palettes_ = Buffer<Mat3x4>(count_ * joints_, current_memory());
+  PaletteComposeJob{joints_, refs_.span(), position_.span(), yaw_.span(), {}, palettes_.span()}.run();
+  return palettes_.span();
 }
 
 void LocomotionStreams::track(std::vector<Index> agents) { skating_.track(std::move(agents), count_, joints_); }
@@ -285,14 +312,18 @@ void LocomotionStreams::record_tracks() {
   if (skating_.tracked().empty()) return;
   const auto J = static_cast<std::size_t>(joints_);
   const Rig& r = rig();
-  std::vector<Mat3x4> palette(J);
+  const auto tracked = static_cast<Index>(skating_.tracked().size());
+  const Memory memory = current_memory();
+  const Buffer<Index> agents(std::span<const Index>(skating_.tracked()), memory);
+  Buffer<Mat3x4> composed(tracked * joints_, memory);
+  PaletteComposeJob{joints_, refs_.span(), position_.span(), yaw_.span(), agents.span(), composed.span()}.run();
+  const std::vector<Mat3x4> palettes = composed.to_vector();
   for (std::size_t t = 0; t < skating_.tracked().size(); ++t) {
-    palettes_.read(skating_.tracked()[t] * joints_, std::span<Mat3x4>(palette));
     const motion::FootSkatingRecorder::Frame f = skating_.append(t);
     for (std::size_t j = 0; j < J; ++j) {
       // The palette maps the bind pose to the world; the bind rotations are
       // identity, so its linear part is the joint's world rotation.
-      const Mat3x4& m = palette[j];
+      const Mat3x4& m = palettes[t * J + j];
       f.positions[j] = transform_point(m, r.bind_positions[j]);
       const glm::mat3 rotation(glm::vec3(m.r0.x, m.r1.x, m.r2.x), glm::vec3(m.r0.y, m.r1.y, m.r2.y),
                                glm::vec3(m.r0.z, m.r1.z, m.r2.z));

@@ -19,15 +19,18 @@
 //   each frame:
 //     loco.drive_from_map(sim_positions, sim_velocities, sim_headings);   // device spans, map coordinates
 //     const LocomotionStreamsStats& stats = loco.animate(&camera);        // one animation frame
-//     renderer: loco.palettes() (palette_offsets(), rig().mesh: docs/streams.md "Pose data for the renderer")
+//     renderer: loco.palette_refs(), positions(), yaws() (render::poses_of)
 //
 // Per frame, all on the device but a few host decisions about streams:
 // anim.from_map, anim.lod, anim.loco_streams_keys (exact or which bucket),
 // a histogram of buckets in use (streams start, history filled, when first
 // needed and stop when unused), the streams' step, anim.loco_streams_select
 // (each agent's phase and desired stream and offset), anim.stream_retarget
-// (transitions), anim.stream_resolve (palettes of streamed agents), then for
-// the exact agents a compaction, anim.pose and anim.joint_palette.
+// (transitions), for the exact agents a compaction, anim.pose and
+// anim.joint_palette, then anim.loco_streams_refs: per agent a PaletteRef
+// (anim/palette_ref.h) to its stream's slot or its own palette. No palette
+// is written per streamed agent: the renderer composes the visible ones
+// (render::poses_of), and palettes() composes all of them on request.
 //
 // The error this sharing costs (sharing_error) and the foot skating of
 // agents (track, foot_skating) are measured by the same object;
@@ -36,6 +39,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <array>
 #include <optional>
 #include <span>
 #include <vector>
@@ -43,6 +47,7 @@
 #include "anim/blend_controller.h"
 #include "anim/crowd_animator.h"
 #include "anim/lod.h"
+#include "anim/palette_ref.h"
 #include "anim/stream_crowd.h"
 #include "core/buffer.h"
 #include "core/camera.h"
@@ -71,22 +76,37 @@ struct JointPaletteJob {
   void run() const;
 };
 
-// Per agent: exact synthesis (some body part at LOD level 0) or the speed
-// bucket whose stream it reads. ("anim.loco_streams_keys")
+// Per agent: exact synthesis (near the camera) or the speed bucket whose
+// stream it reads ("anim.loco_streams_keys"). Near means some body part's
+// sphere covers at least exact_coverage square pixels, as LodJob measures
+// it (level 0 under that threshold). A sphere round the whole body is
+// tried first: a part inside it covers no more than it does, so an agent
+// far from the camera costs one projection instead of five.
 struct StreamBucketJob {
   motion::BlendSpaceView blend;  // quantised to the buckets (BlendSpaceView::quantum)
   float bucket_width = 0.05f;
   std::int32_t bucket_count = 20;
-  Span<const float> speeds;         // per agent, m/s
-  Span<const std::uint8_t> levels;  // agents * kBodyPartCount (LodJob), or empty: nobody is exact
-  Span<std::uint8_t> exact;         // out: 1 = synthesised
-  Span<std::int32_t> exact_flags;   // out: the same as 0/1 integers (to scan)
-  Span<std::int32_t> keys;          // out: cache_key of the bucket, -1 for exact agents
+  Span<const float> speeds;  // per agent, m/s
+  // The exact decision; near_camera false: nobody is exact.
+  bool near_camera = false;
+  CameraView camera;
+  float exact_coverage = 1000.0f;
+  std::array<glm::vec4, kBodyPartCount> part_spheres{};  // BodyParts::rest_spheres
+  glm::vec4 body_sphere{0.0f};                           // holds every part sphere; centre on the +Y axis
+  Span<const glm::vec3> positions;                       // per agent, world (near_camera only)
+  Span<const float> yaws;
+  Span<std::uint8_t> exact;        // out: 1 = synthesised
+  Span<std::int32_t> exact_flags;  // out: the same as 0/1 integers (to scan)
+  Span<std::int32_t> keys;         // out: cache_key of the bucket, -1 for exact agents
 
   Index agent_count() const { return speeds.size(); }
   void validate() const;
   void run() const;
 };
+
+// The sphere round a character's part spheres, centred above its ground
+// point (so that it does not turn with the character).
+glm::vec4 body_sphere(const std::array<glm::vec4, kBodyPartCount>& parts);
 
 // Per agent: the gait phase it shows this frame and the stream and offset
 // it should read ("anim.loco_streams_select"). An exact agent advances at
@@ -105,9 +125,8 @@ struct StreamSelectJob {
   Span<const float> key_phases;  // per key: phase of its stream's newest slot
   Span<const float> key_frames;  // per key: frames per cycle
   Span<const SourceView> streams;
-  Span<const ClusterRef> clusters;  // the crowd's: which stream each agent reads now
+  Span<const ClusterRef> clusters;  // the crowd's: which stream each agent reads now (cluster 0 for all)
   std::int32_t cluster_stride = 1;
-  std::int32_t cluster = 0;    // the cluster whose source is compared
   Span<float> phases;          // in/out
   Span<std::int32_t> sources;  // out
   Span<std::int32_t> offsets;  // out
@@ -131,6 +150,28 @@ struct ExactGatherJob {
   void run() const;
 };
 
+// Per agent, the palette reference the renderer composes (anim/palette_ref.h;
+// "anim.loco_streams_refs"): a streamed agent's slot of its stream and,
+// while a transition runs, the slot it leaves with the transition's alpha;
+// an exact agent's own world palette at exact_palettes[rank * joint_count].
+// Every cluster of a locomotion agent reads the same slot, so cluster 0
+// stands for all.
+struct StreamRefsJob {
+  Span<const SourceView> streams;
+  Span<const ClusterRef> clusters;
+  std::int32_t cluster_stride = 1;
+  std::int32_t frame = 0;  // the crowd's last stepped frame (transition alphas)
+  std::int32_t joint_count = 0;
+  Span<const std::uint8_t> exact;
+  Span<const std::int32_t> exact_ranks;  // exclusive scan of the exact flags
+  Span<const Mat3x4> exact_palettes;     // world space, the exact agents densely
+  Span<PaletteRef> refs;                 // out, per agent
+
+  Index agent_count() const { return refs.size(); }
+  void validate() const;
+  void run() const;
+};
+
 struct LocomotionStreamsConfig {
   float frame_rate = 30.0f;     // animation frames per second: one animate() call is one frame
   float bucket_width = 0.05f;   // of w per segment (MotionCacheConfig::bucket_width's rule)
@@ -140,10 +181,10 @@ struct LocomotionStreamsConfig {
   // this much (LOD level 0 under the default thresholds, docs/lod.md) is
   // synthesised exactly.
   float exact_coverage = 1000.0f;
-  float stop_after_seconds = 2.0f;   // a stream no agent targets for this long stops
-  std::uint32_t cluster_mask = ~0u;  // the clusters that follow locomotion (all by default)
-  std::uint64_t seed = 1;            // initial gait phases
-  void validate() const;             // Error naming "locomotion_streams.<field>"
+  float stop_after_seconds = 2.0f;  // a stream no agent targets for this long stops
+  std::uint64_t seed = 1;           // initial gait phases
+  bool footstep_events = false;     // footsteps delivered to agents (crowd().agent_events(): a pass over the crowd)
+  void validate() const;            // Error naming "locomotion_streams.<field>"
 };
 
 struct LocomotionStreamsStats {
@@ -158,7 +199,8 @@ struct LocomotionStreamsStats {
   std::size_t pose_bytes = 0;         // every stream's history (StreamMemory::stream_poses)
   std::size_t exact_bytes = 0;        // the exact path's per-agent joint buffers this frame
   std::size_t agent_state_bytes = 0;  // cluster refs, rigs, events, palette offsets, phases, speeds, flags
-  std::size_t palette_bytes = 0;
+  std::size_t palette_bytes = 0;      // the exact agents' own palettes
+  std::size_t ref_bytes = 0;          // the agents' palette references
 };
 
 // Joint position error of streamed agents against exact synthesis (the same
@@ -200,10 +242,13 @@ class LocomotionStreams {
   const LocomotionStreamsStats& last_frame() const { return stats_; }
 
   // ---- outputs (current_memory())
-  Span<const Mat3x4> palettes() const { return palettes_.span(); }
-  Span<const Index> palette_offsets() const { return crowd_.palette_offsets(); }  // agent * joint_count()
-  Span<const std::uint8_t> exact() const { return exact_.span(); }                // per agent: 1 = synthesised
-  Span<const float> phases() const { return phase_.span(); }                      // the gait phase each agent shows
+  // Per agent, how its palette is made (valid until the next animate()).
+  Span<const PaletteRef> palette_refs() const { return refs_.span(); }
+  // Every agent's palette, [agent * joint_count() + j], composed from the
+  // references now (a pass over the whole crowd: for tests and measurements).
+  Span<const Mat3x4> palettes() const;
+  Span<const std::uint8_t> exact() const { return exact_.span(); }  // per agent: 1 = synthesised
+  Span<const float> phases() const { return phase_.span(); }        // the gait phase each agent shows
   Span<const float> speeds() const { return speed_.span(); }
   Span<const glm::vec3> positions() const { return position_.span(); }
   Span<const float> yaws() const { return yaw_.span(); }
@@ -226,6 +271,7 @@ class LocomotionStreams {
   std::vector<Index> classify(const Camera* camera);  // agents per bucket
   void select(float dt);
   void synthesise_exact();
+  void make_refs();
   void manage_streams(const std::vector<Index>& counts);
   void record_tracks();
 
@@ -248,18 +294,17 @@ class LocomotionStreams {
   Buffer<float> yaw_, speed_, phase_;
   Buffer<std::uint8_t> exact_;
   Buffer<std::int32_t> key_, source_, offset_;
-  Buffer<Mat3x4> palettes_;
-  // LOD (the exact decision).
-  std::optional<BodyParts> parts_;
-  std::optional<LodTables> lod_tables_;
-  Buffer<std::uint8_t> levels_;
-  Buffer<std::uint32_t> masks_;
+  Buffer<PaletteRef> refs_;
+  mutable Buffer<Mat3x4> palettes_;  // palettes(), allocated on first use
+  // The exact decision.
+  std::array<glm::vec4, kBodyPartCount> part_spheres_{};
   // The exact path, sized to the exact agents of the frame.
   Buffer<Mat3x4> inverse_bind_;
   Buffer<glm::vec3> bind_positions_;
   Buffer<std::int32_t> exact_rank_;
   Buffer<Index> exact_agents_;
   Buffer<glm::vec3> exact_position_, joint_position_;
+  Buffer<Mat3x4> exact_palettes_;
   Buffer<float> exact_yaw_, exact_phase_, exact_speed_;
   Buffer<glm::quat> joint_rotation_;
   LocomotionStreamsStats stats_;

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "anim/locomotion_streams.h"
+#include "anim/sphere_projection.h"
 #include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -49,21 +50,47 @@ void JointPaletteJob::run() const {
 
 void StreamBucketJob::validate() const {
   const Index n = agent_count();
-  if (!levels.empty()) check_length("StreamBucketJob", "levels", levels.size(), n * kBodyPartCount);
+  if (near_camera) {
+    check_length("StreamBucketJob", "positions", positions.size(), n);
+    check_length("StreamBucketJob", "yaws", yaws.size(), n);
+    if (!(camera.focal_px > 0.0f && camera.width >= 1.0f && camera.height >= 1.0f))
+      throw Error("focal length and viewport must be positive", at_field("StreamBucketJob.camera"));
+  }
   check_length("StreamBucketJob", "exact", exact.size(), n);
   check_length("StreamBucketJob", "exact_flags", exact_flags.size(), n);
   check_length("StreamBucketJob", "keys", keys.size(), n);
   if (bucket_count < 1) throw Error("must be positive", at_field("StreamBucketJob.bucket_count"));
 }
 
+namespace {
+
+// Whether some part sphere of the agent (rest spheres turned by its yaw
+// about +Y and moved to its ground point, as LodJob places them) covers
+// at least `least` square pixels; the body sphere first.
+THRONG_HOST_DEVICE inline bool near_camera_at(const StreamBucketJob& job, Index a) {
+  const glm::vec3 p = job.positions[a];
+  const glm::vec3 body = p + glm::vec3(job.body_sphere);
+  if (sphere_pixel_coverage(to_camera_space(job.camera, body), job.body_sphere.w, job.camera, true) <
+      job.exact_coverage)
+    return false;
+  const float c = glm::cos(job.yaws[a]), s = glm::sin(job.yaws[a]);
+  for (int k = 0; k < kBodyPartCount; ++k) {
+    const glm::vec4 t = job.part_spheres[static_cast<std::size_t>(k)];
+    const glm::vec3 centre = p + glm::vec3(c * t.x + s * t.z, t.y, -s * t.x + c * t.z);
+    if (sphere_pixel_coverage(to_camera_space(job.camera, centre), t.w, job.camera, true) >= job.exact_coverage)
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 void StreamBucketJob::run() const {
   validate();
   parallel_for(
       "anim.loco_streams_keys", agent_count(),
       THRONG_JOB_LAMBDA(Index a) {
-        bool near = false;
-        if (!levels.empty())
-          for (int p = 0; p < kBodyPartCount; ++p) near = near || levels[a * kBodyPartCount + p] == 0;
+        const bool near = near_camera && near_camera_at(*this, a);
         exact[a] = near ? 1 : 0;
         exact_flags[a] = near ? 1 : 0;
         keys[a] = near ? -1
@@ -83,8 +110,6 @@ void StreamSelectJob::validate() const {
   check_length("StreamSelectJob", "phases", phases.size(), n);
   check_length("StreamSelectJob", "sources", sources.size(), n);
   check_length("StreamSelectJob", "offsets", offsets.size(), n);
-  if (cluster < 0 || cluster >= cluster_stride)
-    throw Error("must be below the cluster stride", at_field("StreamSelectJob.cluster"));
 }
 
 void StreamSelectJob::run() const {
@@ -104,7 +129,7 @@ void StreamSelectJob::run() const {
         }
         const float F = key_frames[k];
         std::int32_t o = 0;
-        const ClusterRef& ref = clusters[a * cluster_stride + cluster];
+        const ClusterRef& ref = clusters[a * cluster_stride];
         if (ref.source == k) {
           o = ref.offset;  // same bucket: keep the offset, play at the stream's cadence
         } else {
@@ -161,6 +186,76 @@ void ExactGatherJob::run() const {
       1024);
 }
 
+namespace {
+
+// The model-space palette a stream's slot holds for an offset; null for the
+// rest pose (kNoSource), a unique instance or a stream of another rig.
+THRONG_HOST_DEVICE inline const Mat3x4* slot_palette(Span<const SourceView> streams, std::int32_t source,
+                                                     std::int32_t offset, std::int32_t joints) {
+  if (source < 0 || source >= streams.size()) return nullptr;
+  const SourceView& s = streams[source];
+  if (s.skinning == nullptr || s.joints != joints) return nullptr;
+  return s.skinning + static_cast<Index>(history_slot(s, offset)) * joints;
+}
+
+}  // namespace
+
+void StreamRefsJob::validate() const {
+  const Index n = agent_count();
+  if (joint_count <= 0) throw Error("must be positive", at_field("StreamRefsJob.joint_count"));
+  check_length("StreamRefsJob", "clusters", clusters.size(), n * cluster_stride);
+  check_length("StreamRefsJob", "exact", exact.size(), n);
+  check_length("StreamRefsJob", "exact_ranks", exact_ranks.size(), n);
+}
+
+void StreamRefsJob::run() const {
+  validate();
+  const Index exact_count = exact_palettes.size() / joint_count;
+  parallel_for(
+      "anim.loco_streams_refs", agent_count(),
+      THRONG_JOB_LAMBDA(Index a) {
+        PaletteRef r;
+        if (exact[a] != 0) {
+          const Index rank = exact_ranks[a];
+          if (rank >= 0 && rank < exact_count) {
+            r.pose = exact_palettes.data() + rank * joint_count;
+            r.world = 1u;
+          }
+          refs[a] = r;
+          return;
+        }
+        const ClusterRef& c = clusters[a * cluster_stride];
+        r.pose = slot_palette(streams, c.source, c.offset, joint_count);
+        r.alpha = transition_alpha(c, frame);
+        if (r.alpha < 1.0f) r.from = slot_palette(streams, c.from_source, c.from_offset, joint_count);
+        refs[a] = r;
+      },
+      1024);
+}
+
+void PaletteComposeJob::validate() const {
+  if (joint_count <= 0) throw Error("must be positive", at_field("PaletteComposeJob.joint_count"));
+  const Index n = refs.size();
+  check_length("PaletteComposeJob", "positions", positions.size(), n);
+  check_length("PaletteComposeJob", "yaws", yaws.size(), n);
+  check_length("PaletteComposeJob", "palettes", palettes.size(), count() * joint_count);
+}
+
+void PaletteComposeJob::run() const {
+  validate();
+  const Index n = refs.size();
+  parallel_for(
+      "anim.compose_palettes", count(),
+      THRONG_JOB_LAMBDA(Index k) {
+        const Index a = agents.empty() ? k : agents[k];
+        if (a < 0 || a >= n) return;
+        const PaletteRef r = refs[a];
+        const Mat3x4 root = root_transform(positions[a], yaws[a]);
+        for (std::int32_t j = 0; j < joint_count; ++j) palettes[k * joint_count + j] = compose_palette(r, root, j);
+      },
+      64);
+}
+
 // ---- the error of sharing ----------------------------------------------------------------------
 
 SharingError LocomotionStreams::sharing_error() const {
@@ -175,7 +270,7 @@ SharingError LocomotionStreams::sharing_error() const {
   Buffer<float> errors(count_, m);
   const std::int32_t J = joints_;
   const auto exact = exact_.span();
-  const auto pal = palettes_.span();
+  const auto pal = palettes();
   const auto bind = bind_positions_.span();
   const auto ref = reference.span();
   const auto out = errors.span();

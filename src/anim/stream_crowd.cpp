@@ -484,7 +484,7 @@ void StreamCrowd::step() {
                                .cluster_stride = cluster_stride_,
                                .cluster_event_filter = event_filter_,
                                .out_events = agent_events_.span()};
-  events.run();
+  if (config_.events) events.run();
 
   // Unique animations that should hand back to a stream, arriving as they end.
   std::vector<std::pair<Index, UniqueRef>> returning;

@@ -45,6 +45,7 @@ struct VarietySpec {
 struct StreamCrowdConfig {
   float frame_rate = 30.0f;  // animation frames per second (animFrameRate)
   std::uint64_t seed = 1;    // offsets chosen by transitions
+  bool events = true;        // step() delivers the sources' events to agents (a pass over the crowd)
   void validate() const;
 };
 

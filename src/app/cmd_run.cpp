@@ -83,7 +83,8 @@ struct RunOptions {
   bool animate = false;
   bool no_animate = false;
   bool no_lod = false;
-  bool lod_colours = false;  // render: colour characters by joint-LOD level (a debug view)
+  std::string animation = "auto";  // exact | streams | auto (streams from kStreamsFrom agents)
+  bool lod_colours = false;        // render: colour characters by joint-LOD level (a debug view)
   std::vector<float> lod_thresholds;
   // Rendering (video or frames) under the scenario's camera.
   std::string render;
@@ -200,9 +201,20 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
               colour ? stage_ms(stats, "sim.sense_steer") : stage_ms(stats, "sim.sense"), stage_ms(stats, "sim.move"));
   if (stats.contains("locomotion")) {
     const auto& l = stats["locomotion"];
-    std::printf("  locomotion: %lld frames, median %.3f ms per frame; joints synthesised %.1f of %d per agent",
-                l["frames"].get<long long>(), l["frame_ms"]["median"].get<double>(),
-                l["joints_synthesised_per_character"].get<double>(), l["joints"].get<int>());
+    std::printf("  locomotion (%s): %lld frames, median %.3f ms per frame", l["path"].get<std::string>().c_str(),
+                l["frames"].get<long long>(), l["frame_ms"]["median"].get<double>());
+    if (l.contains("joints_synthesised_per_character"))
+      std::printf("; joints synthesised %.1f of %d per agent", l["joints_synthesised_per_character"].get<double>(),
+                  l["joints"].get<int>());
+    if (l.contains("streams")) {
+      const auto& st = l["streams"];
+      std::printf("; %d streams in use, %.1f agents exact per frame", st["streams_in_use"].get<int>(),
+                  st["exact_per_frame"].get<double>());
+      const auto& e = st["sharing_error_cm"];
+      if (e["agents"].get<long long>() > 0)
+        std::printf("; sharing error (worst joint per agent) mean %.2f cm, p95 %.2f cm, max %.2f cm",
+                    e["mean"].get<double>(), e["p95"].get<double>(), e["max"].get<double>());
+    }
     if (l.contains("cache")) std::printf("; cache hits %.1f%%", 100.0 * l["cache"]["hit_rate"].get<double>());
     const auto& skate = l["foot_skating_cm"];
     if (skate["contacts"].get<int>() > 0) {
@@ -448,13 +460,13 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
     ScopedTimer timer("render.frame");
     character_px->push_back(median_character_px(*camera, *simulation));
     if (!*recorder) {
-      *recorder = std::make_unique<render::Recorder>(
-          record, render::make_crowd_rigs(moved.animator().blend_space().skeleton()));
+      *recorder = std::make_unique<render::Recorder>(record, render::make_crowd_rigs(moved.skeleton()));
       (*recorder)->set_world(simulation->world());
       (*recorder)->set_routes(routes);
       (*recorder)->set_field_lines(field_lines);
     }
-    (*recorder)->add_frame(*camera, render::poses_of(moved.animator(), simulation->crowd()));
+    (*recorder)->add_frame(*camera, moved.streamed() ? render::poses_of(moved.streams(), simulation->crowd())
+                                                     : render::poses_of(moved.animator(), simulation->crowd()));
   };
   hooks.finish_render = [recorder, record] {
     if (!*recorder) return std::string();
@@ -466,6 +478,20 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
                o.render_mode.c_str(), o.width, o.height, o.fps, speed, dir.c_str());
 }
 #endif
+
+// Streams for --animation streams, and for auto from kStreamsFrom agents
+// unless every joint is asked for (--no-lod) or the video draws joints,
+// which streams do not give.
+bool animate_by_streams(const RunOptions& o, Index agents) {
+  const AnimationPath path = parse_animation_path(o.animation, "--animation");
+  if (path == AnimationPath::Streams && o.no_lod)
+    throw Error("streams share poses between agents: --no-lod needs --animation exact", at_field("--animation"));
+  if (path == AnimationPath::Streams && o.render_mode == "joints" && !o.render.empty())
+    throw Error("streams give skinning palettes, not joints: --render-mode joints needs --animation exact",
+                at_field("--animation"));
+  if (path == AnimationPath::Auto && (o.no_lod || (o.render_mode == "joints" && !o.render.empty()))) return false;
+  return use_streams(path, agents);
+}
 
 // The locomotion stage, on by default up to kAnimateUpTo agents: joint LOD
 // under the scenario's camera and, with --render, the recorder.
@@ -489,6 +515,7 @@ RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& si
   const Camera lod_camera = scenario_camera(sim);  // the camera that renders is the one LOD measures with
   lo.camera = [lod_camera](double) { return lod_camera; };
   lo.lod = !o.no_lod;
+  lo.locomotion.streams = animate_by_streams(o, n);
   if (!o.render.empty()) {
 #if defined(THRONG_HAVE_RENDER)
     attach_recorder(lo, lod_camera, o, spec, sim, dir, hooks);
@@ -586,6 +613,22 @@ void run_scenario(const RunOptions& o) {
   write_and_report(*sim, result, stats, spec, dir, outputs);
 }
 
+// How agents are animated: on or off, exact or through streams, joint LOD.
+void add_locomotion_options(CLI::App& cmd, RunOptions& o) {
+  auto* no_animate = cmd.add_flag("--no-animate", o.no_animate, "Skip the locomotion stage (agents are not animated)");
+  cmd.add_flag("--animate", o.animate, fmt::format("Animate even above {} agents", kAnimateUpTo))->excludes(no_animate);
+  cmd.add_option("--animation", o.animation,
+                 fmt::format("How agents are animated: exact (per-agent synthesis), streams (far agents share a few "
+                             "speed-bucket streams, exact near the camera) or auto (streams from {} agents)",
+                             kStreamsFrom))
+      ->check(CLI::IsMember({"auto", "exact", "streams"}))
+      ->capture_default_str();
+  cmd.add_flag("--no-lod", o.no_lod, "Synthesise every joint of every agent (no joint LOD)");
+  cmd.add_option("--lod-thresholds", o.lod_thresholds,
+                 "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")
+      ->delimiter(',');
+}
+
 }  // namespace
 
 void add_run_command(CLI::App& app, const GlobalOptions& g) {
@@ -619,18 +662,12 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
          "resident "
          "memory growing over 5% after the first tenth of the run; DIR/soak.jsonl and stats.json's soak section")
       ->check(at_least(1));
-  auto* no_animate = cmd->add_flag("--no-animate", o.no_animate, "Skip the locomotion stage (agents are not animated)");
-  cmd->add_flag("--animate", o.animate, fmt::format("Animate even above {} agents", kAnimateUpTo))
-      ->excludes(no_animate);
+  add_locomotion_options(*cmd, o);
   cmd->add_option("--render", o.render,
                   "Write DIR/crowd.mp4 (video) or DIR/frame_NNNNN.png (frames) under the scenario's camera")
       ->check(CLI::IsMember({"video", "frames"}));
-  cmd->add_flag("--no-lod", o.no_lod, "Synthesise every joint of every agent (no joint LOD)");
   cmd->add_flag("--lod-colours", o.lod_colours,
                 "Render characters in joint-LOD level colours instead of their clothes (a debug view)");
-  cmd->add_option("--lod-thresholds", o.lod_thresholds,
-                  "Joint-LOD thresholds in square pixels, decreasing (default 1000,30)")
-      ->delimiter(',');
   cmd->add_flag("--no-render", o.no_render, "The demo: do not write its video");
   cmd->add_option("--render-mode", o.render_mode, "skinned (the mannequin) or joints (a sphere per bone)")
       ->check(CLI::IsMember({"skinned", "joints"}))
@@ -678,6 +715,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& g) {
                    "--camera-period", "--lod-colours", "--routes", "--field-lines"},
                   "--render video|frames");
     refuse_unless(*cmd, !o.no_lod, {"--lod-thresholds"}, "joint LOD (it has no effect with --no-lod)");
+    refuse_unless(*cmd, !o.no_animate, {"--animation"}, "the locomotion stage (it has no effect with --no-animate)");
     check_lod_thresholds(o.lod_thresholds, "--lod-thresholds");
     // Checked here, like the other flags, before the (possibly long) set-up.
     if (!o.trajectory_format.empty())

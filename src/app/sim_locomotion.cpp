@@ -43,6 +43,17 @@ Camera scenario_camera(const sim::Simulation& sim) {
   return sim::overview_camera(box);
 }
 
+AnimationPath parse_animation_path(const std::string& text, const std::string& field) {
+  if (text == "auto") return AnimationPath::Auto;
+  if (text == "exact") return AnimationPath::Exact;
+  if (text == "streams") return AnimationPath::Streams;
+  throw Error("is auto, exact or streams (got '" + text + "')", at_field(field));
+}
+
+bool use_streams(AnimationPath path, Index agents) {
+  return path == AnimationPath::Streams || (path == AnimationPath::Auto && agents >= kStreamsFrom);
+}
+
 SimulationLocomotion::SimulationLocomotion(const sim::Simulation& sim, const SimulationLocomotionOptions& options)
     : space_(options.space ? options.space
                            : std::make_shared<const motion::BlendSpace1D>(motion::make_default_blend_space())),
@@ -51,20 +62,30 @@ SimulationLocomotion::SimulationLocomotion(const sim::Simulation& sim, const Sim
   anim::CrowdAnimatorConfig config;
   if (!thresholds_.empty()) config.lod_thresholds = thresholds_;
   thresholds_ = config.lod_thresholds;
-  crowd_ = std::make_unique<anim::CrowdAnimator>(*space_, n, config);
   // Gait phases drawn from the scenario's seed, so neighbours do not step in unison.
   std::mt19937 rng(static_cast<std::uint32_t>(sim.spec().seed));
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  const std::vector<glm::vec2> at = sim.positions();
-  const std::vector<float> headings = sim.headings();
-  std::vector<glm::vec3> positions(static_cast<std::size_t>(n));
-  std::vector<float> yaws(static_cast<std::size_t>(n)), phases(static_cast<std::size_t>(n));
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    positions[i] = world_from_ground(at[i]);
-    yaws[i] = yaw_from_heading(headings[i]);
-    phases[i] = unit(rng);
+  std::vector<float> phases(static_cast<std::size_t>(n));
+  for (float& p : phases) p = unit(rng);
+  if (options.streams) {
+    anim::LocomotionStreamsConfig streams;
+    streams.frame_rate = options.frame_rate;
+    streams.exact_coverage = thresholds_.front();  // exact where joint LOD would synthesise every joint
+    streams.seed = sim.spec().seed;
+    streams_ = std::make_unique<anim::LocomotionStreams>(space_, n, streams);
+    streams_->set_phases(phases);
+  } else {
+    crowd_ = std::make_unique<anim::CrowdAnimator>(*space_, n, config);
+    const std::vector<glm::vec2> at = sim.positions();
+    const std::vector<float> headings = sim.headings();
+    std::vector<glm::vec3> positions(static_cast<std::size_t>(n));
+    std::vector<float> yaws(static_cast<std::size_t>(n));
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      positions[i] = world_from_ground(at[i]);
+      yaws[i] = yaw_from_heading(headings[i]);
+    }
+    crowd_->place(positions, yaws, {}, phases);
   }
-  crowd_->place(positions, yaws, {}, phases);
   tracked_ = options.skating_agents;
   const Memory m = current_memory();
   previous_positions_ = Buffer<glm::vec2>(n, m);
@@ -76,14 +97,23 @@ SimulationLocomotion::SimulationLocomotion(const sim::Simulation& sim, const Sim
   remember(sim);
 }
 
+anim::CrowdAnimator& SimulationLocomotion::animator() {
+  if (!crowd_) throw Error("the crowd is animated by streams, not by exact synthesis", at_field("locomotion.animator"));
+  return *crowd_;
+}
+
+const anim::CrowdAnimator& SimulationLocomotion::animator() const {
+  return const_cast<SimulationLocomotion*>(this)->animator();
+}
+
 void SimulationLocomotion::remember(const sim::Simulation& sim) {
   const Index n = sim.agent_count();
   copy_span(sim.crowd().position.span(), previous_positions_.span().subspan(0, n));
   copy_span(sim.crowd().heading.span(), previous_headings_.span().subspan(0, n));
 }
 
-const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim, float alpha, float dt,
-                                                      const Camera* camera, bool moving) {
+void SimulationLocomotion::animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera,
+                                   bool moving) {
   const auto t0 = std::chrono::steady_clock::now();
   const sim::CrowdState& c = sim.crowd();
   // Agents between the steps, moving at their displacement over the step.
@@ -99,25 +129,47 @@ const anim::FrameStats& SimulationLocomotion::animate(const sim::Simulation& sim
   between.out_velocities = moved_.span();
   between.periodic = sim.world().periodic();
   between.run();
-  crowd_->drive_from_map(shown_positions_.span(), moving ? moved_.span() : still_.span(), shown_headings_.span());
-  const anim::FrameStats& s = crowd_->animate({dt, camera, false});
-  tally_.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  const Span<const glm::vec2> velocities = moving ? moved_.span() : still_.span();
+  if (streams_) {
+    streams_->drive_from_map(shown_positions_.span(), velocities, shown_headings_.span());
+    const anim::LocomotionStreamsStats& s = streams_->animate(camera);
+    anim::FrameStats frame;
+    frame.characters = s.agents;
+    tally_.add(frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    exact_frames_ += s.exact;
+  } else {
+    crowd_->drive_from_map(shown_positions_.span(), velocities, shown_headings_.span());
+    const anim::FrameStats& s = crowd_->animate({dt, camera, false});
+    tally_.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
   // Foot tracking starts with the first frame that moves time on, in windows.
   if (dt > 0.0f && tracked_ > 0 && (skating_frames_ == 0 || skating_frames_ >= kSkatingWindow)) {
-    if (skating_frames_ > 0) skating_.add(crowd_->foot_skating());
-    crowd_->track(tracked_agents(crowd_->count(), tracked_));
+    if (skating_frames_ > 0) skating_.add(foot_skating());
+    track(tracked_agents(sim.agent_count(), tracked_));
     skating_frames_ = 0;
   }
   if (skating_frames_ > 0 || (dt > 0.0f && tracked_ > 0)) ++skating_frames_;
-  return s;
+}
+
+void SimulationLocomotion::track(std::vector<Index> agents) {
+  if (streams_) {
+    streams_->track(std::move(agents));
+  } else {
+    crowd_->track(std::move(agents));
+  }
+}
+
+motion::FootSkatingReport SimulationLocomotion::foot_skating() const {
+  return streams_ ? streams_->foot_skating() : crowd_->foot_skating();
 }
 
 nlohmann::json SimulationLocomotion::stats() const {
   nlohmann::json out;
-  const anim::CrowdAnimator& crowd = *crowd_;
   const std::int64_t frames = tally_.frames;
-  out["characters"] = crowd.count();
-  out["joints"] = crowd.joint_count();
+  const Index n = streams_ ? streams_->agent_count() : crowd_->count();
+  out["path"] = streams_ ? "streams" : "exact";
+  out["characters"] = n;
+  out["joints"] = space_->joint_count();
   out["frames"] = frames;
   out["frame_ms"] = tally_.frame_ms_json();
   // The stage's kernels (anim.*): milliseconds per frame.
@@ -129,21 +181,60 @@ nlohmann::json SimulationLocomotion::stats() const {
                          {"median_ms", k.median_ms},
                          {"ms_per_frame", frames > 0 ? k.total_ms / static_cast<double>(frames) : 0.0}};
   out["kernels"] = kernels;
-  out["joints_synthesised_per_character"] =
-      tally_.character_frames() > 0.0 ? static_cast<double>(tally_.joints_synthesised) / tally_.character_frames()
-                                      : 0.0;
-  if (nlohmann::json lod = tally_.lod_json(crowd, thresholds_); !lod.is_null()) out["lod"] = lod;
-  if (nlohmann::json cache = tally_.cache_json(crowd); !cache.is_null()) out["cache"] = cache;
+  if (streams_) {
+    out["streams"] = streams_json();
+  } else {
+    out["joints_synthesised_per_character"] =
+        tally_.character_frames() > 0.0 ? static_cast<double>(tally_.joints_synthesised) / tally_.character_frames()
+                                        : 0.0;
+    if (nlohmann::json lod = tally_.lod_json(*crowd_, thresholds_); !lod.is_null()) out["lod"] = lod;
+    if (nlohmann::json cache = tally_.cache_json(*crowd_); !cache.is_null()) out["cache"] = cache;
+  }
   SkatingTally skating = skating_;
-  if (skating_frames_ > 0) skating.add(crowd.foot_skating());
-  out["foot_skating_cm"] = skating.json(std::min(crowd.count(), tracked_));
+  if (skating_frames_ > 0) skating.add(foot_skating());
+  out["foot_skating_cm"] = skating.json(std::min(n, tracked_));
   return out;
 }
 
-LocomotionStage::LocomotionStage(const sim::Simulation& sim, LocomotionStageOptions options)
-    : options_(std::move(options)), locomotion_(sim, options_.locomotion) {
-  if (!(options_.fps >= 0.0) || !std::isfinite(options_.fps)) throw Error("must be >= 0", at_field("locomotion.fps"));
+nlohmann::json SimulationLocomotion::streams_json() const {
+  const anim::LocomotionStreams& loco = *streams_;
+  const anim::LocomotionStreamsStats& s = loco.last_frame();
+  nlohmann::json out = {
+      {"bucket_width", loco.config().bucket_width},
+      {"frame_rate", loco.config().frame_rate},
+      {"streams", s.streams},
+      {"streams_running", s.streams_running},
+      {"streams_in_use", s.streams_in_use},
+      {"exact_per_frame",
+       tally_.frames > 0 ? static_cast<double>(exact_frames_) / static_cast<double>(tally_.frames) : 0.0},
+      {"pose_bytes", s.pose_bytes},
+      {"agent_state_bytes", s.agent_state_bytes},
+      {"ref_bytes", s.ref_bytes}};
+  // The error of sharing on the last frame: every streamed agent against
+  // its own exact synthesis (worst joint per agent).
+  const anim::SharingError e = loco.sharing_error();
+  out["sharing_error_cm"] = {{"agents", e.agents},
+                             {"max", e.agents > 0 ? nlohmann::json(e.max_cm) : nlohmann::json()},
+                             {"mean", e.agents > 0 ? nlohmann::json(e.mean_cm) : nlohmann::json()},
+                             {"p95", e.agents > 0 ? nlohmann::json(e.p95_cm) : nlohmann::json()}};
+  return out;
 }
+
+namespace {
+
+// The stage's options with the streams' frame rate: one animation frame per
+// stage frame (a video frame, else a step).
+LocomotionStageOptions checked(LocomotionStageOptions options, const sim::Simulation& sim) {
+  if (!(options.fps >= 0.0) || !std::isfinite(options.fps)) throw Error("must be >= 0", at_field("locomotion.fps"));
+  options.locomotion.frame_rate =
+      static_cast<float>(options.fps > 0.0 ? options.fps : 1.0 / static_cast<double>(sim.spec().dt));
+  return options;
+}
+
+}  // namespace
+
+LocomotionStage::LocomotionStage(const sim::Simulation& sim, LocomotionStageOptions options)
+    : options_(checked(std::move(options), sim)), locomotion_(sim, options_.locomotion) {}
 
 void LocomotionStage::frame_at(const sim::Simulation& sim, double time, float alpha, float dt) {
   std::optional<Camera> camera;

@@ -10,6 +10,11 @@
 // SimulationScene) all animate through SimulationLocomotion::animate().
 // Between two simulation steps agents are interpolated
 // (anim::InterpolateAgentsJob), so frames faster than the steps stay smooth.
+//
+// Two ways to animate, chosen at construction: exact per-agent synthesis
+// (anim::CrowdAnimator, the default) or locomotion through streams
+// (anim::LocomotionStreams: far agents read a few shared speed-bucket
+// streams, agents near the camera are synthesised; docs/streams.md).
 #pragma once
 
 #include <cstdint>
@@ -21,6 +26,7 @@
 #include <vector>
 
 #include "anim/crowd_animator.h"
+#include "anim/locomotion_streams.h"
 #include "app/follow_camera.h"
 #include "app/locomotion_stats.h"
 #include "core/buffer.h"
@@ -37,7 +43,19 @@ struct SimulationLocomotionOptions {
   std::shared_ptr<const motion::BlendSpace1D> space;
   std::vector<float> lod_thresholds;  // square pixels, decreasing; empty = anim's defaults
   Index skating_agents = 64;          // agents, evenly spread over the crowd, whose foot skating is measured
+  bool streams = false;               // locomotion through streams instead of exact synthesis
+  float frame_rate = 30.0f;           // streams: animation frames per simulated second (one per animate())
 };
+
+// How `throng run` animates a crowd: exact synthesis, streams, or streams
+// from kStreamsFrom agents up (auto).
+enum class AnimationPath : std::uint8_t { Auto, Exact, Streams };
+// "auto" | "exact" | "streams"; Error naming `field` otherwise.
+AnimationPath parse_animation_path(const std::string& text, const std::string& field);
+// The crowd size from which auto picks streams (docs/streams.md: where
+// streams cost less than exact synthesis per frame on the plaza).
+inline constexpr Index kStreamsFrom = 20000;
+bool use_streams(AnimationPath path, Index agents);
 
 // The scenario's motion set (its `motion` key, io/motion_set.h; the default
 // set without one), loaded. Errors name the clip's file.
@@ -53,8 +71,12 @@ class SimulationLocomotion {
   SimulationLocomotion(const SimulationLocomotion&) = delete;
   SimulationLocomotion& operator=(const SimulationLocomotion&) = delete;
 
-  anim::CrowdAnimator& animator() { return *crowd_; }
-  const anim::CrowdAnimator& animator() const { return *crowd_; }
+  // The exact path's animator; Error when the crowd is animated by streams.
+  anim::CrowdAnimator& animator();
+  const anim::CrowdAnimator& animator() const;
+  bool streamed() const { return streams_ != nullptr; }
+  anim::LocomotionStreams& streams() { return *streams_; }  // streamed() only
+  const motion::Skeleton& skeleton() const { return space_->skeleton(); }
 
   // Where the agents stand now: the start of the next interpolation. Call
   // before each simulation step (or after it, for the step that follows).
@@ -64,19 +86,26 @@ class SimulationLocomotion {
   // over that step (what the root moves, so strides match it), dt seconds
   // after the previous frame, joint LOD for `camera` (null: every joint).
   // moving = false shows everyone standing (a finished simulation).
-  const anim::FrameStats& animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera,
-                                  bool moving = true);
+  void animate(const sim::Simulation& sim, float alpha, float dt, const Camera* camera, bool moving = true);
 
   std::int64_t frames() const { return tally_.frames; }
-  // stats.json's "locomotion" section: frame timings, kernels (anim.*),
-  // joint-LOD histogram, cache counters, foot skating (cm: mean, p95).
+  // Foot skating of the tracked agents (the path's own probe).
+  void track(std::vector<Index> agents);
+  motion::FootSkatingReport foot_skating() const;
+  // stats.json's "locomotion" section: the path, frame timings, kernels
+  // (anim.*), joint-LOD histogram and cache counters (exact) or the
+  // streams' figures and sharing error (streams), foot skating (cm: mean, p95).
   nlohmann::json stats() const;
 
  private:
   std::shared_ptr<const motion::BlendSpace1D> space_;
-  std::unique_ptr<anim::CrowdAnimator> crowd_;
+  std::unique_ptr<anim::CrowdAnimator> crowd_;        // exact synthesis, or
+  std::unique_ptr<anim::LocomotionStreams> streams_;  // locomotion through streams
   std::vector<float> thresholds_;
+  nlohmann::json streams_json() const;
+
   Index tracked_ = 0;
+  Index exact_frames_ = 0;  // streams: exact agents summed over the frames
   Buffer<glm::vec2> previous_positions_, shown_positions_, moved_, still_;
   Buffer<float> previous_headings_, shown_headings_;
   LocomotionTally tally_;            // over the frames

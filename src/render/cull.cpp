@@ -35,6 +35,10 @@ void CullJob::validate() const {
     if (rigs.count != 1) throw Error("joint frames are of one rig", at_field("cull.rigs.count"));
     check_size(joint_positions.size(), n * joint_count, "cull.joint_positions");
     if (!scales.empty()) check_size(scales.size(), n, "cull.scales");
+  } else if (!palette_refs.empty()) {
+    check_size(palette_refs.size(), n, "cull.palette_refs");
+    check_size(root_positions.size(), n, "cull.root_positions");
+    check_size(root_yaws.size(), n, "cull.root_yaws");
   } else {
     check_size(palette_offsets.size(), n, "cull.palette_offsets");
     if (!character_rigs.empty()) check_size(character_rigs.size(), n, "cull.character_rigs");
@@ -102,6 +106,10 @@ void PalettePackJob::validate() const {
     for (std::int32_t g = 0; g < groups.count; ++g)
       if (groups.joints[g] != joint_count)
         throw Error("joint frames are of one rig", at_field(fmt::format("pack.groups.joints[{}]", g)));
+  } else if (!palette_refs.empty()) {
+    check_size(palette_refs.size(), n, "pack.palette_refs");
+    check_size(root_positions.size(), n, "pack.root_positions");
+    check_size(root_yaws.size(), n, "pack.root_yaws");
   } else {
     check_size(palette_offsets.size(), n, "pack.palette_offsets");
   }

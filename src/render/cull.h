@@ -22,6 +22,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "anim/palette_ref.h"
 #include "anim/pose.h"
 #include "core/camera.h"
 #include "core/span.h"
@@ -68,6 +69,11 @@ struct CullJob {
   Span<const anim::Mat3x4> palettes;
   Span<const Index> palette_offsets;
   Span<const std::int32_t> character_rigs;
+  // ... or palette references (palette_refs not empty, rig 0): the root is
+  // root_positions[c] + its yaw times root_bind, scale 1.
+  Span<const anim::PaletteRef> palette_refs;
+  Span<const glm::vec3> root_positions;
+  Span<const float> root_yaws;
   // Characters whose flags lack a bit of visible_bits are not drawn; empty = all.
   Span<const std::uint8_t> flags;
   std::uint8_t visible_bits = 0;
@@ -79,7 +85,8 @@ struct CullJob {
 
   std::int32_t group_count() const { return rigs.count * kDrawTiers; }
   Index character_count() const {
-    return joint_count > 0 ? joint_positions.size() / joint_count : palette_offsets.size();
+    if (joint_count > 0) return joint_positions.size() / joint_count;
+    return palette_refs.empty() ? palette_offsets.size() : palette_refs.size();
   }
   void validate() const;  // Error naming the span or parameter
   void run() const;       // parallel_for "render.cull"
@@ -162,9 +169,13 @@ struct PalettePackJob {
   Span<const glm::quat> joint_rotations;
   Span<const float> scales;
   Span<const anim::Mat3x4> inverse_bind;
-  // ... or palettes to copy (joint_count 0).
+  // ... or palettes to copy (joint_count 0) ...
   Span<const anim::Mat3x4> palettes;
   Span<const Index> palette_offsets;
+  // ... or palette references to compose (anim::compose_palette).
+  Span<const anim::PaletteRef> palette_refs;
+  Span<const glm::vec3> root_positions;
+  Span<const float> root_yaws;
   Span<const std::uint8_t> lod_levels;  // empty, characters, or characters * 5
   Span<const std::uint32_t> group_flags;
   Span<const std::uint32_t> slots;

@@ -24,6 +24,8 @@ void CullJob::run() const {
         if (joint_count > 0) {
           root = joint_positions[c * joint_count];
           if (!scales.empty()) s = scales[c];
+        } else if (!palette_refs.empty()) {
+          root = anim::transform_point(anim::root_transform(root_positions[c], root_yaws[c]), rigs.rig[0].root_bind);
         } else {
           r = character_rigs.empty() ? 0 : character_rigs[c];
           if (r < 0 || r >= rigs.count) return;
@@ -97,6 +99,10 @@ void PalettePackJob::run() const {
             world.r2 = glm::vec4(glm::vec3(world.r2) * s, world.r2.w);
             out_palettes[at + j] = world * inverse_bind[j];
           }
+        } else if (!palette_refs.empty()) {
+          const anim::PaletteRef ref = palette_refs[c];
+          const anim::Mat3x4 root = anim::root_transform(root_positions[c], root_yaws[c]);
+          for (std::int32_t j = 0; j < joints; ++j) out_palettes[at + j] = anim::compose_palette(ref, root, j);
         } else {
           const Index first = palette_offsets[c];
           const bool in_range = first >= 0 && first + joints <= palettes.size();  // CullJob leaves others out

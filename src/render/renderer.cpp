@@ -363,6 +363,9 @@ DrawGroups Renderer::State::cull(const Camera* camera, const CharacterPoses& pos
   job.palettes = poses.palettes;
   job.palette_offsets = poses.palette_offsets;
   job.character_rigs = poses.rigs;
+  job.palette_refs = poses.palette_refs;
+  job.root_positions = poses.root_positions;
+  job.root_yaws = poses.root_yaws;
   job.flags = poses.flags;
   job.visible_bits = poses.visible_bits;
   job.group_flags = group_flags.span().subspan(0, flags);
@@ -423,6 +426,9 @@ void Renderer::State::pack_palettes(const CharacterPoses& poses, const DrawGroup
   if (poses.joint_count > 0) pack.inverse_bind = inverse_bind.span();
   pack.palettes = poses.palettes;
   pack.palette_offsets = poses.palette_offsets;
+  pack.palette_refs = poses.palette_refs;
+  pack.root_positions = poses.root_positions;
+  pack.root_yaws = poses.root_yaws;
   pack.lod_levels = poses.lod_levels;
   pack.group_flags = group_flags.span();
   pack.slots = slots.span();

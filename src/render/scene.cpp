@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "anim/crowd_animator.h"
+#include "anim/locomotion_streams.h"
 #include "anim/lod.h"
 #include "anim/rig.h"
 #include "anim/stream_crowd.h"
@@ -284,6 +285,17 @@ void CharacterPoses::validate(const CrowdRigs& crowd, RenderMode mode) const {
       throw Error("the renderer has no skinned mesh", at_field("render.mode"));
     if (rig_joints != joint_count)
       throw Error(fmt::format("{} joints, the rig has {}", joint_count, rig_joints), at_field("poses.joint_count"));
+  } else if (from_refs()) {
+    if (mode != RenderMode::Skinned)
+      throw Error("palette references are drawn in skinned mode only", at_field("render.mode"));
+    if (crowd.skins.empty()) throw Error("the renderer has no skinned mesh", at_field("render.mode"));
+    if (!palettes.empty() || !palette_offsets.empty() || !rigs.empty() || !scales.empty())
+      throw Error("give palette references or palettes, not both", at_field("poses.palette_refs"));
+    n = character_count();
+    if (root_positions.size() != n || root_yaws.size() != n)
+      throw Error(
+          fmt::format("{} root positions and {} yaws for {} characters", root_positions.size(), root_yaws.size(), n),
+          at_field("poses.root_positions"));
   } else if (!palette_offsets.empty() || !palettes.empty()) {
     if (mode != RenderMode::Skinned) throw Error("palettes are drawn in skinned mode only", at_field("render.mode"));
     if (crowd.skins.empty()) throw Error("the renderer has no skinned mesh", at_field("render.mode"));
@@ -329,6 +341,16 @@ CharacterPoses poses_of(const anim::StreamCrowd& crowd, Span<const anim::Mat3x4>
   p.palettes = palettes;
   p.palette_offsets = crowd.palette_offsets();
   p.rigs = crowd.agent_rigs();
+  return p;
+}
+
+CharacterPoses poses_of(const anim::LocomotionStreams& streams, const sim::CrowdState& agents) {
+  CharacterPoses p;
+  p.palette_refs = streams.palette_refs();
+  p.root_positions = streams.positions();
+  p.root_yaws = streams.yaws();
+  p.flags = agents.flags.span();
+  p.visible_bits = sim::kAgentActive;
   return p;
 }
 

@@ -18,12 +18,14 @@
 
 #include "anim/lod_spheres.h"
 #include "anim/mannequin.h"
+#include "anim/palette_ref.h"
 #include "anim/pose.h"
 #include "core/span.h"
 #include "motion/skeleton.h"
 
 namespace throng::anim {
 class CrowdAnimator;
+class LocomotionStreams;
 class StreamCrowd;
 struct Rig;
 }  // namespace throng::anim
@@ -136,6 +138,12 @@ struct CharacterPoses {
   Span<const anim::Mat3x4> palettes;
   Span<const Index> palette_offsets;
   Span<const std::int32_t> rigs;
+  // Or palette references (skinned mode only; locomotion through streams):
+  // character c's joint j is anim::compose_palette(palette_refs[c],
+  // root_transform(root_positions[c], root_yaws[c]), j), rig 0, joint_count 0.
+  Span<const anim::PaletteRef> palette_refs;
+  Span<const glm::vec3> root_positions;  // world, on the ground
+  Span<const float> root_yaws;
   // Joint-LOD levels, 0 = finest: empty (all 0), one per character, or one
   // per character and body part (characters * 5, as anim::LodJob writes).
   Span<const std::uint8_t> lod_levels;
@@ -145,10 +153,11 @@ struct CharacterPoses {
   Span<const std::uint8_t> flags;
   std::uint8_t visible_bits = 0;
 
-  bool from_palettes() const { return joint_positions.empty() && !palette_offsets.empty(); }
+  bool from_palettes() const { return joint_positions.empty() && (!palette_offsets.empty() || from_refs()); }
+  bool from_refs() const { return !palette_refs.empty(); }
   Index character_count() const {
     if (joint_count > 0) return joint_positions.size() / joint_count;
-    return palette_offsets.size();
+    return from_refs() ? palette_refs.size() : palette_offsets.size();
   }
   // Throws Error naming the span whose size disagrees with the rigs.
   void validate(const CrowdRigs& rigs, RenderMode mode) const;
@@ -160,6 +169,9 @@ CharacterPoses poses_of(const anim::CrowdAnimator& crowd);
 CharacterPoses poses_of(const anim::CrowdAnimator& crowd, const sim::CrowdState& agents);
 // A stream crowd's palettes (resolved with world positions and yaws).
 CharacterPoses poses_of(const anim::StreamCrowd& crowd, Span<const anim::Mat3x4> palettes);
+// Locomotion through streams: palette references and root transforms; for
+// the simulation's agents, despawned ones are not drawn.
+CharacterPoses poses_of(const anim::LocomotionStreams& streams, const sim::CrowdState& agents);
 
 // Obstacles of the simulation's map (x, y metres, z up), drawn extruded.
 struct ObstacleStyle {

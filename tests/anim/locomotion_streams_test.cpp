@@ -54,10 +54,11 @@ std::vector<float> speed_sweep(int count, float top) {
 // World joint positions of agent a from its palette (palette * bind position).
 std::vector<glm::vec3> palette_joints(const LocomotionStreams& loco, Index a) {
   const Rig& rig = loco.rig();
+  const Span<const Mat3x4> palettes = loco.palettes();
   std::vector<glm::vec3> out;
   for (std::int32_t j = 0; j < loco.joint_count(); ++j)
     out.push_back(
-        transform_point(loco.palettes()[a * loco.joint_count() + j], rig.bind_positions[static_cast<std::size_t>(j)]));
+        transform_point(palettes[a * loco.joint_count() + j], rig.bind_positions[static_cast<std::size_t>(j)]));
   return out;
 }
 
@@ -162,6 +163,44 @@ TEST(LocomotionStreams, ChangingBucketIsATransitionFromTheOldStream) {
   EXPECT_LT(largest_distance(palette_joints(loco, 0), synthesised(loco, 0, 0.05f)), 2e-4);
 }
 
+// The palettes composed from references (what the renderer draws) against
+// the stream crowd's own resolve (forward kinematics of the slots' local
+// rotations, SLERP across a transition): the same for agents on one
+// stream, within a few millimetres while a bucket change cross-fades.
+TEST(LocomotionStreams, PaletteReferencesComposeWhatTheStreamResolveWrites) {
+  Crowd c = grid_crowd(speed_sweep(60, 3.0f), 11);
+  LocomotionStreams loco(space(), 60);
+  loco.set_agents(c.positions, c.yaws, c.speeds);
+  for (int f = 0; f < 5; ++f) loco.animate(nullptr);
+  for (std::size_t i = 0; i < c.speeds.size(); i += 3) c.speeds[i] += 0.35f;  // a third change bucket
+  loco.set_agents(c.positions, c.yaws, c.speeds);
+  loco.animate(nullptr);
+  loco.animate(nullptr);  // 2 of the 7.5 frames of the cross-fade
+
+  std::vector<Mat3x4> reference(static_cast<std::size_t>(60 * loco.joint_count()));
+  loco.crowd().resolve(Span<const glm::vec3>(c.positions), Span<const float>(c.yaws), Span<Mat3x4>(reference));
+  const Span<const Mat3x4> composed = loco.palettes();
+  const Rig& rig = loco.rig();
+  double steady = 0.0, blending = 0.0;
+  int blended = 0;
+  for (Index a = 0; a < 60; ++a) {
+    const ClusterRef ref = loco.crowd().clusters_of(a)[0];
+    const bool fading = transition_alpha(ref, loco.crowd().frame()) < 1.0f;
+    blended += fading ? 1 : 0;
+    for (std::int32_t j = 0; j < loco.joint_count(); ++j) {
+      const glm::vec3 bind = rig.bind_positions[static_cast<std::size_t>(j)];
+      const Index k = a * loco.joint_count() + j;
+      const double d = glm::length(transform_point(composed[k], bind) - transform_point(reference[k], bind));
+      (fading ? blending : steady) = std::max(fading ? blending : steady, d);
+    }
+  }
+  std::cout << "[ figures ] composed against resolve: " << 60 - blended << " agents on one stream, worst joint "
+            << steady * 1000.0 << " mm; " << blended << " cross-fading, worst joint " << blending * 1000.0 << " mm\n";
+  EXPECT_GE(blended, 15);
+  EXPECT_LT(steady, 1e-4);
+  EXPECT_LT(blending, 0.015);
+}
+
 TEST(LocomotionStreams, AgentsNearTheCameraAreSynthesisedExactly) {
   // A line of agents walking away from a camera: the nearest are large on screen.
   std::vector<glm::vec3> positions;
@@ -190,6 +229,18 @@ TEST(LocomotionStreams, AgentsNearTheCameraAreSynthesisedExactly) {
       EXPECT_EQ(loco.crowd().clusters_of(a)[0].source, kNoSource);
     }
     EXPECT_EQ(exact, s.exact);
+    // Exact where joint LOD under the same threshold puts some body part at level 0.
+    const BodyParts parts = make_body_parts(space()->skeleton());
+    const LodTables tables(make_lod_config(parts, {LocomotionStreamsConfig{}.exact_coverage}), Memory::Host);
+    std::vector<std::uint8_t> levels(60 * kBodyPartCount);
+    std::vector<std::uint32_t> masks(static_cast<std::size_t>(60 * tables.mask_words));
+    make_lod_job(camera, tables, parts, {positions, yaws, {}}, levels, masks).run();
+    for (Index a = 0; a < 60; ++a) {
+      bool level0 = false;
+      for (int p = 0; p < kBodyPartCount; ++p)
+        level0 = level0 || levels[static_cast<std::size_t>(a * kBodyPartCount + p)] == 0;
+      EXPECT_EQ(loco.exact()[a] != 0, level0) << a;
+    }
     EXPECT_TRUE(loco.exact()[0]);    // 4 m from the camera
     EXPECT_FALSE(loco.exact()[59]);  // 90 m away
   }
@@ -410,10 +461,20 @@ TEST(LocomotionStreams, RejectsBadInput) {
   select.phases = speeds;
   select.sources = flags;
   select.offsets = flags;
-  std::vector<ClusterRef> refs(2);
-  select.clusters = refs;
-  select.cluster = 1;  // stride 1
+  std::vector<ClusterRef> refs(1);
+  select.clusters = refs;  // one agent's, for two
   EXPECT_THROW(select.run(), Error);
+
+  std::vector<PaletteRef> palette_refs(2);
+  std::vector<glm::vec3> positions(2);
+  std::vector<Mat3x4> palettes(2 * 22 - 1);
+  PaletteComposeJob compose{22, palette_refs, positions, speeds, {}, palettes};
+  try {
+    compose.run();
+    ADD_FAILURE() << "a short palette buffer accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("PaletteComposeJob.palettes"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -320,6 +320,60 @@ TEST_F(RunCommand, AScenarioAnimatesItsOwnMotionCaptureClips) {
   EXPECT_NE(missing.out.find("no_such_walk.bvh"), std::string::npos) << missing.out;
 }
 
+// Locomotion through streams (--animation streams): far agents read shared
+// speed-bucket streams; stats.json says so, with the error of sharing
+// against exact synthesis and the streamed feet's skating; a video draws
+// them. Streams cannot give every joint (--no-lod) nor joints to draw.
+TEST_F(RunCommand, AnimatesThroughStreamsWhenAsked) {
+  const fs::path out = dir_ / "streams";
+  const Outcome o = run({"run", "circle", "--agents", "300", "--seconds", "12", "--animation", "streams",
+                         "--no-trajectories", "--out", out.string()});
+  ASSERT_EQ(o.code, 0) << o.out;
+  EXPECT_NE(o.out.find("locomotion (streams)"), std::string::npos) << o.out;
+  const nlohmann::json l = nlohmann::json::parse(slurp(out / "stats.json"))["locomotion"];
+  EXPECT_EQ(l["path"], "streams");
+  EXPECT_EQ(l["frames"].get<long>(), 121);
+  EXPECT_TRUE(l["kernels"].contains("anim.loco_streams_refs")) << l["kernels"].dump();
+  EXPECT_FALSE(l["kernels"].contains("anim.stream_resolve")) << "no palette per streamed agent";
+  const auto& st = l["streams"];
+  std::printf("streams: %s\nfeet: %s\n", st.dump().c_str(), l["foot_skating_cm"].dump().c_str());
+  EXPECT_GT(st["streams_in_use"].get<int>(), 0);
+  const auto& e = st["sharing_error_cm"];
+  EXPECT_GT(e["agents"].get<long>(), 0);
+  EXPECT_LT(e["p95"].get<double>(), 3.0) << e.dump();
+  // Streamed feet are measured from the streams' palettes under any camera.
+  const auto& feet = l["foot_skating_cm"];
+  EXPECT_GT(feet["contacts"].get<int>(), 50) << feet.dump();
+  EXPECT_LT(feet["mean"].get<double>(), 2.0) << feet.dump();
+
+  const Outcome exact = run({"run", "circle", "--agents", "300", "--seconds", "1", "--animation", "exact",
+                             "--no-trajectories", "--out", (dir_ / "exact").string()});
+  ASSERT_EQ(exact.code, 0) << exact.out;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "exact" / "stats.json"))["locomotion"]["path"], "exact");
+
+  const Outcome no_lod =
+      run({"run", "circle", "--animation", "streams", "--no-lod", "--no-render", "--out", (dir_ / "x").string()});
+  EXPECT_EQ(no_lod.code, 1) << no_lod.out;
+  EXPECT_NE(no_lod.out.find("--no-lod needs --animation exact"), std::string::npos) << no_lod.out;
+  const Outcome unanimated =
+      run({"run", "circle", "--animation", "streams", "--no-animate", "--out", (dir_ / "y").string()});
+  EXPECT_EQ(unanimated.code, 1) << unanimated.out;
+  EXPECT_NE(unanimated.out.find("--animation"), std::string::npos) << unanimated.out;
+#if defined(THRONG_HAVE_RENDER)
+  const Outcome video =
+      run({"--threads", "2", "run", "circle", "--agents", "300", "--seconds", "3", "--animation", "streams", "--render",
+           "frames", "--width", "320", "--height", "180", "--no-trajectories", "--out", (dir_ / "frames").string()});
+  ASSERT_EQ(video.code, 0) << video.out;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "frames" / "stats.json"));
+  EXPECT_GT(stats["render"]["frames"].get<long>(), 10);
+  EXPECT_GE(stats["render"]["median_character_px"].get<double>(), 30.0) << stats["render"];
+  const Outcome joints = run({"run", "circle", "--animation", "streams", "--render", "frames", "--render-mode",
+                              "joints", "--out", (dir_ / "z").string()});
+  EXPECT_EQ(joints.code, 1) << joints.out;
+  EXPECT_NE(joints.out.find("--render-mode joints needs --animation exact"), std::string::npos) << joints.out;
+#endif
+}
+
 TEST_F(RunCommand, NoAnimateSkipsTheLocomotionStage) {
   const Outcome o = run({"run", "circle", "--agents", "50", "--seconds", "1", "--no-animate", "--out", dir_.string()});
   ASSERT_EQ(o.code, 0) << o.out;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "anim/locomotion_streams.h"
 #include "anim/controller.h"
 #include "anim/crowd_animator.h"
 #include "anim/rig.h"
@@ -465,6 +466,24 @@ TEST_F(RendererTest, GpuSkinningMatchesTheCpuReference) {
   streams.resolve(positions, agent_yaws, resolved.span());
   compare(r.capture_skinned(poses_of(streams, resolved.span()), DrawTier::Fine), resolved.to_vector(), rig.mesh,
           agents);
+
+  // Palette references: locomotion through streams, some agents changing
+  // bucket (cross-fading two slots), composed by the renderer's packing.
+  anim::LocomotionStreams loco(anim::default_blend_spaces().speeds, n);
+  loco.set_agents(at, yaws, speeds);
+  for (int f = 0; f < 6; ++f) loco.animate(nullptr);
+  std::vector<float> faster = speeds;
+  for (float& v : faster) v += 0.3f;
+  loco.set_agents(at, yaws, faster);
+  loco.animate(nullptr);
+  ASSERT_GT(loco.last_frame().retargeted, 0);
+  CharacterPoses refs;
+  refs.palette_refs = loco.palette_refs();
+  refs.root_positions = loco.positions();
+  refs.root_yaws = loco.yaws();
+  const Span<const anim::Mat3x4> composed = loco.palettes();
+  compare(r.capture_skinned(refs, DrawTier::Fine), std::vector<anim::Mat3x4>(composed.begin(), composed.end()),
+          rig.mesh, n);
 }
 
 // A crowd exported to glTF and read back (io/crowd_gltf.h) draws like the

@@ -1,0 +1,73 @@
+// The locomotion stage as `throng run` animates the built-in plaza, per
+// frame, by either path: exact per-agent synthesis (anim::CrowdAnimator:
+// joint LOD under the scenario's camera, the motion cache, foot locking)
+// or locomotion through streams (anim::LocomotionStreams: speed-bucket
+// streams, exact synthesis near the camera, palette references for the
+// renderer). Rows: app/plaza_locomotion/<path>. Each frame interpolates
+// the agents over one step and animates them (SimulationLocomotion::
+// animate, alpha 1: agents walk at their displacement over the step); the
+// simulation is not stepped inside the timing. The streams
+// rows report the error of sharing (worst joint per streamed agent, cm).
+#include <map>
+#include <memory>
+#include <tuple>
+
+#include "app/sim_locomotion.h"
+#include "bench/registry.h"
+#include "core/exec.h"
+#include "io/scenario_yaml.h"
+#include "sim/simulation.h"
+
+namespace throng::bench {
+
+namespace {
+
+// A plaza of n agents in motion, built once per size and backend (routes
+// are not planned: the rows time the animation).
+sim::Simulation& plaza(Index n) {
+  static std::map<std::tuple<Index, Backend>, std::unique_ptr<sim::Simulation>> cache;
+  auto& slot = cache[{n, current_backend()}];
+  if (!slot) {
+    io::LoadedScenario s = io::load_builtin_scenario("plaza");
+    sim::scale_agent_counts(s.spec, n);
+    s.spec.planning = sim::PlanningKind::None;
+    slot = io::build_simulation(s);
+    slot->run(20);  // walking, not starting from rest
+  }
+  return *slot;
+}
+
+Body frame(bool streams) {
+  return [streams](benchmark::State& state, Index n) {
+    sim::Simulation& sim = plaza(n);
+    app::SimulationLocomotionOptions options;
+    options.streams = streams;
+    options.frame_rate = 1.0f / sim.spec().dt;
+    app::SimulationLocomotion locomotion(sim, options);  // remembers where the agents stand
+    sim.step();                                          // frames show them walking over this step
+    const Camera camera = app::scenario_camera(sim);
+    const float dt = sim.spec().dt;
+    locomotion.animate(sim, 1.0f, dt, &camera);  // streams in use started, cache filled
+    for (auto _ : state) locomotion.animate(sim, 1.0f, dt, &camera);
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
+    if (!streams) return;
+    const anim::SharingError e = locomotion.streams().sharing_error();
+    state.counters["sharing_max_cm"] = e.max_cm;
+    state.counters["sharing_p95_cm"] = e.p95_cm;
+    state.counters["sharing_mean_cm"] = e.mean_cm;
+    state.counters["exact_agents"] = static_cast<double>(locomotion.streams().last_frame().exact);
+    state.counters["streams_in_use"] = static_cast<double>(locomotion.streams().last_frame().streams_in_use);
+  };
+}
+
+void register_locomotion(const Options& options) {
+  const std::vector<Index> sizes = {10000, 100000};
+  add(options, {"app/plaza_locomotion/exact", sizes, frame(false), true});
+  add(options, {"app/plaza_locomotion/streams", sizes, frame(true), true});
+}
+
+const bool registered = register_suite("app_locomotion", &register_locomotion);
+
+}  // namespace
+
+}  // namespace throng::bench
