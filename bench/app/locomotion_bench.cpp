@@ -3,11 +3,13 @@
 // joint LOD under the scenario's camera, the motion cache, foot locking)
 // or locomotion through streams (anim::LocomotionStreams: speed-bucket
 // streams, exact synthesis near the camera, palette references for the
-// renderer). Rows: app/plaza_locomotion/<path>. Each frame interpolates
-// the agents over one step and animates them (SimulationLocomotion::
-// animate, alpha 1: agents walk at their displacement over the step); the
-// simulation is not stepped inside the timing. The streams
-// rows report the error of sharing (worst joint per streamed agent, cm).
+// renderer). Rows: app/plaza_locomotion/<path>. Each iteration steps the
+// simulation (not timed), then times one frame: the agents interpolated
+// over that step and animated (SimulationLocomotion::animate, alpha 1:
+// agents walk at their displacement over the step), as `throng run`
+// animates a frame per step. The streams rows report the error of sharing
+// (worst joint per streamed agent, cm; 10,000 agents spread over the
+// crowd) on the last frame.
 #include <map>
 #include <memory>
 #include <tuple>
@@ -43,18 +45,32 @@ Body frame(bool streams) {
     app::SimulationLocomotionOptions options;
     options.streams = streams;
     options.frame_rate = 1.0f / sim.spec().dt;
-    app::SimulationLocomotion locomotion(sim, options);  // remembers where the agents stand
-    sim.step();                                          // frames show them walking over this step
+    app::SimulationLocomotion locomotion(sim, options);
     const Camera camera = app::scenario_camera(sim);
     const float dt = sim.spec().dt;
+    const auto step = [&] {
+      locomotion.remember(sim);
+      sim.step();
+    };
+    step();
     locomotion.animate(sim, 1.0f, dt, &camera);  // streams in use started, cache filled
-    for (auto _ : state) locomotion.animate(sim, 1.0f, dt, &camera);
+    for (auto _ : state) {
+      state.PauseTiming();
+      step();  // a frame per step: agents change speed, bucket and stream as in a run
+      state.ResumeTiming();
+      locomotion.animate(sim, 1.0f, dt, &camera);
+    }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
     if (!streams) return;
-    const anim::SharingError e = locomotion.streams().sharing_error();
+    const anim::SharingError e = locomotion.streams().sharing_error(10000);
     state.counters["sharing_max_cm"] = e.max_cm;
     state.counters["sharing_p95_cm"] = e.p95_cm;
     state.counters["sharing_mean_cm"] = e.mean_cm;
+    state.counters["steady_p95_cm"] = e.steady_p95_cm;
+    state.counters["steady_max_cm"] = e.steady_max_cm;
+    state.counters["fading_share"] = e.agents > 0 ? static_cast<double>(e.fading) / static_cast<double>(e.agents) : 0.0;
+    state.counters["retargeted_share"] =
+        static_cast<double>(locomotion.streams().last_frame().retargeted) / static_cast<double>(n);
     state.counters["exact_agents"] = static_cast<double>(locomotion.streams().last_frame().exact);
     state.counters["streams_in_use"] = static_cast<double>(locomotion.streams().last_frame().streams_in_use);
   };

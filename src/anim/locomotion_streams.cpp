@@ -98,10 +98,13 @@ LocomotionStreams::LocomotionStreams(std::shared_ptr<const motion::BlendSpace1D>
   source_ = Buffer<std::int32_t>(count_, m);
   offset_ = Buffer<std::int32_t>(count_, m);
   exact_rank_ = Buffer<std::int32_t>(count_, m);
-  refs_ = Buffer<PaletteRef>(count_, m);
+  refs_ = Buffer<PaletteRef>::zeros(count_, m);  // the rest pose until the first frame
   inverse_bind_ = Buffer<Mat3x4>(std::span<const Mat3x4>(crowd_.rig(rig).inverse_bind), m);
   bind_positions_ = Buffer<glm::vec3>(std::span<const glm::vec3>(crowd_.rig(rig).bind_positions), m);
-  if (config_.exact_near_camera) part_spheres_ = make_body_parts(space_->skeleton()).rest_spheres;
+  if (config_.exact_near_camera) {
+    const BodyParts parts = make_body_parts(space_->skeleton());
+    for (int p = 0; p < kBodyPartCount; ++p) part_spheres_[p] = parts.rest_spheres[static_cast<std::size_t>(p)];
+  }
 }
 
 void LocomotionStreams::drive_from_map(Span<const glm::vec2> positions, Span<const glm::vec2> velocities,
@@ -196,7 +199,7 @@ std::vector<Index> LocomotionStreams::classify(const Camera* camera) {
   if (buckets.near_camera) {
     buckets.camera = make_camera_view(*camera);
     buckets.exact_coverage = config_.exact_coverage;
-    buckets.part_spheres = part_spheres_;
+    for (int p = 0; p < kBodyPartCount; ++p) buckets.part_spheres[p] = part_spheres_[p];
     buckets.body_sphere = body_sphere(part_spheres_);
     buckets.positions = position_.span();
     buckets.yaws = yaw_.span();
@@ -209,7 +212,7 @@ std::vector<Index> LocomotionStreams::classify(const Camera* camera) {
   return histogram(key_.span(), keys_);
 }
 
-glm::vec4 body_sphere(const std::array<glm::vec4, kBodyPartCount>& parts) {
+glm::vec4 body_sphere(const glm::vec4 (&parts)[kBodyPartCount]) {
   float low = parts[0].y - parts[0].w, high = parts[0].y + parts[0].w;
   for (const glm::vec4& p : parts) {
     low = std::min(low, p.y - p.w);
@@ -306,18 +309,25 @@ Span<const Mat3x4> LocomotionStreams::palettes() const {
   return palettes_.span();
 }
 
-void LocomotionStreams::track(std::vector<Index> agents) { skating_.track(std::move(agents), count_, joints_); }
+void LocomotionStreams::track(std::vector<Index> agents) {
+  skating_.track(std::move(agents), count_, joints_);
+  tracked_palettes_ = Buffer<Mat3x4>();  // sized to the new agents at the next frame
+}
 
 void LocomotionStreams::record_tracks() {
   if (skating_.tracked().empty()) return;
   const auto J = static_cast<std::size_t>(joints_);
   const Rig& r = rig();
   const auto tracked = static_cast<Index>(skating_.tracked().size());
-  const Memory memory = current_memory();
-  const Buffer<Index> agents(std::span<const Index>(skating_.tracked()), memory);
-  Buffer<Mat3x4> composed(tracked * joints_, memory);
-  PaletteComposeJob{joints_, refs_.span(), position_.span(), yaw_.span(), agents.span(), composed.span()}.run();
-  const std::vector<Mat3x4> palettes = composed.to_vector();
+  if (tracked_palettes_.size() != tracked * joints_) {
+    const Memory memory = current_memory();
+    tracked_agents_ = Buffer<Index>(std::span<const Index>(skating_.tracked()), memory);
+    tracked_palettes_ = Buffer<Mat3x4>(tracked * joints_, memory);
+  }
+  PaletteComposeJob{joints_,     refs_.span(),           position_.span(),
+                    yaw_.span(), tracked_agents_.span(), tracked_palettes_.span()}
+      .run();
+  const std::vector<Mat3x4> palettes = tracked_palettes_.to_vector();
   for (std::size_t t = 0; t < skating_.tracked().size(); ++t) {
     const motion::FootSkatingRecorder::Frame f = skating_.append(t);
     for (std::size_t j = 0; j < J; ++j) {

@@ -22,7 +22,7 @@
 //     renderer: loco.palette_refs(), positions(), yaws() (render::poses_of)
 //
 // Per frame, all on the device but a few host decisions about streams:
-// anim.from_map, anim.lod, anim.loco_streams_keys (exact or which bucket),
+// anim.from_map, anim.loco_streams_keys (exact near the camera or which bucket),
 // a histogram of buckets in use (streams start, history filled, when first
 // needed and stop when unused), the streams' step, anim.loco_streams_select
 // (each agent's phase and desired stream and offset), anim.stream_retarget
@@ -91,9 +91,9 @@ struct StreamBucketJob {
   bool near_camera = false;
   CameraView camera;
   float exact_coverage = 1000.0f;
-  std::array<glm::vec4, kBodyPartCount> part_spheres{};  // BodyParts::rest_spheres
-  glm::vec4 body_sphere{0.0f};                           // holds every part sphere; centre on the +Y axis
-  Span<const glm::vec3> positions;                       // per agent, world (near_camera only)
+  glm::vec4 part_spheres[kBodyPartCount]{};  // BodyParts::rest_spheres (a plain array: it travels into kernels)
+  glm::vec4 body_sphere{0.0f};               // holds every part sphere; centre on the +Y axis
+  Span<const glm::vec3> positions;           // per agent, world (near_camera only)
   Span<const float> yaws;
   Span<std::uint8_t> exact;        // out: 1 = synthesised
   Span<std::int32_t> exact_flags;  // out: the same as 0/1 integers (to scan)
@@ -106,7 +106,7 @@ struct StreamBucketJob {
 
 // The sphere round a character's part spheres, centred above its ground
 // point (so that it does not turn with the character).
-glm::vec4 body_sphere(const std::array<glm::vec4, kBodyPartCount>& parts);
+glm::vec4 body_sphere(const glm::vec4 (&parts)[kBodyPartCount]);
 
 // Per agent: the gait phase it shows this frame and the stream and offset
 // it should read ("anim.loco_streams_select"). An exact agent advances at
@@ -211,6 +211,11 @@ struct SharingError {
   double mean_cm = 0.0;             // of every agent's largest joint error
   double p95_cm = 0.0;              // of every agent's largest joint error
   std::vector<float> agent_max_cm;  // per compared agent (agent order)
+  // The agents cross-fading between two streams (a bucket change under
+  // way) show a blend of both; the others, steady, only their bucket's.
+  Index fading = 0;
+  double steady_max_cm = 0.0;
+  double steady_p95_cm = 0.0;
 };
 
 class LocomotionStreams {
@@ -255,8 +260,10 @@ class LocomotionStreams {
 
   // ---- measurements
   // Streamed agents' palettes this frame against PoseJob at their own speed
-  // and shown phase (exact w): every joint's world position.
-  SharingError sharing_error() const;
+  // and shown phase (exact w): every joint's world position. at_most > 0:
+  // that many agents evenly spread over the crowd are compared (memory in
+  // proportion to them), else all.
+  SharingError sharing_error(Index at_most = 0) const;
   // Foot skating: the world joints of these agents are recorded from their
   // palettes every frame from now on; foot_skating() measures every contact.
   void track(std::vector<Index> agents);
@@ -297,7 +304,7 @@ class LocomotionStreams {
   Buffer<PaletteRef> refs_;
   mutable Buffer<Mat3x4> palettes_;  // palettes(), allocated on first use
   // The exact decision.
-  std::array<glm::vec4, kBodyPartCount> part_spheres_{};
+  glm::vec4 part_spheres_[kBodyPartCount]{};
   // The exact path, sized to the exact agents of the frame.
   Buffer<Mat3x4> inverse_bind_;
   Buffer<glm::vec3> bind_positions_;
@@ -308,8 +315,10 @@ class LocomotionStreams {
   Buffer<float> exact_yaw_, exact_phase_, exact_speed_;
   Buffer<glm::quat> joint_rotation_;
   LocomotionStreamsStats stats_;
-  // Foot-skating probe.
+  // Foot-skating probe: the tracked agents and their palettes each frame.
   motion::FootSkatingRecorder skating_;
+  Buffer<Index> tracked_agents_;
+  Buffer<Mat3x4> tracked_palettes_;
 };
 
 }  // namespace throng::anim

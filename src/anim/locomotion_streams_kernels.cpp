@@ -75,7 +75,7 @@ THRONG_HOST_DEVICE inline bool near_camera_at(const StreamBucketJob& job, Index 
     return false;
   const float c = glm::cos(job.yaws[a]), s = glm::sin(job.yaws[a]);
   for (int k = 0; k < kBodyPartCount; ++k) {
-    const glm::vec4 t = job.part_spheres[static_cast<std::size_t>(k)];
+    const glm::vec4 t = job.part_spheres[k];
     const glm::vec3 centre = p + glm::vec3(c * t.x + s * t.z, t.y, -s * t.x + c * t.z);
     if (sphere_pixel_coverage(to_camera_space(job.camera, centre), t.w, job.camera, true) >= job.exact_coverage)
       return true;
@@ -258,49 +258,86 @@ void PaletteComposeJob::run() const {
 
 // ---- the error of sharing ----------------------------------------------------------------------
 
-SharingError LocomotionStreams::sharing_error() const {
+namespace {
+
+// Largest, mean and nearest-rank 95th percentile of per-agent errors (0 for none).
+void summarise(std::vector<float> values, double& max, double& mean, double& p95) {
+  max = mean = p95 = 0.0;
+  if (values.empty()) return;
+  double sum = 0.0;
+  for (const float x : values) {
+    max = std::max(max, static_cast<double>(x));
+    sum += x;
+  }
+  mean = sum / static_cast<double>(values.size());
+  const auto k = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(values.size()))) - 1;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  p95 = values[k];
+}
+
+}  // namespace
+
+SharingError LocomotionStreams::sharing_error(Index at_most) const {
   SharingError e;
   if (count_ == 0) return e;
+  // The agents compared, evenly spread over the crowd, and their inputs.
+  const Index n = at_most > 0 ? std::min(at_most, count_) : count_;
+  std::vector<Index> agents(static_cast<std::size_t>(n));
+  for (Index k = 0; k < n; ++k) agents[static_cast<std::size_t>(k)] = k * count_ / n;
+  const auto pick = [&](const auto& buffer) {
+    const auto all = buffer.to_vector();
+    std::vector<typename decltype(all)::value_type> some;
+    for (const Index a : agents) some.push_back(all[static_cast<std::size_t>(a)]);
+    return some;
+  };
   const Memory m = current_memory();
-  Buffer<glm::vec3> reference(count_ * joints_, m);
-  Buffer<glm::quat> rotations(count_ * joints_, m);
-  make_pose_job(tables_.view(), {position_.span(), yaw_.span(), {}, phase_.span(), speed_.span()}, reference.span(),
+  const Buffer<glm::vec3> positions(std::span<const glm::vec3>(pick(position_)), m);
+  const Buffer<float> yaws(std::span<const float>(pick(yaw_)), m), phases(std::span<const float>(pick(phase_)), m),
+      speeds(std::span<const float>(pick(speed_)), m);
+  const Buffer<std::uint8_t> exact(std::span<const std::uint8_t>(pick(exact_)), m);
+  const Buffer<Index> which(std::span<const Index>(agents), m);
+  Buffer<glm::vec3> reference(n * joints_, m);
+  Buffer<glm::quat> rotations(n * joints_, m);
+  make_pose_job(tables_.view(), {positions.span(), yaws.span(), {}, phases.span(), speeds.span()}, reference.span(),
                 rotations.span())
       .run();
-  Buffer<float> errors(count_, m);
+  Buffer<Mat3x4> palettes(n * joints_, m);
+  PaletteComposeJob{joints_, refs_.span(), position_.span(), yaw_.span(), which.span(), palettes.span()}.run();
+  Buffer<float> errors(n, m);
   const std::int32_t J = joints_;
-  const auto exact = exact_.span();
-  const auto pal = palettes();
+  const auto flags = exact.span();
+  const auto pal = palettes.span();
   const auto bind = bind_positions_.span();
   const auto ref = reference.span();
   const auto out = errors.span();
   parallel_for(
-      "anim.loco_streams_error", count_,
-      THRONG_LAMBDA(Index a) {
-        if (exact[a] != 0) {
-          out[a] = -1.0f;
+      "anim.loco_streams_error", n,
+      THRONG_LAMBDA(Index k) {
+        if (flags[k] != 0) {
+          out[k] = -1.0f;
           return;
         }
         float worst = 0.0f;
         for (std::int32_t j = 0; j < J; ++j)
-          worst = glm::max(worst, glm::length(transform_point(pal[a * J + j], bind[j]) - ref[a * J + j]));
-        out[a] = 100.0f * worst;
+          worst = glm::max(worst, glm::length(transform_point(pal[k * J + j], bind[j]) - ref[k * J + j]));
+        out[k] = 100.0f * worst;
       },
       256);
-  double sum = 0.0;
-  for (const float x : errors.to_vector()) {
-    if (x < 0.0f) continue;
-    e.agent_max_cm.push_back(x);
-    e.max_cm = std::max(e.max_cm, static_cast<double>(x));
-    sum += x;
+  // Agents cross-fading between two streams apart from the others.
+  const std::vector<PaletteRef> refs = pick(refs_);
+  const std::vector<float> worst = errors.to_vector();
+  std::vector<float> steady;
+  for (std::size_t k = 0; k < worst.size(); ++k) {
+    if (worst[k] < 0.0f) continue;
+    e.agent_max_cm.push_back(worst[k]);
+    const bool fading = refs[k].from != nullptr && refs[k].alpha < 1.0f;
+    e.fading += fading ? 1 : 0;
+    if (!fading) steady.push_back(worst[k]);
   }
   e.agents = static_cast<Index>(e.agent_max_cm.size());
-  if (e.agents == 0) return e;
-  e.mean_cm = sum / static_cast<double>(e.agents);
-  std::vector<float> sorted = e.agent_max_cm;
-  const auto k = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(sorted.size()))) - 1;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
-  e.p95_cm = sorted[k];
+  summarise(e.agent_max_cm, e.max_cm, e.mean_cm, e.p95_cm);
+  double steady_mean = 0.0;
+  summarise(steady, e.steady_max_cm, steady_mean, e.steady_p95_cm);
   return e;
 }
 

@@ -103,7 +103,7 @@ struct RunOptions {
 };
 
 // Above this many agents `throng run` leaves the locomotion stage off unless
-// --animate asks for it (docs/render.md: its cost per agent and frame).
+// --animate or --animation asks for it (docs/render.md: its cost per agent and frame).
 constexpr std::int64_t kAnimateUpTo = 200000;
 
 // The demo (`throng run` with no scenario) writes a short time-lapse video.
@@ -212,17 +212,22 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
                   st["exact_per_frame"].get<double>());
       const auto& e = st["sharing_error_cm"];
       if (e["agents"].get<long long>() > 0)
-        std::printf("; sharing error (worst joint per agent) mean %.2f cm, p95 %.2f cm, max %.2f cm",
-                    e["mean"].get<double>(), e["p95"].get<double>(), e["max"].get<double>());
+        std::printf(
+            "\n  sharing error (worst joint per agent, %lld sampled): steady p95 %.2f cm, max %.2f cm; with the %lld "
+            "cross-fading between streams p95 %.2f cm, max %.2f cm",
+            e["agents"].get<long long>(), e["steady_p95"].get<double>(), e["steady_max"].get<double>(),
+            e["fading"].get<long long>(), e["p95"].get<double>(), e["max"].get<double>());
     }
     if (l.contains("cache")) std::printf("; cache hits %.1f%%", 100.0 * l["cache"]["hit_rate"].get<double>());
     const auto& skate = l["foot_skating_cm"];
+    // Exact synthesis measures only the legs that joint LOD synthesises; streams every sampled agent's.
+    const char* unmeasured = l["path"] == "exact" ? "; legs that joint LOD holds are not measured" : "";
     if (skate["contacts"].get<int>() > 0) {
       std::printf(
-          "\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts of %d agents (of %d sampled; legs that joint "
-          "LOD holds are not measured)\n    by what the body does (mean / p95 cm, contacts):",
+          "\n  foot skating: mean %.2f cm, p95 %.2f cm over %d contacts of %d agents (of %d sampled%s)\n    by "
+          "what the body does (mean / p95 cm, contacts):",
           skate["mean"].get<double>(), skate["p95"].get<double>(), skate["contacts"].get<int>(),
-          skate["agents_measured"].get<int>(), skate["agents"].get<int>());
+          skate["agents_measured"].get<int>(), skate["agents"].get<int>(), unmeasured);
       for (int k = 0; k < motion::kGaitRegimes; ++k) {
         const char* regime = motion::to_string(static_cast<motion::GaitRegime>(k));
         const auto& f = skate["by_regime"][regime];
@@ -232,10 +237,8 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
       }
       std::printf("\n");
     } else {
-      std::printf(
-          "\n  foot skating: no contacts measured (%d agents sampled; legs that joint LOD holds are not "
-          "measured)\n",
-          skate["agents"].get<int>());
+      std::printf("\n  foot skating: no contacts measured (%d agents sampled%s)\n", skate["agents"].get<int>(),
+                  unmeasured);
     }
   }
   if (stats.contains("soak")) {
@@ -480,17 +483,22 @@ void attach_recorder(LocomotionStageOptions& lo, const Camera& lod_camera, const
 #endif
 
 // Streams for --animation streams, and for auto from kStreamsFrom agents
-// unless every joint is asked for (--no-lod) or the video draws joints,
-// which streams do not give.
+// unless what streams do not give is asked for: every joint (--no-lod),
+// joints to draw (--render-mode joints) or joint-LOD colours.
 bool animate_by_streams(const RunOptions& o, Index agents) {
   const AnimationPath path = parse_animation_path(o.animation, "--animation");
-  if (path == AnimationPath::Streams && o.no_lod)
-    throw Error("streams share poses between agents: --no-lod needs --animation exact", at_field("--animation"));
-  if (path == AnimationPath::Streams && o.render_mode == "joints" && !o.render.empty())
-    throw Error("streams give skinning palettes, not joints: --render-mode joints needs --animation exact",
+  const bool rendered = !o.render.empty();
+  const char* needs_exact = o.no_lod                                ? "--no-lod"
+                            : rendered && o.render_mode == "joints" ? "--render-mode joints"
+                            : rendered && o.lod_colours             ? "--lod-colours"
+                                                                    : nullptr;
+  if (needs_exact == nullptr) return use_streams(path, agents);
+  if (path == AnimationPath::Streams)
+    throw Error(fmt::format("streams share poses between agents and give palettes, not joints or LOD levels: {} needs "
+                            "--animation exact",
+                            needs_exact),
                 at_field("--animation"));
-  if (path == AnimationPath::Auto && (o.no_lod || (o.render_mode == "joints" && !o.render.empty()))) return false;
-  return use_streams(path, agents);
+  return false;
 }
 
 // The locomotion stage, on by default up to kAnimateUpTo agents: joint LOD
@@ -502,10 +510,11 @@ RenderHooks add_locomotion_stage(sim::FrameLoop& loop, const sim::Simulation& si
   const Index n = sim.agent_count();
   if (o.no_animate && !o.render.empty())
     throw Error("--render draws the animated agents: drop --no-animate", at_field("--render"));
-  const bool animate = !o.no_animate && (o.animate || !o.render.empty() || n <= kAnimateUpTo);
+  const bool animate = !o.no_animate && (o.animate || o.animation != "auto" || !o.render.empty() || n <= kAnimateUpTo);
   if (!animate && !o.no_animate)
     std::fprintf(stderr,
-                 "throng run: %lld agents: locomotion off above %lld agents (--animate turns it on; see docs/render.md "
+                 "throng run: %lld agents: locomotion off above %lld agents (--animate or --animation turns it on; see "
+                 "docs/render.md "
                  "for its cost)\n",
                  static_cast<long long>(n), static_cast<long long>(kAnimateUpTo));
   if (!animate) return hooks;

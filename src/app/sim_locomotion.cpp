@@ -1,5 +1,7 @@
 #include "app/sim_locomotion.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,10 +18,20 @@ namespace throng::app {
 
 namespace {
 
-// Frames of foot tracking pooled at a time: the probe keeps every tracked
-// joint of every frame, so long runs are measured in windows (a contact cut
-// by a window's end counts as two shorter ones).
-constexpr std::int32_t kSkatingWindow = 600;
+// Foot tracking is measured in windows of frames: the probe keeps every
+// joint of every tracked agent in every frame, so a window holds at most
+// kSkatingBytes of them, and from 60 to 600 frames (a contact cut by a
+// window's end counts as two shorter ones).
+constexpr double kSkatingBytes = 64.0 * 1024.0 * 1024.0;
+
+std::int32_t skating_window(Index tracked, std::int32_t joints) {
+  const double per_frame = static_cast<double>(tracked) * joints * (sizeof(glm::vec3) + sizeof(glm::quat) + 1);
+  return static_cast<std::int32_t>(std::clamp(kSkatingBytes / std::max(per_frame, 1.0), 60.0, 600.0));
+}
+
+// Agents whose error of sharing stats.json reports (evenly spread): the
+// measure synthesises each of them exactly once more.
+constexpr Index kSharingSample = 10000;
 
 std::vector<Index> tracked_agents(Index n, Index wanted) {
   std::vector<Index> out;
@@ -131,6 +143,12 @@ void SimulationLocomotion::animate(const sim::Simulation& sim, float alpha, floa
   between.run();
   const Span<const glm::vec2> velocities = moving ? moved_.span() : still_.span();
   if (streams_) {
+    // One stream frame per call: the caller's frames must be that far apart
+    // (a frame that does not move time on, the first, still takes one).
+    const float rate = streams_->config().frame_rate;
+    if (dt > 0.0f && std::abs(dt * rate - 1.0f) > 0.01f)
+      throw Error(fmt::format("a frame of {} s, streams play {} frames a second", dt, rate),
+                  at_field("locomotion.frame_rate"));
     streams_->drive_from_map(shown_positions_.span(), velocities, shown_headings_.span());
     const anim::LocomotionStreamsStats& s = streams_->animate(camera);
     anim::FrameStats frame;
@@ -143,7 +161,8 @@ void SimulationLocomotion::animate(const sim::Simulation& sim, float alpha, floa
     tally_.add(s, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   // Foot tracking starts with the first frame that moves time on, in windows.
-  if (dt > 0.0f && tracked_ > 0 && (skating_frames_ == 0 || skating_frames_ >= kSkatingWindow)) {
+  const std::int32_t window = skating_window(std::min(sim.agent_count(), tracked_), space_->joint_count());
+  if (dt > 0.0f && tracked_ > 0 && (skating_frames_ == 0 || skating_frames_ >= window)) {
     if (skating_frames_ > 0) skating_.add(foot_skating());
     track(tracked_agents(sim.agent_count(), tracked_));
     skating_frames_ = 0;
@@ -210,13 +229,17 @@ nlohmann::json SimulationLocomotion::streams_json() const {
       {"pose_bytes", s.pose_bytes},
       {"agent_state_bytes", s.agent_state_bytes},
       {"ref_bytes", s.ref_bytes}};
-  // The error of sharing on the last frame: every streamed agent against
-  // its own exact synthesis (worst joint per agent).
-  const anim::SharingError e = loco.sharing_error();
+  // The error of sharing on the last frame: streamed agents against their
+  // own exact synthesis (worst joint per agent), on a sample of the crowd.
+  const anim::SharingError e = loco.sharing_error(kSharingSample);
+  const auto figure = [&](double cm) { return e.agents > 0 ? nlohmann::json(cm) : nlohmann::json(); };
   out["sharing_error_cm"] = {{"agents", e.agents},
-                             {"max", e.agents > 0 ? nlohmann::json(e.max_cm) : nlohmann::json()},
-                             {"mean", e.agents > 0 ? nlohmann::json(e.mean_cm) : nlohmann::json()},
-                             {"p95", e.agents > 0 ? nlohmann::json(e.p95_cm) : nlohmann::json()}};
+                             {"max", figure(e.max_cm)},
+                             {"mean", figure(e.mean_cm)},
+                             {"p95", figure(e.p95_cm)},
+                             {"fading", e.fading},
+                             {"steady_max", figure(e.steady_max_cm)},
+                             {"steady_p95", figure(e.steady_p95_cm)}};
   return out;
 }
 

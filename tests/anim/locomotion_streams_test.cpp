@@ -198,6 +198,17 @@ TEST(LocomotionStreams, PaletteReferencesComposeWhatTheStreamResolveWrites) {
             << steady * 1000.0 << " mm; " << blended << " cross-fading, worst joint " << blending * 1000.0 << " mm\n";
   EXPECT_GE(blended, 15);
   EXPECT_LT(steady, 1e-4);
+  // The error of sharing tells the fading agents from the steady ones, and
+  // measures a sample when asked.
+  const SharingError all = loco.sharing_error();
+  EXPECT_EQ(all.agents, 60);
+  EXPECT_EQ(all.fading, blended);
+  EXPECT_LE(all.steady_max_cm, all.max_cm);
+  EXPECT_LT(all.steady_max_cm, 5.0);  // half a bucket from its stream's centre (derived bound 5.3 cm)
+  const SharingError some = loco.sharing_error(12);
+  EXPECT_EQ(some.agents, 12);
+  for (Index k = 0; k < 12; ++k)  // agents 0, 5, 10, ...: the full measure's figures for them
+    EXPECT_FLOAT_EQ(some.agent_max_cm[static_cast<std::size_t>(k)], all.agent_max_cm[static_cast<std::size_t>(k * 5)]);
   EXPECT_LT(blending, 0.015);
 }
 
