@@ -228,7 +228,8 @@ class LocomotionStreams {
   const LocomotionStreamsConfig& config() const { return config_; }
   const motion::BlendSpace1D& blend_space() const { return *space_; }
   const Rig& rig() const { return crowd_.rig(0); }
-  StreamCrowd& crowd() { return crowd_; }
+  // Read only: every cluster of an agent follows its speed's stream (the
+  // palette references read cluster 0 for all).
   const StreamCrowd& crowd() const { return crowd_; }
   std::int32_t bucket_count() const { return buckets_; }
   // The stream of a speed bucket (cache_key order) and the speed it plays.
