@@ -3,11 +3,12 @@
 // joint LOD under the scenario's camera, the motion cache, foot locking)
 // or locomotion through streams (anim::LocomotionStreams: speed-bucket
 // streams, exact synthesis near the camera, palette references for the
-// renderer). Rows: app/plaza_locomotion/<path>. Each iteration steps the
+// renderer). Rows: app/plaza_locomotion/<path>: each iteration steps the
 // simulation (not timed), then times one frame: the agents interpolated
 // over that step and animated (SimulationLocomotion::animate, alpha 1:
 // agents walk at their displacement over the step), as `throng run`
-// animates a frame per step. The streams rows report the error of sharing
+// animates a frame per step; app/plaza_frame/<path>: the step timed too (a
+// whole frame of a run). The streams rows report the error of sharing
 // (worst joint per streamed agent, cm; 10,000 agents spread over the
 // crowd) on the last frame.
 #include <map>
@@ -39,8 +40,10 @@ sim::Simulation& plaza(Index n) {
   return *slot;
 }
 
-Body frame(bool streams) {
-  return [streams](benchmark::State& state, Index n) {
+// with_step: the step is timed too (a whole frame of a run: simulation,
+// then locomotion), else only the locomotion.
+Body frame(bool streams, bool with_step) {
+  return [streams, with_step](benchmark::State& state, Index n) {
     sim::Simulation& sim = plaza(n);
     app::SimulationLocomotionOptions options;
     options.streams = streams;
@@ -55,9 +58,9 @@ Body frame(bool streams) {
     step();
     locomotion.animate(sim, 1.0f, dt, &camera);  // streams in use started, cache filled
     for (auto _ : state) {
-      state.PauseTiming();
+      if (!with_step) state.PauseTiming();
       step();  // a frame per step: agents change speed, bucket and stream as in a run
-      state.ResumeTiming();
+      if (!with_step) state.ResumeTiming();
       locomotion.animate(sim, 1.0f, dt, &camera);
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
@@ -78,8 +81,11 @@ Body frame(bool streams) {
 
 void register_locomotion(const Options& options) {
   const std::vector<Index> sizes = {10000, 100000};
-  add(options, {"app/plaza_locomotion/exact", sizes, frame(false), true});
-  add(options, {"app/plaza_locomotion/streams", sizes, frame(true), true});
+  add(options, {"app/plaza_locomotion/exact", sizes, frame(false, false), true});
+  add(options, {"app/plaza_locomotion/streams", sizes, frame(true, false), true});
+  // The whole frame of `throng run`: the collision-free speed model's step, then the locomotion.
+  add(options, {"app/plaza_frame/exact", sizes, frame(false, true), true});
+  add(options, {"app/plaza_frame/streams", sizes, frame(true, true), true});
 }
 
 const bool registered = register_suite("app_locomotion", &register_locomotion);
