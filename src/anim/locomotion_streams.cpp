@@ -249,9 +249,8 @@ void LocomotionStreams::synthesise_exact() {
   const Memory m = current_memory();
   const Index n = stats_.exact;
   exclusive_scan(exact_rank_.span(), exact_rank_.span());
-  if (exact_agents_.size() < n) {  // grows to the largest exact count seen
-    const Index cap = std::max(n, exact_agents_.size() * 2);
-    exact_agents_ = Buffer<Index>(cap, m);
+  if (exact_position_.size() < n) {  // grows to the largest exact count seen
+    const Index cap = std::max(n, exact_position_.size() * 2);
     exact_position_ = Buffer<glm::vec3>(cap, m);
     exact_yaw_ = Buffer<float>(cap, m);
     exact_phase_ = Buffer<float>(cap, m);
@@ -266,7 +265,7 @@ void LocomotionStreams::synthesise_exact() {
                               .yaws = yaw_.span(),
                               .phases = phase_.span(),
                               .speeds = speed_.span(),
-                              .agents = exact_agents_.span().subspan(0, n),
+                              .count = n,
                               .out_positions = exact_position_.span(),
                               .out_yaws = exact_yaw_.span(),
                               .out_phases = exact_phase_.span(),

@@ -39,7 +39,6 @@
 
 #include <cstdint>
 #include <memory>
-#include <array>
 #include <optional>
 #include <span>
 #include <vector>
@@ -143,7 +142,7 @@ struct ExactGatherJob {
   Span<const std::int32_t> ranks;
   Span<const glm::vec3> positions;
   Span<const float> yaws, phases, speeds;
-  Span<Index> agents;  // out, dense
+  Index count = 0;  // exact agents: the ranks run from 0 to count - 1
   Span<glm::vec3> out_positions;
   Span<float> out_yaws, out_phases, out_speeds;
   void validate() const;  // Error naming the field
@@ -310,7 +309,6 @@ class LocomotionStreams {
   Buffer<Mat3x4> inverse_bind_;
   Buffer<glm::vec3> bind_positions_;
   Buffer<std::int32_t> exact_rank_;
-  Buffer<Index> exact_agents_;
   Buffer<glm::vec3> exact_position_, joint_position_;
   Buffer<Mat3x4> exact_palettes_;
   Buffer<float> exact_yaw_, exact_phase_, exact_speed_;

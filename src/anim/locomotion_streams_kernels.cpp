@@ -156,11 +156,12 @@ void ExactGatherJob::validate() const {
   check_length("ExactGatherJob", "yaws", yaws.size(), n);
   check_length("ExactGatherJob", "phases", phases.size(), n);
   check_length("ExactGatherJob", "speeds", speeds.size(), n);
-  // The outputs may be longer than agents (buffers that keep their largest size).
-  const Index room = agents.size();
-  const auto at_least_room = [room](const char* field, Index got) {
-    if (got < room)
-      throw Error("has " + std::to_string(got) + " elements, fewer than agents (" + std::to_string(room) + ")",
+  if (count < 0 || count > n)
+    throw Error("must be in [0, " + std::to_string(n) + "]", at_field("ExactGatherJob.count"));
+  // The outputs may be longer than count (buffers that keep their largest size).
+  const auto at_least_room = [this](const char* field, Index got) {
+    if (got < count)
+      throw Error("has " + std::to_string(got) + " elements, fewer than count (" + std::to_string(count) + ")",
                   at_field(std::string("ExactGatherJob.") + field));
   };
   at_least_room("out_positions", out_positions.size());
@@ -176,8 +177,7 @@ void ExactGatherJob::run() const {
       THRONG_JOB_LAMBDA(Index a) {
         if (exact[a] == 0) return;
         const Index r = ranks[a];
-        if (r < 0 || r >= agents.size()) return;
-        agents[r] = a;
+        if (r < 0 || r >= count) return;
         out_positions[r] = positions[a];
         out_yaws[r] = yaws[a];
         out_phases[r] = phases[a];
