@@ -2,9 +2,16 @@
 // built-in plaza (1200 m x 1200 m, 3000 obstacles) with 10^3 to 10^6 agents,
 // for every steering model under both schedulers, and the naive O(N^2)
 // reference (every agent senses every other; contacts still binned) up to
-// 10^4 agents. Rows: sim/plaza_step/<model>/<scheduler>. Items are
-// agent-steps, so items/s is agent-steps per second and the median ns is
-// the time of one step.
+// 10^4 agents. Rows: sim/plaza_step/<model>/<scheduler>. And RVO2's disc
+// (disc_scenario_text below), the layout its example and peers/rvo_circle
+// time, for the default model and the paper's: sim/disc_step/<model>, and
+// beside it at 10^5 and 10^6 the same step without the shortcuts that
+// change no bit (sim/disc_step/<model>/reference).
+// Items are agent-steps, so items/s is agent-steps per second and the
+// median ns is the time of one step.
+#include <fmt/format.h>
+
+#include <cmath>
 #include <map>
 #include <memory>
 #include <string>
@@ -44,6 +51,50 @@ sim::Simulation& plaza(Index n, sim::ModelKind model, Variant variant) {
   return *slot;
 }
 
+// N agents on a disc at 16 m^2 each (radius sqrt(16 N / pi)), each walking
+// to its antipode, with RVO2's example body and step: radius 1.5 m,
+// preferred speed 1 m/s, dt 0.25 s, no obstacles, no route planning.
+std::string disc_scenario_text(Index n, sim::ModelKind model) {
+  const double radius = std::sqrt(16.0 * static_cast<double>(n) / 3.14159265358979);
+  return fmt::format(R"(name: disc
+seed: 1
+dt: 0.25
+duration: 100000
+planning: none
+model: {{type: {}, max_speed: 2.0, max_radius: 1.5}}
+groups:
+  - count: {}
+    radius: 1.5
+    speed: 1.0
+    spawn: {{disc: {{center: [0, 0], radius: {:.2f}}}}}
+    goal: {{mirror: [0, 0]}}
+    on_arrival: stop
+)",
+                     sim::to_string(model), n, radius);
+}
+
+// `reference`: the step without its shortcuts (hashed bins, every contact
+// pass; sim::SimulationOptions), the same bits at the cost before them.
+sim::Simulation& disc(Index n, sim::ModelKind model, bool reference) {
+  static std::map<std::tuple<Index, sim::ModelKind, bool, Backend>, std::unique_ptr<sim::Simulation>> cache;
+  auto& slot = cache[{n, model, reference, current_backend()}];
+  if (!slot) {
+    sim::SimulationOptions options;
+    options.dense_bins = options.skip_idle_contact_passes = !reference;
+    slot = io::build_simulation(io::parse_scenario(disc_scenario_text(n, model), "disc"), options);
+    slot->run(4);  // 1 s: past the first steps from rest
+  }
+  return *slot;
+}
+
+Body disc_step(sim::ModelKind model, bool reference) {
+  return [model, reference](benchmark::State& state, Index n) {
+    sim::Simulation& sim = disc(n, model, reference);
+    for (auto _ : state) sim.step();
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
+  };
+}
+
 Body step(sim::ModelKind model, Variant variant) {
   return [model, variant](benchmark::State& state, Index n) {
     sim::Simulation& sim = plaza(n, model, variant);
@@ -60,6 +111,11 @@ void register_sim(const Options& options) {
     add(options, {prefix + "/double_buffer", sizes, step(model, Variant::DoubleBuffer), true});
     add(options, {prefix + "/four_colour", sizes, step(model, Variant::FourColour), true});
     add(options, {prefix + "/all_pairs_reference", {1000, 10000}, step(model, Variant::AllPairs), true});
+  }
+  for (const sim::ModelKind model : {sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Priority}) {
+    const std::string prefix = std::string("sim/disc_step/") + sim::to_string(model);
+    add(options, {prefix, sizes, disc_step(model, false), true});
+    add(options, {prefix + "/reference", {100000, 1000000}, disc_step(model, true), true});
   }
 }
 

@@ -332,8 +332,8 @@ class Reader : public YamlReader {
   // those every model shares. A parameter of another model is an error that
   // says which type it belongs to.
   sim::ModelParams model(const YAML::Node& n, const std::string& path) {
-    static const std::vector<std::string_view> shared = {"type", "max_speed", "contact_iterations",
-                                                         "contact_extra_iterations", "contact_tolerance"};
+    static const std::vector<std::string_view> shared = {
+        "type", "max_speed", "max_radius", "contact_iterations", "contact_extra_iterations", "contact_tolerance"};
     static const std::vector<std::string_view> priority = {"pred_time",       "max_force",       "personal_space",
                                                            "lane_half_width", "relaxation_time", "probe_margin"};
     static const std::vector<std::string_view> cfs = {
@@ -377,6 +377,7 @@ class Reader : public YamlReader {
       if (n[key]) out = real(n[key], child(path, key));
     };
     opt("max_speed", m.max_speed);
+    opt("max_radius", m.body_radius_limit);
     opt("pred_time", m.pred_time);
     opt("max_force", m.max_force);
     opt("personal_space", m.personal_space);

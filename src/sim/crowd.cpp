@@ -300,9 +300,8 @@ void check_group_body(const ScenarioSpec& spec, const GroupSpec& G, const std::s
                     step, 0.9f * G.radius),
         at_field(field + ".radius"));
   if (2.0f * G.radius + 2.0f * step > cell || G.radius > spec.model.max_radius())
-    throw Error(fmt::format("radius {} m is too large for the {} model (at most {:.3g} m, and 2 * radius + 2 * dt * "
-                            "max_speed within its "
-                            "bins of side {:.3g} m)",
+    throw Error(fmt::format("radius {} m is too large for the {} model (at most {:.3g} m, model.max_radius, and 2 "
+                            "* radius + 2 * dt * max_speed within its bins of side {:.3g} m)",
                             G.radius, to_string(spec.model.kind), spec.model.max_radius(), cell),
                 at_field(field + ".radius"));
   const SpeedSpec& S = G.speed;

@@ -103,9 +103,11 @@ GridView AgentGrid::view() const {
   v.wrap_x = wrap_x_;
   v.wrap_y = wrap_y_;
   v.mask = mask_;
-  v.keys = keys_.span();
-  v.start = start_.span();
-  v.count = count_.span();
+  v.dense_x0 = dense_x0_, v.dense_y0 = dense_y0_;
+  v.dense_nx = dense_nx_, v.dense_ny = dense_ny_;
+  v.keys = keys_.span().subspan(0, slots());
+  v.start = start_.span().subspan(0, slots());
+  v.count = count_.span().subspan(0, slots());
   // Only the first binned_ items are agents (inactive ones are not binned).
   v.items = items_.span().subspan(0, binned_);
   return v;
@@ -113,7 +115,8 @@ GridView AgentGrid::view() const {
 
 Index AgentGrid::occupied_cells() const {
   Index n = 0;
-  for (std::uint64_t k : keys_.to_vector()) n += k != kEmptyCell;
+  const std::vector<std::uint64_t> keys = keys_.to_vector();
+  for (Index s = 0; s < slots(); ++s) n += keys[static_cast<std::size_t>(s)] != kEmptyCell;
   return n;
 }
 

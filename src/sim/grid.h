@@ -76,17 +76,25 @@ THRONG_HOST_DEVICE inline std::uint64_t home_slot(std::uint64_t key, std::uint64
 // item grouped by cell: iterating it visits agents cell by cell, which keeps
 // the lookups of neighbouring agents in the same part of memory.
 //
+// A dense grid (dense_nx > 0) has no hashing: its slots are the cells of the
+// box of dense_nx x dense_ny cells from (dense_x0, dense_y0), row by row, so
+// a lookup is an index computation and the neighbouring cells of a row are
+// neighbouring slots. AgentGrid builds one whenever the box of the occupied
+// cells fits the table it would have hashed into (memory stays the same).
+//
 // Over a periodic area (core/periodic.h) the cells of a wrapping axis tile the
 // period exactly, `wrap_x` (or `wrap_y`) of them, an even number so that the
 // four colours stay two cells apart across the seam, and cell coordinates
 // are taken modulo that count: the cell beyond the last is the first.
 // Elsewhere cells are squares of side cell_size from the origin (0, 0).
 struct GridView {
-  float cell_size = 1.0f;               // m: the side along x
-  float cell_size_y = 1.0f;             // m: the side along y (differs from cell_size only on a periodic grid)
-  glm::vec2 origin{0.0f};               // m: where cell (0, 0) starts
-  std::int32_t wrap_x = 0, wrap_y = 0;  // cells per period along a wrapping axis; 0 elsewhere
-  std::uint64_t mask = 0;               // capacity - 1 (capacity is a power of two)
+  float cell_size = 1.0f;                   // m: the side along x
+  float cell_size_y = 1.0f;                 // m: the side along y (differs from cell_size only on a periodic grid)
+  glm::vec2 origin{0.0f};                   // m: where cell (0, 0) starts
+  std::int32_t wrap_x = 0, wrap_y = 0;      // cells per period along a wrapping axis; 0 elsewhere
+  std::uint64_t mask = 0;                   // hashed: capacity - 1 (capacity is a power of two)
+  std::int32_t dense_x0 = 0, dense_y0 = 0;  // dense: the first cell of the box
+  std::int32_t dense_nx = 0, dense_ny = 0;  // dense: the box's cells along x and y; 0 when hashed
   Span<const std::uint64_t> keys;
   Span<const std::int32_t> start;
   Span<const std::int32_t> count;
@@ -100,15 +108,30 @@ struct GridView {
   THRONG_HOST_DEVICE glm::vec2 cell_min(std::int32_t cx, std::int32_t cy) const {
     return origin + glm::vec2(static_cast<float>(cx) * cell_size, static_cast<float>(cy) * cell_size_y);
   }
-  // The key of cell (cx, cy), wrapped along the periodic axes.
-  THRONG_HOST_DEVICE std::uint64_t key_of(std::int32_t cx, std::int32_t cy) const {
+  // Cell (cx, cy) wrapped along the periodic axes.
+  THRONG_HOST_DEVICE void wrap(std::int32_t& cx, std::int32_t& cy) const {
     if (wrap_x > 0) cx = ((cx % wrap_x) + wrap_x) % wrap_x;
     if (wrap_y > 0) cy = ((cy % wrap_y) + wrap_y) % wrap_y;
+  }
+  // The key of cell (cx, cy), wrapped along the periodic axes.
+  THRONG_HOST_DEVICE std::uint64_t key_of(std::int32_t cx, std::int32_t cy) const {
+    wrap(cx, cy);
     return cell_key(cx, cy);
+  }
+  // A dense grid's slot of wrapped cell (cx, cy), -1 outside its box.
+  THRONG_HOST_DEVICE Index dense_slot(std::int32_t cx, std::int32_t cy) const {
+    const std::int64_t x = std::int64_t{cx} - dense_x0, y = std::int64_t{cy} - dense_y0;
+    if (x < 0 || y < 0 || x >= dense_nx || y >= dense_ny) return -1;
+    return static_cast<Index>(y * dense_nx + x);
   }
   // Slot holding the cell, or -1.
   THRONG_HOST_DEVICE Index find(std::int32_t cx, std::int32_t cy) const {
     if (items.size() == 0) return -1;  // nothing binned (e.g. a world without walls)
+    if (dense_nx > 0) {
+      wrap(cx, cy);
+      const Index s = dense_slot(cx, cy);
+      return s >= 0 && count[s] > 0 ? s : -1;
+    }
     const std::uint64_t key = key_of(cx, cy);
     std::uint64_t s = home_slot(key, mask);
     for (;;) {
@@ -207,8 +230,13 @@ class AgentGrid {
   // Error when the period is shorter than four cell sides).
   AgentGrid(float cell_size, const Periodic& periodic);
   // Bins every agent whose flags[i] has bit 0 (active) set, by positions[i].
-  // Spans in current_memory().
-  void rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags);
+  // Spans in current_memory(). Dense when the box of the occupied cells
+  // has at most as many cells as the hash table would have slots, unless
+  // `allow_dense` is false (tests compare both).
+  void rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, bool allow_dense = true);
+  bool dense() const { return dense_nx_ > 0; }
+  // The table's slots in use: a dense grid's box of cells, else the whole table.
+  Index slots() const { return dense() ? Index{dense_nx_} * dense_ny_ : keys_.size(); }
   GridView view() const;
   // The side asked for; the view's cells are at least as wide (wider along
   // a periodic axis, to tile its period).
@@ -220,10 +248,14 @@ class AgentGrid {
   std::size_t bytes() const;
 
  private:
+  void choose_layout(GridView& cells, Span<const glm::vec2> positions, Span<const std::uint8_t> flags,
+                     bool allow_dense);
+
   float asked_ = 1.0f, cell_size_ = 1.0f, cell_size_y_ = 1.0f;
   Periodic periodic_;
   std::int32_t wrap_x_ = 0, wrap_y_ = 0;
   std::uint64_t mask_ = 0;
+  std::int32_t dense_x0_ = 0, dense_y0_ = 0, dense_nx_ = 0, dense_ny_ = 0;  // as GridView's
   Index binned_ = 0;
   Buffer<std::uint64_t> keys_;
   Buffer<std::int32_t> start_, count_, cursor_, items_, slot_of_agent_;

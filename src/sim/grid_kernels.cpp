@@ -42,9 +42,74 @@ THRONG_HOST_DEVICE inline void sort_run(std::int32_t* a, std::int32_t n) {
     sift_down(a, 0, end);
   }
 }
+
+// The box of the cells holding active agents (x0 > x1 when none does).
+struct CellBox {
+  std::int32_t x0, y0, x1, y1;
+};
+struct CellOfAgent {
+  GridView cells;
+  Span<const glm::vec2> positions;
+  Span<const std::uint8_t> flags;
+  THRONG_HOST_DEVICE CellBox operator()(Index i) const {
+    if ((flags[i] & 1u) == 0) return {kCellCoordLimit, kCellCoordLimit, -kCellCoordLimit, -kCellCoordLimit};
+    std::int32_t cx = cells.cell_x(positions[i].x), cy = cells.cell_y(positions[i].y);
+    cells.wrap(cx, cy);
+    return {cx, cy, cx, cy};
+  }
+};
+struct Enclose {
+  THRONG_HOST_DEVICE CellBox operator()(const CellBox& a, const CellBox& b) const {
+    return {a.x0 < b.x0 ? a.x0 : b.x0, a.y0 < b.y0 ? a.y0 : b.y0, a.x1 > b.x1 ? a.x1 : b.x1, a.y1 > b.y1 ? a.y1 : b.y1};
+  }
+};
+
+// The slot of each active agent's cell (-1 for inactive agents), its count
+// raised, in a dense grid: the index of the cell in the box, no hashing.
+struct CountDense {
+  GridView cells;
+  Span<const glm::vec2> positions;
+  Span<const std::uint8_t> flags;
+  Span<std::int32_t> count, slot_of;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    if ((flags[i] & 1u) == 0) {
+      slot_of[i] = -1;
+      return;
+    }
+    std::int32_t cx = cells.cell_x(positions[i].x), cy = cells.cell_y(positions[i].y);
+    cells.wrap(cx, cy);
+    const Index s = cells.dense_slot(cx, cy);
+    slot_of[i] = static_cast<std::int32_t>(s);
+    atomic_fetch_add(&count[s], 1);
+  }
+};
+// The same in a hashed grid: find or claim the cell's slot by probing.
+struct CountHashed {
+  GridView cells;
+  Span<const glm::vec2> positions;
+  Span<const std::uint8_t> flags;
+  Span<std::uint64_t> keys;
+  Span<std::int32_t> count, slot_of;
+  THRONG_HOST_DEVICE void operator()(Index i) const {
+    if ((flags[i] & 1u) == 0) {
+      slot_of[i] = -1;
+      return;
+    }
+    const std::uint64_t key = cells.key_of(cells.cell_x(positions[i].x), cells.cell_y(positions[i].y));
+    std::uint64_t s = home_slot(key, cells.mask);
+    for (;;) {
+      std::uint64_t found = atomic_load(&keys[static_cast<Index>(s)]);
+      if (found == kEmptyCell) found = atomic_compare_swap(&keys[static_cast<Index>(s)], kEmptyCell, key);
+      if (found == kEmptyCell || found == key) break;
+      s = (s + 1) & cells.mask;
+    }
+    slot_of[i] = static_cast<std::int32_t>(s);
+    atomic_fetch_add(&count[static_cast<Index>(s)], 1);
+  }
+};
 }  // namespace
 
-void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags) {
+void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, bool allow_dense) {
   const Index n = positions.size();
   const Index cap = grid_capacity_for(n);
   const Memory m = current_memory();
@@ -59,46 +124,36 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
     slot_of_agent_ = Buffer<std::int32_t>(n, m);
   }
   mask_ = static_cast<std::uint64_t>(cap - 1);
-  const std::uint64_t mask = mask_;
   GridView cells;  // the cell geometry only (its tables are being built)
   cells.cell_size = cell_size_;
   cells.cell_size_y = cell_size_y_;
   if (periodic_.wraps()) cells.origin = periodic_.origin;
   cells.wrap_x = wrap_x_;
   cells.wrap_y = wrap_y_;
-  auto keys = keys_.span();
-  auto start = start_.span();
-  auto count = count_.span();
-  auto cursor = cursor_.span();
+  cells.mask = mask_;
+  choose_layout(cells, positions, flags, allow_dense);
+  const Index slots = this->slots();
+  auto keys = keys_.span().subspan(0, slots);
+  auto start = start_.span().subspan(0, slots);
+  auto count = count_.span().subspan(0, slots);
+  auto cursor = cursor_.span().subspan(0, slots);
   auto items = items_.span();
   auto slot_of = slot_of_agent_.span();
 
   parallel_for(
-      "sim.bin.clear", cap, THRONG_LAMBDA(Index s) {
+      "sim.bin.clear", slots, THRONG_LAMBDA(Index s) {
         keys[s] = kEmptyCell;
         count[s] = 0;
         cursor[s] = 0;
       });
-  // Histogram: find or claim the agent's cell slot, count it.
-  parallel_for(
-      "sim.bin.count", n, THRONG_LAMBDA(Index i) {
-        if ((flags[i] & 1u) == 0) {
-          slot_of[i] = -1;
-          return;
-        }
-        const std::uint64_t key = cells.key_of(cells.cell_x(positions[i].x), cells.cell_y(positions[i].y));
-        std::uint64_t s = home_slot(key, mask);
-        for (;;) {
-          std::uint64_t found = atomic_load(&keys[static_cast<Index>(s)]);
-          if (found == kEmptyCell) found = atomic_compare_swap(&keys[static_cast<Index>(s)], kEmptyCell, key);
-          if (found == kEmptyCell || found == key) break;
-          s = (s + 1) & mask;
-        }
-        slot_of[i] = static_cast<std::int32_t>(s);
-        atomic_fetch_add(&count[static_cast<Index>(s)], 1);
-      });
+  if (dense())
+    parallel_for("sim.bin.count", n, CountDense{cells, positions, flags, count, slot_of});
+  else
+    parallel_for("sim.bin.count", n, CountHashed{cells, positions, flags, keys, count, slot_of});
   binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
-  // Scatter in arbitrary order, then sort each run by agent index.
+  // Scatter in arbitrary order, then sort each run by agent index (and
+  // give a dense grid's occupied slots their keys, for the slot-by-slot
+  // launches of the four colours).
   parallel_for(
       "sim.bin.scatter", n, THRONG_LAMBDA(Index i) {
         const std::int32_t s = slot_of[i];
@@ -106,11 +161,38 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
         const std::int32_t k = atomic_fetch_add(&cursor[s], 1);
         items[start[s] + k] = static_cast<std::int32_t>(i);
       });
+  const bool is_dense = dense();
   parallel_for(
-      "sim.bin.sort", cap, THRONG_LAMBDA(Index s) {
+      "sim.bin.sort", slots, THRONG_LAMBDA(Index s) {
         const std::int32_t c = count[s];
         if (c > 1) sort_run(items.data() + start[s], c);
+        if (is_dense && c > 0) {
+          const auto x = static_cast<std::int32_t>(s % cells.dense_nx),
+                     y = static_cast<std::int32_t>(s / cells.dense_nx);
+          keys[s] = cell_key(cells.dense_x0 + x, cells.dense_y0 + y);
+        }
       });
+}
+
+// Dense when the box of the occupied cells (every cell of a wrapping axis)
+// has no more cells than the table has slots; records the box in `cells`.
+void AgentGrid::choose_layout(GridView& cells, Span<const glm::vec2> positions, Span<const std::uint8_t> flags,
+                              bool allow_dense) {
+  dense_nx_ = dense_ny_ = 0;
+  if (allow_dense) {
+    const CellBox none{kCellCoordLimit, kCellCoordLimit, -kCellCoordLimit, -kCellCoordLimit};
+    CellBox box =
+        parallel_reduce("sim.bin.box", positions.size(), none, CellOfAgent{cells, positions, flags}, Enclose{});
+    if (wrap_x_ > 0) box.x0 = 0, box.x1 = wrap_x_ - 1;
+    if (wrap_y_ > 0) box.y0 = 0, box.y1 = wrap_y_ - 1;
+    const std::int64_t nx = std::int64_t{box.x1} - box.x0 + 1, ny = std::int64_t{box.y1} - box.y0 + 1;
+    if (box.x0 <= box.x1 && box.y0 <= box.y1 && nx * ny <= keys_.size()) {
+      dense_x0_ = box.x0, dense_y0_ = box.y0;
+      dense_nx_ = static_cast<std::int32_t>(nx), dense_ny_ = static_cast<std::int32_t>(ny);
+    }
+  }
+  cells.dense_x0 = dense_x0_, cells.dense_y0 = dense_y0_;
+  cells.dense_nx = dense_nx_, cells.dense_ny = dense_ny_;
 }
 
 }  // namespace throng::sim

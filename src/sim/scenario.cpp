@@ -35,6 +35,8 @@ void ModelParams::validate() const {
     throw Error(fmt::format("extra contact iterations must be in [0, 64] (got {})", contact_extra_iterations),
                 at_field("model.contact_extra_iterations"));
   check_range(contact_tolerance, 0.0f, 1.0f, true, "model.contact_tolerance", "contact tolerance (m)");
+  check_range(body_radius_limit, 0.0f, 10.0f, true, "model.max_radius",
+              "largest agent radius (m; 0 = the model's default)");
   check_range(cfs.time_gap, 0.0f, 100.0f, false, "model.time_gap", "time gap (s)");
   check_range(cfs.neighbour_strength, 0.0f, 1000.0f, true, "model.neighbour_strength", "neighbour repulsion strength");
   check_range(cfs.neighbour_range, 0.001f, 10.0f, true, "model.neighbour_range", "neighbour repulsion range (m)");

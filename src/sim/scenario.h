@@ -105,24 +105,30 @@ struct ModelParams {
   // by more than contact_tolerance (a jam; see sim/simulation.h).
   std::int32_t contact_extra_iterations = 8;
   float contact_tolerance = 0.03f;  // m
+  // m: the largest agent radius the scenario may use (0: the model's
+  // default, max_radius() below); the collision-free speed model's bins
+  // grow with it.
+  float body_radius_limit = 0.0f;
   // Side of the steering bins: every neighbour the model looks at lies
   // within it. Priority: 2 * pred_time * max_speed (the paper's). Collision-
   // free speed: the gap that allows max_speed (T * max_speed) plus two of
-  // the largest radius (kCfsMaxRadius), at least the anticipation reach.
+  // the largest radius (max_radius()), at least the anticipation reach.
   // Time to collision and social force: their sensing radius.
   THRONG_HOST_DEVICE float query_radius() const {
     if (kind == ModelKind::Priority) return 2.0f * pred_time * max_speed;
     if (kind == ModelKind::Ttc) return ttc.sensing_radius;
     if (kind == ModelKind::SocialForce) return sf.sensing_radius;
     const float gap = cfs.time_gap * max_speed, anticipate = 0.5f * cfs.avoid_time * max_speed;
-    return 2.0f * kCfsMaxRadius + (gap > anticipate ? gap : anticipate);
+    return 2.0f * max_radius() + (gap > anticipate ? gap : anticipate);
   }
-  // The largest agent radius the bins allow (time to collision and social
-  // force: as the collision-free speed model).
+  // The largest agent radius the bins allow: body_radius_limit when given,
+  // else pred_time * max_speed for the priority model and kDefaultMaxRadius
+  // for the others.
   THRONG_HOST_DEVICE float max_radius() const {
-    return kind == ModelKind::Priority ? pred_time * max_speed : kCfsMaxRadius;
+    if (body_radius_limit > 0.0f) return body_radius_limit;
+    return kind == ModelKind::Priority ? pred_time * max_speed : kDefaultMaxRadius;
   }
-  static constexpr float kCfsMaxRadius = 0.5f;  // m
+  static constexpr float kDefaultMaxRadius = 0.5f;  // m
   // Throws Error naming the field ("model.pred_time") for NaN, negative or
   // out-of-range values.
   void validate() const;

@@ -148,7 +148,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   // (the same speeds, far fewer neighbours). Past kCfsHolders of them (a
   // crush) the gap passes walk the bins.
   const float hold =
-      me.radius + ModelParams::kCfsMaxRadius + v0 * fmaxf(c.time_gap, dt) + m.max_speed * c.anticipation_time + 1e-3f;
+      me.radius + m.max_radius() + v0 * fmaxf(c.time_gap, dt) + m.max_speed * c.anticipation_time + 1e-3f;
   std::int32_t holders[kCfsHolders];
   int held = 0;
   for_each_candidate([&](Index j) {

@@ -19,7 +19,11 @@ AgentArrays arrays_of(CrowdState& c) {
 }
 
 Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& options)
-    : spec_(spec), scheduler_(spec.scheduler), neighbours_(options.neighbours) {
+    : spec_(spec),
+      scheduler_(spec.scheduler),
+      neighbours_(options.neighbours),
+      dense_bins_(options.dense_bins),
+      skip_idle_contact_passes_(options.skip_idle_contact_passes) {
   spec_.model.validate();
   world_ = World::build(spec_.world, spec_.model.query_radius(), options.limits, current_memory());
   const CrowdHost host = spawn_crowd(spec_, world_, options.limits, options.planner);
@@ -182,8 +186,8 @@ void Simulation::step() {
 }
 
 void Simulation::bin() {
-  bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
-  contact_bins_.rebuild(crowd_.position.span(), crowd_.flags.span());
+  bins_.rebuild(crowd_.position.span(), crowd_.flags.span(), dense_bins_);
+  contact_bins_.rebuild(crowd_.position.span(), crowd_.flags.span(), dense_bins_);
 }
 
 // The arriving agents due by now, in order of entry time, each entering
@@ -255,11 +259,20 @@ void Simulation::move(const StepContext& ctx) {
     }
   };
   if (scheduler_ == SchedulerKind::DoubleBuffer) {  // (the all-pairs reference included)
+    // A pass that moved nobody ends them: the passes left, fixed or extra,
+    // would each give these positions again (bit for bit), so a sparse
+    // crowd pays for one pass.
     Span<glm::vec2> in = candidate_.span(), out = scratch_.span();
-    run_passes([&] {
+    const std::int32_t most = m.contact_iterations > 0 ? m.contact_iterations + m.contact_extra_iterations : 0;
+    for (contact_passes_ = 0; contact_passes_ < most;) {
       contacts_double_buffer(ctx, a, anchor, cells, in, out, depth);
+      ++contact_passes_;
+      const ContactPass pass = contact_pass_outcome(depth, in, out);
       std::swap(in, out);
-    });
+      if ((skip_idle_contact_passes_ && !pass.moved) ||
+          (contact_passes_ >= m.contact_iterations && pass.deepest <= m.contact_tolerance))
+        break;
+    }
     finalize_step(ctx, a, anchor, cells, in);
   } else {
     run_passes([&] { contacts_four_colour(ctx, a, anchor, cells, depth); });

@@ -122,6 +122,14 @@ void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<con
                           Span<const MoveCells> cells, Span<float> depth);
 // The deepest of the per-agent overlaps a contact pass wrote.
 float deepest_contact(Span<const float> depth);
+// The same for a double-buffer pass from `in` to `out`, and whether it
+// moved any agent: a pass that moved none would give the same positions
+// again, and so would every pass after it.
+struct ContactPass {
+  float deepest = 0.0f;  // m
+  bool moved = false;
+};
+ContactPass contact_pass_outcome(Span<const float> depth, Span<const glm::vec2> in, Span<const glm::vec2> out);
 // Both: accepts or rejects each moved position, sets velocity, heading,
 // arrivals and waypoints. `moved` may alias a.position.
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
@@ -161,6 +169,12 @@ struct SimulationOptions {
   // (the simulation keeps the builder). Null: none.
   std::shared_ptr<const FieldBuilder> fields;
   NeighbourSearch neighbours = NeighbourSearch::Bins;
+  // The reference forms of two shortcuts that change no result (tests
+  // compare them bit for bit): bins hashed even where a dense box of cells
+  // fits (AgentGrid), and every contact pass run even after one that moved
+  // nobody (the double buffer's passes).
+  bool dense_bins = true;
+  bool skip_idle_contact_passes = true;
 };
 
 class Simulation {
@@ -187,7 +201,8 @@ class Simulation {
   void set_scheduler(SchedulerKind s) { scheduler_ = s; }
   std::int64_t steps_done() const { return steps_done_; }
   // Contact passes the last step ran: contact_iterations, plus the extra
-  // passes a jam needed.
+  // passes a jam needed; under the double buffer fewer when a pass moved
+  // nobody (the passes left would have changed nothing).
   std::int32_t last_contact_passes() const { return contact_passes_; }
   double time() const { return static_cast<double>(steps_done_) * spec_.dt; }
   Index agent_count() const { return crowd_.count; }
@@ -222,6 +237,7 @@ class Simulation {
   AgentGrid contact_bins_;
   SchedulerKind scheduler_ = SchedulerKind::DoubleBuffer;
   NeighbourSearch neighbours_ = NeighbourSearch::Bins;
+  bool dense_bins_ = true, skip_idle_contact_passes_ = true;
   float max_radius_ = 0.0f;
   std::int64_t steps_done_ = 0;
   std::int32_t contact_passes_ = 0;

@@ -1,5 +1,7 @@
 // The per-step stages of the crowd simulation. Compiled by nvcc in CUDA
 // builds: bodies touch only spans and values.
+#include <cstring>
+
 #include "core/parallel.h"
 #include "core/reduce.h"
 #include "sim/sense.h"
@@ -541,6 +543,37 @@ float deepest_contact(Span<const float> depth) {
   return parallel_reduce(
       "sim.move.contacts.deepest", depth.size(), 0.0f, THRONG_LAMBDA(Index i)->float { return depth[i]; },
       THRONG_LAMBDA(float x, float y)->float { return x > y ? x : y; });
+}
+
+namespace {
+// What one double-buffer contact pass did: its deepest overlap and whether
+// it moved any agent (bit for bit, so -0 differs from 0).
+struct PassOutcome {
+  float deepest;
+  bool moved;
+};
+struct OutcomeOf {
+  Span<const float> depth;
+  Span<const glm::vec2> in, out;
+  THRONG_HOST_DEVICE PassOutcome operator()(Index i) const {
+    const glm::vec2 a = in[i], b = out[i];
+    std::uint32_t bits_a[2], bits_b[2];
+    memcpy(bits_a, &a, sizeof bits_a);
+    memcpy(bits_b, &b, sizeof bits_b);
+    return {depth[i], bits_a[0] != bits_b[0] || bits_a[1] != bits_b[1]};
+  }
+};
+struct CombineOutcome {
+  THRONG_HOST_DEVICE PassOutcome operator()(const PassOutcome& a, const PassOutcome& b) const {
+    return {a.deepest > b.deepest ? a.deepest : b.deepest, a.moved || b.moved};
+  }
+};
+}  // namespace
+
+ContactPass contact_pass_outcome(Span<const float> depth, Span<const glm::vec2> in, Span<const glm::vec2> out) {
+  const PassOutcome o = parallel_reduce("sim.move.contacts.outcome", depth.size(), PassOutcome{0.0f, false},
+                                        OutcomeOf{depth, in, out}, CombineOutcome{});
+  return {o.deepest, o.moved};
 }
 
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,

@@ -144,7 +144,7 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
     const NeighbourArrays n{Span<const glm::vec2>(p), Span<const glm::vec2>(v), Span<const float>(r),
                             Span<const std::uint8_t>(f), Periodic{}};
     const float v0 = 1.3f, dt = 0.1f;
-    const float hold = r[0] + ModelParams::kCfsMaxRadius + v0 * m.cfs.time_gap + m.max_speed * l.anticipation;
+    const float hold = r[0] + m.max_radius() + v0 * m.cfs.time_gap + m.max_speed * l.anticipation;
     Index near = 0;
     for (const glm::vec2 q : p) near += glm::length(q) < hold ? 1 : 0;
     EXPECT_EQ(near - 1 > kCfsHolders, l.overflows) << near - 1 << " neighbours within " << hold << " m";

@@ -60,19 +60,69 @@ TEST(CountingSort, EveryActiveAgentOnceInItsCellInIndexOrder) {
     want[{cell_coord(p[i].x, cell), cell_coord(p[i].y, cell)}].push_back(static_cast<std::int32_t>(i));
     ++active;
   }
-  for (int threads : {1, 2, 4}) {
-    ScopedExecution exec(Backend::Cpu, threads);
-    AgentGrid g(cell);
-    g.rebuild(p, flags);
-    const Binned got = read_back(g);
-    EXPECT_EQ(got.binned, active) << threads;
-    EXPECT_EQ(got.cells, want) << threads << " threads";
-    EXPECT_EQ(g.occupied_cells(), static_cast<Index>(want.size()));
-    // find() reaches every cell; an empty cell is not found.
-    const GridView v = g.view();
-    for (const auto& [c, items] : want) ASSERT_GE(v.find(c.first, c.second), 0);
-    EXPECT_EQ(v.find(100000, 100000), -1);
-  }
+  // The box of occupied cells (76 x 76) fits the table: dense unless
+  // hashing is asked for; both layouts hold the same runs.
+  for (const bool dense : {true, false})
+    for (int threads : {1, 2, 4}) {
+      SCOPED_TRACE(dense ? "dense" : "hashed");
+      ScopedExecution exec(Backend::Cpu, threads);
+      AgentGrid g(cell);
+      g.rebuild(p, flags, dense);
+      EXPECT_EQ(g.dense(), dense);
+      const Binned got = read_back(g);
+      EXPECT_EQ(got.binned, active) << threads;
+      EXPECT_EQ(got.cells, want) << threads << " threads";
+      EXPECT_EQ(g.occupied_cells(), static_cast<Index>(want.size()));
+      // find() reaches every cell; an empty cell is not found, in the box or out of it.
+      const GridView v = g.view();
+      for (const auto& [c, items] : want) {
+        const Index s = v.find(c.first, c.second);
+        ASSERT_GE(s, 0);
+        EXPECT_EQ(v.count[s], static_cast<std::int32_t>(items.size()));
+      }
+      EXPECT_EQ(v.find(100000, 100000), -1);
+      EXPECT_EQ(v.find(-100000, 3), -1);
+      for (std::int32_t x = -40; x <= 40; ++x)
+        for (std::int32_t y = -40; y <= 40; ++y)
+          if (!want.count({x, y})) ASSERT_EQ(v.find(x, y), -1) << x << ", " << y;
+    }
+}
+
+// Over a periodic area the dense box spans each wrapping period, and a
+// lookup past the seam finds the cell at the other end, as the hashed
+// grid's does.
+TEST(CountingSort, DenseAndHashedGridsWrapAlike) {
+  const Periodic periodic{{0.0f, 0.0f}, {40.0f, 0.0f}};
+  std::vector<glm::vec2> p = random_points(400, 20.0f, 6);
+  for (auto& q : p) q.x = std::fabs(q.x) * 1.99f;  // inside the period [0, 40)
+  const std::vector<std::uint8_t> flags(p.size(), kAgentActive);
+  AgentGrid dense(4.0f, periodic), hashed(4.0f, periodic);
+  dense.rebuild(p, flags);
+  hashed.rebuild(p, flags, false);
+  ASSERT_TRUE(dense.dense());
+  ASSERT_FALSE(hashed.dense());
+  EXPECT_EQ(read_back(dense).cells, read_back(hashed).cells);
+  const GridView d = dense.view(), h = hashed.view();
+  for (std::int32_t x = -12; x <= 22; ++x)
+    for (std::int32_t y = -8; y <= 8; ++y) {
+      const Index a = d.find(x, y), b = h.find(x, y);
+      ASSERT_EQ(a < 0, b < 0) << x << ", " << y;
+      if (a >= 0) EXPECT_EQ(d.count[a], h.count[b]);
+    }
+}
+
+// Agents spread far apart (a box of cells much larger than the table)
+// are hashed: memory follows the agents, not the box.
+TEST(CountingSort, ASparseCrowdIsHashed) {
+  std::vector<glm::vec2> p = {{0.0f, 0.0f}, {5000.0f, 5000.0f}, {10.0f, 10.0f}};
+  const std::vector<std::uint8_t> flags(p.size(), kAgentActive);
+  AgentGrid g(4.0f);
+  g.rebuild(p, flags);
+  EXPECT_FALSE(g.dense());
+  p[1] = {12.0f, 4.0f};
+  g.rebuild(p, flags);
+  EXPECT_TRUE(g.dense());  // 4 x 3 cells fit the table's 16 slots
+  EXPECT_EQ(read_back(g).cells.size(), 3u);
 }
 
 TEST(CountingSort, RebuildAfterMovingAndWithNoAgents) {
