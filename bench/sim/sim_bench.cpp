@@ -2,9 +2,10 @@
 // built-in plaza (1200 m x 1200 m, 3000 obstacles) with 10^3 to 10^6 agents,
 // for every steering model under both schedulers, and the naive O(N^2)
 // reference (every agent senses every other; contacts still binned) up to
-// 10^4 agents. Rows: sim/plaza_step/<model>/<scheduler>. And RVO2's disc
-// (disc_scenario_text below), the layout its example and peers/rvo_circle
-// time, for the default model and the paper's: sim/disc_step/<model>, and
+// 10^4 agents. Rows: sim/plaza_step/<model>/<scheduler>. And the disc
+// (disc_scenario_text below) with RVO2's example body and step, the layout
+// the RVO2 driver of ../shared/peers (rvo_circle.cc, `disk`) times, for the
+// default model and the paper's: sim/disc_step/<model>, and
 // beside it at 10^5 and 10^6 the same step without the shortcuts that
 // change no bit (sim/disc_step/<model>/reference).
 // Items are agent-steps, so items/s is agent-steps per second and the
@@ -74,7 +75,8 @@ groups:
 }
 
 // `reference`: the step without its shortcuts (hashed bins, every contact
-// pass; sim::SimulationOptions), the same bits at the cost before them.
+// pass; sim::SimulationOptions): the same bits, at what they cost before
+// the shortcuts.
 sim::Simulation& disc(Index n, sim::ModelKind model, bool reference) {
   static std::map<std::tuple<Index, sim::ModelKind, bool, Backend>, std::unique_ptr<sim::Simulation>> cache;
   auto& slot = cache[{n, model, reference, current_backend()}];

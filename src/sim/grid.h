@@ -1,9 +1,11 @@
 // Sparse uniform grids: cell (cx, cy) -> a run of item indices.
 //
-// Only occupied cells are stored, in an open-addressing hash table keyed by
-// the packed cell coordinates, so memory grows with the items and the area
-// they occupy, never with the extent of the scene (a 10 km scene with a few
-// agents costs a few cells). Two builders share one view type:
+// Cells live in a table of about twice as many slots as items: an
+// open-addressing hash table of the occupied cells keyed by the packed cell
+// coordinates, or, for agents whose box of occupied cells fits the table,
+// that box densely (GridView below). Memory grows with the items, never
+// with the extent of the scene (a 10 km scene with a few agents costs a few
+// cells). Two builders share one view type:
 //   - StaticGrid: built once on the host from (cell, item) pairs (obstacles);
 //   - AgentGrid: rebuilt every step by a counting sort through parallel_for
 //     (histogram with atomics -> exclusive_scan -> scatter -> sort inside each

@@ -267,11 +267,16 @@ void Simulation::move(const StepContext& ctx) {
     for (contact_passes_ = 0; contact_passes_ < most;) {
       contacts_double_buffer(ctx, a, anchor, cells, in, out, depth);
       ++contact_passes_;
-      const ContactPass pass = contact_pass_outcome(depth, in, out);
+      const bool fixed_done = contact_passes_ >= m.contact_iterations;
+      bool done = false;
+      if (skip_idle_contact_passes_) {
+        const ContactPass pass = contact_pass_outcome(depth, in, out);
+        done = !pass.moved || (fixed_done && pass.deepest <= m.contact_tolerance);
+      } else {
+        done = fixed_done && deepest_contact(depth) <= m.contact_tolerance;
+      }
       std::swap(in, out);
-      if ((skip_idle_contact_passes_ && !pass.moved) ||
-          (contact_passes_ >= m.contact_iterations && pass.deepest <= m.contact_tolerance))
-        break;
+      if (done) break;
     }
     finalize_step(ctx, a, anchor, cells, in);
   } else {
