@@ -84,7 +84,9 @@ TEST(CountingSort, EveryActiveAgentOnceInItsCellInIndexOrder) {
       EXPECT_EQ(v.find(-100000, 3), -1);
       for (std::int32_t x = -40; x <= 40; ++x)
         for (std::int32_t y = -40; y <= 40; ++y)
-          if (!want.count({x, y})) ASSERT_EQ(v.find(x, y), -1) << x << ", " << y;
+          if (!want.count({x, y})) {
+            ASSERT_EQ(v.find(x, y), -1) << x << ", " << y;
+          }
     }
 }
 
@@ -107,7 +109,9 @@ TEST(CountingSort, DenseAndHashedGridsWrapAlike) {
     for (std::int32_t y = -8; y <= 8; ++y) {
       const Index a = d.find(x, y), b = h.find(x, y);
       ASSERT_EQ(a < 0, b < 0) << x << ", " << y;
-      if (a >= 0) EXPECT_EQ(d.count[a], h.count[b]);
+      if (a >= 0) {
+        EXPECT_EQ(d.count[a], h.count[b]);
+      }
     }
 }
 
