@@ -65,26 +65,9 @@ struct Enclose {
 };
 
 // The slot of each active agent's cell (-1 for inactive agents), its count
-// raised, in a dense grid: the index of the cell in the box, no hashing.
-struct CountDense {
-  GridView cells;
-  Span<const glm::vec2> positions;
-  Span<const std::uint8_t> flags;
-  Span<std::int32_t> count, slot_of;
-  THRONG_HOST_DEVICE void operator()(Index i) const {
-    if ((flags[i] & 1u) == 0) {
-      slot_of[i] = -1;
-      return;
-    }
-    std::int32_t cx = cells.cell_x(positions[i].x), cy = cells.cell_y(positions[i].y);
-    cells.wrap(cx, cy);
-    const Index s = cells.dense_slot(cx, cy);
-    slot_of[i] = static_cast<std::int32_t>(s);
-    atomic_fetch_add(&count[s], 1);
-  }
-};
-// The same in a hashed grid: find or claim the cell's slot by probing.
-struct CountHashed {
+// raised. A dense grid's slot is the cell's index in the box, no hashing; a
+// hashed grid finds or claims the cell's slot by probing.
+struct CountCells {
   GridView cells;
   Span<const glm::vec2> positions;
   Span<const std::uint8_t> flags;
@@ -95,16 +78,20 @@ struct CountHashed {
       slot_of[i] = -1;
       return;
     }
-    const std::uint64_t key = cells.key_of(cells.cell_x(positions[i].x), cells.cell_y(positions[i].y));
+    std::int32_t cx = cells.cell_x(positions[i].x), cy = cells.cell_y(positions[i].y);
+    cells.wrap(cx, cy);
+    const Index s = cells.dense_nx > 0 ? cells.dense_slot(cx, cy) : claim(cells.key_of(cx, cy));
+    slot_of[i] = static_cast<std::int32_t>(s);
+    atomic_fetch_add(&count[s], 1);
+  }
+  THRONG_HOST_DEVICE Index claim(std::uint64_t key) const {
     std::uint64_t s = home_slot(key, cells.mask);
     for (;;) {
       std::uint64_t found = atomic_load(&keys[static_cast<Index>(s)]);
       if (found == kEmptyCell) found = atomic_compare_swap(&keys[static_cast<Index>(s)], kEmptyCell, key);
-      if (found == kEmptyCell || found == key) break;
+      if (found == kEmptyCell || found == key) return static_cast<Index>(s);
       s = (s + 1) & cells.mask;
     }
-    slot_of[i] = static_cast<std::int32_t>(s);
-    atomic_fetch_add(&count[static_cast<Index>(s)], 1);
   }
 };
 }  // namespace
@@ -146,10 +133,7 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
         count[s] = 0;
         cursor[s] = 0;
       });
-  if (dense())
-    parallel_for("sim.bin.count", n, CountDense{cells, positions, flags, count, slot_of});
-  else
-    parallel_for("sim.bin.count", n, CountHashed{cells, positions, flags, keys, count, slot_of});
+  parallel_for("sim.bin.count", n, CountCells{cells, positions, flags, keys, count, slot_of});
   binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
   // Scatter in arbitrary order, then sort each run by agent index (and
   // give a dense grid's occupied slots their keys, for the slot-by-slot

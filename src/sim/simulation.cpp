@@ -249,38 +249,32 @@ void Simulation::move(const StepContext& ctx) {
   const Span<float> depth = contact_depth_.span();
   const ModelParams& m = spec_.model;
   // The fixed passes, then extra ones while the last pass found a pair
-  // deeper than the tolerance (the depth it saw before pushing).
+  // deeper than the tolerance (the depth it saw before pushing). A pass that
+  // moved nobody ends them: the passes left, fixed or extra, would each give
+  // the same positions again (bit for bit), so a sparse crowd pays for one
+  // pass. `pass(want_depth)` runs one and says what it did.
+  const std::int32_t most = m.contact_iterations > 0 ? m.contact_iterations + m.contact_extra_iterations : 0;
   auto run_passes = [&](auto&& pass) {
-    for (contact_passes_ = 0; contact_passes_ < m.contact_iterations; ++contact_passes_) pass();
-    while (m.contact_iterations > 0 && contact_passes_ < m.contact_iterations + m.contact_extra_iterations &&
-           deepest_contact(depth) > m.contact_tolerance) {
-      pass();
+    for (contact_passes_ = 0; contact_passes_ < most;) {
+      const ContactPass done = pass(contact_passes_ + 1 >= m.contact_iterations);
       ++contact_passes_;
+      if (!done.moved || (contact_passes_ >= m.contact_iterations && done.deepest <= m.contact_tolerance)) break;
     }
   };
   if (scheduler_ == SchedulerKind::DoubleBuffer) {  // (the all-pairs reference included)
-    // A pass that moved nobody ends them: the passes left, fixed or extra,
-    // would each give these positions again (bit for bit), so a sparse
-    // crowd pays for one pass.
     Span<glm::vec2> in = candidate_.span(), out = scratch_.span();
-    const std::int32_t most = m.contact_iterations > 0 ? m.contact_iterations + m.contact_extra_iterations : 0;
-    for (contact_passes_ = 0; contact_passes_ < most;) {
+    run_passes([&](bool want_depth) {
       contacts_double_buffer(ctx, a, anchor, cells, in, out, depth);
-      ++contact_passes_;
-      const bool fixed_done = contact_passes_ >= m.contact_iterations;
-      bool done = false;
-      if (skip_idle_contact_passes_) {
-        const ContactPass pass = contact_pass_outcome(depth, in, out);
-        done = !pass.moved || (fixed_done && pass.deepest <= m.contact_tolerance);
-      } else {
-        done = fixed_done && deepest_contact(depth) <= m.contact_tolerance;
-      }
       std::swap(in, out);
-      if (done) break;
-    }
+      if (skip_idle_contact_passes_) return contact_pass_outcome(depth, out, in);
+      return ContactPass{want_depth ? deepest_contact(depth) : 0.0f, true};
+    });
     finalize_step(ctx, a, anchor, cells, in);
-  } else {
-    run_passes([&] { contacts_four_colour(ctx, a, anchor, cells, depth); });
+  } else {  // in place: whether a pass moved anybody is not kept
+    run_passes([&](bool want_depth) {
+      contacts_four_colour(ctx, a, anchor, cells, depth);
+      return ContactPass{want_depth ? deepest_contact(depth) : 0.0f, true};
+    });
     finalize_step(ctx, a, anchor, cells, a.position);
   }
 }

@@ -546,16 +546,12 @@ float deepest_contact(Span<const float> depth) {
 }
 
 namespace {
-// What one double-buffer contact pass did: its deepest overlap and whether
-// it moved any agent (bit for bit, so -0 differs from 0).
-struct PassOutcome {
-  float deepest;
-  bool moved;
-};
+// One agent's share of a double-buffer pass's outcome: moved bit for bit,
+// so -0 differs from 0.
 struct OutcomeOf {
   Span<const float> depth;
   Span<const glm::vec2> in, out;
-  THRONG_HOST_DEVICE PassOutcome operator()(Index i) const {
+  THRONG_HOST_DEVICE ContactPass operator()(Index i) const {
     const glm::vec2 a = in[i], b = out[i];
     std::uint32_t bits_a[2], bits_b[2];
     memcpy(bits_a, &a, sizeof bits_a);
@@ -564,16 +560,15 @@ struct OutcomeOf {
   }
 };
 struct CombineOutcome {
-  THRONG_HOST_DEVICE PassOutcome operator()(const PassOutcome& a, const PassOutcome& b) const {
+  THRONG_HOST_DEVICE ContactPass operator()(const ContactPass& a, const ContactPass& b) const {
     return {a.deepest > b.deepest ? a.deepest : b.deepest, a.moved || b.moved};
   }
 };
 }  // namespace
 
 ContactPass contact_pass_outcome(Span<const float> depth, Span<const glm::vec2> in, Span<const glm::vec2> out) {
-  const PassOutcome o = parallel_reduce("sim.move.contacts.outcome", depth.size(), PassOutcome{0.0f, false},
-                                        OutcomeOf{depth, in, out}, CombineOutcome{});
-  return {o.deepest, o.moved};
+  return parallel_reduce("sim.move.contacts.outcome", depth.size(), ContactPass{0.0f, false}, OutcomeOf{depth, in, out},
+                         CombineOutcome{});
 }
 
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
