@@ -20,10 +20,8 @@ using motion::BlendSpaceView;
 // at its offset from the path point, lowered by the IK's pelvis drop.
 void synthesise_local(const BlendSpaceView& v, const BlendPoint& p, float phase, Pose& out) {
   const motion::CharacterFrame f = motion::character_frame_at(v, p, phase, glm::vec3(0.0f), 0.0f, 1.0f);
-  const motion::PlantedLegs legs = motion::plant_legs(v, f, nullptr);
   out.local.resize(static_cast<std::size_t>(v.joint_count));
-  for (std::int32_t j = 0; j < v.joint_count; ++j)
-    out.local[static_cast<std::size_t>(j)] = motion::synthesised_rotation(v, f, legs, j);
+  const motion::PlantedLegs legs = motion::synthesise_locals(v, f, nullptr, out.local.data());
   out.local[0] = f.frame * out.local[0];
   out.root = f.root_position - glm::vec3(0.0f, legs.pelvis_drop, 0.0f);
 }

@@ -184,9 +184,8 @@ CachedCycle CycleCacheTable::synthesise(std::int32_t segment, float w, std::vect
   for (std::int32_t k = 0; k < frames_; ++k) {
     const float phase = static_cast<float>(k) / static_cast<float>(frames_);
     const motion::CharacterFrame f = motion::character_frame_at(view, point, phase, glm::vec3(0.0f), 0.0f, 1.0f);
-    const motion::PlantedLegs legs = motion::plant_legs(view, f, nullptr);
-    for (std::int32_t j = 0; j < J; ++j)
-      cycle.rotations[at(static_cast<Index>(k) * J + j)] = motion::synthesised_rotation(view, f, legs, j);
+    const motion::PlantedLegs legs =
+        motion::synthesise_locals(view, f, nullptr, cycle.rotations.data() + static_cast<std::size_t>(k) * J);
     if (drops != nullptr) (*drops)[at(k)] = legs.pelvis_drop;
   }
   return cycle;
@@ -244,8 +243,7 @@ QuantisationError CycleCacheTable::quantisation_error(std::int32_t w_samples, st
       point.b = view.clip_count > 1 ? segment + 1 : segment;
       point.w = view.clip_count > 1 ? w : 0.0f;
       const motion::CharacterFrame f = motion::character_frame_at(view, point, phase, glm::vec3(0.0f), 0.0f, 1.0f);
-      const motion::PlantedLegs legs = motion::plant_legs(view, f, nullptr);
-      for (std::int32_t j = 0; j < view.joint_count; ++j) out[j] = motion::synthesised_rotation(view, f, legs, j);
+      motion::synthesise_locals(view, f, nullptr, out.data());
     };
     const QuantisationError e =
         measure_quantisation_error(cache_.config(), synthesise_at, exact, w_samples, phase_samples);

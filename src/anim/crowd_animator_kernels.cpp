@@ -10,15 +10,14 @@ namespace throng::anim {
 
 namespace {
 
-// masked_pose's evaluator when a character synthesises: the blend of its two
-// clips (with the leg IK); the root's rotation goes into its world frame.
+// masked_pose's evaluator when a character synthesises: the local rotations
+// synthesise_locals wrote into the output (masked_pose reads joint j before
+// it writes j's world rotation there); the root's goes into its world frame.
 struct SynthesisedJoint {
-  const motion::BlendSpaceView* view;
-  const motion::CharacterFrame* frame;
-  const motion::PlantedLegs* legs;
+  const glm::quat* local;
+  glm::quat frame;
   THRONG_HOST_DEVICE glm::quat operator()(std::int32_t joint) const {
-    const glm::quat q = motion::synthesised_rotation(*view, *frame, *legs, joint);
-    return joint == 0 ? frame->frame * q : q;
+    return joint == 0 ? frame * local[0] : local[joint];
   }
 };
 
@@ -92,8 +91,8 @@ THRONG_HOST_DEVICE inline void pose_character(const PoseJob& job, Index c) {
     n = masked_pose(J, view.parents, view.offsets, mask, e, held, f.root_position - glm::vec3(0.0f, lowered, 0.0f),
                     joints_p, joints_r, f.scale);
   } else {
-    const motion::PlantedLegs legs = motion::plant_legs(view, f, mask);
-    const SynthesisedJoint e{&view, &f, &legs};
+    const motion::PlantedLegs legs = motion::synthesise_locals(view, f, mask, joints_r);
+    const SynthesisedJoint e{joints_r, f.frame};
     n = masked_pose(J, view.parents, view.offsets, mask, e, held,
                     f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f), joints_p, joints_r, f.scale);
   }

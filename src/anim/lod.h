@@ -182,7 +182,9 @@ LodHistogram lod_histogram(Span<const std::uint8_t> levels, Span<const std::uint
 // them all), and otherwise is not evaluated: the joint holds its parent's
 // frame (local rotation held_rotations[j], identity when held_rotations is
 // null) carried by its rest offset times `scale`. The root's evaluate(0) is
-// its world rotation. Returns how many joints were evaluated.
+// its world rotation. Returns how many joints were evaluated. evaluate(j)
+// runs before out_rotations[j] is written, so it may read local rotations
+// stored there.
 template <class Evaluate>
 THRONG_HOST_DEVICE inline std::int32_t masked_pose(std::int32_t joints, const std::int32_t* parents,
                                                    const glm::vec3* offsets, const std::uint32_t* mask,

@@ -129,6 +129,20 @@ THRONG_HOST_DEVICE inline bool plants_leg(const BlendSpaceView& v, int leg, cons
   return mask_bit(mask, thigh) && mask_bit(mask, knee) && mask_bit(mask, ankle);
 }
 
+// Where the stages read joint rotations: a sampler has blended(j), joint
+// j's blended local rotation (joint_rotation), and clip(leg, c, j), joint
+// j's local rotation in clip c (0 = a, 1 = b) at that leg's rows. This one
+// samples the texture on every call (the reference); SampledJoints
+// (motion/locomotion_pose.h) reads what one pass over the joints sampled.
+struct SampleOnDemand {
+  const BlendSpaceView* v;
+  const CharacterFrame* f;
+  THRONG_HOST_DEVICE glm::quat blended(std::int32_t joint) const { return joint_rotation(*v, *f, joint); }
+  THRONG_HOST_DEVICE glm::quat clip(int leg, int c, std::int32_t joint) const {
+    return clip_rotation(*v, f->rows[1 + leg][c], joint);
+  }
+};
+
 // Stage 1. Where the two clips put one leg's foot. Input: the frame (blend
 // point, the leg's synchronised phases and rows). Output: in the path frame
 // at the canonical phase, scale 1, metres: the lerp by w of the clips'
@@ -141,7 +155,9 @@ struct ClipLegTargets {
   float ground = 0.0f;
   float lift[2] = {0.0f, 0.0f};  // clip a, clip b
 };
-THRONG_HOST_DEVICE inline ClipLegTargets clip_leg_targets(const BlendSpaceView& v, const CharacterFrame& f, int leg) {
+template <class Sampler>
+THRONG_HOST_DEVICE inline ClipLegTargets clip_leg_targets(const BlendSpaceView& v, const CharacterFrame& f, int leg,
+                                                          const Sampler& sample) {
   const LegChain& chain = v.legs[leg];
   const std::int32_t n = chain.count;
   const BlendPoint& p = f.point;
@@ -155,11 +171,11 @@ THRONG_HOST_DEVICE inline ClipLegTargets clip_leg_targets(const BlendSpaceView& 
     const float ahead = phase_lead(clip_phase, f.phase);
     glm::vec3 pos = clip_root_offset(v, rows);
     pos.z += info.stride * ahead;
-    glm::quat rot = clip_rotation(v, rows, chain.joints[0]);
+    glm::quat rot = sample.clip(leg, c, chain.joints[0]);
     if (info.turn != 0.0f) rot = yaw_quat(info.turn * ahead) * rot;
     for (std::int32_t i = 1; i < n; ++i) {
       pos += rot * v.offsets[chain.joints[i]];
-      rot = rot * clip_rotation(v, rows, chain.joints[i]);
+      rot = rot * sample.clip(leg, c, chain.joints[i]);
     }
     const float weight = c == 0 ? 1.0f - p.w : p.w;
     out.ankle += weight * pos;
@@ -181,22 +197,24 @@ struct BlendedLeg {
   glm::quat knee{1.0f, 0.0f, 0.0f, 0.0f};
   glm::quat foot{1.0f, 0.0f, 0.0f, 0.0f};
 };
-THRONG_HOST_DEVICE inline BlendedLeg blended_leg(const BlendSpaceView& v, const CharacterFrame& f, int leg) {
+template <class Sampler>
+THRONG_HOST_DEVICE inline BlendedLeg blended_leg(const BlendSpaceView& v, const CharacterFrame& f, int leg,
+                                                 const Sampler& sample) {
   const LegChain& chain = v.legs[leg];
   const std::int32_t n = chain.count;
   const std::int32_t thigh = chain.joints[n - 3], knee = chain.joints[n - 2], ankle = chain.joints[n - 1];
   glm::vec3 pos = f.root.position;
-  glm::quat rot = yaw_quat(f.root.yaw) * joint_rotation(v, f, chain.joints[0]);
+  glm::quat rot = yaw_quat(f.root.yaw) * sample.blended(chain.joints[0]);
   for (std::int32_t i = 1; i + 3 < n; ++i) {
     pos += rot * v.offsets[chain.joints[i]];
-    rot = rot * joint_rotation(v, f, chain.joints[i]);
+    rot = rot * sample.blended(chain.joints[i]);
   }
   BlendedLeg out;
   out.hip_parent = rot;
   out.hip = pos + rot * v.offsets[thigh];
-  out.thigh = rot * joint_rotation(v, f, thigh);
-  out.knee = out.thigh * joint_rotation(v, f, knee);
-  out.foot = out.knee * joint_rotation(v, f, ankle);
+  out.thigh = rot * sample.blended(thigh);
+  out.knee = out.thigh * sample.blended(knee);
+  out.foot = out.knee * sample.blended(ankle);
   return out;
 }
 
@@ -210,12 +228,14 @@ struct PlantedLegGoal {
   glm::vec3 target{0.0f};
   BlendedLeg leg;
 };
-THRONG_HOST_DEVICE inline PlantedLegGoal planted_leg_goal(const BlendSpaceView& v, const CharacterFrame& f, int leg) {
+template <class Sampler>
+THRONG_HOST_DEVICE inline PlantedLegGoal planted_leg_goal(const BlendSpaceView& v, const CharacterFrame& f, int leg,
+                                                          const Sampler& sample) {
   const LegChain& chain = v.legs[leg];
   const BlendPoint& p = f.point;
-  const ClipLegTargets clips = clip_leg_targets(v, f, leg);
+  const ClipLegTargets clips = clip_leg_targets(v, f, leg, sample);
   PlantedLegGoal goal;
-  goal.leg = blended_leg(v, f, leg);
+  goal.leg = blended_leg(v, f, leg, sample);
   glm::vec3 t = clips.ankle;
   if (chain.has_ball) {
     const glm::vec3 ball_offset(chain.ball[0], chain.ball[1], chain.ball[2]);
@@ -263,8 +283,9 @@ THRONG_HOST_DEVICE inline void solve_planted_leg(const BlendSpaceView& v, int le
   out.corrected[leg][2] = glm::inverse(b.knee) * b.foot;
 }
 
+template <class Sampler>
 THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const CharacterFrame& f,
-                                                 const std::uint32_t* mask) {
+                                                 const std::uint32_t* mask, const Sampler& sample) {
   PlantedLegs out;
   if (!v.plant_feet || f.point.w <= 0.0f || f.point.w >= 1.0f) return out;
   PlantedLegGoal goal[2];
@@ -272,7 +293,7 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
   float drop = 0.0f;
   for (int leg = 0; leg < 2; ++leg) {
     if (!plants_leg(v, leg, mask)) continue;
-    goal[leg] = planted_leg_goal(v, f, leg);
+    goal[leg] = planted_leg_goal(v, f, leg, sample);
     use[leg] = true;
     drop = pelvis_drop_to_reach(v, leg, goal[leg], drop);
   }
@@ -280,6 +301,10 @@ THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const 
   for (int leg = 0; leg < 2; ++leg)
     if (use[leg]) solve_planted_leg(v, leg, goal[leg], out);
   return out;
+}
+THRONG_HOST_DEVICE inline PlantedLegs plant_legs(const BlendSpaceView& v, const CharacterFrame& f,
+                                                 const std::uint32_t* mask) {
+  return plant_legs(v, f, mask, SampleOnDemand{&v, &f});
 }
 
 }  // namespace throng::motion

@@ -30,6 +30,61 @@ THRONG_HOST_DEVICE inline glm::quat synthesised_rotation(const BlendSpaceView& v
   return joint_rotation(v, f, joint);
 }
 
+// A character's joints sampled once (the sampler of plant_legs): blended
+// local rotations where the mask keeps the joint, and each clip's rotation
+// of every leg's thigh, knee and ankle; anything else is sampled on demand.
+struct SampledJoints {
+  const BlendSpaceView* v;
+  const CharacterFrame* f;
+  const std::uint32_t* mask;
+  const glm::quat* local;
+  glm::quat leg_clip[2][3][2];  // [leg][thigh, knee, ankle][clip a, b]
+  THRONG_HOST_DEVICE glm::quat blended(std::int32_t joint) const {
+    return mask_bit(mask, joint) ? local[joint] : joint_rotation(*v, *f, joint);
+  }
+  THRONG_HOST_DEVICE glm::quat clip(int leg, int c, std::int32_t joint) const {
+    const LegChain& chain = v->legs[leg];
+    for (int k = 0; k < 3; ++k)
+      if (chain.joints[chain.count - 3 + k] == joint) return leg_clip[leg][k][c];
+    return clip_rotation(*v, f->rows[1 + leg][c], joint);
+  }
+};
+
+// Every local rotation synthesised_rotation gives, bit for bit, each joint
+// sampled once: writes local[j] for the joints the mask keeps (a null mask
+// keeps all) and returns the leg IK's result (for its pelvis drop).
+THRONG_HOST_DEVICE inline PlantedLegs synthesise_locals(const BlendSpaceView& v, const CharacterFrame& f,
+                                                        const std::uint32_t* mask, glm::quat* local) {
+  SampledJoints s{&v, &f, mask, local, {}};
+  const float w = f.point.w;
+  const SlerpAt blend(w);
+  for (std::int32_t j = 0; j < v.joint_count; ++j) {
+    if (!mask_bit(mask, j)) continue;
+    const std::uint8_t g = v.joint_group[j];
+    const ClipRows &ra = f.rows[g][0], &rb = f.rows[g][1];
+    if (w <= 0.0f || w >= 1.0f) {  // one clip, no IK (blended_rotation's shortcut)
+      local[j] = clip_rotation(v, w <= 0.0f ? ra : rb, j);
+      continue;
+    }
+    const glm::quat qa = clip_rotation(v, ra, j), qb = clip_rotation(v, rb, j);
+    local[j] = blend(qa, qb);
+    if (g == 0) continue;
+    const LegChain& chain = v.legs[g - 1];
+    for (int k = 0; k < 3 && chain.count >= 4; ++k)
+      if (chain.joints[chain.count - 3 + k] == j) {
+        s.leg_clip[g - 1][k][0] = qa;
+        s.leg_clip[g - 1][k][1] = qb;
+      }
+  }
+  const PlantedLegs legs = plant_legs(v, f, mask, s);
+  for (int leg = 0; leg < 2; ++leg) {
+    if (!legs.active[leg]) continue;
+    const LegChain& chain = v.legs[leg];
+    for (int k = 0; k < 3; ++k) local[chain.joints[chain.count - 3 + k]] = legs.corrected[leg][k];
+  }
+  return legs;
+}
+
 // World position and rotation of every joint (reference: every joint
 // synthesised; the batch stage adds LOD masks and the cache).
 THRONG_HOST_DEVICE inline void synthesise_pose(const BlendSpaceView& v, const CharacterFrame& f,

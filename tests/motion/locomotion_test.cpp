@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include "core/error.h"
@@ -30,18 +31,37 @@ double angle_deg(const glm::dquat& a, const glm::dquat& b) {
 
 using test::reference_slerp;
 
+// slerp_shortest's weights are a polynomial (no acos, no sine): against
+// SLERP through the exponential map (double), on random pairs and on a
+// sweep of half angles up to pi/2 (opposite rotations, where the series
+// is worst), it turns within 1e-5 rad of the true rotation and stays unit.
 TEST(LocomotionSlerp, SlerpShortestMatchesTheExponentialMapAndKeepsEndsExact) {
+  constexpr double kDeg = kPi / 180.0;
   std::mt19937 rng(7);
   std::normal_distribution<float> g(0.0f, 1.0f);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  double worst = 0.0, worst_length = 0.0;
+  const auto check = [&](const glm::quat& a, const glm::quat& b, float t) {
+    const glm::quat q = slerp_shortest(a, b, t);
+    worst = std::max(worst, angle_deg(glm::dquat(q), reference_slerp(glm::dquat(a), glm::dquat(b), t)) * kDeg);
+    worst_length = std::max(worst_length, std::abs(glm::length(glm::dquat(q)) - 1.0));
+  };
   for (int i = 0; i < 4000; ++i) {
     const glm::quat a = glm::normalize(glm::quat(g(rng), g(rng), g(rng), g(rng)));
     glm::quat b = glm::normalize(glm::quat(g(rng), g(rng), g(rng), g(rng)));
     if (i % 2 == 0) b = -b;  // the other hemisphere: must still take the short way
-    const float t = u(rng);
-    ASSERT_LT(angle_deg(glm::dquat(slerp_shortest(a, b, t)), reference_slerp(glm::dquat(a), glm::dquat(b), t)), 2e-3)
-        << i;
+    check(a, b, u(rng));
   }
+  for (int i = 0; i <= 400; ++i) {
+    const float h = static_cast<float>(i) / 400.0f * static_cast<float>(kPi / 2.0);  // half angle
+    const glm::quat a = glm::normalize(glm::quat(g(rng), g(rng), g(rng), g(rng)));
+    const glm::vec3 axis = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+    const glm::quat b = a * glm::angleAxis(2.0f * h, axis);
+    for (int k = 1; k < 40; ++k) check(a, b, static_cast<float>(k) / 40.0f);
+  }
+  std::printf("polynomial SLERP within %.2e rad of the exponential map, |q| within %.1e of 1\n", worst, worst_length);
+  EXPECT_LT(worst, 1e-5);
+  EXPECT_LT(worst_length, 1e-6);
   const glm::quat a(0.5f, 0.5f, 0.5f, 0.5f), b(0.0f, 1.0f, 0.0f, 0.0f);
   EXPECT_EQ(slerp_shortest(a, b, 0.0f), a);
   EXPECT_EQ(slerp_shortest(a, b, 1.0f), b);
@@ -85,6 +105,91 @@ TEST(LocomotionSlerp, BlendedRotationIsTheReferenceSlerpOfBothClipsSamples) {
     worst = std::max(worst, angle_deg(glm::dquat(blended_rotation(v, p, ph, j)), want));
   }
   EXPECT_LT(worst, 2e-3);
+}
+
+// The pose stage samples each joint once (synthesise_locals) and hands the
+// samples to the leg IK; the reference samples on every call
+// (plant_legs + synthesised_rotation). Same bits, with and without masks
+// (one that turns a leg's knee off turns its IK off).
+TEST(LocomotionPose, SamplingEachJointOnceChangesNoBit) {
+  const BlendSpace1D& space = default_space();
+  const BlendSpaceView v = space.view();
+  const std::int32_t J = v.joint_count;
+  ASSERT_LE(J, 32);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<glm::quat> local(static_cast<std::size_t>(J));
+  int planted = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const float speed = u(rng) * 1.2f * space.max_speed();
+    const CharacterFrame f = character_frame(v, speed, u(rng), glm::vec3(0.0f), 0.0f, 1.0f);
+    std::uint32_t bits = i % 3 == 0 ? 0xffffffffu : static_cast<std::uint32_t>(rng());
+    bits |= 1u;  // the root
+    const std::uint32_t* mask = i % 3 == 1 ? nullptr : &bits;
+    std::fill(local.begin(), local.end(), glm::quat(2.0f, 2.0f, 2.0f, 2.0f));
+    const PlantedLegs got = synthesise_locals(v, f, mask, local.data());
+    const PlantedLegs want = plant_legs(v, f, mask);
+    ASSERT_EQ(got.active[0], want.active[0]) << i;
+    ASSERT_EQ(got.active[1], want.active[1]) << i;
+    ASSERT_EQ(got.pelvis_drop, want.pelvis_drop) << i;
+    planted += got.active[0] ? 1 : 0;
+    for (std::int32_t j = 0; j < J; ++j) {
+      if (!mask_bit(mask, j)) continue;
+      const glm::quat r = synthesised_rotation(v, f, want, j);
+      ASSERT_EQ(std::memcmp(&local[static_cast<std::size_t>(j)], &r, sizeof r), 0) << i << " joint " << j;
+    }
+  }
+  EXPECT_GT(planted, 200);  // the IK ran, on its own samples
+}
+
+// The pose with polynomial SLERP against the same pose with exact SLERP
+// (the exponential map in double) in the blend and in the IK's blended
+// leg: every joint's local and world rotation within 0.01 degrees.
+struct ExactSlerpSampler {
+  const BlendSpaceView* v;
+  const CharacterFrame* f;
+  glm::quat blended(std::int32_t joint) const {
+    const std::uint8_t g = v->joint_group[joint];
+    const glm::quat a = clip_rotation(*v, f->rows[g][0], joint), b = clip_rotation(*v, f->rows[g][1], joint);
+    const float w = f->point.w;
+    if (w <= 0.0f) return a;
+    if (w >= 1.0f) return b;
+    return glm::quat(reference_slerp(glm::dquat(a), glm::dquat(b), w));
+  }
+  glm::quat clip(int leg, int c, std::int32_t joint) const { return clip_rotation(*v, f->rows[1 + leg][c], joint); }
+};
+TEST(LocomotionPose, PolynomialSlerpPoseWithinAHundredthOfADegreeOfExactSlerp) {
+  const BlendSpace1D& space = default_space();
+  const BlendSpaceView v = space.view();
+  const std::int32_t J = v.joint_count;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<glm::quat> local(static_cast<std::size_t>(J)), exact(static_cast<std::size_t>(J));
+  std::vector<glm::dquat> world(static_cast<std::size_t>(J)), world_exact(static_cast<std::size_t>(J));
+  double worst_local = 0.0, worst_world = 0.0;
+  for (int i = 0; i < 2000; ++i) {
+    const CharacterFrame f = character_frame(v, u(rng) * space.max_speed(), u(rng), glm::vec3(0.0f), 0.0f, 1.0f);
+    synthesise_locals(v, f, nullptr, local.data());
+    const ExactSlerpSampler sampler{&v, &f};
+    const PlantedLegs legs = plant_legs(v, f, nullptr, sampler);
+    for (std::int32_t j = 0; j < J; ++j) exact[static_cast<std::size_t>(j)] = sampler.blended(j);
+    for (int leg = 0; leg < 2; ++leg)
+      for (int k = 0; k < 3 && legs.active[leg]; ++k)
+        exact[static_cast<std::size_t>(v.legs[leg].joints[v.legs[leg].count - 3 + k])] = legs.corrected[leg][k];
+    for (std::int32_t j = 0; j < J; ++j) {
+      const auto at = static_cast<std::size_t>(j);
+      const std::int32_t p = v.parents[j];
+      world[at] = (p < 0 ? glm::dquat(1, 0, 0, 0) : world[static_cast<std::size_t>(p)]) * glm::dquat(local[at]);
+      world_exact[at] =
+          (p < 0 ? glm::dquat(1, 0, 0, 0) : world_exact[static_cast<std::size_t>(p)]) * glm::dquat(exact[at]);
+      worst_local = std::max(worst_local, angle_deg(glm::dquat(local[at]), glm::dquat(exact[at])));
+      worst_world = std::max(worst_world, angle_deg(world[at], world_exact[at]));
+    }
+  }
+  std::printf("pose with polynomial SLERP: local within %.2e deg, world within %.2e deg of exact SLERP\n", worst_local,
+              worst_world);
+  EXPECT_LT(worst_local, 0.01);
+  EXPECT_LT(worst_world, 0.01);
 }
 
 TEST(LocomotionPrepare, DefaultClipsBecomeCyclesWithTheirSpeedStrideAndEvents) {
