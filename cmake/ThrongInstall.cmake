@@ -61,7 +61,9 @@ endforeach()
 if(THRONG_PACKAGE_RENDER)
   string(APPEND pc_requires " opengl egl glfw3 imgui stb")
 endif()
-set(pc_cflags "")
+# As the libraries' INTERFACE options (ThrongTargets.cmake): inline code in
+# the headers rounds as it does in the libraries.
+set(pc_cflags " -ffp-contract=off")
 if(THRONG_CUDA)
   string(APPEND pc_cflags " -DTHRONG_HAVE_CUDA")
   string(APPEND pc_libs " -L${CUDAToolkit_LIBRARY_DIR} -lcudart")

@@ -201,8 +201,8 @@ void Blend2DController::evaluate(Pose& out) const {
   if (u <= 0.0f) return;
   Pose turning;
   synthesise_local(turn_space().view(), BlendPoint{}, phase_, turning);
-  for (std::size_t j = 0; j < out.local.size(); ++j)
-    out.local[j] = motion::slerp_shortest(out.local[j], turning.local[j], u);
+  const motion::SlerpAt towards_turn(u);
+  for (std::size_t j = 0; j < out.local.size(); ++j) out.local[j] = towards_turn(out.local[j], turning.local[j]);
   out.root += u * (turning.root - out.root);
 }
 

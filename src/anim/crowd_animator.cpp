@@ -243,6 +243,7 @@ QuantisationError CycleCacheTable::quantisation_error(std::int32_t w_samples, st
       point.b = view.clip_count > 1 ? segment + 1 : segment;
       point.w = view.clip_count > 1 ? w : 0.0f;
       const motion::CharacterFrame f = motion::character_frame_at(view, point, phase, glm::vec3(0.0f), 0.0f, 1.0f);
+      check_length("CrowdAnimator quantisation", "out", out.size(), Index{view.joint_count});
       motion::synthesise_locals(view, f, nullptr, out.data());
     };
     const QuantisationError e =

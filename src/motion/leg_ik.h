@@ -119,6 +119,15 @@ THRONG_HOST_DEVICE inline bool mask_bit(const std::uint32_t* mask, std::int32_t 
   return mask == nullptr || ((mask[joint >> 5] >> (joint & 31)) & 1u) != 0u;
 }
 
+// Which of a leg's thigh, knee and ankle (0, 1, 2) a joint is; -1 for
+// none, or when the chain is too short to plant.
+THRONG_HOST_DEVICE inline int leg_slot(const LegChain& chain, std::int32_t joint) {
+  if (chain.count < 4) return -1;
+  for (int k = 0; k < 3; ++k)
+    if (chain.joints[chain.count - 3 + k] == joint) return k;
+  return -1;
+}
+
 // Whether plant_legs moves a leg (0 left, 1 right): its chain reaches the
 // ankle through thigh and knee, and the mask keeps all three.
 THRONG_HOST_DEVICE inline bool plants_leg(const BlendSpaceView& v, int leg, const std::uint32_t* mask) {

@@ -22,17 +22,16 @@ namespace throng::motion {
 THRONG_HOST_DEVICE inline glm::quat synthesised_rotation(const BlendSpaceView& v, const CharacterFrame& f,
                                                          const PlantedLegs& legs, std::int32_t joint) {
   for (int leg = 0; leg < 2; ++leg) {
-    if (!legs.active[leg]) continue;
-    const LegChain& chain = v.legs[leg];
-    for (int k = 0; k < 3; ++k)
-      if (chain.joints[chain.count - 3 + k] == joint) return legs.corrected[leg][k];
+    const int k = legs.active[leg] ? leg_slot(v.legs[leg], joint) : -1;
+    if (k >= 0) return legs.corrected[leg][k];
   }
   return joint_rotation(v, f, joint);
 }
 
 // A character's joints sampled once (the sampler of plant_legs): blended
 // local rotations where the mask keeps the joint, and each clip's rotation
-// of every leg's thigh, knee and ankle; anything else is sampled on demand.
+// of every leg's thigh, knee and ankle in that leg's group; anything else
+// is sampled on demand.
 struct SampledJoints {
   const BlendSpaceView* v;
   const CharacterFrame* f;
@@ -43,10 +42,8 @@ struct SampledJoints {
     return mask_bit(mask, joint) ? local[joint] : joint_rotation(*v, *f, joint);
   }
   THRONG_HOST_DEVICE glm::quat clip(int leg, int c, std::int32_t joint) const {
-    const LegChain& chain = v->legs[leg];
-    for (int k = 0; k < 3; ++k)
-      if (chain.joints[chain.count - 3 + k] == joint) return leg_clip[leg][k][c];
-    return clip_rotation(*v, f->rows[1 + leg][c], joint);
+    const int k = v->joint_group[joint] == 1 + leg ? leg_slot(v->legs[leg], joint) : -1;
+    return k >= 0 ? leg_clip[leg][k][c] : clip_rotation(*v, f->rows[1 + leg][c], joint);
   }
 };
 
@@ -68,19 +65,18 @@ THRONG_HOST_DEVICE inline PlantedLegs synthesise_locals(const BlendSpaceView& v,
     }
     const glm::quat qa = clip_rotation(v, ra, j), qb = clip_rotation(v, rb, j);
     local[j] = blend(qa, qb);
-    if (g == 0) continue;
-    const LegChain& chain = v.legs[g - 1];
-    for (int k = 0; k < 3 && chain.count >= 4; ++k)
-      if (chain.joints[chain.count - 3 + k] == j) {
-        s.leg_clip[g - 1][k][0] = qa;
-        s.leg_clip[g - 1][k][1] = qb;
-      }
+    // Sampled at the group's rows: the leg's own when the joint is in its
+    // group (each thigh's subtree is; clip() samples anything else anew).
+    const int k = g > 0 ? leg_slot(v.legs[g - 1], j) : -1;
+    if (k >= 0) {
+      s.leg_clip[g - 1][k][0] = qa;
+      s.leg_clip[g - 1][k][1] = qb;
+    }
   }
   const PlantedLegs legs = plant_legs(v, f, mask, s);
   for (int leg = 0; leg < 2; ++leg) {
-    if (!legs.active[leg]) continue;
     const LegChain& chain = v.legs[leg];
-    for (int k = 0; k < 3; ++k) local[chain.joints[chain.count - 3 + k]] = legs.corrected[leg][k];
+    for (int k = 0; k < 3 && legs.active[leg]; ++k) local[chain.joints[chain.count - 3 + k]] = legs.corrected[leg][k];
   }
   return legs;
 }

@@ -52,6 +52,10 @@ echo "$flags"
 incdir=$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --variable=includedir throng)
 [ -f "$incdir/core/buffer.h" ] || fail "includedir $incdir has no core/buffer.h"
 [[ " $flags " == *" -I$incdir "* ]] || fail "--cflags lacks -I$incdir"
+# Inline code in the headers must round as in the libraries (no fused multiply-adds).
+[[ " $flags " == *" -ffp-contract=off "* ]] || fail "--cflags lacks -ffp-contract=off"
+grep -q -- "-ffp-contract=off" "$prefix"/lib/cmake/throng/throngTargets.cmake ||
+  fail "the exported targets do not ask consumers for -ffp-contract=off"
 for lib in io path anim sim motion core; do
   [[ " $flags " == *" -lthrong_$lib "* ]] || fail "--libs lacks -lthrong_$lib"
 done

@@ -43,6 +43,7 @@ TEST(LocomotionSlerp, SlerpShortestMatchesTheExponentialMapAndKeepsEndsExact) {
   double worst = 0.0, worst_length = 0.0;
   const auto check = [&](const glm::quat& a, const glm::quat& b, float t) {
     const glm::quat q = slerp_shortest(a, b, t);
+    ASSERT_TRUE(std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z)) << t;
     worst = std::max(worst, angle_deg(glm::dquat(q), reference_slerp(glm::dquat(a), glm::dquat(b), t)) * kDeg);
     worst_length = std::max(worst_length, std::abs(glm::length(glm::dquat(q)) - 1.0));
   };
@@ -134,7 +135,10 @@ TEST(LocomotionPose, SamplingEachJointOnceChangesNoBit) {
     ASSERT_EQ(got.pelvis_drop, want.pelvis_drop) << i;
     planted += got.active[0] ? 1 : 0;
     for (std::int32_t j = 0; j < J; ++j) {
-      if (!mask_bit(mask, j)) continue;
+      if (!mask_bit(mask, j)) {  // not written
+        ASSERT_EQ(local[static_cast<std::size_t>(j)], glm::quat(2.0f, 2.0f, 2.0f, 2.0f)) << i << " joint " << j;
+        continue;
+      }
       const glm::quat r = synthesised_rotation(v, f, want, j);
       ASSERT_EQ(std::memcmp(&local[static_cast<std::size_t>(j)], &r, sizeof r), 0) << i << " joint " << j;
     }
@@ -144,7 +148,8 @@ TEST(LocomotionPose, SamplingEachJointOnceChangesNoBit) {
 
 // The pose with polynomial SLERP against the same pose with exact SLERP
 // (the exponential map in double) in the blend and in the IK's blended
-// leg: every joint's local and world rotation within 0.01 degrees.
+// leg: every joint's local and world rotation within 0.001 degrees (the
+// polynomial's own error, 3.5e-4 degrees, is all that may show).
 struct ExactSlerpSampler {
   const BlendSpaceView* v;
   const CharacterFrame* f;
@@ -182,14 +187,17 @@ TEST(LocomotionPose, PolynomialSlerpPoseWithinAHundredthOfADegreeOfExactSlerp) {
       world[at] = (p < 0 ? glm::dquat(1, 0, 0, 0) : world[static_cast<std::size_t>(p)]) * glm::dquat(local[at]);
       world_exact[at] =
           (p < 0 ? glm::dquat(1, 0, 0, 0) : world_exact[static_cast<std::size_t>(p)]) * glm::dquat(exact[at]);
-      worst_local = std::max(worst_local, angle_deg(glm::dquat(local[at]), glm::dquat(exact[at])));
-      worst_world = std::max(worst_world, angle_deg(world[at], world_exact[at]));
+      const double d_local = angle_deg(glm::dquat(local[at]), glm::dquat(exact[at]));
+      const double d_world = angle_deg(world[at], world_exact[at]);
+      ASSERT_TRUE(std::isfinite(d_local) && std::isfinite(d_world)) << i << " joint " << j;
+      worst_local = std::max(worst_local, d_local);
+      worst_world = std::max(worst_world, d_world);
     }
   }
   std::printf("pose with polynomial SLERP: local within %.2e deg, world within %.2e deg of exact SLERP\n", worst_local,
               worst_world);
-  EXPECT_LT(worst_local, 0.01);
-  EXPECT_LT(worst_world, 0.01);
+  EXPECT_LT(worst_local, 1e-3);  // the bound asked of it is 0.01
+  EXPECT_LT(worst_world, 1e-3);
 }
 
 TEST(LocomotionPrepare, DefaultClipsBecomeCyclesWithTheirSpeedStrideAndEvents) {
