@@ -59,8 +59,8 @@ THRONG_HOST_DEVICE inline PlantedLegs synthesise_locals(const BlendSpaceView& v,
     if (!mask_bit(mask, j)) continue;
     const std::uint8_t g = v.joint_group[j];
     const ClipRows &ra = f.rows[g][0], &rb = f.rows[g][1];
-    if (w <= 0.0f || w >= 1.0f) {  // one clip, no IK (blended_rotation's shortcut)
-      local[j] = clip_rotation(v, w <= 0.0f ? ra : rb, j);
+    if (w <= 0.0f || w >= 1.0f) {  // one clip, no IK
+      local[j] = blended_rotation(v, w, ra, rb, j);
       continue;
     }
     const glm::quat qa = clip_rotation(v, ra, j), qb = clip_rotation(v, rb, j);
