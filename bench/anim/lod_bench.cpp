@@ -11,6 +11,7 @@
 #include "bench/registry.h"
 #include "core/buffer.h"
 #include "core/camera.h"
+#include "core/exec.h"
 #include "motion/roles.h"
 
 namespace throng::bench {
@@ -110,6 +111,7 @@ void register_anim(const Options& options) {
                   for (auto _ : state) {
                     job.camera = make_camera_view(orbit_at(crowd.half_extent, t));
                     job.run();
+                    finish_device_work();
                     t += 1.0f / 60.0f;
                   }
                   state.SetItemsProcessed(state.iterations() * n);
@@ -140,6 +142,7 @@ void register_anim(const Options& options) {
                   for (auto _ : state) {
                     job.camera = make_camera_view(orbit_at(crowd.half_extent, t));
                     job.run();
+                    finish_device_work();
                     t += 1.0f / 60.0f;
                   }
                   state.SetItemsProcessed(state.iterations() * n);
@@ -166,8 +169,10 @@ void register_anim(const Options& options) {
          job.levels = levels.span();
          job.joint_masks = masks.span();
          job.run();
-         for (auto _ : state)
+         for (auto _ : state) {
            benchmark::DoNotOptimize(lod_histogram(levels.span(), masks.span(), config.level_count, config.joint_count));
+           finish_device_work();
+         }
          state.SetItemsProcessed(state.iterations() * n);
        },
        true});
@@ -221,7 +226,10 @@ void register_anim(const Options& options) {
                     // Warm up: the cache fills with the cycles these speeds need.
                     step();
                     while (variant.cache && animator.last_frame().cycles_stored > 0) step();
-                    for (auto _ : state) step();
+                    for (auto _ : state) {
+                      step();
+                      finish_device_work();
+                    }
                     state.SetItemsProcessed(state.iterations() * n);
                     state.counters["joints_per_character"] =
                         static_cast<double>(animator.last_frame().joints_synthesised) / static_cast<double>(n);

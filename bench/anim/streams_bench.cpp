@@ -233,6 +233,7 @@ void register_streams(const Options& options) {
                   for (auto _ : state) {
                     f.crowd->step();
                     f.crowd->resolve(f.placement->positions.span(), f.placement->yaws.span(), f.palettes.span());
+                    finish_device_work();
                   }
                   state.SetItemsProcessed(state.iterations() * n);
                   f.counters(state);
@@ -243,7 +244,10 @@ void register_streams(const Options& options) {
   add(options, {"anim/streams_step", sizes,
                 [](benchmark::State& state, Index n) {
                   StreamsFixture& f = cached<StreamsFixture>(n);
-                  for (auto _ : state) f.crowd->step();
+                  for (auto _ : state) {
+                    f.crowd->step();
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * n);
                   f.counters(state);
                 },
@@ -253,8 +257,10 @@ void register_streams(const Options& options) {
   add(options, {"anim/streams_resolve", sizes,
                 [](benchmark::State& state, Index n) {
                   StreamsFixture& f = cached<StreamsFixture>(n);
-                  for (auto _ : state)
+                  for (auto _ : state) {
                     f.crowd->resolve(f.placement->positions.span(), f.placement->yaws.span(), f.palettes.span());
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * n);
                   f.counters(state);
                 },
@@ -264,7 +270,10 @@ void register_streams(const Options& options) {
   add(options, {"anim/exact_synthesis_palette", sizes,
                 [](benchmark::State& state, Index n) {
                   ExactFixture& f = cached<ExactFixture>(n);
-                  for (auto _ : state) f.frame();
+                  for (auto _ : state) {
+                    f.frame();
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * n);
                   f.counters(state);
                 },
@@ -274,7 +283,10 @@ void register_streams(const Options& options) {
   add(options, {"anim/locomotion_streams_frame", sizes,
                 [](benchmark::State& state, Index n) {
                   LocomotionFixture& f = cached<LocomotionFixture>(n);
-                  for (auto _ : state) f.loco->animate(&f.camera);
+                  for (auto _ : state) {
+                    f.loco->animate(&f.camera);
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * n);
                   f.counters(state);
                 },

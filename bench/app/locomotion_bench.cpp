@@ -60,8 +60,12 @@ Body frame(bool streams, bool with_step) {
     for (auto _ : state) {
       if (!with_step) state.PauseTiming();
       step();  // a frame per step: agents change speed, bucket and stream as in a run
-      if (!with_step) state.ResumeTiming();
+      if (!with_step) {
+        finish_device_work();  // the step's kernels are not the frame's
+        state.ResumeTiming();
+      }
       locomotion.animate(sim, 1.0f, dt, &camera);
+      finish_device_work();
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
     if (!streams) return;

@@ -4,6 +4,7 @@
 #include "bench/registry.h"
 #include "core/array_kernels.h"
 #include "core/buffer.h"
+#include "core/exec.h"
 
 namespace throng::bench {
 
@@ -14,7 +15,10 @@ void register_core(const Options& options) {
                 [](benchmark::State& state, Index n) {
                   Buffer<float> x(std::vector<float>(static_cast<std::size_t>(n), 1.5f), current_memory());
                   Buffer<float> y = Buffer<float>::zeros(n, current_memory());
-                  for (auto _ : state) saxpy(0.5f, x.span(), y.span());
+                  for (auto _ : state) {
+                    saxpy(0.5f, x.span(), y.span());
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * n);
                 },
                 true});
@@ -29,7 +33,10 @@ void register_core(const Options& options) {
                 [](benchmark::State& state, Index n) {
                   Buffer<std::int32_t> x(std::vector<std::int32_t>(static_cast<std::size_t>(n), 3), current_memory());
                   Buffer<std::int32_t> y(n, current_memory());
-                  for (auto _ : state) benchmark::DoNotOptimize(exclusive_scan(x.span(), y.span()));
+                  for (auto _ : state) {
+                    benchmark::DoNotOptimize(exclusive_scan(x.span(), y.span()));
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * n);
                 },
                 true});

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bench/registry.h"
+#include "core/exec.h"
 #include "core/buffer.h"
 #include "io/bvh_reader.h"
 #include "io/bvh_writer.h"
@@ -128,7 +129,10 @@ void register_motion(const Options& options) {
                   job.frames = frame_of.span();
                   job.out_positions = out_p.span();
                   job.out_rotations = out_r.span();
-                  for (auto _ : state) job.run();
+                  for (auto _ : state) {
+                    job.run();
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * n * 31);
                 },
                 true});

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bench/registry.h"
+#include "core/exec.h"
 #include "io/scenario_yaml.h"
 #include "io/state_machine_yaml.h"
 #include "motion/default_set.h"
@@ -136,7 +137,10 @@ void register_path(const Options& options) {
                 [](benchmark::State& state, Index n) {
                   const path::CurveSet cs = curves_of(n);
                   path::MatchGrid grid(scene().machine, cs);
-                  for (auto _ : state) grid.match();
+                  for (auto _ : state) {
+                    grid.match();
+                    finish_device_work();
+                  }
                   state.SetItemsProcessed(state.iterations() * static_cast<Index>(cs.curve_count()) * grid.motions());
                   state.counters["segments"] = cs.curve_count();
                   state.counters["motions"] = grid.motions();

@@ -11,6 +11,7 @@
 
 #include "anim/crowd_animator.h"
 #include "bench/registry.h"
+#include "core/exec.h"
 #include "core/buffer.h"
 #include "core/reduce.h"
 #include "render/camera_path.h"
@@ -130,6 +131,7 @@ void register_render(const Options& options) {
                     pack.slots = slots.span();
                     pack.out_points = packed.span().subspan(0, visible * rig.point_count());
                     pack.run();
+                    finish_device_work();
                     t += 1.0 / 30.0;
                   }
                   state.SetItemsProcessed(state.iterations() * n);
@@ -171,6 +173,7 @@ void register_render(const Options& options) {
            pack.out_palettes = palettes.span().subspan(0, pack.groups.matrices());
            pack.out_tags = tags.span().subspan(0, pack.groups.visible());
            pack.run();
+           finish_device_work();
            t += 1.0 / 30.0;
          }
          state.SetItemsProcessed(state.iterations() * n);

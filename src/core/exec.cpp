@@ -68,6 +68,10 @@ int current_threads() {
   return t <= 0 ? hardware_threads() : t;
 }
 
+void finish_device_work() {
+  if (current_backend() == Backend::Cuda) cuda::synchronize("finish_device_work");
+}
+
 ScopedExecution::ScopedExecution(Backend backend, int threads) : saved_backend_(g_backend), saved_threads_(g_threads) {
   configure_execution(backend, threads);
 }

@@ -37,6 +37,11 @@ class ScopedExecution {
   int saved_threads_;
 };
 
+// Waits until the work queued on the GPU has finished (CUDA launches return
+// before their kernels run); nothing to do on the CPU backend. Host reads of
+// device buffers wait by themselves: this is for timing a stretch of work.
+void finish_device_work();
+
 // True when this build has the CUDA backend and a device answers.
 bool cuda_usable();
 // A one-line description of the GPU situation, for `throng info`.

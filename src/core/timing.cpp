@@ -7,6 +7,8 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 
+#include "core/cuda_runtime.h"
+
 namespace throng {
 
 namespace {
@@ -49,6 +51,7 @@ static double median(std::vector<double> v) {
 }
 
 std::vector<KernelStat> KernelTimings::stats() const {
+  cuda::collect_launch_times();  // GPU launches still queued count too
   std::vector<KernelStat> out;
   {
     std::lock_guard lock(g_mutex);
@@ -84,6 +87,7 @@ std::string KernelTimings::json() const {
 }
 
 void KernelTimings::reset() {
+  cuda::collect_launch_times();  // launches queued before the reset are not counted after it
   std::lock_guard lock(g_mutex);
   g_series.clear();
 }

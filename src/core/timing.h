@@ -25,10 +25,12 @@ class KernelTimings {
 
   static KernelTimings& global();
   void record(std::string_view name, double ms);
-  std::vector<KernelStat> stats() const;  // by total time, largest first
-  std::string table() const;              // aligned text, one row per kernel
-  std::string json() const;               // [{"name":..,"count":..,...}]
-  void reset();
+  // By total time, largest first. Waits for GPU launches still queued (and
+  // so may throw the Error of a kernel that failed); table() and json() too.
+  std::vector<KernelStat> stats() const;
+  std::string table() const;  // aligned text, one row per kernel
+  std::string json() const;   // [{"name":..,"count":..,...}]
+  void reset();               // forgets every series, GPU launches still queued included
 
  private:
   KernelTimings() = default;

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/exec.h"
 #include "core/parallel.h"
 #include "core/timing.h"
 
@@ -183,6 +184,7 @@ void Simulation::step() {
   sense_and_steer(ctx);
   move(ctx);
   ++steps_done_;
+  finish_device_work();  // on CUDA, sim.step then times the step's kernels, not only their launches
 }
 
 void Simulation::bin() {
