@@ -24,8 +24,9 @@ struct Options {
 
 // body(state, n) runs one iteration per `for (auto _ : state)` pass and
 // calls state.SetItemsProcessed for the items/s column. A case that runs on
-// CUDA ends each iteration with finish_device_work() (core/exec.h): launches
-// are asynchronous, so without it a row would time the launches alone.
+// CUDA ends each iteration with finish_device_work() (core/exec.h), or with a
+// call that does so itself (Simulation::step): launches are asynchronous, so
+// without it a row would time the launches alone.
 using Body = std::function<void(benchmark::State&, Index n)>;
 
 struct CaseSpec {

@@ -59,11 +59,8 @@ Body frame(bool streams, bool with_step) {
     locomotion.animate(sim, 1.0f, dt, &camera);  // streams in use started, cache filled
     for (auto _ : state) {
       if (!with_step) state.PauseTiming();
-      step();  // a frame per step: agents change speed, bucket and stream as in a run
-      if (!with_step) {
-        finish_device_work();  // the step's kernels are not the frame's
-        state.ResumeTiming();
-      }
+      step();                                // a frame per step: agents change speed, bucket and stream as in a run
+      if (!with_step) state.ResumeTiming();  // (Simulation::step waits for its own kernels)
       locomotion.animate(sim, 1.0f, dt, &camera);
       finish_device_work();
     }

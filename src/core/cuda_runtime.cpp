@@ -163,24 +163,24 @@ int launch_begin(const char* description) {
 
 void launch_end(int slot) {
   LaunchLog& log = launch_log();
-  std::string description;
-  bool full = false;
+  bool wait = false;
+  std::string waiting_for;  // the description, copied only when the host waits below
   {
     std::lock_guard lock(log.mutex);
     LaunchEvents& e = log.slots[static_cast<std::size_t>(slot)];
-    description = e.description;
     // A launch error (bad configuration, too many resources) is this
     // launch's; a sticky fault reported here may be an earlier kernel's.
     cudaError_t status = cudaGetLastError();
     if (status == cudaSuccess) status = cudaEventRecord(e.stop, nullptr);
     if (status != cudaSuccess) {
       log.idle.push_back(slot);
-      check_wait(status, description.c_str());
+      check_wait(status, e.description.c_str());
     }
     log.queued.push_back(slot);
-    full = log.queued.size() >= kMaxQueued;
+    wait = log.queued.size() >= kMaxQueued || wait_after_each_launch();
+    if (wait) waiting_for = e.description;
   }
-  if (full || wait_after_each_launch()) synchronize(description.c_str());
+  if (wait) synchronize(waiting_for.c_str());
 }
 
 void collect_launch_times() {
