@@ -6,6 +6,8 @@
 
 #include <cerrno>
 #include <cmath>
+#include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -300,10 +302,29 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
   return true;
 }
 
+// Rejects a .glb whose BIN chunk runs past the end of `bytes`. tinygltf 2.7
+// checks the payload against the file's length without the chunk's 8-byte
+// header, then copies buffers from it: up to 8 bytes past the end of the input.
+// Layouts it rejects itself (short header, JSON chunk too long) pass here.
+void check_bin_chunk(std::span<const unsigned char> bytes, const std::string& path) {
+  if (bytes.size() < 20) return;
+  const auto u32_at = [&](std::uint64_t at) {  // GLB is little-endian, as are the hosts throng builds for
+    std::uint32_t v = 0;
+    std::memcpy(&v, bytes.data() + at, sizeof v);
+    return std::uint64_t{v};
+  };
+  const std::uint64_t length = std::min<std::uint64_t>(u32_at(8), bytes.size());
+  const std::uint64_t bin_at = 20 + u32_at(12);
+  if (bin_at >= length) return;
+  if (bin_at + 8 > length || bin_at + 8 + u32_at(bin_at) > length)
+    throw Error("not a glTF binary: its BIN chunk runs past the end of the file", in_file(path));
+}
+
 // The glTF model in `bytes` (a .glb under 4 GiB), images skipped; throws
 // Error naming `path` when it does not parse.
 tinygltf::Model parse_glb(std::span<const unsigned char> bytes, const std::string& path) {
   if (bytes.size() >= (std::size_t{1} << 32)) throw Error("4 GiB or larger", in_file(path));
+  check_bin_chunk(bytes, path);
   tinygltf::Model m;
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skip_image, nullptr);

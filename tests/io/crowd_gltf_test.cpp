@@ -8,10 +8,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <unistd.h>
+#include <vector>
 
 #include "anim/crowd_animator.h"
 #include "anim/rig.h"
@@ -174,6 +178,23 @@ TEST(CrowdGltf, FilesThatAreNotACrowdGiveAnErrorNamingThem) {
   std::ofstream(text, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
   EXPECT_THROW(CrowdGlb{text.string()}, Error);
   EXPECT_THROW(CrowdGlb{(fs::temp_directory_path() / "no_such_crowd.glb").string()}, Error);
+  // A BIN chunk that claims 8 bytes more than the file holds: its payload
+  // would end exactly where the file ends if its header were not counted.
+  std::vector<unsigned char> longer(bytes.begin(), bytes.end());
+  std::uint32_t json_length = 0, bin_length = 0;
+  std::memcpy(&json_length, &longer[12], 4);
+  std::memcpy(&bin_length, &longer[20 + json_length], 4);
+  ASSERT_EQ(20 + json_length + 8 + bin_length, longer.size());
+  EXPECT_NO_THROW(CrowdGlb::parse(longer, "whole.glb"));
+  bin_length += 8;
+  std::memcpy(&longer[20 + json_length], &bin_length, 4);
+  try {
+    CrowdGlb::parse(longer, "long_bin.glb");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.location().file, "long_bin.glb");
+    EXPECT_NE(std::string(e.what()).find("BIN chunk"), std::string::npos) << e.what();
+  }
   fs::remove(text);
   fs::remove(whole);
 }
