@@ -103,14 +103,13 @@ TEST(Ttc, OverlapPushesApartWhileApproachingAndForcesAreClamped) {
 
 // ---- encounters -------------------------------------------------------------------
 
-// Every agent arrives within 1.5x its unhindered time (the circle of twenty
-// within 1.65x), no overlap deeper than 1 cm (encounters.h). Measured: head-on 1.10x,
-// crossing 1.14x, four ways 1.07x, blind corner 1.18x, circle of 20 1.56x.
+// Every agent arrives within 1.5x its unhindered time, the circle of twenty
+// at four turns included, no overlap deeper than 1 cm (encounters.h).
+// Measured: see EncountersResolve's output and docs/simulation.md.
 TEST(Ttc, EncountersResolve) {
-  // All twenty of the circle meet in the middle at once and swirl round
-  // it: 1.56x, just short of the 1.5x aim (collision-free speed 1.91x,
-  // priority 1.64x); the bound guards against regressions.
-  encounters::expect_standard_encounters_resolve(ModelKind::Ttc, 1.65);
+  // All twenty of the circle meet in the middle at once; keeping right
+  // (side_bias) they swirl round it one way instead of braking face to face.
+  encounters::expect_standard_encounters_resolve(ModelKind::Ttc, 1.5);
 }
 
 }  // namespace
