@@ -112,12 +112,12 @@ std::string model(FuzzedDataProvider& in, float dt) {
     case 2:
       if (in.ConsumeBool())
         m += fmt::format("  ttc_strength: {:g}\n  ttc_side_bias: {:g}\n", 0.5f * in.ConsumeIntegralInRange(0, 10),
-                         0.25f * in.ConsumeIntegralInRange(0, 8));
+                         0.5f * in.ConsumeIntegralInRange(0, 20));
       break;
     default:
       if (in.ConsumeBool())
         m += fmt::format("  sf_anisotropy: {:g}\n  sf_side_bias: {:g}\n  sf_max_substep: {:g}\n",
-                         0.25f * in.ConsumeIntegralInRange(0, 4), 0.5f * in.ConsumeIntegralInRange(0, 10),
+                         0.25f * in.ConsumeIntegralInRange(0, 4), 0.5f * in.ConsumeIntegralInRange(0, 20),
                          0.005f * in.ConsumeIntegralInRange(1, 4));
       break;
   }

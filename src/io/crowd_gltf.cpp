@@ -305,7 +305,7 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 // Rejects a .glb whose BIN chunk runs past the end of `bytes`. tinygltf 2.7
 // checks the payload against the file's length without the chunk's 8-byte
 // header, then copies buffers from it: up to 8 bytes past the end of the input.
-// Layouts it rejects itself (short header, JSON chunk too long) pass here.
+// Other bad layouts (short header, JSON chunk too long) are left to tinygltf.
 void check_bin_chunk(std::span<const unsigned char> bytes, const std::string& path) {
   if (bytes.size() < 20) return;
   const auto u32_at = [&](std::uint64_t at) {  // GLB is little-endian, as are the hosts throng builds for

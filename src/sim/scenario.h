@@ -61,7 +61,8 @@ struct TtcParams {
   float relaxation_time = 0.5f;    // s: xi, the goal term (v_pref e0 - v) / xi
   float sensing_radius = 4.0f;     // m: neighbours whose centre lies within this are considered
   float max_acceleration = 20.0f;  // m/s^2: the total force is clamped to this
-  float side_bias = 3.0f;  // keep right: share of |F_ij| also pushed right of the relative velocity (0 = the paper's)
+  float side_bias =
+      3.0f;  // keep right: multiple of |F_ij| also pushed right of the relative velocity (0 = the paper's)
 };
 
 // Parameters of the social force model (social_force.h). Defaults: m, tau,
@@ -82,7 +83,7 @@ struct SocialForceParams {
   float sensing_radius = 2.0f;  // m: neighbours whose centre lies within this are felt
   float max_substep = 0.01f;    // s: the step is integrated in substeps of at most this (the body force's stiffness)
   float side_bias =
-      6.0f;  // keep right: share of the social repulsion also pushed right of the relative velocity (0 = the paper's)
+      6.0f;  // keep right: multiple of the social repulsion also pushed right of the relative velocity (0 = the paper's)
 };
 
 // The steering model and its parameters, and those of the move stage.

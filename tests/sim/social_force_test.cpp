@@ -99,7 +99,7 @@ TEST(SocialForce, ForcesAreOppositeWhenIsotropic) {
   // Newton's third law holds for the 2000 paper's force and for the
   // keep-right bias (each agent keeps to its own right), contact included.
   SocialForceParams biased = kPaper;
-  biased.side_bias = 0.5f;
+  biased.side_bias = kDefaults.side_bias;
   const glm::vec2 xi(0.3f, -0.2f), vi(1.2f, 0.3f), vj(-1.1f, -0.1f);
   for (const glm::vec2 xj : {glm::vec2(0.9f, 0.1f), glm::vec2(0.55f, 0.0f)})
     for (const SocialForceParams& p : {kPaper, biased}) {

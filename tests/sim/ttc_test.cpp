@@ -72,10 +72,14 @@ TEST(Ttc, KeepRightBiasPushesDeadCentreEncountersToTheRight) {
   const glm::vec2 paper = ttc_avoidance({2.0f, 0.0f}, {-2.0f, 0.0f}, 0.5f, kParams);
   EXPECT_FLOAT_EQ(f.x, paper.x);
   EXPECT_NEAR(f.y, kDefaults.side_bias * paper.x, 1e-5f);
-  // A graze (passing at exactly R): no bias.
-  const glm::vec2 g = ttc_avoidance({2.0f, 0.499f}, {-2.0f, 0.0f}, 0.5f, kDefaults);
-  const glm::vec2 gp = ttc_avoidance({2.0f, 0.499f}, {-2.0f, 0.0f}, 0.5f, kParams);
-  EXPECT_NEAR(g.y, gp.y, 0.01f * glm::length(gp) + 1e-6f);
+  // Nearly a graze (passing 1 mm inside R), far enough off that neither
+  // force is clamped: the bias has shrunk to side_bias (1 - m / R) of |F|.
+  const glm::vec2 g = ttc_avoidance({4.0f, 0.499f}, {-2.0f, 0.0f}, 0.5f, kDefaults);
+  const glm::vec2 gp = ttc_avoidance({4.0f, 0.499f}, {-2.0f, 0.0f}, 0.5f, kParams);
+  ASSERT_GT(glm::length(gp), 1.0f);
+  ASSERT_LT(glm::length(g), kDefaults.max_acceleration);
+  EXPECT_FLOAT_EQ(g.x, gp.x);
+  EXPECT_NEAR(g.y - gp.y, kDefaults.side_bias * (1.0f - 0.499f / 0.5f) * glm::length(gp), 1e-3f);
 }
 
 TEST(Ttc, ForcesAreOppositeForEqualRadiiAndOppositeVelocities) {
