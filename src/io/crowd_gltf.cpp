@@ -4,9 +4,9 @@
 
 #include <glm/mat4x4.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <exception>

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/math.h"
 #include "sim/metrics.h"
 #include "sim/simulation.h"
 
@@ -118,10 +119,11 @@ inline void expect_standard_encounters_resolve(ModelKind model, double circle_sl
   expect_encounter_resolves(model, "four ways", four_ways());
   expect_encounter_resolves(model, "blind corner", blind_corner_pair(), l_corridor());
   for (int k = 0; k < 4; ++k) {
+    const float degrees = 1.8f * static_cast<float>(k);
     char what[48];
-    std::snprintf(what, sizeof what, "circle of 20 turned %.1f degrees", 1.8 * k);
-    const float turn = 0.0314159f * static_cast<float>(k);
-    expect_encounter_resolves(model, what, circle_of_twenty(turn), {}, circle_slowest, circle_deepest);
+    std::snprintf(what, sizeof what, "circle of 20 turned %.1f degrees", static_cast<double>(degrees));
+    expect_encounter_resolves(model, what, circle_of_twenty(degrees * kPiF / 180.0f), {}, circle_slowest,
+                              circle_deepest);
   }
 }
 
