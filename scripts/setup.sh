@@ -4,6 +4,8 @@
 #   bash scripts/setup.sh            # deps + build/release
 #   bash scripts/setup.sh --deps     # deps only
 #   BUILD_DIR=build/x CMAKE_ARGS="-DTHRONG_SANITIZE=ON" bash scripts/setup.sh
+#   BUILD_TYPE=RelWithDebInfo BUILD_FLAGS="-O1 -g1 -DNDEBUG" bash scripts/setup.sh
+#                                    # the build type's own flags replaced
 #   BUILD_TARGETS="throng gpu_tests" bash scripts/setup.sh   # only these targets
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -30,8 +32,11 @@ extra=()
 [ "${CI:-}" = "true" ] && extra+=(-DTHRONG_WERROR=ON)
 # shellcheck disable=SC2206
 extra+=(${CMAKE_ARGS:-})
+# One argument however many flags it holds (CMAKE_ARGS splits at spaces).
+build_type=${BUILD_TYPE:-Release}
+[ -n "${BUILD_FLAGS:-}" ] && extra+=("-DCMAKE_CXX_FLAGS_${build_type^^}=$BUILD_FLAGS")
 if [ ! -f "$build_dir/build.ninja" ]; then
-  cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" "${extra[@]}" >/dev/null
+  cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" "${extra[@]}" >/dev/null
 fi
 targets=()
 for t in ${BUILD_TARGETS:-}; do targets+=(--target "$t"); done
