@@ -6,6 +6,7 @@
 #   BUILD_DIR=build/x CMAKE_ARGS="-DTHRONG_SANITIZE=ON" bash scripts/setup.sh
 #   BUILD_TYPE=RelWithDebInfo BUILD_FLAGS="-O1 -g1 -DNDEBUG" bash scripts/setup.sh
 #                                    # the build type's own flags replaced
+# CMAKE_ARGS and BUILD_FLAGS take effect when $BUILD_DIR is first configured.
 #   BUILD_TARGETS="throng gpu_tests" bash scripts/setup.sh   # only these targets
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
