@@ -62,7 +62,10 @@ class SlerpAt {
     series(1.0f - t, ca_);
     series(t, cb_);
   }
-  THRONG_HOST_DEVICE glm::quat operator()(const glm::quat& a, const glm::quat& b) const {
+  // The pair by value: taken by reference, GCC 12 (-O3 -march=native)
+  // compiled a pose blended in place, x[j] = blend(x[j], y[j]), into wrong w
+  // components (tests/anim/blend_controller_test.cpp, part turns).
+  THRONG_HOST_DEVICE glm::quat operator()(const glm::quat a, const glm::quat b) const {
     if (t_ <= 0.0f) return a;
     if (t_ >= 1.0f) return b;
     float c = glm::dot(a, b);

@@ -6,11 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "anim/stream_pool.h"
 #include "core/error.h"
 #include "stream_reference.h"
+#include "tests/motion/reference_rotation.h"
 
 namespace throng::anim {
 namespace {
@@ -193,6 +196,40 @@ TEST(Blend2DController, FullTurnAtTheTurningClipsSpeedIsThatClip) {
     }
     EXPECT_NEAR(c.duration(), info.period, 1e-3 * info.period);
   }
+}
+
+// Part way into a turn each joint is a unit rotation within 0.001 degrees
+// of the SLERP (exponential map, double) of the straight pose and the
+// turning clip's pose by the turn weight (at phase 0: advancing, each
+// controller would keep its own cadence).
+TEST(Blend2DController, PartTurnIsTheSlerpOfTheStraightAndTurningPoses) {
+  const motion::ClipInfo& info = spaces().turn_left->clip_infos()[0];
+  const float rate = info.turn / info.period;
+  auto pose_at = [&](float turn, float* weight) {
+    Blend2DOptions o;
+    o.speed = info.speed;
+    o.turn = turn;
+    Blend2DController c(spaces().speeds, spaces().turn_left, spaces().turn_right, o);
+    Pose p;
+    c.evaluate(p);
+    if (weight != nullptr) *weight = c.turn_weight();
+    return p;
+  };
+  const Pose straight = pose_at(0.0f, nullptr), turning = pose_at(1.5f * rate, nullptr);
+  double worst = 0.0;
+  for (const float part : {0.3f, 0.6f}) {
+    float u = 0.0f;
+    const Pose p = pose_at(part * rate, &u);
+    ASSERT_GT(u, 0.0f);
+    ASSERT_LT(u, 1.0f);
+    for (std::size_t j = 0; j < p.local.size(); ++j) {
+      const glm::dquat want = test::reference_slerp(glm::dquat(straight.local[j]), glm::dquat(turning.local[j]), u);
+      EXPECT_NEAR(glm::length(glm::dquat(p.local[j])), 1.0, 1e-6) << part << " joint " << j;
+      worst = std::max(worst, test::rotation_between_deg(glm::dquat(p.local[j]), want));
+    }
+  }
+  std::printf("part turns within %.2e degrees of the reference SLERP\n", worst);
+  EXPECT_LT(worst, 1e-3);
 }
 
 TEST(Blend2DController, TurnWeightGrowsWithTurnAndFadesAwayFromTheTurningSpeed) {

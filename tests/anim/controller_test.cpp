@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "motion/default_set.h"
 #include "stream_reference.h"
+#include "tests/motion/reference_rotation.h"
 
 namespace throng::anim {
 namespace {
@@ -17,10 +18,7 @@ namespace {
 using namespace testing;
 constexpr float kDt = 1.0f / 30.0f;
 
-double angle_deg(const glm::dquat& a, const glm::dquat& b) {
-  const double d = std::min(1.0, std::abs(glm::dot(glm::normalize(a), glm::normalize(b))));
-  return 2.0 * std::acos(d) * 57.29577951308232;
-}
+using test::rotation_between_deg;
 
 TEST(ClipPlayer, SamplesBetweenFramesBySlerp) {
   const AnimClip clip = wiggle_clip(6, 10, kDt);
@@ -32,7 +30,7 @@ TEST(ClipPlayer, SamplesBetweenFramesBySlerp) {
     for (int j = 0; j < 6; ++j) {
       const glm::dquat want =
           sine_slerp(glm::dquat(clip.clip->rotation(f, j)), glm::dquat(clip.clip->rotation(f + 1, j)), a);
-      EXPECT_LT(angle_deg(glm::dquat(p.local[static_cast<std::size_t>(j)]), want), 1e-3) << t << " " << j;
+      EXPECT_LT(rotation_between_deg(glm::dquat(p.local[static_cast<std::size_t>(j)]), want), 1e-3) << t << " " << j;
     }
     const glm::vec3 r = glm::mix(clip.clip->root_positions[static_cast<std::size_t>(f)],
                                  clip.clip->root_positions[static_cast<std::size_t>(f + 1)], static_cast<float>(a));
@@ -47,13 +45,13 @@ TEST(ClipPlayer, LoopWrapsFromLastFrameToFirstAndOneShotHolds) {
   for (int j = 0; j < 4; ++j) {
     const glm::dquat want =
         sine_slerp(glm::dquat(clip.clip->rotation(9, j)), glm::dquat(clip.clip->rotation(0, j)), 0.5);
-    EXPECT_LT(angle_deg(glm::dquat(p.local[static_cast<std::size_t>(j)]), want), 1e-3);
+    EXPECT_LT(rotation_between_deg(glm::dquat(p.local[static_cast<std::size_t>(j)]), want), 1e-3);
   }
   // Root carried on by the last frame's step, not jumping back.
   const auto& r = clip.clip->root_positions;
   EXPECT_LT(glm::length(p.root - (r[9] + 0.5f * (r[9] - r[8]))), 1e-5f);
   sample_clip(clip, 10.0 * kDt + 2.0 * kDt, p);  // one loop later
-  EXPECT_LT(angle_deg(glm::dquat(p.local[1]), glm::dquat(clip.clip->rotation(2, 1))), 1e-3);
+  EXPECT_LT(rotation_between_deg(glm::dquat(p.local[1]), glm::dquat(clip.clip->rotation(2, 1))), 1e-3);
 
   clip.loop = false;
   ClipPlayer player(clip);
@@ -63,7 +61,7 @@ TEST(ClipPlayer, LoopWrapsFromLastFrameToFirstAndOneShotHolds) {
   for (int i = 0; i < 20; ++i) player.advance(kDt, params, ev);
   EXPECT_TRUE(player.finished());
   player.evaluate(p);
-  EXPECT_LT(angle_deg(glm::dquat(p.local[2]), glm::dquat(clip.clip->rotation(9, 2))), 1e-3);
+  EXPECT_LT(rotation_between_deg(glm::dquat(p.local[2]), glm::dquat(clip.clip->rotation(9, 2))), 1e-3);
 }
 
 TEST(ClipPlayer, EventsFireOnceEachTimeThePlayheadPassesThem) {
@@ -152,7 +150,7 @@ TEST(Layers, OverrideAndAdditiveWithBoneMasks) {
       const glm::dquat ref(glm::angleAxis(0.3f, glm::vec3(0, 0, 1)));
       want = qb * sine_slerp(glm::dquat(1, 0, 0, 0), glm::inverse(ref) * ql, 0.8 * 0.5);
     }
-    EXPECT_LT(angle_deg(glm::dquat(got.local[static_cast<std::size_t>(j)]), want), 2e-3)
+    EXPECT_LT(rotation_between_deg(glm::dquat(got.local[static_cast<std::size_t>(j)]), want), 2e-3)
         << skel.names[static_cast<std::size_t>(j)];
   }
   // A clone evolves independently and equally.
@@ -289,7 +287,7 @@ TEST(StateMachine, CrossFadeBlendsTheTwoStatesBySlerp) {
   for (int j = 0; j < 5; ++j) {
     const glm::dquat want = sine_slerp(glm::dquat(idle.local[static_cast<std::size_t>(j)]),
                                        glm::dquat(walk.local[static_cast<std::size_t>(j)]), w);
-    EXPECT_LT(angle_deg(glm::dquat(got.local[static_cast<std::size_t>(j)]), want), 2e-3);
+    EXPECT_LT(rotation_between_deg(glm::dquat(got.local[static_cast<std::size_t>(j)]), want), 2e-3);
   }
 }
 

@@ -24,12 +24,8 @@ const BlendSpace1D& default_space() {
   return space;
 }
 
-double angle_deg(const glm::dquat& a, const glm::dquat& b) {
-  const glm::dquat r = glm::inverse(a) * b;
-  return 2.0 * std::atan2(std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z), std::abs(r.w)) * 180.0 / kPi;
-}
-
 using test::reference_slerp;
+using test::rotation_between_deg;
 
 // slerp_shortest's weights are a polynomial (no acos, no sine): against
 // SLERP through the exponential map (double), on random pairs and on a
@@ -44,7 +40,8 @@ TEST(LocomotionSlerp, SlerpShortestMatchesTheExponentialMapAndKeepsEndsExact) {
   const auto check = [&](const glm::quat& a, const glm::quat& b, float t) {
     const glm::quat q = slerp_shortest(a, b, t);
     ASSERT_TRUE(std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z)) << t;
-    worst = std::max(worst, angle_deg(glm::dquat(q), reference_slerp(glm::dquat(a), glm::dquat(b), t)) * kDeg);
+    worst =
+        std::max(worst, rotation_between_deg(glm::dquat(q), reference_slerp(glm::dquat(a), glm::dquat(b), t)) * kDeg);
     worst_length = std::max(worst_length, std::abs(glm::length(glm::dquat(q)) - 1.0));
   };
   for (int i = 0; i < 4000; ++i) {
@@ -80,10 +77,10 @@ TEST(LocomotionSlerp, NeighbouringFramesInterpolateAsSlerpDoes) {
     for (std::int32_t i = 0; i < F; ++i)
       for (std::int32_t j = 0; j < space.joint_count(); ++j) {
         const glm::quat a = c.cycle.rotation(i, j), b = c.cycle.rotation((i + 1) % F, j);
-        widest = std::max(widest, angle_deg(glm::dquat(a), glm::dquat(b)));
+        widest = std::max(widest, rotation_between_deg(glm::dquat(a), glm::dquat(b)));
         for (float t : {0.1f, 0.25f, 0.5f, 0.8f})
-          worst = std::max(worst, angle_deg(glm::dquat(interpolate_frames(a, b, t)),
-                                            reference_slerp(glm::dquat(a), glm::dquat(b), t)));
+          worst = std::max(worst, rotation_between_deg(glm::dquat(interpolate_frames(a, b, t)),
+                                                       reference_slerp(glm::dquat(a), glm::dquat(b), t)));
       }
   }
   std::printf("neighbouring frames up to %.2f deg apart; normalised lerp within %.2e deg of SLERP\n", widest, worst);
@@ -103,7 +100,7 @@ TEST(LocomotionSlerp, BlendedRotationIsTheReferenceSlerpOfBothClipsSamples) {
     const auto j = static_cast<std::int32_t>(u(rng) * static_cast<float>(v.joint_count - 1));
     const glm::dquat want =
         reference_slerp(glm::dquat(clip_rotation(v, p.a, ph.a, j)), glm::dquat(clip_rotation(v, p.b, ph.b, j)), p.w);
-    worst = std::max(worst, angle_deg(glm::dquat(blended_rotation(v, p, ph, j)), want));
+    worst = std::max(worst, rotation_between_deg(glm::dquat(blended_rotation(v, p, ph, j)), want));
   }
   EXPECT_LT(worst, 2e-3);
 }
@@ -187,8 +184,8 @@ TEST(LocomotionPose, PolynomialSlerpPoseWithinAHundredthOfADegreeOfExactSlerp) {
       world[at] = (p < 0 ? glm::dquat(1, 0, 0, 0) : world[static_cast<std::size_t>(p)]) * glm::dquat(local[at]);
       world_exact[at] =
           (p < 0 ? glm::dquat(1, 0, 0, 0) : world_exact[static_cast<std::size_t>(p)]) * glm::dquat(exact[at]);
-      const double d_local = angle_deg(glm::dquat(local[at]), glm::dquat(exact[at]));
-      const double d_world = angle_deg(world[at], world_exact[at]);
+      const double d_local = rotation_between_deg(glm::dquat(local[at]), glm::dquat(exact[at]));
+      const double d_world = rotation_between_deg(world[at], world_exact[at]);
       ASSERT_TRUE(std::isfinite(d_local) && std::isfinite(d_world)) << i << " joint " << j;
       worst_local = std::max(worst_local, d_local);
       worst_world = std::max(worst_world, d_world);
@@ -258,8 +255,8 @@ TEST(LocomotionBlend, EndsOfTheBlendReproduceTheInputClips) {
       const CharacterFrame f = character_frame_at(v, p, phase, glm::vec3(0.0f), 0.0f, 1.0f);
       const std::int32_t src = (i + c.source_start_frame) % F;
       for (std::int32_t j = 1; j < J; ++j)
-        worst_rotation = std::max(worst_rotation,
-                                  angle_deg(glm::dquat(joint_rotation(v, f, j)), glm::dquat(input->rotation(src, j))));
+        worst_rotation = std::max(worst_rotation, rotation_between_deg(glm::dquat(joint_rotation(v, f, j)),
+                                                                       glm::dquat(input->rotation(src, j))));
       synthesise_pose(v, f, pos.data(), rot.data());
       // Joints relative to the root, in the root's heading frame.
       const double ours = heading_of(rot[0]), theirs = heading_of(fk.rotations[static_cast<std::size_t>(src * J)]);

@@ -19,4 +19,11 @@ inline glm::dquat reference_slerp(glm::dquat q0, glm::dquat q1, double t) {
   return q0 * glm::dquat(std::cos(half), axis.x * std::sin(half), axis.y * std::sin(half), axis.z * std::sin(half));
 }
 
+// The angle in degrees of the rotation from a to b (unit or not), by atan2:
+// steady near zero, where acos of their dot product is not.
+inline double rotation_between_deg(const glm::dquat& a, const glm::dquat& b) {
+  const glm::dquat r = glm::inverse(a) * b;
+  return 2.0 * std::atan2(std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z), std::abs(r.w)) * 57.29577951308232;
+}
+
 }  // namespace throng::test
