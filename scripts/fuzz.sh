@@ -9,7 +9,8 @@
 # Long offline runs: FUZZ_TARGETS="fuzz_bvh fuzz_scenario" picks targets,
 # FUZZ_CORPUS_DIR=DIR keeps each target's grown corpus in DIR/<target>
 # (seeded from fuzz/ on the first run, reused after) instead of a
-# temporary copy, FUZZ_NICE=19 runs the targets at that niceness.
+# temporary copy, FUZZ_NICE=19 runs the targets at that niceness,
+# FUZZ_JOBS=1 runs them one after another (default: one per core).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -40,8 +41,10 @@ fi
 logs="$root/$build_dir/fuzz-logs"
 crashes="$root/$build_dir/fuzz-crashes"
 mkdir -p "$logs"
-failed=()
-for t in "${targets[@]}"; do
+# run_target PATH: one target for $seconds on a copy of its seeds (or the kept
+# corpus); libFuzzer's exit status goes to $logs/<target>.rc.
+run_target() {
+  local t=$1 name seeds work rc=0
   name=$(basename "$t")
   seeds=$(find fuzz -type d -name "corpus_${name#fuzz_}" | head -n 1)
   if [ -n "${FUZZ_CORPUS_DIR:-}" ]; then
@@ -55,9 +58,32 @@ for t in "${targets[@]}"; do
     [ -n "$seeds" ] && cp -r "$seeds"/. "$work"/
   fi
   mkdir -p "$crashes/$name"
-  echo "fuzz: $name for ${seconds}s (seeds: ${seeds:-none})"
-  if (cd "$work" && nice -n "${FUZZ_NICE:-0}" "$root/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
-        -artifact_prefix="$crashes/$name/" -print_final_stats=1 "$work" >"$logs/$name.log" 2>&1); then
+  (cd "$work" && nice -n "${FUZZ_NICE:-0}" "$root/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+    -artifact_prefix="$crashes/$name/" -print_final_stats=1 "$work" >"$logs/$name.log" 2>&1) || rc=$?
+  [ -n "${FUZZ_CORPUS_DIR:-}" ] || rm -rf "$work"
+  echo "$rc" >"$logs/$name.rc"
+}
+# Each target is one libFuzzer process on one core: FUZZ_JOBS of them run at
+# once (default: one per core), so the run takes about
+# ceil(targets / jobs) x FUZZ_SECONDS. The reports follow in target order.
+jobs=${FUZZ_JOBS:-$(nproc)}
+echo "fuzz: ${#targets[@]} targets for ${seconds}s each, $jobs at a time"
+rm -f "$logs"/*.rc
+running=0
+for t in "${targets[@]}"; do
+  if ((running >= jobs)); then
+    wait -n
+    running=$((running - 1))
+  fi
+  run_target "$t" &
+  running=$((running + 1))
+done
+wait
+failed=()
+for t in "${targets[@]}"; do
+  name=$(basename "$t")
+  if [ "$(cat "$logs/$name.rc" 2>/dev/null)" = "0" ]; then
+    echo "fuzz: $name ran clean"
     grep -E '^(#[0-9]+.*DONE|stat::number_of_executed_units|stat::peak_rss_mb|Done [0-9]+ runs)' "$logs/$name.log" | sed 's/^/  /' || true
   else
     echo "fuzz: $name FAILED; its whole log ($logs/$name.log):" >&2
@@ -66,7 +92,6 @@ for t in "${targets[@]}"; do
     ls -l "$crashes/$name" >&2
     failed+=("$name")
   fi
-  [ -n "${FUZZ_CORPUS_DIR:-}" ] || rm -rf "$work"
   rmdir "$crashes/$name" 2>/dev/null || true  # empty: nothing found
 done
 if ((${#failed[@]})); then

@@ -5,6 +5,7 @@
 #   bash scripts/test.sh               # Release build in build/release
 #   BUILD_DIR=build/asan CMAKE_ARGS="-DTHRONG_SANITIZE=ON" BUILD_TYPE=RelWithDebInfo bash scripts/test.sh
 #   CTEST_ARGS="-R Cuda" bash scripts/test.sh   # a subset
+#   CTEST_EXCLUDE='^(Acceptance\.|Verify\.)' bash scripts/test.sh   # all but these (a regex)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -14,7 +15,8 @@ log=$(mktemp)
 trap 'rm -f "$log"' EXIT
 status=0
 # shellcheck disable=SC2086
-ctest --test-dir "$build_dir" --output-on-failure --no-tests=error -j "${JOBS:-$(nproc)}" --timeout 900 ${CTEST_ARGS:-} 2>&1 | tee "$log" ||
+ctest --test-dir "$build_dir" --output-on-failure --no-tests=error -j "${JOBS:-$(nproc)}" --timeout 900 ${CTEST_ARGS:-} \
+  ${CTEST_EXCLUDE:+-E "$CTEST_EXCLUDE"} 2>&1 | tee "$log" ||
   status=$?
 bash scripts/ctest_summary.sh "$log" || status=1
 exit "$status"
