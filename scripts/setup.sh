@@ -6,6 +6,7 @@
 #   BUILD_DIR=build/x CMAKE_ARGS="-DTHRONG_SANITIZE=ON" bash scripts/setup.sh
 #   BUILD_TYPE=RelWithDebInfo BUILD_FLAGS="-O1 -g1 -DNDEBUG" bash scripts/setup.sh
 #                                    # the build type's own flags replaced
+#                                    # (C++, and nvcc's host code in CUDA builds)
 # CMAKE_ARGS and BUILD_FLAGS take effect when $BUILD_DIR is first configured.
 #   BUILD_TARGETS="throng gpu_tests" bash scripts/setup.sh   # only these targets
 set -euo pipefail
@@ -35,7 +36,11 @@ extra=()
 extra+=(${CMAKE_ARGS:-})
 # One argument however many flags it holds (CMAKE_ARGS splits at spaces).
 build_type=${BUILD_TYPE:-Release}
-[ -n "${BUILD_FLAGS:-}" ] && extra+=("-DCMAKE_CXX_FLAGS_${build_type^^}=$BUILD_FLAGS")
+if [ -n "${BUILD_FLAGS:-}" ]; then
+  extra+=("-DCMAKE_CXX_FLAGS_${build_type^^}=$BUILD_FLAGS")
+  # nvcc's -O sets its host code's level (the device code keeps ptxas's own).
+  [[ " ${CMAKE_ARGS:-} " == *" -DTHRONG_CUDA=ON "* ]] && extra+=("-DCMAKE_CUDA_FLAGS_${build_type^^}=$BUILD_FLAGS")
+fi
 if [ ! -f "$build_dir/build.ninja" ]; then
   cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" "${extra[@]}" >/dev/null
 fi
