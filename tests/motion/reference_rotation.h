@@ -20,10 +20,13 @@ inline glm::dquat reference_slerp(glm::dquat q0, glm::dquat q1, double t) {
 }
 
 // The angle in degrees of the rotation from a to b (unit or not), by atan2:
-// steady near zero, where acos of their dot product is not.
+// steady near zero, where acos of their dot product is not. The tests' own
+// twin of anim::rotation_angle_deg, for double inputs (a reference slerp's)
+// and for the motion tests, which do not link anim.
 inline double rotation_between_deg(const glm::dquat& a, const glm::dquat& b) {
   const glm::dquat r = glm::inverse(a) * b;
-  return 2.0 * std::atan2(std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z), std::abs(r.w)) * 57.29577951308232;
+  return 2.0 * std::atan2(std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z), std::abs(r.w)) *
+         (180.0 / 3.14159265358979323846);
 }
 
 }  // namespace throng::test
