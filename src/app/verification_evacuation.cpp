@@ -7,6 +7,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "app/verification.h"
 #include "app/verification_figures.h"
@@ -158,21 +159,45 @@ VerifyResult escape_routes(const VerifyOptions& o) {
 // ---- Test 11: choosing an escape route
 
 // The file's lines 0 and 1 lie across exits 1 and 2: who left by which
-// (each person counted once, when it first crossed).
+// (each person counted once, when it first crossed). Weighing the quickest
+// way, the crowd loads both doors until they empty together, so one run
+// splits about evenly: exit 1's edge is its head start (the nearer door,
+// about 5 s). Over seeds 1-8 of the file exit 1 took 497-507 of 1000, and
+// a single run's majority is a coin flip with odds of about 6 to 1; the
+// split is judged over kRouteChoiceSeeds runs (the file's seed and the
+// next ones), the first run charted.
+constexpr std::uint64_t kRouteChoiceSeeds = 4;
 VerifyResult route_choice(const VerifyOptions& o) {
   VerifyResult r;
   r.scenarios = {"rimea_11_route_choice"};
-  const ScenarioObservation obs = observe_named(r.scenarios[0], o);
-  const std::vector<double> out1 = obs.first_crossings(0), out2 = obs.first_crossings(1);
-  const std::size_t n1 = out1.size(), n2 = out2.size();
-  r.checks.push_back({"everyone leaves the room", arrived_text(obs), everyone_arrived(obs)});
-  r.checks.push_back({"most leave by exit 1, the nearer", fmt::format("{} by exit 1, {} by exit 2", n1, n2), n1 > n2});
+  std::size_t n1 = 0, n2 = 0;
+  bool all_left = true;
+  std::vector<std::string> arrivals;
+  nlohmann::json runs = nlohmann::json::array();
+  for (std::uint64_t k = 0; k < kRouteChoiceSeeds; ++k) {
+    io::LoadedScenario scenario = load_verification_scenario(r.scenarios[0], o);
+    scenario.spec.seed += k;
+    std::fprintf(stderr, "throng verify: running %s, seed %llu\n", r.scenarios[0].c_str(),
+                 static_cast<unsigned long long>(scenario.spec.seed));
+    const ScenarioObservation obs = observe(scenario);
+    const std::vector<double> out1 = obs.first_crossings(0), out2 = obs.first_crossings(1);
+    n1 += out1.size();
+    n2 += out2.size();
+    all_left = all_left && everyone_arrived(obs);
+    arrivals.push_back(arrived_text(obs));
+    runs.push_back(
+        {{"seed", obs.spec.seed}, {"exit_1", out1.size()}, {"exit_2", out2.size()}, {"run", run_figures(obs)}});
+    if (k > 0) continue;
+    render::Chart c = make_chart("RiMEA 11: 1000 persons choose between two doors", "time (s)", "persons out");
+    c.series.push_back(n_t_curve("exit 1 (nearer)", out1, render::palette_colour(0)));
+    c.series.push_back(n_t_curve("exit 2", out2, render::palette_colour(1)));
+    r.chart = std::move(c);
+  }
+  r.checks.push_back({"everyone leaves the room (each seed)", fmt::format("{}", fmt::join(arrivals, "; ")), all_left});
+  r.checks.push_back({fmt::format("most leave by exit 1, the nearer (over {} seeds)", kRouteChoiceSeeds),
+                      fmt::format("{} by exit 1, {} by exit 2", n1, n2), n1 > n2});
   r.checks.push_back({"some leave by exit 2", fmt::format("{}", n2), n2 > 0});
-  r.figures = {{"exit_1", n1}, {"exit_2", n2}, {"run", run_figures(obs)}};
-  render::Chart c = make_chart("RiMEA 11: 1000 persons choose between two doors", "time (s)", "persons out");
-  c.series.push_back(n_t_curve("exit 1 (nearer)", out1, render::palette_colour(0)));
-  c.series.push_back(n_t_curve("exit 2", out2, render::palette_colour(1)));
-  r.chart = std::move(c);
+  r.figures = {{"exit_1", n1}, {"exit_2", n2}, {"runs", runs}};
   return r;
 }
 

@@ -62,12 +62,14 @@ inline constexpr float kCfsAgainst = 0.5f;
 inline constexpr float kCfsCrossingSpeed = 0.3f;
 inline constexpr float kCfsCrossingCos = 0.7f;
 
-// The agent being steered: position, velocity, radius and e0.
+// The agent being steered: position, velocity, radius, e0 and how far
+// away the point it heads for is (m).
 struct CfsAgent {
   glm::vec2 p{0.0f};
   glm::vec2 v{0.0f};
   float radius = 0.2f;
   glm::vec2 e0{1.0f, 0.0f};
+  float aim_distance = INFINITY;
 };
 
 // R_ij + A_ij of neighbour j at q with velocity w and radius rj; `parked`:
@@ -132,6 +134,23 @@ THRONG_HOST_DEVICE inline float cfs_gap_ahead(glm::vec2 p, float ri, glm::vec2 e
 // Below this speed (m/s) an agent counts as held at rest by its neighbours
 // (collision_free_velocity, sim/sense.h).
 inline constexpr float kCfsBlockedSpeed = 0.05f;
+// Of a neighbour at q that holds agent i at rest: true when it waits for i.
+// One behind i on the way to i's goal ((q - p) . e0 < 0) waits: two agents
+// pressed together at a door, one at the jamb and one beside it, each stand
+// in the other's corridor and both stood still until the crowd shifted;
+// the one further along goes first, as people do. One beside i (more than
+// 60 degrees off e0: kCfsBesideCos) waits when i has the lower index
+// (`i_first`): three agents arched across a door's mouth, the two at the
+// jambs slid along them into the middle one, each hold the next, and each
+// has the next ahead of it (an arch, as in granular flow through a hopper;
+// 5 agents stuck over seeds 1-8 of the built-in bottleneck). The index
+// breaks the tie the same way for any thread count.
+inline constexpr float kCfsBesideCos = 0.5f;
+THRONG_HOST_DEVICE inline bool cfs_waits_for(const CfsAgent& i, glm::vec2 q, bool i_first) {
+  const float ahead = dot2(q - i.p, i.e0);
+  return ahead < 0.0f || (i_first && ahead < kCfsBesideCos * length_of(q - i.p));
+}
+
 // Neighbours close enough to hold an agent's speed that the pushes' pass
 // keeps for the gap passes (collision_free_velocity): a disc of 1.7 m holds
 // about 50 at 6 P/m^2.
@@ -156,6 +175,22 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_slide_along_wall(glm::vec2 e0, glm::vec2
   const glm::vec2 along = e0 - n * into;
   if (length2(along) > 0.05f * 0.05f) return normalize_or(along, along);
   return glm::vec2(-n.y, n.x);  // the wall tangent to the right of walking into it (-n)
+}
+
+// Within kCfsSlideNear (m) of the point it heads for, an agent whose goal
+// direction the walls turned (e0 slid along them to `slid`) walks no faster
+// than v0 times the cosine of that turn, and at least kCfsSlideSlowest v0.
+// It walks along the wall towards an opening near its goal (a door it was
+// pushed beside): at full speed it cannot turn into an opening narrower
+// than its turning circle (about v0 turn_time across), slides past it, and
+// circles in front of the door for good (a 1.8 m/s walker at a 0.5 m door,
+// docs/simulation.md). Further from its aim it walks on at v0: an agent
+// following a wall round a corner to a goal far beyond it does not slow.
+inline constexpr float kCfsSlideNear = 2.0f;
+inline constexpr float kCfsSlideSlowest = 0.3f;
+THRONG_HOST_DEVICE inline float cfs_slide_speed(glm::vec2 slid, glm::vec2 e0, float aim_distance, float v0) {
+  if (aim_distance >= kCfsSlideNear || (slid.x == e0.x && slid.y == e0.y)) return v0;
+  return v0 * fminf(fmaxf(dot2(slid, e0), kCfsSlideSlowest), 1.0f);
 }
 
 // The direction actually walked: the previous one turned towards the new one

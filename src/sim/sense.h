@@ -169,6 +169,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   const glm::vec2 e =
       cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
   if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
+  const float top = cfs_slide_speed(e0, me.e0, me.aim_distance, v0);
   // The time gap is kept to where neighbours will be in anticipation_time
   // (one crossing the agent's path will have left it), to those within the
   // lane; no step may end in a body where it is now.
@@ -176,21 +177,18 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     float gap = INFINITY, gap_now = INFINITY;
     for_each_holder([&](Index j) {
       const glm::vec2 q = n.at(j, me.p);
-      if (!all && dot2(q - me.p, me.e0) < 0.0f) return;
+      if (!all && cfs_waits_for(me, q, j > self)) return;
       gap = fminf(
           gap, cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j], c.lane_width));
       gap_now = fminf(gap_now, cfs_gap_ahead(me.p, me.radius, e, q, n.radius[j]));
     });
-    return fminf(cfs_speed(gap, v0, c.time_gap), fmaxf(gap_now, 0.0f) / dt);
+    return fminf(cfs_speed(gap, top, c.time_gap), fmaxf(gap_now, 0.0f) / dt);
   };
   const float speed = speed_past(true);
-  // Held at rest by a neighbour that is behind the agent on the way to its
-  // goal (beside it at a door's jamb, say) while walking on would take it
-  // forward: that neighbour waits instead. Two agents pressed together at a
-  // door each stand in the other's corridor and both stood still until the
-  // crowd shifted; the one further along goes first, as people do. The
-  // neighbours behind are left out of the no-step-into-a-body cap too: the
-  // agent may press into them, and the contact passes part the pair.
+  // Held at rest while walking on would take it forward: the neighbours
+  // that wait for it (cfs_waits_for) are left out of its gap and of the
+  // no-step-into-a-body cap, so it may press into them, and the contact
+  // passes part the pair.
   if (speed < kCfsBlockedSpeed && dot2(e, me.e0) > 0.0f) return e * speed_past(false);
   return e * speed;
 }

@@ -155,5 +155,19 @@ TEST(Bottleneck, LaboratoryBodySizePassesLaboratoryFlows) {
   }
 }
 
+// Twice the crowd at the 0.5 m door: a fast walker (1.8 m/s) left alone
+// beside the door, sliding along the wall at full speed, could not turn into
+// the opening and circled in front of it for good (one of 300 never left;
+// cfs_slide_speed). Every agent must leave.
+TEST(Bottleneck, EveryAgentOfADenserCrowdTakesAHalfMetreDoor) {
+  const std::int64_t agents = test::sanitized() ? 150 : 300;
+  const DoorRun r = empty_room(0.5f, agents, 1.0f, 0.15f);
+  std::printf("  r = 0.15 m, door 0.5 m: %lld of %lld out, %.2f P/s (%.2f P/(m s)), deepest overlap %.3f m\n",
+              static_cast<long long>(r.left), static_cast<long long>(r.agents), r.flow.flow, r.flow.specific_flow,
+              r.deepest);
+  EXPECT_EQ(r.left, r.agents);
+  EXPECT_LE(r.deepest, 0.05f);
+}
+
 }  // namespace
 }  // namespace throng::sim

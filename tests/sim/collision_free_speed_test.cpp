@@ -109,6 +109,25 @@ TEST(CollisionFreeSpeed, WallsSlideTheGoalDirectionAndTurnsTakeTime) {
   EXPECT_NEAR(cfs_turn({0.0f, 0.0f}, {0.0f, 1.0f}, 0.1f, 0.3f).y, 1.0f, kEps);  // from rest: at once
 }
 
+TEST(CollisionFreeSpeed, NearItsAimAnAgentSlidingAlongAWallSlowsByTheTurn) {
+  const glm::vec2 e0 = glm::normalize(glm::vec2(1.0f, -1.0f));
+  const glm::vec2 slid(0.0f, -1.0f);  // a wall east turned e0 by 45 degrees
+  EXPECT_NEAR(cfs_slide_speed(slid, e0, 1.0f, 1.8f), 1.8f * std::sqrt(0.5f), kEps);
+  EXPECT_EQ(cfs_slide_speed(slid, e0, kCfsSlideNear, 1.8f), 1.8f);  // far from its aim: full speed
+  EXPECT_EQ(cfs_slide_speed(e0, e0, 1.0f, 1.8f), 1.8f);             // no wall turned it
+  // Goal straight through the wall (turned 90 degrees, or the head-on
+  // case's right turn): the floor, never a stop.
+  EXPECT_NEAR(cfs_slide_speed(slid, {1.0f, 0.0f}, 1.0f, 1.8f), kCfsSlideSlowest * 1.8f, kEps);
+}
+
+TEST(CollisionFreeSpeed, NeighboursBehindAndLaterNeighboursBesideWaitForABlockedAgent) {
+  const CfsAgent me{{0.0f, 0.0f}, {0.0f, 0.0f}, 0.25f, {1.0f, 0.0f}};
+  EXPECT_TRUE(cfs_waits_for(me, {-0.1f, 0.5f}, false));   // behind: waits whatever the indices
+  EXPECT_FALSE(cfs_waits_for(me, {0.4f, 0.3f}, true));    // 37 degrees off e0: ahead, holds the agent
+  EXPECT_TRUE(cfs_waits_for(me, {0.2f, 0.46f}, true));    // 66 degrees off: beside; the later index waits
+  EXPECT_FALSE(cfs_waits_for(me, {0.2f, 0.46f}, false));  // the earlier index goes first
+}
+
 // The gap passes read only the neighbours that the pushes' pass kept as
 // close enough to hold the agent's speed (and walk every candidate again
 // past kCfsHolders of them). Either way the speed must be the time-gap
