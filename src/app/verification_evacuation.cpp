@@ -161,11 +161,9 @@ VerifyResult escape_routes(const VerifyOptions& o) {
 // The file's lines 0 and 1 lie across exits 1 and 2: who left by which
 // (each person counted once, when it first crossed). Weighing the quickest
 // way, the crowd loads both doors until they empty together, so one run
-// splits about evenly: exit 1's edge is its head start (the nearer door,
-// about 5 s). Over seeds 1-8 of the file exit 1 took 497-507 of 1000, and
-// a single run's majority is a coin flip with odds of about 6 to 1; the
-// split is judged over kRouteChoiceSeeds runs (the file's seed and the
-// next ones), the first run charted.
+// splits about evenly (exit 1 took 491-511 of 1000 over seeds 1-8 of the
+// file; docs/verification.md): the split is judged over kRouteChoiceSeeds
+// runs (the file's seed and the next ones), the first run charted.
 constexpr std::uint64_t kRouteChoiceSeeds = 4;
 VerifyResult route_choice(const VerifyOptions& o) {
   VerifyResult r;

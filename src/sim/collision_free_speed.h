@@ -139,13 +139,17 @@ inline constexpr float kCfsBlockedSpeed = 0.05f;
 // pressed together at a door, one at the jamb and one beside it, each stand
 // in the other's corridor and both stood still until the crowd shifted;
 // the one further along goes first, as people do. One beside i (more than
-// 60 degrees off e0: kCfsBesideCos) waits when i has the lower index
-// (`i_first`): three agents arched across a door's mouth, the two at the
-// jambs slid along them into the middle one, each hold the next, and each
-// has the next ahead of it (an arch, as in granular flow through a hopper;
-// 5 agents stuck over seeds 1-8 of the built-in bottleneck). The index
-// breaks the tie the same way for any thread count.
+// 60 degrees off e0: kCfsBesideCos) waits when `i_first`: three agents
+// arched across a door's mouth, the two at the jambs slid along them into
+// the middle one, each hold the next, and each has the next ahead of it
+// (an arch, as in granular flow through a hopper). The caller
+// (collision_free_velocity) lets an agent whose goal direction a wall slid
+// go first, and, within kCfsNearWall of a wall, the lower index of two
+// (the same for any thread count); away from walls (a jam in the open)
+// nobody presses past a neighbour beside it, which kept bodies 3 cm deep
+// in each other in the built-in circle's jam.
 inline constexpr float kCfsBesideCos = 0.5f;
+inline constexpr float kCfsNearWall = 1.0f;  // m from the agent's surface
 THRONG_HOST_DEVICE inline bool cfs_waits_for(const CfsAgent& i, glm::vec2 q, bool i_first) {
   const float ahead = dot2(q - i.p, i.e0);
   return ahead < 0.0f || (i_first && ahead < kCfsBesideCos * length_of(q - i.p));

@@ -132,9 +132,11 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   // Walls first: they may slide e0 along them before the pushes are summed.
   const float reach = me.radius + cfs_wall_reach(c);
   glm::vec2 e0 = me.e0, walls(0.0f);
+  bool near_wall = false;
   auto wall_point = [&](glm::vec2 q) {
     const glm::vec2 d = me.p - q;
     const float d2 = length2(d);
+    near_wall = near_wall || d2 < (me.radius + kCfsNearWall) * (me.radius + kCfsNearWall);
     if (d2 >= reach * reach || d2 <= 1e-12f) return;
     e0 = cfs_slide_along_wall(e0, d * (1.0f / sqrtf(d2)));
     walls += cfs_wall_push(me, q, c);
@@ -169,6 +171,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   const glm::vec2 e =
       cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
   if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
+  const bool slid = e0.x != me.e0.x || e0.y != me.e0.y;
   const float top = cfs_slide_speed(e0, me.e0, me.aim_distance, v0);
   // The time gap is kept to where neighbours will be in anticipation_time
   // (one crossing the agent's path will have left it), to those within the
@@ -177,7 +180,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     float gap = INFINITY, gap_now = INFINITY;
     for_each_holder([&](Index j) {
       const glm::vec2 q = n.at(j, me.p);
-      if (!all && cfs_waits_for(me, q, j > self)) return;
+      if (!all && cfs_waits_for(me, q, slid || (near_wall && j > self))) return;
       gap = fminf(
           gap, cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j], c.lane_width));
       gap_now = fminf(gap_now, cfs_gap_ahead(me.p, me.radius, e, q, n.radius[j]));
