@@ -120,12 +120,14 @@ TEST(CollisionFreeSpeed, NearItsAimAnAgentSlidingAlongAWallSlowsByTheTurn) {
   EXPECT_NEAR(cfs_slide_speed(slid, {1.0f, 0.0f}, 1.0f, 1.8f), kCfsSlideSlowest * 1.8f, kEps);
 }
 
-TEST(CollisionFreeSpeed, NeighboursBehindAndLaterNeighboursBesideWaitForABlockedAgent) {
+// (Which agent goes first, slid by a wall or the lower index near one, the
+// caller decides: collision_free_velocity.)
+TEST(CollisionFreeSpeed, NeighboursBehindAndBesideWaitForABlockedAgentThatGoesFirst) {
   const CfsAgent me{{0.0f, 0.0f}, {0.0f, 0.0f}, 0.25f, {1.0f, 0.0f}};
-  EXPECT_TRUE(cfs_waits_for(me, {-0.1f, 0.5f}, false));   // behind: waits whatever the indices
+  EXPECT_TRUE(cfs_waits_for(me, {-0.1f, 0.5f}, false));   // behind: waits for any agent
   EXPECT_FALSE(cfs_waits_for(me, {0.4f, 0.3f}, true));    // 37 degrees off e0: ahead, holds the agent
-  EXPECT_TRUE(cfs_waits_for(me, {0.2f, 0.46f}, true));    // 66 degrees off: beside; the later index waits
-  EXPECT_FALSE(cfs_waits_for(me, {0.2f, 0.46f}, false));  // the earlier index goes first
+  EXPECT_TRUE(cfs_waits_for(me, {0.2f, 0.46f}, true));    // 66 degrees off: beside, waits for one that goes first
+  EXPECT_FALSE(cfs_waits_for(me, {0.2f, 0.46f}, false));  // and holds one that does not
 }
 
 // The gap passes read only the neighbours that the pushes' pass kept as
