@@ -63,7 +63,7 @@ inline constexpr float kCfsCrossingSpeed = 0.3f;
 inline constexpr float kCfsCrossingCos = 0.7f;
 
 // The agent being steered: position, velocity, radius, e0 and how far
-// away the point it heads for is (m).
+// away its current waypoint or goal is (m).
 struct CfsAgent {
   glm::vec2 p{0.0f};
   glm::vec2 v{0.0f};
@@ -181,15 +181,15 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_slide_along_wall(glm::vec2 e0, glm::vec2
   return glm::vec2(-n.y, n.x);  // the wall tangent to the right of walking into it (-n)
 }
 
-// Within kCfsSlideNear (m) of the point it heads for, an agent whose goal
+// Within kCfsSlideNear (m) of its waypoint or goal, an agent whose goal
 // direction the walls turned (e0 slid along them to `slid`) walks no faster
 // than v0 times the cosine of that turn, and at least kCfsSlideSlowest v0.
 // It walks along the wall towards an opening near its goal (a door it was
 // pushed beside): at full speed it cannot turn into an opening narrower
 // than its turning circle (about v0 turn_time across), slides past it, and
 // circles in front of the door for good (a 1.8 m/s walker at a 0.5 m door,
-// docs/simulation.md). Further from its aim it walks on at v0: an agent
-// following a wall round a corner to a goal far beyond it does not slow.
+// docs/simulation.md). Further away it walks on at v0: an agent following
+// a wall round a corner to a goal far beyond it does not slow.
 inline constexpr float kCfsSlideNear = 2.0f;
 inline constexpr float kCfsSlideSlowest = 0.3f;
 THRONG_HOST_DEVICE inline float cfs_slide_speed(glm::vec2 slid, glm::vec2 e0, float aim_distance, float v0) {

@@ -184,7 +184,9 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx,
     const bool to_point = a.waypoint_cursor[i] == a.waypoint_goal[i] || waits_at_waypoint(a, i);
     aim = to_point ? a.goal[i] : waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
   }
-  const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f)), length_of(aim - p)};
+  // How near it is: to its waypoint or goal itself (a field's aim, a gate's
+  // point, lie a step ahead wherever the agent is).
+  const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f)), length_of(a.goal[i] - p)};
   return collision_free_velocity(ctx.world, i, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
 }
 
