@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "motion/cycle.h"
 #include "motion/fk.h"
+#include "motion/phase.h"
 
 namespace throng::anim {
 
@@ -113,8 +114,9 @@ void sample_clip(const AnimClip& anim, double t, Pose& out) {
     f1 = std::min(f0 + 1, N - 1);
     a = static_cast<float>(x - f0);
   }
+  const motion::SlerpAt between(a);
   for (std::int32_t j = 0; j < J; ++j)
-    out.local[static_cast<std::size_t>(j)] = glm::slerp(c.rotation(f0, j), c.rotation(f1, j), a);
+    out.local[static_cast<std::size_t>(j)] = between(c.rotation(f0, j), c.rotation(f1, j));
   const glm::vec3 r0 = c.root_positions[static_cast<std::size_t>(f0)];
   glm::vec3 r1 = c.root_positions[static_cast<std::size_t>(f1)];
   if (anim.loop && f1 == 0 && N >= 2) r1 = r0 + (r0 - c.root_positions[static_cast<std::size_t>(N - 2)]);
@@ -280,11 +282,11 @@ void LayeredController::evaluate(Pose& out) const {
       const float w = weights_[i] * l.mask.weights[j];
       if (w <= 0.0f) continue;
       if (l.mode == LayerMode::Override) {
-        out.local[j] = glm::slerp(out.local[j], scratch_.local[j], w);
+        out.local[j] = motion::slerp_shortest(out.local[j], scratch_.local[j], w);
       } else {
         const glm::quat delta =
             l.reference.empty() ? scratch_.local[j] : glm::inverse(l.reference[j]) * scratch_.local[j];
-        out.local[j] = glm::normalize(out.local[j] * glm::slerp(glm::quat(1, 0, 0, 0), delta, w));
+        out.local[j] = glm::normalize(out.local[j] * motion::slerp_shortest(glm::quat(1, 0, 0, 0), delta, w));
       }
     }
     if (l.mode == LayerMode::Override && !l.mask.weights.empty())
@@ -439,7 +441,8 @@ void StateMachine::evaluate(Pose& out) const {
   if (fading_from_ < 0) return;
   const float w = fade_weight();
   states_[static_cast<std::size_t>(fading_from_)].controller->evaluate(scratch_);
-  for (std::size_t j = 0; j < out.local.size(); ++j) out.local[j] = glm::slerp(scratch_.local[j], out.local[j], w);
+  const motion::SlerpAt fade(w);
+  for (std::size_t j = 0; j < out.local.size(); ++j) out.local[j] = fade(scratch_.local[j], out.local[j]);
   out.root = glm::mix(scratch_.root, out.root, w);
 }
 

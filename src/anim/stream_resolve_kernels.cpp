@@ -4,6 +4,7 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "motion/phase.h"
 
 namespace throng::anim {
 
@@ -329,9 +330,9 @@ THRONG_HOST_DEVICE inline glm::quat local_rotation(const AgentPose& pose, std::i
   if (pose.alpha[c] < 1.0f) {
     const glm::quat src =
         pose.from[c].rotations != nullptr ? pose.from[c].rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-    local = glm::slerp(src, local, pose.alpha[c]);
+    local = motion::slerp_shortest(src, local, pose.alpha[c]);
   }
-  if (o != nullptr && o->kind == OverrideKind::Rotation) local = glm::slerp(local, o->rotation, o->weight);
+  if (o != nullptr && o->kind == OverrideKind::Rotation) local = motion::slerp_shortest(local, o->rotation, o->weight);
   return local;
 }
 

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/ground.h"
+#include "motion/phase.h"
 #include "sim/geometry.h"
 
 namespace throng::path {
@@ -123,7 +124,8 @@ Playback play(const MotionGraph& machine, const ResampledPath& path, const Seque
       placed(*other, tau - other->start, rb, root_b);
       const auto wf = static_cast<float>(w);
       root_a = glm::mix(root_a, root_b, wf);
-      for (std::size_t j = 0; j < ra.size(); ++j) ra[j] = glm::slerp(ra[j], rb[j], wf);
+      const motion::SlerpAt blend_at(wf);
+      for (std::size_t j = 0; j < ra.size(); ++j) ra[j] = blend_at(ra[j], rb[j]);
     }
     for (std::int32_t j = 0; j < J; ++j) out.clip.rotation(f, j) = ra[static_cast<std::size_t>(j)];
     out.clip.root_positions[static_cast<std::size_t>(f)] = root_a;

@@ -11,6 +11,7 @@
 #include "core/ground.h"
 #include "motion/cycle.h"
 #include "motion/fk.h"
+#include "motion/phase.h"
 #include "sim/geometry.h"
 
 namespace throng::path {
@@ -59,8 +60,9 @@ void MotionGraph::pose(std::int32_t seg, double t, std::vector<glm::quat>& rotat
   const FramePos p = frame_pos(c.clip, c.time_of_first_frame, c.fps, s.start_time + t);
   const std::int32_t J = c.clip.joint_count;
   rotations.resize(static_cast<std::size_t>(J));
+  const motion::SlerpAt between(p.w);
   for (std::int32_t j = 0; j < J; ++j)
-    rotations[static_cast<std::size_t>(j)] = glm::slerp(c.clip.rotation(p.f0, j), c.clip.rotation(p.f1, j), p.w);
+    rotations[static_cast<std::size_t>(j)] = between(c.clip.rotation(p.f0, j), c.clip.rotation(p.f1, j));
   root = glm::mix(c.clip.root_positions[static_cast<std::size_t>(p.f0)],
                   c.clip.root_positions[static_cast<std::size_t>(p.f1)], p.w);
 }
