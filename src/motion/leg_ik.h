@@ -29,6 +29,15 @@ THRONG_HOST_DEVICE inline glm::quat rotation_between(const glm::vec3& a, const g
   return glm::normalize(glm::quat(1.0f + d, c.x, c.y, c.z));
 }
 
+// Rotation by the angle whose cosine and sine are c and s about a unit
+// axis: (1 + c, s axis) normalised is (cos(a/2), sin(a/2) axis). Turns
+// within 2.6 degrees of half a circle (1 + c below 1e-3, where that loses
+// digits) take the angle itself.
+THRONG_HOST_DEVICE inline glm::quat turn_about(const glm::vec3& axis, float c, float s) {
+  if (1.0f + c < 1e-3f) return glm::angleAxis(glm::atan(s, c), axis);
+  return glm::normalize(glm::quat(1.0f + c, s * axis.x, s * axis.y, s * axis.z));
+}
+
 // Two-bone IK of one leg. Positions and rotations are all in one frame (the
 // world, or the path frame in plant_legs); lengths in metres.
 // Inputs: hip, the thigh joint's position; knee_offset and ankle_offset,
@@ -61,19 +70,25 @@ THRONG_HOST_DEVICE inline bool two_bone_ik(const glm::vec3& hip, const glm::vec3
   hinge_world -= glm::dot(hinge_world, u) * u;
   const glm::vec3 normal = glm::cross(upper, lower);
   const float area = glm::length(normal);
+  // The bends as cosine and sine, never as angles: the turn from the bend
+  // now to the one wanted follows from the difference formulas, and its
+  // quaternion from the half-angle ones (no acos, atan or sine).
   glm::vec3 axis;
-  float bend_now;
+  float cos_now, sin_now;
   if (area > 1e-3f * l1 * l2 && glm::dot(normal, hinge_world) >= 0.0f) {
     axis = normal / area;
-    bend_now = glm::acos(glm::clamp(glm::dot(upper, lower) / (l1 * l2), -1.0f, 1.0f));
+    cos_now = glm::dot(upper, lower) / (l1 * l2);
+    sin_now = area / (l1 * l2);
   } else {
     if (glm::dot(hinge_world, hinge_world) < 1e-10f) return false;
     axis = glm::normalize(hinge_world);
-    bend_now = glm::atan(glm::dot(normal, axis), glm::dot(upper, lower));
+    const float x = glm::dot(upper, lower), y = glm::dot(normal, axis), r = glm::sqrt(x * x + y * y);
+    cos_now = r > 0.0f ? x / r : 1.0f;
+    sin_now = r > 0.0f ? y / r : 0.0f;
   }
-  const float cos_want = (d * d - l1 * l1 - l2 * l2) / (2.0f * l1 * l2);
-  const float bend_want = glm::acos(glm::clamp(cos_want, -1.0f, 1.0f));
-  r_knee = glm::angleAxis(bend_want - bend_now, axis) * r_knee;
+  const float cos_want = glm::clamp((d * d - l1 * l1 - l2 * l2) / (2.0f * l1 * l2), -1.0f, 1.0f);
+  const float sin_want = glm::sqrt(1.0f - cos_want * cos_want);  // the knee bends 0 to 180 degrees
+  r_knee = turn_about(axis, cos_want * cos_now + sin_want * sin_now, sin_want * cos_now - cos_want * sin_now) * r_knee;
   const glm::vec3 ankle_now = upper + r_knee * ankle_offset;
   if (glm::dot(ankle_now, ankle_now) > 1e-12f && glm::dot(to_target, to_target) > 1e-12f) {
     const glm::quat swing = rotation_between(glm::normalize(ankle_now), glm::normalize(to_target));
