@@ -172,8 +172,9 @@ VerifyResult route_choice(const VerifyOptions& o) {
   bool all_left = true;
   std::vector<std::string> arrivals;
   nlohmann::json runs = nlohmann::json::array();
+  const io::LoadedScenario file = load_verification_scenario(r.scenarios[0], o);
   for (std::uint64_t k = 0; k < kRouteChoiceSeeds; ++k) {
-    io::LoadedScenario scenario = load_verification_scenario(r.scenarios[0], o);
+    io::LoadedScenario scenario = file;
     scenario.spec.seed += k;
     std::fprintf(stderr, "throng verify: running %s, seed %llu\n", r.scenarios[0].c_str(),
                  static_cast<unsigned long long>(scenario.spec.seed));
