@@ -1,9 +1,9 @@
 // Two-bone leg IK (motion/leg_ik.h) against an independent reference in
 // double: the same construction written with angles (acos of the law of
-// cosines, atan2 of the bend now, the turn as an axis and angle), which is
-// how the solver computed it before it worked with cosines and sines only.
-// Also the properties the construction promises: the ankle on a reachable
-// target, the bone lengths kept, the knee bent about its hinge's side.
+// cosines, atan2 of the bend now, the turn as an axis and angle), where the
+// solver works with cosines and sines only. Also the properties the
+// construction promises: the ankle on a reachable target, the bone lengths
+// kept, a target out of reach met by the stretched leg.
 #include "motion/leg_ik.h"
 
 #include <gtest/gtest.h>
