@@ -146,28 +146,38 @@ struct GridView {
 };
 
 // The item runs of the 3x3 cells around cell (cx, cy), row-major (dy, then
-// dx); an empty cell has count 0. Worth keeping when the same neighbourhood
-// is visited several times in a step (the contact passes): the table lookups
-// and their cache misses are paid once.
+// dx), empty cells left out and runs that follow each other in `items`
+// joined (on a dense grid the three cells of a row are one run): the same
+// items in the same order as cell by cell, with fewer loops to end. Worth
+// keeping when the same neighbourhood is visited several times in a step
+// (the contact passes): the table lookups and their cache misses are paid
+// once.
 struct Cells3x3 {
   std::int32_t start[9];
   std::int32_t count[9];
+  std::int32_t runs = 0;
 };
 THRONG_HOST_DEVICE inline Cells3x3 cells_3x3(const GridView& g, std::int32_t cx, std::int32_t cy) {
   Cells3x3 c;
   for (std::int32_t dy = -1; dy <= 1; ++dy)
     for (std::int32_t dx = -1; dx <= 1; ++dx) {
-      const int k = (dy + 1) * 3 + dx + 1;
       const Index s = g.find(cx + dx, cy + dy);
-      c.start[k] = s < 0 ? 0 : g.start[s];
-      c.count[k] = s < 0 ? 0 : g.count[s];
+      if (s < 0) continue;
+      const std::int32_t b = g.start[s], n = g.count[s];
+      if (c.runs > 0 && c.start[c.runs - 1] + c.count[c.runs - 1] == b) {
+        c.count[c.runs - 1] += n;
+      } else {
+        c.start[c.runs] = b;
+        c.count[c.runs] = n;
+        ++c.runs;
+      }
     }
   return c;
 }
 // Calls fn(item) for every item of those cells, in order.
 template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_in_cells(const GridView& g, const Cells3x3& c, Fn&& fn) {
-  for (int k = 0; k < 9; ++k)
+  for (int k = 0; k < c.runs; ++k)
     for (std::int32_t m = 0; m < c.count[k]; ++m) fn(g.items[c.start[k] + m]);
 }
 

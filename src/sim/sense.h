@@ -44,13 +44,36 @@ struct NeighbourArrays {
   THRONG_HOST_DEVICE glm::vec2 at(Index j, glm::vec2 p) const { return periodic.near(position[j], p); }
 };
 
-// Neighbour j as a candidate threat of the agent at p: kept in `best` when
-// it is active, within the query radius and more urgent.
-THRONG_HOST_DEVICE inline void consider_neighbour(Threat& best, Index j, Index self, glm::vec2 p, glm::vec2 v,
+// Calls fn(j, q) for every active candidate j other than `self` whose
+// position q (its image nearest p) lies closer to p than sqrt(range2), in
+// the order for_each_candidate visits them. The candidates are first
+// sifted without a branch into a batch of indices, then the batch is
+// visited: most candidates fail the test, and a branch on each mispredicts
+// often enough to cost more than the test itself.
+inline constexpr int kNeighbourBatch = 32;
+template <class ForEachCandidate, class Fn>
+THRONG_HOST_DEVICE inline void for_each_neighbour(const ForEachCandidate& for_each_candidate, Index self,
+                                                  const NeighbourArrays& n, glm::vec2 p, float range2, const Fn& fn) {
+  std::int32_t batch[kNeighbourBatch];
+  int found = 0;
+  auto visit = [&]() {
+    for (int k = 0; k < found; ++k) fn(static_cast<Index>(batch[k]), n.at(batch[k], p));
+    found = 0;
+  };
+  for_each_candidate([&](Index j) {
+    batch[found] = static_cast<std::int32_t>(j);
+    const bool near = (j != self) & ((n.flags[j] & kAgentActive) != 0) & (length2(n.at(j, p) - p) < range2);
+    found += near ? 1 : 0;
+    if (found == kNeighbourBatch) visit();
+  });
+  visit();
+}
+
+// Neighbour j at q (within the query radius, active) as a threat of the
+// agent at p: kept in `best` when more urgent.
+THRONG_HOST_DEVICE inline void consider_neighbour(Threat& best, Index j, glm::vec2 q, glm::vec2 p, glm::vec2 v,
                                                   glm::vec2 forward, float radius, const NeighbourArrays& n,
-                                                  const ModelParams& m, float query2) {
-  const glm::vec2 q = n.at(j, p);
-  if (length2(q - p) >= query2 || j == self || (n.flags[j] & kAgentActive) == 0) return;
+                                                  const ModelParams& m) {
   // An agent standing at its goal is passed like a post: no personal space,
   // so arriving agents can still reach goals next to those already there.
   const float space = (n.flags[j] & kAgentStopped) != 0 ? 0.0f : m.personal_space;
@@ -69,21 +92,24 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
   Threat best;
   const float query = m.query_radius();
   const float query2 = query * query;
-  for (std::int32_t dy = -1; dy <= 1; ++dy)
-    for (std::int32_t dx = -1; dx <= 1; ++dx) {
-      const glm::vec2 lo = bins.cell_min(cx + dx, cy + dy) - glm::vec2(slack);
-      const glm::vec2 hi = lo + glm::vec2(bins.cell_size, bins.cell_size_y) + glm::vec2(2.0f * slack);
-      const glm::vec2 nearest(fminf(fmaxf(p.x, lo.x), hi.x), fminf(fmaxf(p.y, lo.y), hi.y));
-      if (length2(nearest - p) >= query2) continue;
-      // The corner of the cell furthest along `forward`.
-      const glm::vec2 front(forward.x >= 0.0f ? hi.x : lo.x, forward.y >= 0.0f ? hi.y : lo.y);
-      if (dot2(front - p, forward) <= 0.0f) continue;
-      const Index s = bins.find(cx + dx, cy + dy);
-      if (s < 0) continue;
-      const std::int32_t b = bins.start[s], count = bins.count[s];
-      for (std::int32_t k = 0; k < count; ++k)
-        consider_neighbour(best, bins.items[b + k], self, p, v, forward, radius, n, m, query2);
-    }
+  auto candidates = [&](const auto& fn) {
+    for (std::int32_t dy = -1; dy <= 1; ++dy)
+      for (std::int32_t dx = -1; dx <= 1; ++dx) {
+        const glm::vec2 lo = bins.cell_min(cx + dx, cy + dy) - glm::vec2(slack);
+        const glm::vec2 hi = lo + glm::vec2(bins.cell_size, bins.cell_size_y) + glm::vec2(2.0f * slack);
+        const glm::vec2 nearest(fminf(fmaxf(p.x, lo.x), hi.x), fminf(fmaxf(p.y, lo.y), hi.y));
+        if (length2(nearest - p) >= query2) continue;
+        // The corner of the cell furthest along `forward`.
+        const glm::vec2 front(forward.x >= 0.0f ? hi.x : lo.x, forward.y >= 0.0f ? hi.y : lo.y);
+        if (dot2(front - p, forward) <= 0.0f) continue;
+        const Index s = bins.find(cx + dx, cy + dy);
+        if (s < 0) continue;
+        const std::int32_t b = bins.start[s], count = bins.count[s];
+        for (std::int32_t k = 0; k < count; ++k) fn(static_cast<Index>(bins.items[b + k]));
+      }
+  };
+  for_each_neighbour(candidates, self, n, p, query2,
+                     [&](Index j, glm::vec2 q) { consider_neighbour(best, j, q, p, v, forward, radius, n, m); });
   return best;
 }
 
@@ -93,7 +119,11 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec
                                                             const ModelParams& m) {
   Threat best;
   const float query2 = m.query_radius() * m.query_radius();
-  for (Index j = 0; j < n.position.size(); ++j) consider_neighbour(best, j, self, p, v, forward, radius, n, m, query2);
+  auto candidates = [&](const auto& fn) {
+    for (Index j = 0; j < n.position.size(); ++j) fn(j);
+  };
+  for_each_neighbour(candidates, self, n, p, query2,
+                     [&](Index j, glm::vec2 q) { consider_neighbour(best, j, q, p, v, forward, radius, n, m); });
   return best;
 }
 
@@ -126,9 +156,6 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
                                                             const ForEachCandidate& for_each_candidate) {
   const CollisionFreeSpeedParams& c = m.cfs;
   const float query2 = m.query_radius() * m.query_radius();
-  auto is_neighbour = [&](Index j) {
-    return j != self && (n.flags[j] & kAgentActive) != 0 && length2(n.at(j, me.p) - me.p) < query2;
-  };
   // Walls first: they may slide e0 along them before the pushes are summed.
   const float reach = me.radius + cfs_wall_reach(c);
   glm::vec2 e0 = me.e0, walls(0.0f);
@@ -153,9 +180,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
       me.radius + m.max_radius() + v0 * fmaxf(c.time_gap, dt) + m.max_speed * c.anticipation_time + 1e-3f;
   std::int32_t holders[kCfsHolders];
   int held = 0;
-  for_each_candidate([&](Index j) {
-    if (!is_neighbour(j)) return;
-    const glm::vec2 q = n.at(j, me.p);
+  for_each_neighbour(for_each_candidate, self, n, me.p, query2, [&](Index j, glm::vec2 q) {
     sum += cfs_neighbour_push(me, q, n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
     if (length2(q - me.p) >= hold * hold) return;
     if (held < kCfsHolders) holders[held] = static_cast<std::int32_t>(j);
@@ -163,9 +188,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   });
   auto for_each_holder = [&](const auto& fn) {
     if (held > kCfsHolders)
-      return for_each_candidate([&](Index j) {
-        if (is_neighbour(j)) fn(j);
-      });
+      return for_each_neighbour(for_each_candidate, self, n, me.p, query2, [&](Index j, glm::vec2) { fn(j); });
     for (int k = 0; k < held; ++k) fn(static_cast<Index>(holders[k]));
   };
   const glm::vec2 e =
@@ -226,11 +249,8 @@ THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, co
     if (length2(x) < sense2) f += ttc_avoidance(x, me.v, me.radius, t);
   };
   for_each_wall_point(w, me.p, wall_point);
-  for_each_candidate([&](Index j) {
-    if (j == self || (n.flags[j] & kAgentActive) == 0) return;
-    const glm::vec2 x = me.p - n.at(j, me.p);
-    if (length2(x) >= sense2) return;
-    f += ttc_avoidance(x, me.v - n.velocity[j], me.radius + n.radius[j], t);
+  for_each_neighbour(for_each_candidate, self, n, me.p, sense2, [&](Index j, glm::vec2 q) {
+    f += ttc_avoidance(me.p - q, me.v - n.velocity[j], me.radius + n.radius[j], t);
   });
   return clamp_length(f, t.max_acceleration);
 }

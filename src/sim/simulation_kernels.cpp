@@ -307,14 +307,17 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const 
   return acceptable_move(ctx, cells, anchor, p, r, clear) ? p : anchor;
 }
 
-// Agents are visited in index order; each finds its neighbours in the 3x3
-// bins around it. Inactive agents are not binned and keep a zero sensed force.
+// Agents are visited in bin order (the k-th binned agent), so agents whose
+// 3x3 cells overlap are sensed one after another and find their candidates
+// still in cache; each agent's result depends only on the state it reads,
+// not on the order. Inactive agents are not binned and keep a zero sensed
+// force.
 struct Sense {
   StepContext ctx;
   AgentArrays a;
   Span<glm::vec2> sensed;
-  THRONG_HOST_DEVICE void operator()(Index i) const {
-    if ((a.flags[i] & kAgentActive) == 0) return;
+  THRONG_HOST_DEVICE void operator()(Index k) const {
+    const Index i = ctx.bins.items[k];
     const glm::vec2 p = a.position[i];
     sensed[i] = sense_binned(ctx, a, i, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
   }
@@ -506,7 +509,7 @@ constexpr Index kSlotGrain = 256;
 }  // namespace
 
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
-  parallel_for("sim.sense", a.position.size(), Sense{ctx, a, sensed}, kAgentGrain);
+  parallel_for("sim.sense", ctx.bins.items.size(), Sense{ctx, a, sensed}, kAgentGrain);
 }
 
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {

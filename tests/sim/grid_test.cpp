@@ -152,12 +152,15 @@ TEST(CountingSort, RebuildAfterMovingAndWithNoAgents) {
   EXPECT_EQ(g.view().find(0, 0), -1);
 }
 
-TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
+// Every agent within one cell side is among the 3x3 cells' items, and the
+// cached runs (cells_3x3) visit those items in the same order.
+void three_by_three_finds_every_neighbour(bool dense) {
   const float side = 4.0f;
   const std::vector<glm::vec2> p = random_points(3000, 60.0f, 3);
   const std::vector<std::uint8_t> flags(p.size(), kAgentActive);
   AgentGrid g(side);
-  g.rebuild(p, flags);
+  g.rebuild(p, flags, dense);
+  ASSERT_EQ(g.dense(), dense);
   const GridView v = g.view();
   std::mt19937 rng(4);
   for (int q = 0; q < 300; ++q) {
@@ -172,9 +175,22 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
     // The cached form visits the same items in the same order.
     std::vector<std::int32_t> a, b;
     for_each_in_3x3(v, p[i], [&](std::int32_t j) { a.push_back(j); });
-    for_each_in_cells(v, cells_3x3(v, cell_coord(p[i].x, side), cell_coord(p[i].y, side)),
-                      [&](std::int32_t j) { b.push_back(j); });
+    const Cells3x3 cells = cells_3x3(v, cell_coord(p[i].x, side), cell_coord(p[i].y, side));
+    for_each_in_cells(v, cells, [&](std::int32_t j) { b.push_back(j); });
     EXPECT_EQ(a, b);
+    // Runs that follow each other in `items` are joined: on a dense grid
+    // the three cells of a row are one run.
+    if (dense) {
+      EXPECT_LE(cells.runs, 3);
+    }
+    for (int k = 1; k < cells.runs; ++k) EXPECT_NE(cells.start[k - 1] + cells.count[k - 1], cells.start[k]);
+  }
+}
+
+TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
+  for (const bool dense : {true, false}) {
+    SCOPED_TRACE(dense ? "dense" : "hashed");
+    three_by_three_finds_every_neighbour(dense);
   }
 }
 
