@@ -157,20 +157,39 @@ struct Cells3x3 {
   std::int32_t count[9];
   std::int32_t runs = 0;
 };
+// Appends the run of n items from b, joined to the last run when it follows it.
+THRONG_HOST_DEVICE inline void add_run(Cells3x3& c, std::int32_t b, std::int32_t n) {
+  if (c.runs > 0 && c.start[c.runs - 1] + c.count[c.runs - 1] == b) {
+    c.count[c.runs - 1] += n;
+  } else {
+    c.start[c.runs] = b;
+    c.count[c.runs] = n;
+    ++c.runs;
+  }
+}
+// A dense grid that does not wrap: a row's cells are neighbouring slots,
+// and every slot's start is set (an empty one's where its items would be),
+// so a row of the 3x3 is one lookup of its first and last slot.
+THRONG_HOST_DEVICE inline Cells3x3 dense_cells_3x3(const GridView& g, std::int32_t cx, std::int32_t cy) {
+  Cells3x3 c;
+  const std::int64_t x = std::int64_t{cx} - g.dense_x0;
+  const std::int64_t x0 = x - 1 > 0 ? x - 1 : 0, x1 = x + 1 < g.dense_nx - 1 ? x + 1 : g.dense_nx - 1;
+  if (g.items.size() == 0 || x0 > x1) return c;
+  for (std::int64_t y = std::int64_t{cy} - g.dense_y0 - 1; y <= std::int64_t{cy} - g.dense_y0 + 1; ++y) {
+    if (y < 0 || y >= g.dense_ny) continue;
+    const auto first = static_cast<Index>(y * g.dense_nx + x0), last = static_cast<Index>(y * g.dense_nx + x1);
+    const std::int32_t b = g.start[first], n = g.start[last] + g.count[last] - b;
+    if (n > 0) add_run(c, b, n);
+  }
+  return c;
+}
 THRONG_HOST_DEVICE inline Cells3x3 cells_3x3(const GridView& g, std::int32_t cx, std::int32_t cy) {
+  if (g.dense_nx > 0 && g.wrap_x == 0 && g.wrap_y == 0) return dense_cells_3x3(g, cx, cy);
   Cells3x3 c;
   for (std::int32_t dy = -1; dy <= 1; ++dy)
     for (std::int32_t dx = -1; dx <= 1; ++dx) {
       const Index s = g.find(cx + dx, cy + dy);
-      if (s < 0) continue;
-      const std::int32_t b = g.start[s], n = g.count[s];
-      if (c.runs > 0 && c.start[c.runs - 1] + c.count[c.runs - 1] == b) {
-        c.count[c.runs - 1] += n;
-      } else {
-        c.start[c.runs] = b;
-        c.count[c.runs] = n;
-        ++c.runs;
-      }
+      if (s >= 0) add_run(c, g.start[s], g.count[s]);
     }
   return c;
 }

@@ -185,6 +185,17 @@ void three_by_three_finds_every_neighbour(bool dense) {
     }
     for (int k = 1; k < cells.runs; ++k) EXPECT_NE(cells.start[k - 1] + cells.count[k - 1], cells.start[k]);
   }
+  // Around points anywhere, inside the occupied box, on its edge and up to
+  // three cells beyond it: the same items in the same order.
+  std::uniform_real_distribution<float> anywhere(-3.0f * side, 60.0f + 3.0f * side);
+  for (int q = 0; q < 2000; ++q) {
+    const glm::vec2 at(anywhere(rng), anywhere(rng));
+    std::vector<std::int32_t> a, b;
+    for_each_in_3x3(v, at, [&](std::int32_t j) { a.push_back(j); });
+    for_each_in_cells(v, cells_3x3(v, cell_coord(at.x, side), cell_coord(at.y, side)),
+                      [&](std::int32_t j) { b.push_back(j); });
+    ASSERT_EQ(a, b) << "around (" << at.x << ", " << at.y << ")";
+  }
 }
 
 TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
