@@ -89,8 +89,9 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::v
   // sideways and chokes a door.
   const float ahead = dot2(d, i.e0);
   const float closing = -dot2(w - i.v, u);
-  const bool towards = parked || -dot2(w, u) > kCfsOncoming;
-  if (m.avoid_strength > 0.0f && towards && ahead > 0.0f && closing > 1e-3f) {
+  const bool towards = parked | (-dot2(w, u) > kCfsOncoming);
+  // One branch on the four cheap tests (evaluated without short cuts).
+  if ((m.avoid_strength > 0.0f) & towards & (ahead > 0.0f) & (closing > 1e-3f)) {
     // Past the cheap tests (most neighbours stop there): j's speed and heading.
     const float speed = length_of(w), along = dot2(w, i.e0);
     const bool against = parked || along < kCfsAgainst * speed;

@@ -182,9 +182,10 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   int held = 0;
   for_each_neighbour(for_each_candidate, self, n, me.p, query2, [&](Index j, glm::vec2 q) {
     sum += cfs_neighbour_push(me, q, n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
-    if (length2(q - me.p) >= hold * hold) return;
+    // Kept without a branch on the distance: written in any case, counted
+    // when within `hold` (the next neighbour overwrites one not counted).
     if (held < kCfsHolders) holders[held] = static_cast<std::int32_t>(j);
-    ++held;
+    held += length2(q - me.p) < hold * hold ? 1 : 0;
   });
   auto for_each_holder = [&](const auto& fn) {
     if (held > kCfsHolders)
