@@ -1,7 +1,7 @@
 // The sense stage's neighbour sift (for_each_neighbour, sim/sense.h): the
-// same neighbours, at the same images, in the same order as the plain
-// filter it replaced (a branch per candidate), which every model's sum
-// relies on for its bits.
+// same neighbours, at the same images, in the same order as a plain filter
+// that branches on each candidate; every model's sum relies on that order
+// for its bits.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -72,7 +72,7 @@ void expect_same_as_plain_filter(const Crowd& c, const Periodic& periodic, float
 }
 
 TEST(Sense, NeighbourSiftMatchesThePlainFilter) {
-  const Crowd c(2000, 40.0f, 1);  // about 80 within 4 m
+  const Crowd c(2000, 40.0f, 1);  // about 50 active within 4 m
   expect_same_as_plain_filter(c, Periodic{}, 4.0f);
 }
 
