@@ -310,8 +310,9 @@ THRONG_HOST_DEVICE inline glm::vec2 contact_agent(const StepContext& ctx, const 
 // Agents are visited in bin order (the k-th binned agent), so agents whose
 // 3x3 cells overlap are sensed one after another and find their candidates
 // still in cache; each agent's result depends only on the state it reads,
-// not on the order. Inactive agents are not binned and keep a zero sensed
-// force.
+// not on the order. Inactive agents are not binned: their sensed entry
+// keeps whatever it held (zero, or its last value before it left), which
+// steering ignores for an agent that does not steer.
 struct Sense {
   StepContext ctx;
   AgentArrays a;
