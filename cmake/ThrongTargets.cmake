@@ -13,9 +13,11 @@ set(THRONG_SANITIZER_FLAGS -fsanitize=address,undefined -fno-omit-frame-pointer 
 # installed headers), so on one machine the instruction set changes speed,
 # not results: both builds give the same trajectories and poses bit for bit
 # (the recorded run test holds in each). CUDA device code keeps nvcc's fused
-# multiply-adds: the GPU matches the CPU to tolerances, not bits.
+# multiply-adds: the GPU matches the CPU to tolerances, not bits. Nothing
+# reads errno, so square roots need not set it (-fno-math-errno): they stay
+# one instruction and loops over lanes of them vectorise; results are the same.
 option(THRONG_PORTABLE "Build for the x86-64 baseline instead of this machine's instruction set" OFF)
-set(THRONG_ARCH_FLAGS -ffp-contract=off)
+set(THRONG_ARCH_FLAGS -ffp-contract=off -fno-math-errno)
 if(NOT THRONG_PORTABLE)
   include(CheckCXXCompilerFlag)
   check_cxx_compiler_flag(-march=native THRONG_HAS_MARCH_NATIVE)

@@ -15,6 +15,7 @@
 #include "motion/foot_skating.h"
 #include "motion/leg_ik.h"
 #include "motion/locomotion_step.h"
+#include "motion/quat_lanes.h"
 
 namespace throng::motion {
 
@@ -47,6 +48,44 @@ struct SampledJoints {
   }
 };
 
+// The blend's local rotations of joints j0 .. j0 + kQuatLanes - 1 (those
+// below joint_count) side by side: each clip sampled between its rows (the
+// rows of the joint's group), then SLERP by w in (0, 1). Writes local[j]
+// where the mask keeps j, and each clip's sample of the legs' thigh, knee
+// and ankle into s.
+THRONG_HOST_DEVICE inline void blend_joint_lanes(const BlendSpaceView& v, const CharacterFrame& f, const SlerpAt& blend,
+                                                 std::int32_t j0, SampledJoints& s, glm::quat* local) {
+  QuatLanes a0, a1, b0, b1, qa, qb, q;
+  float ta[kQuatLanes], tb[kQuatLanes];
+  const std::int32_t last = v.joint_count - 1;
+  for (int l = 0; l < kQuatLanes; ++l) {  // lanes past the last joint repeat it
+    const std::int32_t j = j0 + l < last ? j0 + l : last;
+    const std::uint8_t g = v.joint_group[j];
+    const ClipRows &ra = f.rows[g][0], &rb = f.rows[g][1];
+    a0.set(l, texel_quat(v.texture, j, ra.r0));
+    a1.set(l, texel_quat(v.texture, j, ra.r1));
+    b0.set(l, texel_quat(v.texture, j, rb.r0));
+    b1.set(l, texel_quat(v.texture, j, rb.r1));
+    ta[l] = ra.t;
+    tb[l] = rb.t;
+  }
+  interpolate_frames(a0, a1, ta, qa);
+  interpolate_frames(b0, b1, tb, qb);
+  slerp(blend, qa, qb, q);
+  for (int l = 0; l < kQuatLanes && j0 + l <= last; ++l) {
+    const std::int32_t j = j0 + l;
+    if (mask_bit(s.mask, j)) local[j] = q.get(l);
+    // Sampled at the group's rows: the leg's own when the joint is in its
+    // group (each thigh's subtree is; clip() samples anything else anew).
+    const std::uint8_t g = v.joint_group[j];
+    const int k = g > 0 ? leg_slot(v.legs[g - 1], j) : -1;
+    if (k >= 0) {
+      s.leg_clip[g - 1][k][0] = qa.get(l);
+      s.leg_clip[g - 1][k][1] = qb.get(l);
+    }
+  }
+}
+
 // Every local rotation synthesised_rotation gives, bit for bit, each joint
 // sampled once: writes local[j] for the joints the mask keeps (a null mask
 // keeps all) and returns the leg IK's result (for its pelvis drop).
@@ -54,23 +93,13 @@ THRONG_HOST_DEVICE inline PlantedLegs synthesise_locals(const BlendSpaceView& v,
                                                         const std::uint32_t* mask, glm::quat* local) {
   SampledJoints s{&v, &f, mask, local, {}};
   const float w = f.point.w;
-  const SlerpAt blend(w);
-  for (std::int32_t j = 0; j < v.joint_count; ++j) {
-    if (!mask_bit(mask, j)) continue;
-    const std::uint8_t g = v.joint_group[j];
-    const ClipRows &ra = f.rows[g][0], &rb = f.rows[g][1];
-    if (w <= 0.0f || w >= 1.0f) {  // one clip, no IK
-      local[j] = blended_rotation(v, w, ra, rb, j);
-      continue;
-    }
-    const glm::quat qa = clip_rotation(v, ra, j), qb = clip_rotation(v, rb, j);
-    local[j] = blend(qa, qb);
-    // Sampled at the group's rows: the leg's own when the joint is in its
-    // group (each thigh's subtree is; clip() samples anything else anew).
-    const int k = g > 0 ? leg_slot(v.legs[g - 1], j) : -1;
-    if (k >= 0) {
-      s.leg_clip[g - 1][k][0] = qa;
-      s.leg_clip[g - 1][k][1] = qb;
+  if (w > 0.0f && w < 1.0f) {
+    const SlerpAt blend(w);
+    for (std::int32_t j0 = 0; j0 < v.joint_count; j0 += kQuatLanes) blend_joint_lanes(v, f, blend, j0, s, local);
+  } else {  // one clip, no IK
+    for (std::int32_t j = 0; j < v.joint_count; ++j) {
+      const std::uint8_t g = v.joint_group[j];
+      if (mask_bit(mask, j)) local[j] = blended_rotation(v, w, f.rows[g][0], f.rows[g][1], j);
     }
   }
   const PlantedLegs legs = plant_legs(v, f, mask, s);

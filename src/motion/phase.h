@@ -72,11 +72,16 @@ class SlerpAt {
     const float k = c < 0.0f ? -1.0f : 1.0f;
     c *= k;
     const float y = (c < 1.0f ? c : 1.0f) - 1.0f;
-    const float wa = estrin(ca_, y), wb = k * estrin(cb_, y);
+    const float wa = weight_a(y), wb = k * weight_b(y);
     const glm::quat q(wa * a.w + wb * b.w, wa * a.x + wb * b.x, wa * a.y + wb * b.y, wa * a.z + wb * b.z);
     const float s = 1.5f - 0.5f * glm::dot(q, q);
     return glm::quat(s * q.w, s * q.x, s * q.y, s * q.z);
   }
+  THRONG_HOST_DEVICE float t() const { return t_; }
+  // The weights of a and b (before the sign of the shorter arc) at y =
+  // cos(h) - 1, h the half angle between the pair.
+  THRONG_HOST_DEVICE float weight_a(float y) const { return estrin(ca_, y); }
+  THRONG_HOST_DEVICE float weight_b(float y) const { return estrin(cb_, y); }
 
  private:
   // b_i = b_(i-1) (t^2 u_i - v_i) with u_i = 1 / (i (2i + 1)) and v_i = i /
