@@ -14,13 +14,23 @@
 
 namespace throng::motion {
 
-// A GPU thread keeps one lane (its registers are its own; eight lanes of
-// each operand would spill to local memory).
+// Up to kQuatLanes lanes, used in whole vectors of kLaneWidth: a pose of
+// 22 joints fills three of eight floats. A stage runs over every lane
+// before the next stage starts, so the vectors' dependency chains (square
+// root, division, polynomial) overlap. A GPU thread keeps one lane (eight
+// lanes of each operand would spill its registers to local memory).
 #ifdef __CUDA_ARCH__
 inline constexpr int kQuatLanes = 1;
+inline constexpr int kLaneWidth = 1;
 #else
-inline constexpr int kQuatLanes = 8;
+inline constexpr int kQuatLanes = 32;
+inline constexpr int kLaneWidth = 8;
 #endif
+// The lanes that n items take: n rounded up to whole vectors, at most kQuatLanes.
+THRONG_HOST_DEVICE inline int lanes_for(int n) {
+  const int rounded = (n + kLaneWidth - 1) / kLaneWidth * kLaneWidth;
+  return rounded < kQuatLanes ? rounded : kQuatLanes;
+}
 
 struct QuatLanes {
   float w[kQuatLanes], x[kQuatLanes], y[kQuatLanes], z[kQuatLanes];
@@ -38,11 +48,11 @@ THRONG_HOST_DEVICE inline float lane_dot(const QuatLanes& a, const QuatLanes& b,
   return (a.w[l] * b.w[l] + a.x[l] * b.x[l]) + (a.y[l] * b.y[l] + a.z[l] * b.z[l]);
 }
 
-// interpolate_frames lane by lane, each lane its own fraction t[l]
+// interpolate_frames in lanes 0 .. n - 1, each lane its own fraction t[l]
 // (glm::normalize's division by the length included).
-THRONG_HOST_DEVICE inline void interpolate_frames(const QuatLanes& a, const QuatLanes& b, const float* t,
+THRONG_HOST_DEVICE inline void interpolate_frames(int n, const QuatLanes& a, const QuatLanes& b, const float* t,
                                                   QuatLanes& out) {
-  for (int l = 0; l < kQuatLanes; ++l) {
+  for (int l = 0; l < n; ++l) {
     const float k = lane_dot(a, b, l) < 0.0f ? -1.0f : 1.0f;
     const float u = t[l];
     const float w = a.w[l] + u * (k * b.w[l] - a.w[l]), x = a.x[l] + u * (k * b.x[l] - a.x[l]);
@@ -58,13 +68,13 @@ THRONG_HOST_DEVICE inline void interpolate_frames(const QuatLanes& a, const Quat
   }
 }
 
-// SlerpAt's pair lane by lane: out = s(a, b), every lane at s's fraction.
-THRONG_HOST_DEVICE inline void slerp(const SlerpAt& s, const QuatLanes& a, const QuatLanes& b, QuatLanes& out) {
+// SlerpAt's pair in lanes 0 .. n - 1: out = s(a, b), every lane at s's fraction.
+THRONG_HOST_DEVICE inline void slerp(int n, const SlerpAt& s, const QuatLanes& a, const QuatLanes& b, QuatLanes& out) {
   if (s.t() <= 0.0f || s.t() >= 1.0f) {
     out = s.t() <= 0.0f ? a : b;
     return;
   }
-  for (int l = 0; l < kQuatLanes; ++l) {
+  for (int l = 0; l < n; ++l) {
     float c = lane_dot(a, b, l);
     const float k = c < 0.0f ? -1.0f : 1.0f;
     c *= k;
@@ -72,11 +82,11 @@ THRONG_HOST_DEVICE inline void slerp(const SlerpAt& s, const QuatLanes& a, const
     const float wa = s.weight_a(y), wb = k * s.weight_b(y);
     const float w = wa * a.w[l] + wb * b.w[l], x = wa * a.x[l] + wb * b.x[l];
     const float yy = wa * a.y[l] + wb * b.y[l], z = wa * a.z[l] + wb * b.z[l];
-    const float n = 1.5f - 0.5f * ((w * w + x * x) + (yy * yy + z * z));
-    out.w[l] = n * w;
-    out.x[l] = n * x;
-    out.y[l] = n * yy;
-    out.z[l] = n * z;
+    const float m = 1.5f - 0.5f * ((w * w + x * x) + (yy * yy + z * z));
+    out.w[l] = m * w;
+    out.x[l] = m * x;
+    out.y[l] = m * yy;
+    out.z[l] = m * z;
   }
 }
 

@@ -40,7 +40,7 @@ TEST(QuatLanes, InterpolateFramesIsTheScalarOneLaneByLane) {
     random.pairs(a, b);
     float t[kQuatLanes];
     for (int l = 0; l < kQuatLanes; ++l) t[l] = l == 2 ? 0.0f : l == 3 ? 1.0f : random.u(random.rng);
-    interpolate_frames(a, b, t, out);
+    interpolate_frames(kQuatLanes, a, b, t, out);
     for (int l = 0; l < kQuatLanes; ++l)
       ASSERT_TRUE(same_bits(out.get(l), interpolate_frames(a.get(l), b.get(l), t[l]))) << i << " lane " << l;
   }
@@ -53,7 +53,7 @@ TEST(QuatLanes, SlerpIsSlerpAtLaneByLane) {
     random.pairs(a, b);
     const float t = i % 50 == 0 ? 0.0f : i % 50 == 1 ? 1.0f : random.u(random.rng);
     const SlerpAt s(t);
-    slerp(s, a, b, out);
+    slerp(kQuatLanes, s, a, b, out);
     for (int l = 0; l < kQuatLanes; ++l)
       ASSERT_TRUE(same_bits(out.get(l), s(a.get(l), b.get(l)))) << i << " lane " << l << " t " << t;
   }
