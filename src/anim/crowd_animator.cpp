@@ -97,6 +97,12 @@ void PoseJob::validate() const {
   }
   check_optional_length("PoseJob", "evaluated", evaluated.size(), n);
   check_optional_length("PoseJob", "from_cache", from_cache.size(), n);
+  if (!locks.empty()) {
+    lock_config.validate();
+    check_length("PoseJob", "locks", locks.size(), 2 * n);
+    if (!(std::isfinite(lock_dt) && lock_dt >= 0.0f && lock_dt <= 10.0f))
+      throw Error("must be in [0, 10] s", at_field("PoseJob.lock_dt"));
+  }
 }
 
 std::vector<glm::mat4x3> joint_shapes(const motion::Skeleton& skeleton, float thickness, float min_radius) {
@@ -396,31 +402,18 @@ const FrameStats& CrowdAnimator::animate(const FrameInput& input) {
                                joint_position_.span(), joint_rotation_.span());
   if (lod) pose.joint_masks = masks_.span();
   if (cache_) pose.cache = cache_->view();
-  // With foot locking the draw matrices follow the locked legs (below).
-  if (config_.draw_matrices && !config_.foot_lock) {
+  if (config_.draw_matrices) {
     pose.joint_shapes = shapes_.span();
     pose.draw_matrices = draw_.span();
   }
   pose.evaluated = evaluated_.span();
   pose.from_cache = from_cache_.span();
-  pose.run();
   if (config_.foot_lock) {
-    FootLockJob lock;
-    lock.blend = view;
-    lock.config = config_.foot_lock_config;
-    lock.dt = input.dt;
-    lock.positions = position_.span();
-    lock.scales = scale_.span();
-    lock.phases = phase_.span();
-    lock.blend_speeds = blend_speed_.span();
-    if (lod) lock.joint_masks = masks_.span();
-    lock.locks = locks_.span();
-    lock.joint_positions = joint_position_.span();
-    lock.joint_rotations = joint_rotation_.span();
-    lock.run();
-    if (config_.draw_matrices)
-      write_draw_matrices(joint_position_.span(), joint_rotation_.span(), scale_.span(), shapes_.span(), draw_.span());
+    pose.locks = locks_.span();
+    pose.lock_config = config_.foot_lock_config;
+    pose.lock_dt = input.dt;
   }
+  pose.run();
 
   const PoseTotals totals = pose_totals(evaluated_.span(), from_cache_.span());
   stats_.joints_synthesised = totals.joints_synthesised;

@@ -108,6 +108,12 @@ struct PoseJob : CharacterGait {
   Span<glm::mat4x3> draw_matrices;  // optional, with joint_shapes
   Span<std::int32_t> evaluated;     // optional, per character: joints synthesised
   Span<std::uint8_t> from_cache;    // optional, per character: 1 = read the cache
+  // Foot locking (anim/foot_lock.h) right after each pose, before its draw
+  // matrices, as FootLockJob over the same characters would: optional,
+  // empty locks = feet as posed.
+  Span<FootLock> locks;  // in/out: characters * 2 (left, right)
+  FootLockConfig lock_config;
+  float lock_dt = 0.0f;  // s since the last frame
 
   Index character_count() const { return positions.size(); }
   void validate() const;
@@ -161,11 +167,6 @@ THRONG_HOST_DEVICE inline void character_draw_matrices(std::int32_t J, const glm
                                                        const glm::mat4x3* shapes, glm::mat4x3* out) {
   for (std::int32_t j = 0; j < J; ++j) out[j] = draw_matrix(p[j], q[j], s, shapes[j]);
 }
-
-// Every character's draw matrices ([c * J + j]) from world joints, scales
-// (empty = 1) and the J joint shapes: parallel_for "anim.draw_matrices".
-void write_draw_matrices(Span<const glm::vec3> joint_positions, Span<const glm::quat> joint_rotations,
-                         Span<const float> scales, Span<const glm::mat4x3> shapes, Span<glm::mat4x3> out);
 
 // The motion cache with a device mirror: MotionCache (motion_cache.h) keeps
 // keys, FIFO order, byte capacity and counters; the table keeps each held
@@ -249,7 +250,7 @@ struct FrameStats {
 };
 
 // Everything one crowd needs, per frame: LocomoteJob, LodJob, the cache
-// update, PoseJob, FootLockJob. Buffers live in current_memory().
+// update, PoseJob (feet locked in it). Buffers live in current_memory().
 class CrowdAnimator {
  public:
   CrowdAnimator(const motion::BlendSpace1D& space, Index count, CrowdAnimatorConfig config = {});

@@ -1,5 +1,6 @@
 // Locomotion and pose kernels: compiled by nvcc in CUDA builds, by g++ otherwise.
 #include "anim/crowd_animator.h"
+#include "anim/foot_lock_legs.h"
 #include "core/check.h"
 #include "core/error.h"
 #include "core/ground.h"
@@ -96,6 +97,16 @@ THRONG_HOST_DEVICE inline void pose_character(const PoseJob& job, Index c) {
     n = masked_pose(J, view.parents, view.offsets, mask, e, held,
                     f.root_position - glm::vec3(0.0f, f.scale * legs.pelvis_drop, 0.0f), joints_p, joints_r, f.scale);
   }
+  if (!job.locks.empty()) {
+    FootLockCharacter ch;
+    ch.point = f.point;
+    ch.legs[0] = f.phases[1];
+    ch.legs[1] = f.phases[2];
+    ch.ground_y = job.positions[c].y;
+    ch.scale = f.scale;
+    ch.mask = mask;
+    lock_feet(view, job.lock_config, job.lock_dt, ch, job.locks.data() + 2 * c, joints_p, joints_r);
+  }
   if (!job.evaluated.empty()) job.evaluated[c] = n;
   if (!job.from_cache.empty()) job.from_cache[c] = slot >= 0 ? 1 : 0;
   if (!job.draw_matrices.empty())
@@ -108,23 +119,6 @@ void PoseJob::run() const {
   validate();
   parallel_for(
       "anim.pose", character_count(), THRONG_JOB_LAMBDA(Index c) { pose_character(*this, c); }, 32);
-}
-
-void write_draw_matrices(Span<const glm::vec3> joint_positions, Span<const glm::quat> joint_rotations,
-                         Span<const float> scales, Span<const glm::mat4x3> shapes, Span<glm::mat4x3> out) {
-  const Index J = shapes.size();
-  const Index n = J > 0 ? joint_positions.size() / J : 0;
-  check_length("write_draw_matrices", "joint_rotations", joint_rotations.size(), n * J);
-  check_optional_length("write_draw_matrices", "scales", scales.size(), n);
-  check_length("write_draw_matrices", "out", out.size(), n * J);
-  parallel_for(
-      "anim.draw_matrices", n,
-      THRONG_LAMBDA(Index c) {
-        character_draw_matrices(static_cast<std::int32_t>(J), joint_positions.data() + c * J,
-                                joint_rotations.data() + c * J, scales.empty() ? 1.0f : scales[c], shapes.data(),
-                                out.data() + c * J);
-      },
-      64);
 }
 
 PoseTotals pose_totals(Span<const std::int32_t> evaluated, Span<const std::uint8_t> from_cache) {

@@ -399,6 +399,84 @@ TEST(FootLock, AWalkRoundACircleBetweenSimulationSteps) {
   EXPECT_LT(locked.skating.mean_cm, 0.5 * free.skating.mean_cm);
 }
 
+// PoseJob locks each character's feet right after its pose; the stage on
+// its own is FootLockJob over the posed crowd. On a crowd under LOD (masks
+// that turn legs off and on) with speeds and turns redrawn every second,
+// frame after frame: the same joints, draw matrices and leg state, bit for bit.
+TEST(FootLock, LockedInThePoseAsFootLockJobAfterIt) {
+  const Index n = 300;
+  const testing::Crowd crowd = testing::random_crowd(n, 21);
+  const Camera cam = testing::crowd_camera();
+  CrowdAnimatorConfig config;
+  config.draw_matrices = true;
+  config.cache = false;
+  CrowdAnimator animator(space(), n, config);  // feet locked in its PoseJob
+  animator.place(crowd.positions, crowd.yaws, crowd.scales, crowd.phases);
+  const Index J = animator.joint_count();
+  const motion::BlendSpaceTables tables(space(), current_memory());
+  const std::vector<glm::mat4x3> shapes = joint_shapes(space().skeleton());
+  Buffer<glm::vec3> p(n * J, current_memory());
+  Buffer<glm::quat> q(n * J, current_memory());
+  Buffer<FootLock> locks = Buffer<FootLock>::zeros(2 * n, current_memory());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> speeds(static_cast<std::size_t>(n)), turns(static_cast<std::size_t>(n));
+  int stepping = 0;
+  for (int frame = 0; frame < 120; ++frame) {
+    if (frame % 30 == 0) {
+      for (std::size_t i = 0; i < speeds.size(); ++i) {
+        speeds[i] = frame == 60 && i % 3 == 0 ? 0.0f : 1.0f + u(rng);  // some stop, the rest walk
+        turns[i] = 1.5f * u(rng);
+      }
+      animator.set_speeds(speeds);
+      animator.set_turn_rates(turns);
+    }
+    animator.animate({kFrame, &cam, true});
+    // The reference: the same gait posed, then its feet locked on their own.
+    PoseJob pose = make_pose_job(
+        tables.view(),
+        {animator.positions(), animator.yaws(), animator.scales(), animator.phases(), animator.blend_speeds()},
+        p.span(), q.span());
+    pose.joint_masks = animator.joint_masks();
+    pose.run();
+    const FootLockJob lock{.blend = tables.view(),
+                           .config = {},
+                           .dt = kFrame,
+                           .positions = animator.positions(),
+                           .scales = animator.scales(),
+                           .phases = animator.phases(),
+                           .blend_speeds = animator.blend_speeds(),
+                           .joint_masks = animator.joint_masks(),
+                           .locks = locks.span(),
+                           .joint_positions = p.span(),
+                           .joint_rotations = q.span()};
+    lock.run();
+    const std::vector<glm::vec3> want_p = p.to_vector(),
+                                 got_p(animator.joint_positions().begin(), animator.joint_positions().end());
+    const std::vector<glm::quat> want_q = q.to_vector(),
+                                 got_q(animator.joint_rotations().begin(), animator.joint_rotations().end());
+    ASSERT_EQ(std::memcmp(want_p.data(), got_p.data(), want_p.size() * sizeof(glm::vec3)), 0) << frame;
+    ASSERT_EQ(std::memcmp(want_q.data(), got_q.data(), want_q.size() * sizeof(glm::quat)), 0) << frame;
+    const std::vector<FootLock> want_l = locks.to_vector(),
+                                got_l(animator.foot_locks().begin(), animator.foot_locks().end());
+    for (std::size_t i = 0; i < want_l.size(); ++i) {
+      ASSERT_EQ(std::memcmp(&want_l[i].correction, &got_l[i].correction, sizeof(glm::vec2)), 0) << frame << " " << i;
+      ASSERT_EQ(want_l[i].step_left, got_l[i].step_left) << frame << " " << i;
+      ASSERT_EQ(want_l[i].seen, got_l[i].seen) << frame << " " << i;
+      ASSERT_EQ(want_l[i].down, got_l[i].down) << frame << " " << i;
+      stepping += want_l[i].step_left > 0.0f ? 1 : 0;
+    }
+    const std::vector<glm::mat4x3> draw(animator.draw_matrices().begin(), animator.draw_matrices().end());
+    for (Index c = 0; c < n; c += 37) {
+      std::vector<glm::mat4x3> want(static_cast<std::size_t>(J));
+      character_draw_matrices(static_cast<std::int32_t>(J), want_p.data() + c * J, want_q.data() + c * J,
+                              crowd.scales[static_cast<std::size_t>(c)], shapes.data(), want.data());
+      ASSERT_EQ(std::memcmp(want.data(), draw.data() + c * J, want.size() * sizeof(glm::mat4x3)), 0) << frame;
+    }
+  }
+  EXPECT_GT(stepping, 0);  // turning feet took steps of their own
+}
+
 TEST(FootLock, BadSettingsAreNamed) {
   auto message = [](FootLockConfig c) {
     try {
