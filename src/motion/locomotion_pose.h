@@ -94,13 +94,29 @@ THRONG_HOST_DEVICE inline PlantedLegs synthesise_locals(const BlendSpaceView& v,
                                                         const std::uint32_t* mask, glm::quat* local) {
   SampledJoints s{&v, &f, mask, local, {}};
   const float w = f.point.w;
-  if (w > 0.0f && w < 1.0f) {
-    const SlerpAt blend(w);
+  const SlerpAt blend(w);
+  // Lanes sample every joint: worth it while the mask keeps most of them
+  // (joint LOD keeps a few of a far character's).
+  std::int32_t kept = 0;
+  for (std::int32_t j = 0; j < v.joint_count; ++j) kept += mask_bit(mask, j) ? 1 : 0;
+  if (w > 0.0f && w < 1.0f && 2 * kept >= v.joint_count) {
     for (std::int32_t j0 = 0; j0 < v.joint_count; j0 += kQuatLanes) blend_joint_lanes(v, f, blend, j0, s, local);
-  } else {  // one clip, no IK
+  } else {
     for (std::int32_t j = 0; j < v.joint_count; ++j) {
+      if (!mask_bit(mask, j)) continue;
       const std::uint8_t g = v.joint_group[j];
-      if (mask_bit(mask, j)) local[j] = blended_rotation(v, w, f.rows[g][0], f.rows[g][1], j);
+      const ClipRows &ra = f.rows[g][0], &rb = f.rows[g][1];
+      if (w <= 0.0f || w >= 1.0f) {  // one clip, no IK
+        local[j] = blended_rotation(v, w, ra, rb, j);
+        continue;
+      }
+      const glm::quat qa = clip_rotation(v, ra, j), qb = clip_rotation(v, rb, j);
+      local[j] = blend(qa, qb);
+      const int k = g > 0 ? leg_slot(v.legs[g - 1], j) : -1;  // as in blend_joint_lanes
+      if (k >= 0) {
+        s.leg_clip[g - 1][k][0] = qa;
+        s.leg_clip[g - 1][k][1] = qb;
+      }
     }
   }
   const PlantedLegs legs = plant_legs(v, f, mask, s);
