@@ -59,7 +59,8 @@ THRONG_HOST_DEVICE inline void blend_joint_lanes(const BlendSpaceView& v, const 
   float ta[kQuatLanes], tb[kQuatLanes];
   const std::int32_t last = v.joint_count - 1;
   const int n = lanes_for(v.joint_count - j0);
-  for (int l = 0; l < n; ++l) {  // lanes past the last joint repeat it
+  int l = 0;
+  do {  // n >= 1 (the compiler sees every lane array written); lanes past the last joint repeat it
     const std::int32_t j = j0 + l < last ? j0 + l : last;
     const std::uint8_t g = v.joint_group[j];
     const ClipRows &ra = f.rows[g][0], &rb = f.rows[g][1];
@@ -69,11 +70,11 @@ THRONG_HOST_DEVICE inline void blend_joint_lanes(const BlendSpaceView& v, const 
     b1.set(l, texel_quat(v.texture, j, rb.r1));
     ta[l] = ra.t;
     tb[l] = rb.t;
-  }
+  } while (++l < n);
   interpolate_frames(n, a0, a1, ta, qa);
   interpolate_frames(n, b0, b1, tb, qb);
   slerp(n, blend, qa, qb, q);
-  for (int l = 0; l < n && j0 + l <= last; ++l) {
+  for (l = 0; l < n && j0 + l <= last; ++l) {
     const std::int32_t j = j0 + l;
     if (mask_bit(s.mask, j)) local[j] = q.get(l);
     // Sampled at the group's rows: the leg's own when the joint is in its
