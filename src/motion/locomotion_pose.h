@@ -42,6 +42,17 @@ struct SampledJoints {
   THRONG_HOST_DEVICE glm::quat blended(std::int32_t joint) const {
     return mask_bit(mask, joint) ? local[joint] : joint_rotation(*v, *f, joint);
   }
+  // Keeps joint's two clip samples when it is a thigh, knee or ankle in
+  // its own leg's group (each thigh's subtree is; clip() samples anything
+  // else anew).
+  THRONG_HOST_DEVICE void keep_clip_samples(std::int32_t joint, const glm::quat& qa, const glm::quat& qb) {
+    const std::uint8_t g = v->joint_group[joint];
+    const int k = g > 0 ? leg_slot(v->legs[g - 1], joint) : -1;
+    if (k >= 0) {
+      leg_clip[g - 1][k][0] = qa;
+      leg_clip[g - 1][k][1] = qb;
+    }
+  }
   THRONG_HOST_DEVICE glm::quat clip(int leg, int c, std::int32_t joint) const {
     const int k = v->joint_group[joint] == 1 + leg ? leg_slot(v->legs[leg], joint) : -1;
     return k >= 0 ? leg_clip[leg][k][c] : clip_rotation(*v, f->rows[1 + leg][c], joint);
@@ -77,14 +88,7 @@ THRONG_HOST_DEVICE inline void blend_joint_lanes(const BlendSpaceView& v, const 
   for (l = 0; l < n && j0 + l <= last; ++l) {
     const std::int32_t j = j0 + l;
     if (mask_bit(s.mask, j)) local[j] = q.get(l);
-    // Sampled at the group's rows: the leg's own when the joint is in its
-    // group (each thigh's subtree is; clip() samples anything else anew).
-    const std::uint8_t g = v.joint_group[j];
-    const int k = g > 0 ? leg_slot(v.legs[g - 1], j) : -1;
-    if (k >= 0) {
-      s.leg_clip[g - 1][k][0] = qa.get(l);
-      s.leg_clip[g - 1][k][1] = qb.get(l);
-    }
+    s.keep_clip_samples(j, qa.get(l), qb.get(l));
   }
 }
 
@@ -98,8 +102,8 @@ THRONG_HOST_DEVICE inline PlantedLegs synthesise_locals(const BlendSpaceView& v,
   const SlerpAt blend(w);
   // Lanes sample every joint: worth it while the mask keeps most of them
   // (joint LOD keeps a few of a far character's).
-  std::int32_t kept = 0;
-  for (std::int32_t j = 0; j < v.joint_count; ++j) kept += mask_bit(mask, j) ? 1 : 0;
+  std::int32_t kept = mask == nullptr ? v.joint_count : 0;
+  for (std::int32_t j = 0; mask != nullptr && j < v.joint_count; ++j) kept += mask_bit(mask, j) ? 1 : 0;
   if (w > 0.0f && w < 1.0f && 2 * kept >= v.joint_count) {
     for (std::int32_t j0 = 0; j0 < v.joint_count; j0 += kQuatLanes) blend_joint_lanes(v, f, blend, j0, s, local);
   } else {
@@ -113,11 +117,7 @@ THRONG_HOST_DEVICE inline PlantedLegs synthesise_locals(const BlendSpaceView& v,
       }
       const glm::quat qa = clip_rotation(v, ra, j), qb = clip_rotation(v, rb, j);
       local[j] = blend(qa, qb);
-      const int k = g > 0 ? leg_slot(v.legs[g - 1], j) : -1;  // as in blend_joint_lanes
-      if (k >= 0) {
-        s.leg_clip[g - 1][k][0] = qa;
-        s.leg_clip[g - 1][k][1] = qb;
-      }
+      s.keep_clip_samples(j, qa, qb);
     }
   }
   const PlantedLegs legs = plant_legs(v, f, mask, s);
