@@ -198,6 +198,18 @@ THRONG_HOST_DEVICE inline float cfs_slide_speed(glm::vec2 slid, glm::vec2 e0, fl
   return v0 * fminf(fmaxf(dot2(slid, e0), kCfsSlideSlowest), 1.0f);
 }
 
+// Within kCfsSlideNear of its aim, an agent walking more than 60 degrees off
+// its goal direction (e against e0; cos 60 = 0.5) slows with the turn, to
+// kCfsSlideSlowest v0 at about 80 degrees: people slow to turn sharply. At
+// full speed one that overshot a door narrower than its turning circle (a
+// lone walker at a 0.5 m door led by the door line's gate) circled in front
+// of it for good. Milder turns keep v0: jostled walkers near their goals
+// do not brake.
+THRONG_HOST_DEVICE inline float cfs_turn_speed(glm::vec2 e, glm::vec2 e0, float aim_distance, float v0) {
+  if (aim_distance >= kCfsSlideNear) return v0;
+  return v0 * fminf(fmaxf(2.0f * dot2(e, e0), kCfsSlideSlowest), 1.0f);
+}
+
 // The direction actually walked: the previous one turned towards the new one
 // by dt / turn_time (at once when turn_time <= dt or the agent stood). A
 // first-order model otherwise turns instantly, and agents pressed between

@@ -55,10 +55,12 @@ float ExitChooser::exit_distance(std::int32_t group, std::uint32_t e, glm::vec2 
   return along < INFINITY ? along : length_of(to - p);
 }
 
-float ExitChooser::exit_cost(const Chooser& c, glm::vec2 p, std::uint32_t e, const std::vector<Index>& queued) const {
+float ExitChooser::exit_cost(const Chooser& c, glm::vec2 p, std::uint32_t e, float nearest,
+                             const std::vector<Index>& queued) const {
   const ExitSpec& x = exits_[static_cast<std::size_t>(c.group)][e];
   const auto q = static_cast<float>(queued[c.queue_base + e]);
-  const float cost = exit_distance(c.group, e, p) / c.speed + q / (kExitSpecificFlow * x.width);
+  const float walk = nearest + kExitDetourWeight * (exit_distance(c.group, e, p) - nearest);
+  const float cost = walk / c.speed + q / (kExitSpecificFlow * x.width);
   return e == c.exit ? cost * (1.0f - kExitSwitchGain) : cost;
 }
 
@@ -91,10 +93,10 @@ Index ExitChooser::update(double time, CrowdState& crowd) {
     const auto i = static_cast<std::size_t>(c.agent);
     const auto count = static_cast<std::uint32_t>(exits_[static_cast<std::size_t>(c.group)].size());
     std::uint32_t best = c.exit;
-    float best_cost = exit_cost(c, position[i], best, queued);
+    float best_cost = exit_cost(c, position[i], best, nearest, queued);
     for (std::uint32_t r = 0; r < count; ++r) {
       const std::uint32_t e = static_cast<std::uint32_t>((c.tie + r) % count);  // the agent's own order on ties
-      const float cost = exit_cost(c, position[i], e, queued);
+      const float cost = exit_cost(c, position[i], e, nearest, queued);
       if (cost < best_cost) {
         best = e;
         best_cost = cost;

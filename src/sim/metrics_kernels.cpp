@@ -258,6 +258,12 @@ LineFlow line_flow(std::span<const double> times, double width) {
   if (!f.timed) return f;
   f.flow = static_cast<double>(times.size() - 1) / (f.last_time - f.first_time);
   f.specific_flow = width > 0 ? f.flow / width : 0.0;
+  const std::size_t n = times.size();
+  const auto from = static_cast<std::size_t>(kSteadyFlowFrom * static_cast<double>(n)),
+             to = static_cast<std::size_t>(kSteadyFlowTo * static_cast<double>(n));
+  f.steady_flow =
+      n >= 10 && times[to] > times[from] ? static_cast<double>(to - from) / (times[to] - times[from]) : f.flow;
+  f.steady_specific_flow = width > 0 ? f.steady_flow / width : 0.0;
   return f;
 }
 

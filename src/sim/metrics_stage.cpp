@@ -273,6 +273,8 @@ nlohmann::json CrowdMetricsStage::measurement_section(const std::vector<Sample>&
                             {"last_s", or_null(n > 0, f.last_time)},
                             {"flow_per_s", or_null(f.timed, f.flow)},
                             {"specific_flow_per_m_s", or_null(f.timed, f.specific_flow)},
+                            {"steady_flow_per_s", or_null(f.timed, f.steady_flow)},
+                            {"steady_specific_flow_per_m_s", or_null(f.timed, f.steady_specific_flow)},
                             {"nt", nt}};
     };
     lines.push_back({{"name", l.name},

@@ -196,7 +196,8 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
       cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
   if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
   const bool slid = e0.x != me.e0.x || e0.y != me.e0.y;
-  const float top = cfs_slide_speed(e0, me.e0, me.aim_distance, v0);
+  const float top =
+      fminf(cfs_slide_speed(e0, me.e0, me.aim_distance, v0), cfs_turn_speed(e, me.e0, me.aim_distance, v0));
   // The time gap is kept to where neighbours will be in anticipation_time
   // (one crossing the agent's path will have left it), to those within the
   // lane; no step may end in a body where it is now.

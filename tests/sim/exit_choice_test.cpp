@@ -34,10 +34,11 @@ GoalSpec two_exits(ExitSpec a, ExitSpec b, ExitChoice choice) {
 }
 
 // Three agents at x = 2, 3, 4 on the line between a 0.1 m door at x = 0
-// (0.13 P/s) and a wide one at x = 20, all at 1.3 m/s. In order of distance:
-// the first has no queue (A: 1.5 s); the second waits for one (A: 2.3 + 7.7
-// = 10.0 s against B: 13.1 s); the third for two (A: 3.1 + 15.4 = 18.5 s
-// against B: 12.3 s) and takes B.
+// (0.13 P/s) and a wide one at x = 12, all at 1.3 m/s; the walk beyond the
+// nearest door (A) counts twice. In order of distance: the first has no
+// queue (A: 1.5 s); the second waits for one (A: 2.3 + 7.7 = 10.0 s against
+// B: (3 + 2 x 6) / 1.3 = 11.5 s); the third for two (A: 3.1 + 15.4 = 18.5 s
+// against B: (4 + 2 x 4) / 1.3 = 9.2 s) and takes B.
 TEST(ExitChoice, QuickestWeighsTheQueueAhead) {
   ScenarioSpec s = test::open_field(0, {0, 0}, {1, 1}, {0, 0});
   s.planning = PlanningKind::None;
@@ -46,7 +47,7 @@ TEST(ExitChoice, QuickestWeighsTheQueueAhead) {
   g.spawn.points = {{4, 0}, {2, 0}, {3, 0}};
   g.count = 3;
   g.speed = {1.3f, 0.0f, 1.3f, 1.3f};
-  g.goal = two_exits(door({0, 0}, 0.1f), door({20, 0}, 2.0f), ExitChoice::Quickest);
+  g.goal = two_exits(door({0, 0}, 0.1f), door({12, 0}, 2.0f), ExitChoice::Quickest);
   Simulation sim(s);
   // Spawning aims everyone at the nearest exit; the first step chooses.
   for (glm::vec2 goal : sim.crowd().goal.to_vector()) EXPECT_EQ(goal, glm::vec2(0, 0));
@@ -54,7 +55,7 @@ TEST(ExitChoice, QuickestWeighsTheQueueAhead) {
   const std::vector<glm::vec2> goals = sim.crowd().goal.to_vector();
   EXPECT_EQ(goals[1], glm::vec2(0, 0));
   EXPECT_EQ(goals[2], glm::vec2(0, 0));
-  EXPECT_EQ(goals[0], glm::vec2(20, 0));
+  EXPECT_EQ(goals[0], glm::vec2(12, 0));
 }
 
 // With navigation fields the quickest exit is weighed by the walk, not the

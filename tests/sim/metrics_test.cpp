@@ -352,6 +352,25 @@ TEST(MetricsLines, CrossingsOfStraightWalkersAtKnownTimes) {
   EXPECT_EQ(line_flow(negative, 10.0).flow, 0.0);
 }
 
+// The steady flow: a door that passes one person every 0.5 s once the
+// crowd presses on it, after a slow build-up (crossings 3 s apart up to
+// t[4]) and before a slow emptying (3 s apart from t[36]): of 40
+// crossings, t[4] (10%) to t[36] (90%) span 32 intervals of 0.5 s.
+TEST(MetricsLines, SteadyFlowLeavesOutTheBuildUpAndTheEmptying) {
+  std::vector<double> t;
+  for (int k = 0; k < 5; ++k) t.push_back(3.0 * k);
+  for (int k = 0; k < 32; ++k) t.push_back(t.back() + 0.5);
+  for (int k = 0; k < 3; ++k) t.push_back(t.back() + 3.0);
+  const LineFlow f = line_flow(t, 2.0);
+  EXPECT_NEAR(f.steady_flow, 2.0, 1e-12);
+  EXPECT_NEAR(f.steady_specific_flow, 1.0, 1e-12);
+  EXPECT_NEAR(f.flow, 39.0 / (t.back() - t.front()), 1e-12);  // the whole run: far less
+  EXPECT_LT(f.flow, 0.6 * f.steady_flow);
+  // Below 10 crossings there is no steady part to tell apart: the whole run's.
+  const std::vector<double> few(t.begin(), t.begin() + 9);
+  EXPECT_DOUBLE_EQ(line_flow(few, 2.0).steady_flow, line_flow(few, 2.0).flow);
+}
+
 // An agent that crosses, turns back and crosses again is counted each
 // time, once each way; one that stops exactly on the line and walks on is
 // counted once, when it reached the line.
