@@ -6,11 +6,11 @@
 //
 // d_e the distance to the exit (along its navigation field where the run
 // has one, sim/navigation_field.h; else straight), d_min that to the
-// nearest exit (a detour to a farther exit weighs twice its walk: people
-// prefer the nearest exit, and with the walk weighed at its time the
+// nearest exit (the walk beyond it to a farther exit counts twice: people
+// prefer the nearest exit, and with every metre weighed at its time the
 // crowd split evenly between RiMEA 3.0 test 11's two doors, both emptying
-// at the same moment, where most should take the nearer; docs/verification.md),
-// v0 the agent's preferred speed and
+// at the same moment, where most should take the nearer;
+// docs/verification.md), v0 the agent's preferred speed and
 // q_e the agents heading for e that are nearer the exits than it (each takes
 // its turn at the door, which passes kExitSpecificFlow persons per metre of
 // width and second), and heads for the cheapest. Agents decide in order of
