@@ -251,6 +251,9 @@ TEST(FrameLoop, MetricsStageMeasuresAreasAndEveryStepsLineCrossings) {
                    static_cast<double>(t.size() - 1) / (t.back() - t.front()));
   EXPECT_DOUBLE_EQ(line["positive"]["specific_flow_per_m_s"].get<double>(),
                    line["positive"]["flow_per_s"].get<double>() / 60.0);
+  EXPECT_DOUBLE_EQ(line["positive"]["steady_flow_per_s"].get<double>(), line_flow(t, 60.0).steady_flow);
+  EXPECT_DOUBLE_EQ(line["positive"]["steady_specific_flow_per_m_s"].get<double>(),
+                   line["positive"]["steady_flow_per_s"].get<double>() / 60.0);
   EXPECT_EQ(line["positive"]["nt"].size(), t.size());
   EXPECT_EQ(line["positive"]["nt"].back()[1], t.size());
   // The fundamental diagram is the first area's, with its Voronoi values.
