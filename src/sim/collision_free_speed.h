@@ -193,9 +193,15 @@ THRONG_HOST_DEVICE inline glm::vec2 cfs_slide_along_wall(glm::vec2 e0, glm::vec2
 // a wall round a corner to a goal far beyond it does not slow.
 inline constexpr float kCfsSlideNear = 2.0f;
 inline constexpr float kCfsSlideSlowest = 0.3f;
+// v0 times `factor` within kCfsSlideNear of the aim (between kCfsSlideSlowest
+// and 1), v0 further away: the one rule of both slowdowns below.
+THRONG_HOST_DEVICE inline float cfs_near_aim_speed(float factor, float aim_distance, float v0) {
+  if (aim_distance >= kCfsSlideNear) return v0;
+  return v0 * fminf(fmaxf(factor, kCfsSlideSlowest), 1.0f);
+}
 THRONG_HOST_DEVICE inline float cfs_slide_speed(glm::vec2 slid, glm::vec2 e0, float aim_distance, float v0) {
-  if (aim_distance >= kCfsSlideNear || (slid.x == e0.x && slid.y == e0.y)) return v0;
-  return v0 * fminf(fmaxf(dot2(slid, e0), kCfsSlideSlowest), 1.0f);
+  if (slid.x == e0.x && slid.y == e0.y) return v0;
+  return cfs_near_aim_speed(dot2(slid, e0), aim_distance, v0);
 }
 
 // Within kCfsSlideNear of its aim, an agent walking more than 60 degrees off
@@ -206,8 +212,7 @@ THRONG_HOST_DEVICE inline float cfs_slide_speed(glm::vec2 slid, glm::vec2 e0, fl
 // of it for good. Milder turns keep v0: jostled walkers near their goals
 // do not brake.
 THRONG_HOST_DEVICE inline float cfs_turn_speed(glm::vec2 e, glm::vec2 e0, float aim_distance, float v0) {
-  if (aim_distance >= kCfsSlideNear) return v0;
-  return v0 * fminf(fmaxf(2.0f * dot2(e, e0), kCfsSlideSlowest), 1.0f);
+  return cfs_near_aim_speed(2.0f * dot2(e, e0), aim_distance, v0);
 }
 
 // The direction actually walked: the previous one turned towards the new one

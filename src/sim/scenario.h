@@ -224,6 +224,14 @@ struct GoalSpec {
     g.value = p;
     return g;
   }
+  // A gate waypoint: the line from `from` to `to`.
+  static GoalSpec gate(glm::vec2 from, glm::vec2 to) {
+    GoalSpec g;
+    g.kind = Kind::Gate;
+    g.value = from;
+    g.gate_to = to;
+    return g;
+  }
 };
 
 struct SpeedSpec {

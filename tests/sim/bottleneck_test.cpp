@@ -73,12 +73,7 @@ DoorRun empty_room(float width, const Crowd& crowd) {
   g.spawn.kind = Region::Kind::rect;
   g.spawn.min = {0.3f, 0.3f};
   g.spawn.max = {9.0f, 9.7f};
-  g.waypoints = {GoalSpec::at({11.0f, 5.0f})};
-  if (crowd.door_line) {
-    g.waypoints[0].kind = GoalSpec::Kind::Gate;
-    g.waypoints[0].value = {10.2f, lo};
-    g.waypoints[0].gate_to = {10.2f, hi};
-  }
+  g.waypoints = {crowd.door_line ? GoalSpec::gate({10.2f, lo}, {10.2f, hi}) : GoalSpec::at({11.0f, 5.0f})};
   g.goal.kind = GoalSpec::Kind::Random;
   g.goal.region.kind = Region::Kind::rect;
   g.goal.region.min = {25.0f, -8.0f};

@@ -37,14 +37,6 @@ ScenarioSpec walkers(ModelKind model, const std::vector<glm::vec2>& starts, cons
   return s;
 }
 
-GoalSpec gate(glm::vec2 from, glm::vec2 to) {
-  GoalSpec g;
-  g.kind = GoalSpec::Kind::Gate;
-  g.value = from;
-  g.gate_to = to;
-  return g;
-}
-
 // Where each agent's path first crosses x = line_x (the y there), NaN if never.
 std::vector<float> crossings_of(Simulation& sim, float line_x) {
   std::vector<glm::vec2> before = sim.positions();
@@ -73,7 +65,7 @@ TEST(Journey, AGateIsPassedWhereverTheAgentMeetsIt) {
   starts.push_back({0.0f, 8.0f});
   for (const ModelKind model : kModels) {
     SCOPED_TRACE(to_string(model));
-    const ScenarioSpec s = walkers(model, starts, gate({10.0f, -5.0f}, {10.0f, 5.0f}));
+    const ScenarioSpec s = walkers(model, starts, GoalSpec::gate({10.0f, -5.0f}, {10.0f, 5.0f}));
     Simulation sim(s);
     const std::vector<float> y = crossings_of(sim, 10.0f);
     ASSERT_TRUE(sim.all_arrived()) << sim.arrived_count() << " of " << sim.agent_count();
@@ -105,8 +97,9 @@ TEST(Journey, APointWaypointInsteadDrawsWalkersToIt) {
 // passed the same, and only once the agent is across it.
 TEST(Journey, AGateCountsFromEitherSideOnceCrossed) {
   for (const bool reversed : {false, true}) {
-    ScenarioSpec s = walkers(ModelKind::CollisionFreeSpeed, {{20.0f, 0.0f}},
-                             reversed ? gate({10.0f, 5.0f}, {10.0f, -5.0f}) : gate({10.0f, -5.0f}, {10.0f, 5.0f}));
+    ScenarioSpec s = walkers(
+        ModelKind::CollisionFreeSpeed, {{20.0f, 0.0f}},
+        reversed ? GoalSpec::gate({10.0f, 5.0f}, {10.0f, -5.0f}) : GoalSpec::gate({10.0f, -5.0f}, {10.0f, 5.0f}));
     s.groups[0].goal.value = {-20.0f, 0.0f};
     Simulation sim(s);
     while (!sim.all_arrived() && sim.time() < 40.0) {
@@ -126,7 +119,7 @@ TEST(Journey, AGateCountsFromEitherSideOnceCrossed) {
 TEST(Journey, ATurnstileWithAWaitIsPassedByEveryModel) {
   for (const ModelKind model : kModels) {
     SCOPED_TRACE(to_string(model));
-    GoalSpec turnstile = gate({10.0f, -0.15f}, {10.0f, 0.15f});
+    GoalSpec turnstile = GoalSpec::gate({10.0f, -0.15f}, {10.0f, 0.15f});
     turnstile.wait_s = 3.0f;
     const ScenarioSpec s = walkers(model, {{0.0f, 0.0f}}, turnstile);
     Simulation sim(s);
@@ -289,9 +282,9 @@ TEST(Journey, BadStagesAreLocatedErrors) {
   EXPECT_NE(error_with(nan_wait).find("groups[0].waypoints[0].wait"), std::string::npos);
   nan_wait.wait_s = -1.0f;
   EXPECT_NE(error_with(nan_wait).find("groups[0].waypoints[0].wait"), std::string::npos);
-  EXPECT_NE(error_with(gate({5, 0}, {5, 0.01f})).find("groups[0].waypoints[0].gate"), std::string::npos);
-  EXPECT_NE(error_with(gate({5, 0}, {5, NAN})).find("groups[0].waypoints[0].gate"), std::string::npos);
-  EXPECT_NE(error_with(gate({5, -1}, {5, 1}), true).find("groups[0].goal"), std::string::npos);
+  EXPECT_NE(error_with(GoalSpec::gate({5, 0}, {5, 0.01f})).find("groups[0].waypoints[0].gate"), std::string::npos);
+  EXPECT_NE(error_with(GoalSpec::gate({5, 0}, {5, NAN})).find("groups[0].waypoints[0].gate"), std::string::npos);
+  EXPECT_NE(error_with(GoalSpec::gate({5, -1}, {5, 1}), true).find("groups[0].goal"), std::string::npos);
   GoalSpec waiting_goal = GoalSpec::at({5.0f, 0.0f});
   waiting_goal.wait_s = 3.0f;
   EXPECT_NE(error_with(waiting_goal, true).find("groups[0].goal.wait"), std::string::npos);
