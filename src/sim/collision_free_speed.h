@@ -156,6 +156,47 @@ THRONG_HOST_DEVICE inline bool cfs_waits_for(const CfsAgent& i, glm::vec2 q, boo
   return ahead < 0.0f || (i_first && ahead < kCfsBesideCos * length_of(q - i.p));
 }
 
+// Yielding to a walker abreast (this engine's addition). Two walkers side
+// by side, each with its goal across the other's way (in the circle of 20,
+// one bound south-east beside one bound west-north-west), walked on
+// together for seconds, away from both goals: each is pushed off its goal
+// direction by the other's repulsion as far as its goal pulls it across,
+// and neither stands in the other's corridor, so neither brakes. People let
+// the one a little ahead go first: an agent walking at least kCfsYieldSpeed
+// with its goal more than 45 degrees off its heading (kCfsYieldGoalSide =
+// sin 45) falls back to kCfsYieldShare of the speed of a neighbour beside
+// it on that side (ahead of it by no more than it is beside it, within
+// kCfsYieldGap, walking its way within 37 degrees: kCfsYieldAlong, at least
+// kCfsYieldSpeed too), and its goal leads it behind that neighbour. The
+// speed floor keeps the rule out of jams: in a dense counterflow, walkers
+// shoved sideways at a crawl yielding to each other stopped both streams.
+inline constexpr float kCfsYieldSpeed = 0.8f;     // m/s
+inline constexpr float kCfsYieldGoalSide = 0.7f;  // sin 45 degrees
+inline constexpr float kCfsYieldAlong = 0.8f;     // cos 37 degrees
+inline constexpr float kCfsYieldGap = 0.3f;       // m between the bodies
+inline constexpr float kCfsYieldShare = 0.7f;
+
+// The side of the agent's heading its goal lies on when it may have to
+// yield (+1 left, -1 right), 0 when it walks slower than kCfsYieldSpeed or
+// within 45 degrees of its goal (most agents: no neighbour is looked at).
+THRONG_HOST_DEVICE inline float cfs_yield_side(const CfsAgent& i) {
+  const float speed2 = length2(i.v);
+  if (speed2 < kCfsYieldSpeed * kCfsYieldSpeed) return 0.0f;
+  const float across = dot2(i.e0, perp_left(i.v)) / sqrtf(speed2);
+  return across > kCfsYieldGoalSide ? 1.0f : (across < -kCfsYieldGoalSide ? -1.0f : 0.0f);
+}
+
+// The most the agent walks beside neighbour j at q (velocity w, radius rj)
+// with its goal on side `side` of its heading (cfs_yield_side): +inf unless
+// j walks abreast of it on that side.
+THRONG_HOST_DEVICE inline float cfs_yield_speed(const CfsAgent& i, float side, glm::vec2 q, glm::vec2 w, float rj) {
+  const glm::vec2 h = normalize_or(i.v, glm::vec2(0.0f)), d = q - i.p;
+  const float beside = dot2(d, perp_left(h)) * side, ahead = dot2(d, h), along = dot2(w, h);
+  const bool abreast = beside > 0.0f && ahead > 0.0f && ahead <= beside && length_of(d) - i.radius - rj <= kCfsYieldGap;
+  const bool our_way = along >= kCfsYieldSpeed && along >= kCfsYieldAlong * length_of(w);
+  return abreast && our_way ? kCfsYieldShare * along : INFINITY;
+}
+
 // Neighbours close enough to hold an agent's speed that the pushes' pass
 // keeps for the gap passes (collision_free_velocity): a disc of 1.7 m holds
 // about 50 at 6 P/m^2.

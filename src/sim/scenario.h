@@ -41,9 +41,9 @@ struct CollisionFreeSpeedParams {
   float neighbour_range = 0.1f;     // m: D, its decay length
   float wall_strength = 5.0f;       // b: wall repulsion at contact
   float wall_range = 0.02f;         // m: Dw
-  float avoid_strength = 3.0f;      // k: sideways push from an oncoming neighbour about to meet us (0 = off)
+  float avoid_strength = 4.5f;      // k: sideways push from an oncoming neighbour about to meet us (0 = off)
   float avoid_time = 4.0f;          // s: how far ahead oncoming neighbours are anticipated
-  float side_margin = 0.5f;         // m: an oncoming neighbour counts when its centre is within l + this of our line
+  float side_margin = 0.75f;        // m: an oncoming neighbour counts when its centre is within l + this of our line
   float turn_time = 0.3f;           // s: the walking direction turns towards the wanted one over about this
   float anticipation_time = 0.0f;   // s: the gap ahead is measured to where neighbours will be after this
   float lane_width = 1.0f;          // of r_i + r_j: the time gap is kept to neighbours ahead within this of our line

@@ -212,7 +212,12 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     });
     return fminf(cfs_speed(gap, top, c.time_gap), fmaxf(gap_now, 0.0f) / dt);
   };
-  const float speed = speed_past(true);
+  float speed = speed_past(true);
+  // Abreast of a neighbour with its goal across that neighbour's way: it
+  // falls back and passes behind (cfs_yield_speed).
+  if (const float side = cfs_yield_side(me); side != 0.0f)
+    for_each_holder(
+        [&](Index j) { speed = fminf(speed, cfs_yield_speed(me, side, n.at(j, me.p), n.velocity[j], n.radius[j])); });
   // Held at rest while walking on would take it forward: the neighbours
   // that wait for it (cfs_waits_for) are left out of its gap and of the
   // no-step-into-a-body cap, so it may press into them, and the contact

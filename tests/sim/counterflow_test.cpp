@@ -53,9 +53,11 @@ struct CounterflowRun {
 // long west of its middle, as many west from the mirrored block east of
 // it, each block starting 18 m from the middle; each agent walks
 // block + 20 m and leaves.
-CounterflowRun counterflow(ModelKind model, std::int64_t per_side, float block, float duration) {
+CounterflowRun counterflow(ModelKind model, std::int64_t per_side, float block, float duration,
+                           std::uint64_t seed = 1) {
   ScenarioSpec s;
   s.name = "counterflow";
+  s.seed = seed;
   s.model.kind = model;
   s.model.max_speed = 1.8f;  // dt * max_speed below 0.9 radius
   s.planning = PlanningKind::None;
@@ -125,6 +127,31 @@ TEST(Counterflow, DenseStreamsInAFourMetreCorridorPassEachOther) {
   run_every_model(40.0f, 300.0f, [](ModelKind model, const CounterflowRun& r) {
     EXPECT_GE(r.arrived, model == ModelKind::Priority ? r.agents * 97 / 100 : r.agents);
   });
+}
+
+// The dense run under the default model from other draws of the crowd
+// (positions and free speeds). Whether the two streams lock face to face
+// across the whole corridor is a chaotic outcome of the draw, so one seed
+// says little: before walkers yielded to one abreast and the sideways push
+// was strengthened (avoid_strength 3 -> 4.5, side_margin 0.5 -> 0.75 m),
+// about half the draws locked (13 of seeds 1-24 through the Python module,
+// 109-296 of 400 out at 300 s); now 2 of seeds 2-25 do (5 and 10: 195 and
+// 169 out). The test asks at least 21 of these 24 draws to let everyone
+// through (under the sanitizers, 100 a side, 7 of seeds 2-9).
+TEST(Counterflow, DenseStreamsPassEachOtherInMostDrawsOfTheCrowd) {
+  const bool sanitized = test::sanitized();
+  const std::int64_t per_side = sanitized ? 100 : 200;
+  const std::uint64_t last = sanitized ? 9 : 25;
+  int through = 0, draws = 0;
+  for (std::uint64_t seed = 2; seed <= last; ++seed, ++draws) {
+    const CounterflowRun r = counterflow(ModelKind::CollisionFreeSpeed, per_side, 40.0f, 300.0f, seed);
+    std::printf("  collision_free_speed, seed %llu: arrived %lld of %lld within 300 s, mean progress speed %.2f m/s\n",
+                static_cast<unsigned long long>(seed), static_cast<long long>(r.arrived),
+                static_cast<long long>(r.agents), r.progress_speed);
+    through += r.arrived == r.agents ? 1 : 0;
+  }
+  std::printf("  everyone through in %d of %d draws\n", through, draws);
+  EXPECT_GE(through, sanitized ? 7 : 21);
 }
 
 // Moderate: 0.74 P/m^2 in each block, about 1.5 P/m^2 where the streams

@@ -109,6 +109,17 @@ inline std::vector<Walker> circle_of_twenty(float turn = 0.0f) {
 inline WorldSpec l_corridor();
 inline std::vector<Walker> blind_corner_pair();
 
+// The circle of twenty under `model` at four turns of the ring (0-5.4
+// degrees; it repeats every 18), each held to `slowest` and `deepest`.
+inline void expect_circle_resolves(ModelKind model, double slowest, float deepest = 0.01f) {
+  for (int k = 0; k < 4; ++k) {
+    const float degrees = 1.8f * static_cast<float>(k);
+    char what[48];
+    std::snprintf(what, sizeof what, "circle of 20 turned %.1f degrees", static_cast<double>(degrees));
+    expect_encounter_resolves(model, what, circle_of_twenty(degrees * kPiF / 180.0f), {}, slowest, deepest);
+  }
+}
+
 // The five standard encounters under `model`: head-on, crossing, four ways
 // and the blind corner held to 1.5x (the aim), the circle of twenty (all
 // meet at once: the hardest of them) to its own bounds, laid out at four
@@ -118,13 +129,7 @@ inline void expect_standard_encounters_resolve(ModelKind model, double circle_sl
   expect_encounter_resolves(model, "crossing", crossing_pair());
   expect_encounter_resolves(model, "four ways", four_ways());
   expect_encounter_resolves(model, "blind corner", blind_corner_pair(), l_corridor());
-  for (int k = 0; k < 4; ++k) {
-    const float degrees = 1.8f * static_cast<float>(k);
-    char what[48];
-    std::snprintf(what, sizeof what, "circle of 20 turned %.1f degrees", static_cast<double>(degrees));
-    expect_encounter_resolves(model, what, circle_of_twenty(degrees * kPiF / 180.0f), {}, circle_slowest,
-                              circle_deepest);
-  }
+  expect_circle_resolves(model, circle_slowest, circle_deepest);
 }
 
 inline WorldSpec l_corridor() {
