@@ -166,10 +166,12 @@ THRONG_HOST_DEVICE inline bool cfs_waits_for(const CfsAgent& i, glm::vec2 q, boo
 // with its goal more than 45 degrees off its heading (kCfsYieldGoalSide =
 // sin 45) falls back to kCfsYieldShare of the speed of a neighbour beside
 // it on that side (ahead of it by no more than it is beside it, within
-// kCfsYieldGap, walking its way within 37 degrees: kCfsYieldAlong, at least
-// kCfsYieldSpeed too), and its goal leads it behind that neighbour. The
-// speed floor keeps the rule out of jams: in a dense counterflow, walkers
-// shoved sideways at a crawl yielding to each other stopped both streams.
+// kCfsYieldGap, walking its way within 37 degrees, kCfsYieldAlong, at
+// kCfsYieldSpeed or more along the agent's heading), and its goal leads it
+// behind that neighbour. The speed floor keeps the rule out of jams: with
+// a floor of 0.5 m/s, walkers shoved sideways in the dense counterflow
+// yielded to each other and the streams locked in 2 of 16 draws, against
+// none at 0.8 m/s.
 inline constexpr float kCfsYieldSpeed = 0.8f;     // m/s
 inline constexpr float kCfsYieldGoalSide = 0.7f;  // sin 45 degrees
 inline constexpr float kCfsYieldAlong = 0.8f;     // cos 37 degrees
