@@ -19,7 +19,7 @@ struct Periodic {
 
   THRONG_HOST_DEVICE bool wraps() const { return period.x > 0.0f || period.y > 0.0f; }
   // The copy of q nearest p.
-  THRONG_HOST_DEVICE glm::vec2 near(glm::vec2 q, glm::vec2 p) const {
+  THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 near(glm::vec2 q, glm::vec2 p) const {
     return {near_axis(q.x, p.x, period.x), near_axis(q.y, p.y, period.y)};
   }
   // Calls fn(shift) with the shift to each copy of the area that touches
@@ -38,7 +38,7 @@ struct Periodic {
   }
 
  private:
-  THRONG_HOST_DEVICE static float near_axis(float q, float p, float L) {
+  THRONG_HOST_DEVICE THRONG_INLINE static float near_axis(float q, float p, float L) {
     if (!(L > 0.0f)) return q;
     const float d = q - p;
     if (d > 0.5f * L) return q - L * floorf(d / L + 0.5f);

@@ -74,8 +74,8 @@ struct CfsAgent {
 
 // R_ij + A_ij of neighbour j at q with velocity w and radius rj; `parked`:
 // j stands at its goal for good.
-THRONG_HOST_DEVICE inline glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj,
-                                                       bool parked, const CollisionFreeSpeedParams& m) {
+THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj,
+                                                              bool parked, const CollisionFreeSpeedParams& m) {
   const glm::vec2 d = q - i.p;
   const float dist = length_of(d);
   if (dist <= 1e-6f) return glm::vec2(0.0f);  // coincident: the contact passes separate them

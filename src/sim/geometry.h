@@ -54,19 +54,19 @@ struct Aabb {
 
 // ---- inline kernels-friendly primitives -------------------------------------
 
-THRONG_HOST_DEVICE inline float cross2(glm::vec2 a, glm::vec2 b) { return a.x * b.y - a.y * b.x; }
-THRONG_HOST_DEVICE inline float dot2(glm::vec2 a, glm::vec2 b) { return a.x * b.x + a.y * b.y; }
-THRONG_HOST_DEVICE inline float length2(glm::vec2 a) { return dot2(a, a); }
-THRONG_HOST_DEVICE inline float length_of(glm::vec2 a) { return sqrtf(dot2(a, a)); }
+THRONG_HOST_DEVICE THRONG_INLINE float cross2(glm::vec2 a, glm::vec2 b) { return a.x * b.y - a.y * b.x; }
+THRONG_HOST_DEVICE THRONG_INLINE float dot2(glm::vec2 a, glm::vec2 b) { return a.x * b.x + a.y * b.y; }
+THRONG_HOST_DEVICE THRONG_INLINE float length2(glm::vec2 a) { return dot2(a, a); }
+THRONG_HOST_DEVICE THRONG_INLINE float length_of(glm::vec2 a) { return sqrtf(dot2(a, a)); }
 // Left-hand perpendicular (rotated +90 degrees).
-THRONG_HOST_DEVICE inline glm::vec2 perp_left(glm::vec2 a) { return glm::vec2(-a.y, a.x); }
+THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 perp_left(glm::vec2 a) { return glm::vec2(-a.y, a.x); }
 // a / |a|, or `fallback` when a is (nearly) zero.
-THRONG_HOST_DEVICE inline glm::vec2 normalize_or(glm::vec2 a, glm::vec2 fallback) {
+THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 normalize_or(glm::vec2 a, glm::vec2 fallback) {
   const float l2 = dot2(a, a);
   return l2 > 1e-12f ? a * (1.0f / sqrtf(l2)) : fallback;
 }
 // a scaled down to length at most `max_length`.
-THRONG_HOST_DEVICE inline glm::vec2 clamp_length(glm::vec2 a, float max_length) {
+THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 clamp_length(glm::vec2 a, float max_length) {
   const float l2 = dot2(a, a);
   if (l2 <= max_length * max_length || l2 <= 0.0f) return a;
   return a * (max_length / sqrtf(l2));

@@ -41,7 +41,7 @@ struct NeighbourArrays {
   Span<const float> radius;
   Span<const std::uint8_t> flags;
   Periodic periodic;
-  THRONG_HOST_DEVICE glm::vec2 at(Index j, glm::vec2 p) const { return periodic.near(position[j], p); }
+  THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 at(Index j, glm::vec2 p) const { return periodic.near(position[j], p); }
 };
 
 // Calls fn(j, q) for every active candidate j other than `self` whose

@@ -51,6 +51,7 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   sensed_ = Buffer<glm::vec2>::zeros(crowd_.count, m);      // inactive agents are never sensed
   move_cells_ = Buffer<MoveCells>::zeros(crowd_.count, m);  // nor given move cells
   contact_depth_ = Buffer<float>::zeros(crowd_.count, m);
+  moved_before_ = Buffer<std::int32_t>(crowd_.count + 1, m);
 }
 
 StepContext Simulation::context() const {
@@ -264,12 +265,18 @@ void Simulation::move(const StepContext& ctx) {
     }
   };
   if (scheduler_ == SchedulerKind::DoubleBuffer) {  // (the all-pairs reference included)
+    // Past the first pass, agents whose move cells the pass before left
+    // still are passed over (contacts_double_buffer).
     Span<glm::vec2> in = candidate_.span(), out = scratch_.span();
+    Span<const std::int32_t> moved_before;
     run_passes([&](bool want_depth) {
-      contacts_double_buffer(ctx, a, anchor, cells, in, out, depth);
+      contacts_double_buffer(ctx, a, anchor, cells, in, out, depth, moved_before);
       std::swap(in, out);
-      if (skip_idle_contact_passes_) return contact_pass_outcome(depth, out, in);
-      return ContactPass{want_depth ? deepest_contact(depth) : 0.0f, true};
+      const float deepest = want_depth ? deepest_contact(depth) : 0.0f;
+      if (!skip_idle_contact_passes_) return ContactPass{deepest, true};
+      const Index moved = mark_moved_items(ctx.contact_bins, out, in, moved_before_.span());
+      moved_before = moved_before_.span();
+      return ContactPass{deepest, moved > 0};
     });
     finalize_step(ctx, a, anchor, cells, in);
   } else {  // in place: whether a pass moved anybody is not kept

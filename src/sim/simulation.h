@@ -111,10 +111,15 @@ void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<cons
 void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells);
 // Contact passes write, per agent, the deepest overlap the pass found
 // before pushing (`depth`, m; 0 for inactive agents).
-// Double buffer: one contact pass from `in` to `out`.
+// Double buffer: one contact pass from `in` to `out`. `moved_before`, from
+// mark_moved_items on the pass before (empty for the first pass): an agent
+// none of whose move cells holds an agent that pass moved gets its input
+// back, and keeps its depth, without looking at its neighbours: both are
+// what the look would give, bit for bit, since everything it reads is what
+// the pass before read.
 void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
                             Span<const MoveCells> cells, Span<const glm::vec2> in, Span<glm::vec2> out,
-                            Span<float> depth);
+                            Span<float> depth, Span<const std::int32_t> moved_before = {});
 // Four colour: sense + steer, then each contact pass, in place on a.position
 // and a.velocity, colour by colour.
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a);
@@ -122,14 +127,19 @@ void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<con
                           Span<const MoveCells> cells, Span<float> depth);
 // The deepest of the per-agent overlaps a contact pass wrote.
 float deepest_contact(Span<const float> depth);
-// The same for a double-buffer pass from `in` to `out`, and whether it
-// moved any agent: a pass that moved none would give the same positions
-// again, and so would every pass after it.
+// The agents a double-buffer pass from `in` to `out` moved (bit for bit:
+// -0 differs from 0), counted along the contact bins' items:
+// moved_before[k] = how many of items[0, k) moved, for k up to the item
+// count (one entry more than items; further entries unused). Returns how
+// many moved: a pass that moved none would give the same positions again,
+// and so would every pass after it.
+Index mark_moved_items(const GridView& contact_bins, Span<const glm::vec2> in, Span<const glm::vec2> out,
+                       Span<std::int32_t> moved_before);
+// What a contact pass did: its deepest overlap, and whether it moved anybody.
 struct ContactPass {
   float deepest = 0.0f;  // m
   bool moved = false;
 };
-ContactPass contact_pass_outcome(Span<const float> depth, Span<const glm::vec2> in, Span<const glm::vec2> out);
 // Both: accepts or rejects each moved position, sets velocity, heading,
 // arrivals and waypoints. `moved` may alias a.position.
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
@@ -172,7 +182,8 @@ struct SimulationOptions {
   // The reference forms of two shortcuts that change no result (tests
   // compare them bit for bit): bins hashed even where a dense box of cells
   // fits (AgentGrid), and every contact pass run even after one that moved
-  // nobody (the double buffer's passes).
+  // nobody, every agent looking at its neighbours in every pass (the double
+  // buffer's passes; contacts_double_buffer).
   bool dense_bins = true;
   bool skip_idle_contact_passes = true;
 };
@@ -244,6 +255,7 @@ class Simulation {
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
   Buffer<float> contact_depth_;  // per agent: the deepest overlap the last contact pass found
   Buffer<MoveCells> move_cells_;
+  Buffer<std::int32_t> moved_before_;  // contact items moved by the last pass, counted (mark_moved_items)
   std::vector<PendingEntry> pending_;  // by entry time, then agent
   ExitChooser exits_;                  // groups choosing the quickest exit
   Replanner replan_;                   // planned routes, planned again for agents pushed off them

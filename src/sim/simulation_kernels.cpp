@@ -376,6 +376,14 @@ struct FindMoveCells {
   }
 };
 
+// True when no agent of the cells moved in the pass that counted
+// moved_before (mark_moved_items).
+THRONG_HOST_DEVICE inline bool quiet_cells(const Cells3x3& c, Span<const std::int32_t> moved_before) {
+  for (int k = 0; k < c.runs; ++k)
+    if (moved_before[c.start[k] + c.count[k]] != moved_before[c.start[k]]) return false;
+  return true;
+}
+
 struct ContactsDoubleBuffer {
   StepContext ctx;
   AgentArrays a;
@@ -383,7 +391,12 @@ struct ContactsDoubleBuffer {
   Span<const MoveCells> cells;
   Span<glm::vec2> out;
   Span<float> depth;
+  Span<const std::int32_t> moved_before;  // empty: every agent looks at its neighbours
   THRONG_HOST_DEVICE void operator()(Index i) const {
+    if (moved_before.size() > 0 && quiet_cells(cells[i].agents, moved_before)) {
+      out[i] = in[i];
+      return;
+    }
     out[i] = contact_agent(ctx, a, i, cells[i], anchor[i], in, depth[i]);
   }
 };
@@ -528,9 +541,9 @@ void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveC
 
 void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
                             Span<const MoveCells> cells, Span<const glm::vec2> in, Span<glm::vec2> out,
-                            Span<float> depth) {
-  parallel_for("sim.move.contacts", a.position.size(), ContactsDoubleBuffer{ctx, a, anchor, in, cells, out, depth},
-               kAgentGrain);
+                            Span<float> depth, Span<const std::int32_t> moved_before) {
+  parallel_for("sim.move.contacts", a.position.size(),
+               ContactsDoubleBuffer{ctx, a, anchor, in, cells, out, depth, moved_before}, kAgentGrain);
 }
 
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
@@ -551,30 +564,27 @@ float deepest_contact(Span<const float> depth) {
       THRONG_LAMBDA(float x, float y)->float { return x > y ? x : y; });
 }
 
-namespace {
-// One agent's share of a double-buffer pass's outcome: moved bit for bit,
-// so -0 differs from 0.
-struct OutcomeOf {
-  Span<const float> depth;
-  Span<const glm::vec2> in, out;
-  THRONG_HOST_DEVICE ContactPass operator()(Index i) const {
-    const glm::vec2 a = in[i], b = out[i];
-    std::uint32_t bits_a[2], bits_b[2];
-    memcpy(bits_a, &a, sizeof bits_a);
-    memcpy(bits_b, &b, sizeof bits_b);
-    return {depth[i], bits_a[0] != bits_b[0] || bits_a[1] != bits_b[1]};
-  }
-};
-struct CombineOutcome {
-  THRONG_HOST_DEVICE ContactPass operator()(const ContactPass& a, const ContactPass& b) const {
-    return {a.deepest > b.deepest ? a.deepest : b.deepest, a.moved || b.moved};
-  }
-};
-}  // namespace
-
-ContactPass contact_pass_outcome(Span<const float> depth, Span<const glm::vec2> in, Span<const glm::vec2> out) {
-  return parallel_reduce("sim.move.contacts.outcome", depth.size(), ContactPass{0.0f, false}, OutcomeOf{depth, in, out},
-                         CombineOutcome{});
+Index mark_moved_items(const GridView& contact_bins, Span<const glm::vec2> in, Span<const glm::vec2> out,
+                       Span<std::int32_t> moved_before) {
+  const Span<const std::int32_t> items = contact_bins.items;
+  const Index n = items.size();
+  const Span<std::int32_t> flags = moved_before.subspan(0, n + 1);
+  parallel_for(
+      "sim.move.contacts.moved", n + 1,
+      THRONG_LAMBDA(Index k) {
+        if (k == n) {
+          flags[k] = 0;
+          return;
+        }
+        const Index i = items[k];
+        const glm::vec2 a = in[i], b = out[i];
+        std::uint32_t bits_a[2], bits_b[2];
+        memcpy(bits_a, &a, sizeof bits_a);
+        memcpy(bits_b, &b, sizeof bits_b);
+        flags[k] = bits_a[0] != bits_b[0] || bits_a[1] != bits_b[1] ? 1 : 0;
+      },
+      kAgentGrain);
+  return exclusive_scan("sim.move.contacts.moved_scan", Span<const std::int32_t>(flags), flags);
 }
 
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,

@@ -358,7 +358,8 @@ TEST(Determinism, FourColourIsBitwiseTheSameForOneTwoAndFourThreads) {
 // Two shortcuts that must change no bit, against their reference forms:
 // dense bins (a box of cells indexed directly) against hashed ones, and
 // the double buffer's contact passes ending at the first that moved nobody
-// against every pass run. The bottleneck's bins are dense and its jam needs
+// and passing over agents whose move cells the pass before left still
+// against every pass run by every agent. The bottleneck's bins are dense and its jam needs
 // every pass; the circle's contact bins are hashed (a ring 100 m across in
 // cells of 1 m) and most of its steps move nobody in their second pass.
 TEST(Determinism, DenseBinsAndSkippedIdleContactPassesChangeNoBit) {
@@ -380,6 +381,62 @@ TEST(Determinism, DenseBinsAndSkippedIdleContactPassesChangeNoBit) {
   EXPECT_FALSE(full.bins().dense());
   EXPECT_EQ(sim.last_contact_passes(), 1);
   EXPECT_EQ(full.last_contact_passes(), spec.model.contact_iterations);
+}
+
+// The contact passes' other shortcut at the kernel: past the first pass an
+// agent none of whose move cells holds an agent the pass before moved keeps
+// its input, unlooked. Two overlapping pairs far apart and a lone agent:
+// the count of moved agents is checked against a plain count, the pass
+// after gives with it what it gives without, bit for bit, and a count
+// claiming nobody moved leaves even overlapping pairs where they are (so
+// the count is what decides).
+TEST(ContactPasses, AgentsWhoseMoveCellsStayedStillAreNotLookedAtAgain) {
+  const World world = World::build(WorldSpec{}, 1.0f);
+  const std::vector<glm::vec2> start = {{0.0f, 0.0f}, {0.3f, 0.05f}, {20.0f, 0.0f}, {20.35f, 0.0f}, {40.0f, 0.0f}};
+  const Index n = static_cast<Index>(start.size());
+  const Memory mem = current_memory();
+  const Buffer<glm::vec2> anchor(std::span<const glm::vec2>(start), mem);
+  const std::vector<float> radii(start.size(), 0.25f);
+  const std::vector<std::uint8_t> active(start.size(), kAgentActive);
+  const Buffer<float> radius(std::span<const float>(radii), mem);
+  Buffer<std::uint8_t> flags(std::span<const std::uint8_t>(active), mem);
+  AgentGrid bins(1.0f);
+  bins.rebuild(anchor.span(), flags.span());
+  StepContext ctx;
+  ctx.world = world.view();
+  ctx.contact_bins = bins.view();
+  Buffer<glm::vec2> position(std::span<const glm::vec2>(start), mem);  // (a pass reads only its input)
+  AgentArrays a;
+  a.position = position.span();  // sets the agent count
+  a.radius = radius.span();
+  a.flags = flags.span();
+  Buffer<MoveCells> cells(n, mem);
+  move_cells(ctx, anchor.span(), cells.span());
+  auto pass = [&](const Buffer<glm::vec2>& in, Span<const std::int32_t> moved_before, std::vector<float>* depths) {
+    Buffer<glm::vec2> out(n, mem);
+    Buffer<float> depth = Buffer<float>::zeros(n, mem);
+    contacts_double_buffer(ctx, a, anchor.span(), cells.span(), in.span(), out.span(), depth.span(), moved_before);
+    if (depths != nullptr) *depths = depth.to_vector();
+    return out;
+  };
+  const Buffer<glm::vec2> first = pass(anchor, {}, nullptr);
+  Buffer<std::int32_t> moved_before(n + 1, mem);
+  const Index moved = mark_moved_items(ctx.contact_bins, anchor.span(), first.span(), moved_before.span());
+  const std::vector<glm::vec2> p0 = anchor.to_vector(), p1 = first.to_vector();
+  Index counted = 0;
+  for (Index i = 0; i < n; ++i) counted += test::same_bits(std::vector{p0[i]}, std::vector{p1[i]}) ? 0 : 1;
+  EXPECT_EQ(moved, 4);  // both pairs; the lone agent stays
+  EXPECT_EQ(moved, counted);
+  std::vector<float> depth_with, depth_without;
+  const Buffer<glm::vec2> with = pass(first, moved_before.span(), &depth_with);
+  const Buffer<glm::vec2> without = pass(first, {}, &depth_without);
+  EXPECT_TRUE(test::same_bits(with.to_vector(), without.to_vector()));
+  EXPECT_TRUE(test::same_bits(depth_with, depth_without));
+  // Told that nobody moved, a pass leaves the overlapping start as it is.
+  const std::vector<std::int32_t> none(static_cast<std::size_t>(n + 1), 0);
+  const Buffer<std::int32_t> still(std::span<const std::int32_t>(none), mem);
+  EXPECT_TRUE(test::same_bits(pass(anchor, still.span(), nullptr).to_vector(), p0));
+  EXPECT_FALSE(test::same_bits(pass(anchor, {}, nullptr).to_vector(), p0));
 }
 
 // The bins against the O(N^2) reference under the priority model: the same
