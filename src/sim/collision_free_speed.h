@@ -178,22 +178,29 @@ inline constexpr float kCfsYieldAlong = 0.8f;     // cos 37 degrees
 inline constexpr float kCfsYieldGap = 0.3f;       // m between the bodies
 inline constexpr float kCfsYieldShare = 0.7f;
 
-// The side of the agent's heading its goal lies on when it may have to
-// yield (+1 left, -1 right), 0 when it walks slower than kCfsYieldSpeed or
-// within 45 degrees of its goal (most agents: no neighbour is looked at).
-THRONG_HOST_DEVICE inline float cfs_yield_side(const CfsAgent& i) {
+// When the agent may have to yield: the side of its heading its goal lies
+// on (+1 left, -1 right; 0 when it walks slower than kCfsYieldSpeed or
+// within 45 degrees of its goal: most agents, and no neighbour is looked
+// at) and that heading (its unit velocity), found once for every neighbour.
+struct CfsYield {
+  float side = 0.0f;
+  glm::vec2 heading{0.0f};
+};
+THRONG_HOST_DEVICE inline CfsYield cfs_yield(const CfsAgent& i) {
   const float speed2 = length2(i.v);
-  if (speed2 < kCfsYieldSpeed * kCfsYieldSpeed) return 0.0f;
+  if (speed2 < kCfsYieldSpeed * kCfsYieldSpeed) return {};
   const float across = dot2(i.e0, perp_left(i.v)) / sqrtf(speed2);
-  return across > kCfsYieldGoalSide ? 1.0f : (across < -kCfsYieldGoalSide ? -1.0f : 0.0f);
+  const float side = across > kCfsYieldGoalSide ? 1.0f : (across < -kCfsYieldGoalSide ? -1.0f : 0.0f);
+  return {side, i.v * (1.0f / sqrtf(speed2))};  // (normalize_or's bits)
 }
 
 // The most the agent walks beside neighbour j at q (velocity w, radius rj)
-// with its goal on side `side` of its heading (cfs_yield_side): +inf unless
-// j walks abreast of it on that side.
-THRONG_HOST_DEVICE inline float cfs_yield_speed(const CfsAgent& i, float side, glm::vec2 q, glm::vec2 w, float rj) {
-  const glm::vec2 h = normalize_or(i.v, glm::vec2(0.0f)), d = q - i.p;
-  const float beside = dot2(d, perp_left(h)) * side, ahead = dot2(d, h), along = dot2(w, h);
+// when it may have to yield (cfs_yield, side not 0): +inf unless j walks
+// abreast of it on its goal's side.
+THRONG_HOST_DEVICE inline float cfs_yield_speed(const CfsAgent& i, const CfsYield& y, glm::vec2 q, glm::vec2 w,
+                                                float rj) {
+  const glm::vec2 h = y.heading, d = q - i.p;
+  const float beside = dot2(d, perp_left(h)) * y.side, ahead = dot2(d, h), along = dot2(w, h);
   const bool abreast = beside > 0.0f && ahead > 0.0f && ahead <= beside && length_of(d) - i.radius - rj <= kCfsYieldGap;
   const bool our_way = along >= kCfsYieldSpeed && along >= kCfsYieldAlong * length_of(w);
   return abreast && our_way ? kCfsYieldShare * along : INFINITY;

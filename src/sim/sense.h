@@ -95,10 +95,9 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
   auto candidates = [&](const auto& fn) {
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
+        if (!cell_within(bins, cx + dx, cy + dy, p, query2, slack)) continue;
         const glm::vec2 lo = bins.cell_min(cx + dx, cy + dy) - glm::vec2(slack);
         const glm::vec2 hi = lo + glm::vec2(bins.cell_size, bins.cell_size_y) + glm::vec2(2.0f * slack);
-        const glm::vec2 nearest(fminf(fmaxf(p.x, lo.x), hi.x), fminf(fmaxf(p.y, lo.y), hi.y));
-        if (length2(nearest - p) >= query2) continue;
         // The corner of the cell furthest along `forward`.
         const glm::vec2 front(forward.x >= 0.0f ? hi.x : lo.x, forward.y >= 0.0f ? hi.y : lo.y);
         if (dot2(front - p, forward) <= 0.0f) continue;
@@ -215,9 +214,9 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   float speed = speed_past(true);
   // Abreast of a neighbour with its goal across that neighbour's way: it
   // falls back and passes behind (cfs_yield_speed).
-  if (const float side = cfs_yield_side(me); side != 0.0f)
+  if (const CfsYield yield = cfs_yield(me); yield.side != 0.0f)
     for_each_holder(
-        [&](Index j) { speed = fminf(speed, cfs_yield_speed(me, side, n.at(j, me.p), n.velocity[j], n.radius[j])); });
+        [&](Index j) { speed = fminf(speed, cfs_yield_speed(me, yield, n.at(j, me.p), n.velocity[j], n.radius[j])); });
   // Held at rest while walking on would take it forward: the neighbours
   // that wait for it (cfs_waits_for) are left out of its gap and of the
   // no-step-into-a-body cap, so it may press into them, and the contact

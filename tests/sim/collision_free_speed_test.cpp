@@ -140,20 +140,21 @@ TEST(CollisionFreeSpeed, NearItsAimAnAgentTurningSharplySlows) {
 TEST(CollisionFreeSpeed, AWalkerAbreastOnTheGoalsSideIsLetGoFirst) {
   const glm::vec2 goal_east_of_north(std::sin(60.0f * kPiF / 180.0f), std::cos(60.0f * kPiF / 180.0f));
   const CfsAgent me{{0.0f, 0.0f}, {0.0f, 1.3f}, 0.2f, goal_east_of_north};
-  const float side = cfs_yield_side(me);
-  EXPECT_EQ(side, -1.0f);  // the goal lies to the right of the heading
+  const CfsYield yield = cfs_yield(me);
+  EXPECT_EQ(yield.side, -1.0f);  // the goal lies to the right of the heading
+  EXPECT_NEAR(yield.heading.y, 1.0f, kEps);
   const glm::vec2 north(0.0f, 1.2f);
-  EXPECT_NEAR(cfs_yield_speed(me, side, {0.6f, 0.1f}, north, 0.2f), kCfsYieldShare * 1.2f, kEps);
-  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, side, {-0.6f, 0.1f}, north, 0.2f)));        // on the other side
-  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, side, {0.6f, -0.1f}, north, 0.2f)));        // behind: it yields to us
-  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, side, {0.4f, 0.45f}, north, 0.2f)));        // more ahead than beside
-  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, side, {0.75f, 0.1f}, north, 0.2f)));        // gap 0.36 m: too far
-  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, side, {0.6f, 0.1f}, {0.9f, 0.9f}, 0.2f)));  // 45 degrees off our way
-  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, side, {0.6f, 0.1f}, {0.0f, 0.7f}, 0.2f)));  // slower than the floor
+  EXPECT_NEAR(cfs_yield_speed(me, yield, {0.6f, 0.1f}, north, 0.2f), kCfsYieldShare * 1.2f, kEps);
+  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, yield, {-0.6f, 0.1f}, north, 0.2f)));        // on the other side
+  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, yield, {0.6f, -0.1f}, north, 0.2f)));        // behind: it yields to us
+  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, yield, {0.4f, 0.45f}, north, 0.2f)));        // more ahead than beside
+  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, yield, {0.75f, 0.1f}, north, 0.2f)));        // gap 0.36 m: too far
+  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, yield, {0.6f, 0.1f}, {0.9f, 0.9f}, 0.2f)));  // 45 degrees off our way
+  EXPECT_TRUE(std::isinf(cfs_yield_speed(me, yield, {0.6f, 0.1f}, {0.0f, 0.7f}, 0.2f)));  // slower than the floor
   const glm::vec2 goal_40_degrees(std::sin(40.0f * kPiF / 180.0f), std::cos(40.0f * kPiF / 180.0f));
-  EXPECT_EQ(cfs_yield_side({{0.0f, 0.0f}, {0.0f, 1.3f}, 0.2f, goal_40_degrees}), 0.0f);
-  EXPECT_EQ(cfs_yield_side({{0.0f, 0.0f}, {0.0f, 0.7f}, 0.2f, goal_east_of_north}), 0.0f);
-  EXPECT_EQ(cfs_yield_side({{0.0f, 0.0f}, {0.0f, 1.3f}, 0.2f, {-goal_east_of_north.x, goal_east_of_north.y}}), 1.0f);
+  EXPECT_EQ(cfs_yield({{0.0f, 0.0f}, {0.0f, 1.3f}, 0.2f, goal_40_degrees}).side, 0.0f);
+  EXPECT_EQ(cfs_yield({{0.0f, 0.0f}, {0.0f, 0.7f}, 0.2f, goal_east_of_north}).side, 0.0f);
+  EXPECT_EQ(cfs_yield({{0.0f, 0.0f}, {0.0f, 1.3f}, 0.2f, {-goal_east_of_north.x, goal_east_of_north.y}}).side, 1.0f);
 }
 
 // (Which agent goes first, slid by a wall or the lower index near one, the
