@@ -6,6 +6,7 @@
 #include "sim/collision_free_speed.h"
 #include "sim/crowd.h"
 #include "sim/grid.h"
+#include "sim/neighbours.h"
 #include "sim/social_force.h"
 #include "sim/steering.h"
 #include "sim/ttc.h"
@@ -31,42 +32,6 @@ THRONG_HOST_DEVICE inline ObstacleSense sense_obstacles(const WorldView& w, cons
   for_each_in_cell(w.circle_grid, pr.origin,
                    [&](std::int32_t k) { consider(probe_circle(pr, w.circles[k].center, w.circles[k].radius)); });
   return best;
-}
-
-// Read-only view of the neighbours' state. Models read a neighbour's
-// position through at(j, p): over a periodic area, the image nearest p.
-struct NeighbourArrays {
-  Span<const glm::vec2> position;
-  Span<const glm::vec2> velocity;
-  Span<const float> radius;
-  Span<const std::uint8_t> flags;
-  Periodic periodic;
-  THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 at(Index j, glm::vec2 p) const { return periodic.near(position[j], p); }
-};
-
-// Calls fn(j, q) for every active candidate j other than `self` whose
-// position q (its image nearest p) lies closer to p than sqrt(range2), in
-// the order for_each_candidate visits them. The candidates are first
-// sifted without a branch into a batch of indices, then the batch is
-// visited: most candidates fail the test, and a branch on each mispredicts
-// often enough to cost more than the test itself.
-inline constexpr int kNeighbourBatch = 32;
-template <class ForEachCandidate, class Fn>
-THRONG_HOST_DEVICE inline void for_each_neighbour(const ForEachCandidate& for_each_candidate, Index self,
-                                                  const NeighbourArrays& n, glm::vec2 p, float range2, const Fn& fn) {
-  std::int32_t batch[kNeighbourBatch];
-  int found = 0;
-  auto visit = [&]() {
-    for (int k = 0; k < found; ++k) fn(static_cast<Index>(batch[k]), n.at(batch[k], p));
-    found = 0;
-  };
-  for_each_candidate([&](Index j) {
-    batch[found] = static_cast<std::int32_t>(j);
-    const bool near = (j != self) & ((n.flags[j] & kAgentActive) != 0) & (length2(n.at(j, p) - p) < range2);
-    found += near ? 1 : 0;
-    if (found == kNeighbourBatch) visit();
-  });
-  visit();
 }
 
 // Neighbour j at q (within the query radius, active) as a threat of the
@@ -103,8 +68,7 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
         if (dot2(front - p, forward) <= 0.0f) continue;
         const Index s = bins.find(cx + dx, cy + dy);
         if (s < 0) continue;
-        const std::int32_t b = bins.start[s], count = bins.count[s];
-        for (std::int32_t k = 0; k < count; ++k) fn(static_cast<Index>(bins.items[b + k]));
+        for_each_binned_candidate(bins, bins.start[s], bins.count[s], n, fn);
       }
   };
   for_each_neighbour(candidates, self, n, p, query2,
@@ -118,9 +82,7 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours_all_pairs(Index self, glm::vec
                                                             const ModelParams& m) {
   Threat best;
   const float query2 = m.query_radius() * m.query_radius();
-  auto candidates = [&](const auto& fn) {
-    for (Index j = 0; j < n.position.size(); ++j) fn(j);
-  };
+  auto candidates = [&](const auto& fn) { for_each_active_candidate(n, fn); };
   for_each_neighbour(candidates, self, n, p, query2,
                      [&](Index j, glm::vec2 q) { consider_neighbour(best, j, q, p, v, forward, radius, n, m); });
   return best;
@@ -143,10 +105,9 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 // ---- collision-free speed -------------------------------------------------------
 
 // The new velocity of agent `self` under the collision-free speed model
-// (collision_free_speed.h). `for_each_candidate(fn)` calls fn(j) for every
-// agent that may be a neighbour, in a fixed order (the 3x3 bins, or all
-// agents for the reference); those beyond the query radius, inactive or
-// `self` are skipped here. Walls and circles come from the agent's cell of
+// (collision_free_speed.h). `for_each_candidate` visits every active agent
+// that may be a neighbour (for_each_binned_candidate, or all agents for the
+// reference); those beyond the query radius or `self` are skipped here. Walls and circles come from the agent's cell of
 // the world's halo grids (everything within one cell side).
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, Index self, const CfsAgent& me,
@@ -279,9 +240,9 @@ THRONG_HOST_DEVICE inline glm::vec2 sf_total_force(const WorldView& w, Index sel
     if (length2(me.p - q) < sense2) f += sf_wall_force(me.p, me.v, me.radius, q, s, h);
   });
   const glm::vec2 heading = normalize_or(me.v, me.e0);
-  for_each_candidate([&](Index j) {
-    if (j == self || (n.flags[j] & kAgentActive) == 0) return;
-    const glm::vec2 x = me.p - (n.at(j, me.p) + n.velocity[j] * t);
+  for_each_candidate([&](Index j, glm::vec2 at) {
+    if (j == self) return;
+    const glm::vec2 x = me.p - (n.periodic.near(at, me.p) + n.velocity[j] * t);
     if (length2(x) < sense2) f += sf_neighbour_force(x, me.v, n.velocity[j], me.radius + n.radius[j], heading, s, h);
   });
   return f;

@@ -52,6 +52,7 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   move_cells_ = Buffer<MoveCells>::zeros(crowd_.count, m);  // nor given move cells
   contact_depth_ = Buffer<float>::zeros(crowd_.count, m);
   moved_before_ = Buffer<std::int32_t>(crowd_.count + 1, m);
+  binned_position_ = Buffer<glm::vec2>(crowd_.count, m);
 }
 
 StepContext Simulation::context() const {
@@ -237,7 +238,12 @@ void Simulation::sense_and_steer(const StepContext& ctx) {
     sense_all_pairs(ctx, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else if (scheduler_ == SchedulerKind::DoubleBuffer) {
-    sense_double_buffer(ctx, a, sensed_.span());
+    // Neighbours read from the bins' copy in cell order (the positions
+    // stay as binned until the move stage).
+    StepContext gathered = ctx;
+    gathered.binned_position = binned_position_.span().subspan(0, ctx.bins.items.size());
+    gather_binned_positions(ctx.bins, crowd_.position.span(), binned_position_.span());
+    sense_double_buffer(gathered, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else {
     sense_steer_four_colour(ctx, a);

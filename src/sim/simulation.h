@@ -95,12 +95,17 @@ struct StepContext {
   float bin_slack = 0.0f;
   FieldsView fields;  // navigation fields (none: every agent steers at its waypoint)
   Periodic periodic;  // the world's periodic boundaries (none: periods 0)
+  // The positions of the bins' items in item order while they stay as
+  // binned (the double buffer's sense stage; NeighbourArrays), else empty.
+  Span<const glm::vec2> binned_position;
 };
 
 // Stages (each one or more parallel_for launches named "sim.<stage>...").
 // Double buffer: what the model senses for every binned (active) agent (a
 // force, or the collision-free velocity), then candidate positions.
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
+// The positions of the grid's items in item order: out[k] = position[items[k]].
+void gather_binned_positions(const GridView& bins, Span<const glm::vec2> position, Span<glm::vec2> out);
 // The naive reference for the sense stage: every agent against every other,
 // O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
@@ -255,6 +260,7 @@ class Simulation {
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
   Buffer<float> contact_depth_;  // per agent: the deepest overlap the last contact pass found
   Buffer<MoveCells> move_cells_;
+  Buffer<glm::vec2> binned_position_;  // the steering bins' items' positions (gather_binned_positions)
   Buffer<std::int32_t> moved_before_;  // contact items moved by the last pass, counted (mark_moved_items)
   std::vector<PendingEntry> pending_;  // by entry time, then agent
   ExitChooser exits_;                  // groups choosing the quickest exit

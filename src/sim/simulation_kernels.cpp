@@ -148,7 +148,7 @@ THRONG_HOST_DEVICE inline bool led_target(const StepContext& ctx, const AgentArr
 
 // The agents as the models read their neighbours.
 THRONG_HOST_DEVICE inline NeighbourArrays neighbours_of(const StepContext& ctx, const AgentArrays& a) {
-  return {a.position, a.velocity, a.radius, a.flags, ctx.periodic};
+  return {a.position, a.velocity, a.radius, a.flags, ctx.periodic, ctx.binned_position};
 }
 
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
@@ -235,7 +235,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
   if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
-    auto candidates = [&](const auto& fn) { for_each_in_cells(ctx.bins, cells, fn); };
+    const NeighbourArrays n = neighbours_of(ctx, a);
+    auto candidates = [&](const auto& fn) { for_each_binned_candidate(ctx.bins, cells, n, fn); };
     return sense_candidates(ctx, a, i, candidates);
   }
   const NeighbourArrays n = neighbours_of(ctx, a);
@@ -335,15 +336,12 @@ struct SenseAllPairs {
       sensed[i] = glm::vec2(0.0f);
       return;
     }
+    const NeighbourArrays n = neighbours_of(ctx, a);
     if (ctx.model.kind != ModelKind::Priority) {
-      const Index count = a.position.size();
-      auto candidates = [&](const auto& fn) {
-        for (Index j = 0; j < count; ++j) fn(j);
-      };
+      auto candidates = [&](const auto& fn) { for_each_active_candidate(n, fn); };
       sensed[i] = sense_candidates(ctx, a, i, candidates);
       return;
     }
-    const NeighbourArrays n = neighbours_of(ctx, a);
     const ModelParams m = ctx.model;
     sensed[i] = sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
       return sense_neighbours_all_pairs(i, p, v, forward, r, n, m);
@@ -524,6 +522,12 @@ constexpr Index kSlotGrain = 256;
 
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
   parallel_for("sim.sense", ctx.bins.items.size(), Sense{ctx, a, sensed}, kAgentGrain);
+}
+
+void gather_binned_positions(const GridView& bins, Span<const glm::vec2> position, Span<glm::vec2> out) {
+  const Span<const std::int32_t> items = bins.items;
+  parallel_for(
+      "sim.sense.gather", items.size(), THRONG_LAMBDA(Index k) { out[k] = position[items[k]]; }, kAgentGrain);
 }
 
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {

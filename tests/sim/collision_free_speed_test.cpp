@@ -206,9 +206,7 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
     Index near = 0;
     for (const glm::vec2 q : p) near += glm::length(q) < hold ? 1 : 0;
     EXPECT_EQ(near - 1 > kCfsHolders, l.overflows) << near - 1 << " neighbours within " << hold << " m";
-    auto all = [&](const auto& fn) {
-      for (Index j = 0; j < static_cast<Index>(p.size()); ++j) fn(j);
-    };
+    auto all = [&](const auto& fn) { for_each_active_candidate(n, fn); };
     const CfsAgent me{p[0], v[0], r[0], {1.0f, 0.0f}};
     const glm::vec2 got = collision_free_velocity(world.view(), 0, me, v0, dt, n, m, all);
     const float speed = glm::length(got);

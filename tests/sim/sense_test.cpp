@@ -1,4 +1,4 @@
-// The sense stage's neighbour sift (for_each_neighbour, sim/sense.h): the
+// The sense stage's neighbour sift (for_each_neighbour, sim/neighbours.h): the
 // same neighbours, at the same images, in the same order as a plain filter
 // that branches on each candidate; every model's sum relies on that order
 // for its bits.
@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <numeric>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "sim/sense.h"
+#include "sim/simulation.h"
 
 namespace throng::sim {
 namespace {
@@ -44,26 +46,33 @@ struct Crowd {
   }
 };
 
+// The same agents at the same points, in the same order.
+void expect_same_seen(const std::vector<Seen>& expected, const std::vector<Seen>& got) {
+  ASSERT_EQ(expected.size(), got.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(expected[k].j, got[k].j) << "neighbour " << k;
+    EXPECT_EQ(expected[k].q, got[k].q) << "neighbour " << k;
+  }
+}
+
 void expect_same_as_plain_filter(const Crowd& c, const Periodic& periodic, float range) {
   const NeighbourArrays n = c.arrays(periodic);
   auto candidates = [&](const auto& fn) {
-    for (Index j : c.order) fn(j);
+    for (Index j : c.order)
+      if ((c.flags[static_cast<std::size_t>(j)] & kAgentActive) != 0) fn(j, c.position[static_cast<std::size_t>(j)]);
   };
   std::size_t most = 0;
   for (Index self = 0; self < static_cast<Index>(c.position.size()); self += 7) {
     const glm::vec2 p = c.position[static_cast<std::size_t>(self)];
     std::vector<Seen> plain, sifted;
-    candidates([&](Index j) {
-      if (j == self || (n.flags[j] & kAgentActive) == 0) return;
+    candidates([&](Index j, glm::vec2) {
+      if (j == self) return;
       const glm::vec2 q = n.at(j, p);
       if (length2(q - p) < range * range) plain.push_back({j, q});
     });
     for_each_neighbour(candidates, self, n, p, range * range, [&](Index j, glm::vec2 q) { sifted.push_back({j, q}); });
-    ASSERT_EQ(plain.size(), sifted.size()) << "agent " << self;
-    for (std::size_t k = 0; k < plain.size(); ++k) {
-      EXPECT_EQ(plain[k].j, sifted[k].j) << "agent " << self << ", neighbour " << k;
-      EXPECT_EQ(plain[k].q, sifted[k].q) << "agent " << self << ", neighbour " << k;
-    }
+    SCOPED_TRACE("agent " + std::to_string(self));
+    expect_same_seen(plain, sifted);
     most = std::max(most, plain.size());
   }
   // Some agents have more neighbours than one batch holds, so batches are
@@ -80,6 +89,33 @@ TEST(Sense, NeighbourSiftTakesTheImageAcrossTheSeam) {
   const Crowd c(2000, 40.0f, 2);
   const Periodic periodic{{0.0f, 0.0f}, {40.0f, 0.0f}};  // wraps along x
   expect_same_as_plain_filter(c, periodic, 4.0f);
+}
+
+// The bins' candidates read from the copy in cell order are the crowd's
+// active agents of the 3 x 3 cells, in item order, at their positions.
+TEST(Sense, BinnedCandidatesFromTheCopyInCellOrderAreTheCrowdsOwn) {
+  const Crowd c(2000, 40.0f, 4);
+  AgentGrid bins(4.0f);
+  bins.rebuild(Span<const glm::vec2>(c.position), Span<const std::uint8_t>(c.flags));
+  const GridView g = bins.view();
+  std::vector<glm::vec2> copy(static_cast<std::size_t>(g.items.size()));
+  gather_binned_positions(g, Span<const glm::vec2>(c.position), Span<glm::vec2>(copy));
+  const NeighbourArrays plain = c.arrays(Periodic{});
+  NeighbourArrays copied = plain;
+  copied.binned_position = Span<const glm::vec2>(copy);
+  for (std::size_t i = 0; i < c.position.size(); i += 11) {
+    const glm::vec2 p = c.position[i];
+    const Cells3x3 cells = cells_3x3(g, g.cell_x(p.x), g.cell_y(p.y));
+    std::vector<Seen> from_copy, from_crowd, expected;
+    for_each_binned_candidate(g, cells, copied, [&](Index j, glm::vec2 at) { from_copy.push_back({j, at}); });
+    for_each_binned_candidate(g, cells, plain, [&](Index j, glm::vec2 at) { from_crowd.push_back({j, at}); });
+    for_each_in_cells(g, cells, [&](std::int32_t j) {
+      expected.push_back({j, c.position[static_cast<std::size_t>(j)]});
+      EXPECT_NE(c.flags[static_cast<std::size_t>(j)] & kAgentActive, 0);
+    });
+    expect_same_seen(expected, from_copy);
+    expect_same_seen(expected, from_crowd);
+  }
 }
 
 TEST(Sense, NeighbourSiftOfNoCandidatesVisitsNothing) {

@@ -1,0 +1,85 @@
+// The neighbours a sense stage reads: their state (NeighbourArrays), the
+// candidates of an agent (from the bins' cells, or every agent for the
+// O(N^2) reference) and the sift of those within a range
+// (for_each_neighbour). Host+device.
+#pragma once
+
+#include "core/periodic.h"
+#include "core/span.h"
+#include "sim/crowd.h"
+#include "sim/geometry.h"
+#include "sim/grid.h"
+
+namespace throng::sim {
+
+// Read-only view of the neighbours' state. Models read a neighbour's
+// position through at(j, p): over a periodic area, the image nearest p.
+// `binned_position`, where given, holds the positions of the steering
+// bins' items in item order (binned_position[k] = position[items[k]]): the
+// candidates of a 3 x 3 are then read from a few contiguous runs instead
+// of all over `position`. Only while positions stay as binned (the double
+// buffer's sense stage); empty elsewhere.
+struct NeighbourArrays {
+  Span<const glm::vec2> position;
+  Span<const glm::vec2> velocity;
+  Span<const float> radius;
+  Span<const std::uint8_t> flags;
+  Periodic periodic;
+  Span<const glm::vec2> binned_position = {};
+  THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 at(Index j, glm::vec2 p) const { return periodic.near(position[j], p); }
+};
+
+// The candidate neighbours of a sense stage: for_each_candidate(c) calls
+// c(j, at) for every active agent j that may be a neighbour, in a fixed
+// order, `at` its position as stored. These two visit the bins' cells
+// (items in their order; every binned agent is active) and every agent
+// (the O(N^2) reference).
+// (One run of `count` items from `start`, then every run of `cells`.)
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_binned_candidate(const GridView& bins, std::int32_t start, std::int32_t count,
+                                                         const NeighbourArrays& n, const Fn& fn) {
+  const bool copied = n.binned_position.size() > 0;
+  for (std::int32_t k = start; k < start + count; ++k) {
+    const std::int32_t j = bins.items[k];
+    fn(static_cast<Index>(j), copied ? n.binned_position[k] : n.position[j]);
+  }
+}
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_binned_candidate(const GridView& bins, const Cells3x3& cells,
+                                                         const NeighbourArrays& n, const Fn& fn) {
+  for (int r = 0; r < cells.runs; ++r) for_each_binned_candidate(bins, cells.start[r], cells.count[r], n, fn);
+}
+template <class Fn>
+THRONG_HOST_DEVICE inline void for_each_active_candidate(const NeighbourArrays& n, const Fn& fn) {
+  for (Index j = 0; j < n.position.size(); ++j)
+    if ((n.flags[j] & kAgentActive) != 0) fn(j, n.position[j]);
+}
+
+// Calls fn(j, q) for every candidate j other than `self` whose position q
+// (its image nearest p) lies closer to p than sqrt(range2), in the order
+// for_each_candidate visits them. The candidates are first sifted without
+// a branch into a batch, then the batch is visited: most candidates fail
+// the test, and a branch on each mispredicts often enough to cost more
+// than the test itself.
+inline constexpr int kNeighbourBatch = 32;
+template <class ForEachCandidate, class Fn>
+THRONG_HOST_DEVICE inline void for_each_neighbour(const ForEachCandidate& for_each_candidate, Index self,
+                                                  const NeighbourArrays& n, glm::vec2 p, float range2, const Fn& fn) {
+  std::int32_t batch[kNeighbourBatch];
+  glm::vec2 image[kNeighbourBatch];
+  int found = 0;
+  auto visit = [&]() {
+    for (int k = 0; k < found; ++k) fn(static_cast<Index>(batch[k]), image[k]);
+    found = 0;
+  };
+  for_each_candidate([&](Index j, glm::vec2 at) {
+    const glm::vec2 q = n.periodic.near(at, p);
+    batch[found] = static_cast<std::int32_t>(j);
+    image[found] = q;
+    found += (j != self) & (length2(q - p) < range2) ? 1 : 0;
+    if (found == kNeighbourBatch) visit();
+  });
+  visit();
+}
+
+}  // namespace throng::sim
