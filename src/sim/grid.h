@@ -193,17 +193,23 @@ THRONG_HOST_DEVICE inline Cells3x3 cells_3x3(const GridView& g, std::int32_t cx,
     }
   return c;
 }
-// True when some point of cell (cx, cy), widened by `slack` on every side,
-// lies closer to p than sqrt(reach2): an item in a cell that fails holds
-// no neighbour within that reach of p, in float arithmetic too (each
-// coordinate difference to an item is at least the one to the cell's
-// nearest point, and rounding keeps that order). NaN p keeps every cell.
-THRONG_HOST_DEVICE inline bool cell_within(const GridView& g, std::int32_t cx, std::int32_t cy, glm::vec2 p,
-                                           float reach2, float slack) {
+// Cell (cx, cy) widened by `slack` on every side (for items that may have
+// moved that far since they were binned): its lower and upper corners.
+struct CellBounds {
+  glm::vec2 lo, hi;
+};
+THRONG_HOST_DEVICE inline CellBounds cell_bounds(const GridView& g, std::int32_t cx, std::int32_t cy, float slack) {
   const glm::vec2 lo = g.cell_min(cx, cy) - glm::vec2(slack);
-  const glm::vec2 hi = lo + glm::vec2(g.cell_size, g.cell_size_y) + glm::vec2(2.0f * slack);
-  const float nx = p.x < lo.x ? lo.x : (p.x > hi.x ? hi.x : p.x);
-  const float ny = p.y < lo.y ? lo.y : (p.y > hi.y ? hi.y : p.y);
+  return {lo, lo + glm::vec2(g.cell_size, g.cell_size_y) + glm::vec2(2.0f * slack)};
+}
+// True when some point of the bounds lies closer to p than sqrt(reach2):
+// an item within bounds that fail holds no neighbour within that reach of
+// p, in float arithmetic too (each coordinate difference to an item is at
+// least the one to the nearest point, and rounding keeps that order). NaN
+// p keeps every cell.
+THRONG_HOST_DEVICE inline bool within_reach(const CellBounds& c, glm::vec2 p, float reach2) {
+  const float nx = p.x < c.lo.x ? c.lo.x : (p.x > c.hi.x ? c.hi.x : p.x);
+  const float ny = p.y < c.lo.y ? c.lo.y : (p.y > c.hi.y ? c.hi.y : p.y);
   return !((nx - p.x) * (nx - p.x) + (ny - p.y) * (ny - p.y) >= reach2);
 }
 // Calls fn(item) for every item of those cells, in order.

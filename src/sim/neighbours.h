@@ -31,10 +31,10 @@ struct NeighbourArrays {
 
 // The candidate neighbours of a sense stage: for_each_candidate(c) calls
 // c(j, at) for every active agent j that may be a neighbour, in a fixed
-// order, `at` its position as stored. These two visit the bins' cells
-// (items in their order; every binned agent is active) and every agent
-// (the O(N^2) reference).
-// (One run of `count` items from `start`, then every run of `cells`.)
+// order, `at` its position as stored. Below: the bins' items (in their
+// order; every binned agent is active), of one run of `count` from
+// `start` or of every run of `cells`; and every agent (the O(N^2)
+// reference).
 template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_binned_candidate(const GridView& bins, std::int32_t start, std::int32_t count,
                                                          const NeighbourArrays& n, const Fn& fn) {

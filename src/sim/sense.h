@@ -60,11 +60,10 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
   auto candidates = [&](const auto& fn) {
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
-        if (!cell_within(bins, cx + dx, cy + dy, p, query2, slack)) continue;
-        const glm::vec2 lo = bins.cell_min(cx + dx, cy + dy) - glm::vec2(slack);
-        const glm::vec2 hi = lo + glm::vec2(bins.cell_size, bins.cell_size_y) + glm::vec2(2.0f * slack);
+        const CellBounds cell = cell_bounds(bins, cx + dx, cy + dy, slack);
+        if (!within_reach(cell, p, query2)) continue;
         // The corner of the cell furthest along `forward`.
-        const glm::vec2 front(forward.x >= 0.0f ? hi.x : lo.x, forward.y >= 0.0f ? hi.y : lo.y);
+        const glm::vec2 front(forward.x >= 0.0f ? cell.hi.x : cell.lo.x, forward.y >= 0.0f ? cell.hi.y : cell.lo.y);
         if (dot2(front - p, forward) <= 0.0f) continue;
         const Index s = bins.find(cx + dx, cy + dy);
         if (s < 0) continue;
@@ -107,8 +106,9 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 // The new velocity of agent `self` under the collision-free speed model
 // (collision_free_speed.h). `for_each_candidate` visits every active agent
 // that may be a neighbour (for_each_binned_candidate, or all agents for the
-// reference); those beyond the query radius or `self` are skipped here. Walls and circles come from the agent's cell of
-// the world's halo grids (everything within one cell side).
+// reference); those beyond the query radius or `self` are skipped here.
+// Walls and circles come from the agent's cell of the world's halo grids
+// (everything within one cell side).
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, Index self, const CfsAgent& me,
                                                             float v0, float dt, const NeighbourArrays& n,

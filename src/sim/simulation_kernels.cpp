@@ -233,13 +233,12 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, con
 THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx,
                                                  std::int32_t cy) {
   if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
+  const NeighbourArrays n = neighbours_of(ctx, a);
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
-    const NeighbourArrays n = neighbours_of(ctx, a);
     auto candidates = [&](const auto& fn) { for_each_binned_candidate(ctx.bins, cells, n, fn); };
     return sense_candidates(ctx, a, i, candidates);
   }
-  const NeighbourArrays n = neighbours_of(ctx, a);
   return sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
     return sense_neighbours(ctx.bins, cx, cy, i, p, v, forward, r, n, ctx.model, ctx.bin_slack);
   });

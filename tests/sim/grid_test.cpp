@@ -205,7 +205,7 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
   }
 }
 
-// A cell that cell_within leaves out holds no item within the reach, also
+// A cell that within_reach leaves out holds no item within the reach, also
 // for items moved up to the slack since they were binned; around random
 // points some of the 3x3 cells are left out.
 TEST(Bins, ACellLeftOutOfReachHoldsNothingWithinIt) {
@@ -225,7 +225,7 @@ TEST(Bins, ACellLeftOutOfReachHoldsNothingWithinIt) {
     const std::int32_t cx = cell_coord(at.x, side), cy = cell_coord(at.y, side);
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
-        if (cell_within(v, cx + dx, cy + dy, at, side * side, slack)) continue;
+        if (within_reach(cell_bounds(v, cx + dx, cy + dy, slack), at, side * side)) continue;
         ++left_out;
         const Index s = v.find(cx + dx, cy + dy);
         for (std::int32_t m = 0; s >= 0 && m < v.count[s]; ++m)
