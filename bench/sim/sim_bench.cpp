@@ -9,7 +9,9 @@
 // beside it at 10^5 and 10^6 the same step without the shortcuts that
 // change no bit (sim/disc_step/<model>/reference).
 // Items are agent-steps, so items/s is agent-steps per second and the
-// median ns is the time of one step.
+// median ns is the time of one step. The counter bytes_per_agent_step is
+// the step's kernels' estimate of the memory they move (core/parallel.h,
+// count_traffic: each array a kernel passes over counted at its size).
 #include <fmt/format.h>
 
 #include <cmath>
@@ -20,6 +22,7 @@
 
 #include "bench/registry.h"
 #include "core/exec.h"
+#include "core/timing.h"
 #include "io/scenario_yaml.h"
 #include "sim/simulation.h"
 
@@ -100,26 +103,49 @@ sim::Simulation& disc(Index n, sim::ModelKind model, bool reference) {
   return *slot;
 }
 
+// The bytes the timed steps' kernels counted (count_traffic), set aside
+// while the timing is paused.
+class TimedBytes {
+ public:
+  void pause() { counted_ += now() - from_; }
+  void resume() { from_ = now(); }
+  void report(benchmark::State& state, Index n) {
+    pause();
+    const double agent_steps = static_cast<double>(state.iterations()) * static_cast<double>(n);
+    if (agent_steps > 0) state.counters["bytes_per_agent_step"] = static_cast<double>(counted_) / agent_steps;
+  }
+
+ private:
+  static std::int64_t now() { return KernelTimings::global().bytes_under("sim."); }
+  std::int64_t counted_ = 0, from_ = now();
+};
+
 Body disc_step(sim::ModelKind model, bool reference) {
   return [model, reference](benchmark::State& state, Index n) {
     sim::Simulation* sim = &disc(n, model, reference);
+    TimedBytes bytes;
     for (auto _ : state) {
       if (sim->time() >= kDiscTimedUntil) {
         state.PauseTiming();
+        bytes.pause();
         sim = &disc(n, model, reference);
+        bytes.resume();
         state.ResumeTiming();
       }
       sim->step();
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
+    bytes.report(state, n);
   };
 }
 
 Body step(sim::ModelKind model, Variant variant) {
   return [model, variant](benchmark::State& state, Index n) {
     sim::Simulation& sim = plaza(n, model, variant);
+    TimedBytes bytes;
     for (auto _ : state) sim.step();
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * n);
+    bytes.report(state, n);
   };
 }
 

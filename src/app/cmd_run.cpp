@@ -161,6 +161,15 @@ double stage_ms(const nlohmann::json& stats, const char* stage) {
   return stages.contains(stage) ? stages[stage]["ms_per_step"].get<double>() : 0.0;
 }
 
+// The kernels' estimate of the memory a step moves (from the arrays'
+// sizes, stats.json's timings.step_bytes), per agent and at what rate.
+void print_memory_moved(const nlohmann::json& timings, Index agents) {
+  const double bytes = timings["step_bytes"].get<double>(), ms = timings["step_ms"].get<double>();
+  if (bytes > 0 && agents > 0 && ms > 0)
+    std::printf("  memory moved per step: %.0f bytes per agent (estimated from the arrays' sizes), %.2f GB/s\n",
+                bytes / static_cast<double>(agents), bytes / (ms * 1e6));
+}
+
 void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nlohmann::json& stats,
                    const std::string& written) {
   const auto& crowd = stats["crowd"];
@@ -199,6 +208,7 @@ void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nl
   std::printf("  ms per step: %.3f (bin %.3f, %s %.3f, move %.3f)\n", stats["timings"]["step_ms"].get<double>(),
               stage_ms(stats, "sim.bin"), colour ? "sense+steer" : "sense",
               colour ? stage_ms(stats, "sim.sense_steer") : stage_ms(stats, "sim.sense"), stage_ms(stats, "sim.move"));
+  print_memory_moved(stats["timings"], sim.agent_count());
   if (stats.contains("locomotion")) {
     const auto& l = stats["locomotion"];
     std::printf("  locomotion (%s): %lld frames, median %.3f ms per frame", l["path"].get<std::string>().c_str(),

@@ -11,6 +11,7 @@
 
 #include "core/config.h"
 #include "core/exec.h"
+#include "core/span.h"
 #include "core/timing.h"
 
 #if defined(__CUDACC__)
@@ -90,6 +91,15 @@ void parallel_for(const char* description, Index n, const Body& body, Index grai
   }
   ScopedTimer timer(description);
   detail::cpu_parallel_for(n, grain, &detail::run_range<Body>, &body);
+}
+
+// Counts what a launch moves under its description, estimated from the
+// sizes of the arrays it passes over: each span it reads, and each it
+// writes, once (a span read and written is passed twice). Called beside
+// the launch, on the host (KernelTimings::count_bytes).
+template <class... T>
+void count_traffic(const char* description, const Span<T>&... spans) {
+  KernelTimings::global().count_bytes(description, bytes_of(spans...));
 }
 
 // Host-only parallel loops for work that cannot run as a kernel (A* with its

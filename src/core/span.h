@@ -50,4 +50,11 @@ struct Span {
   std::span<T> std() const { return std::span<T>(ptr, static_cast<std::size_t>(count)); }
 };
 
+// Bytes of the elements the spans view, summed: what a pass over each of
+// them once moves (KernelTimings::count_bytes).
+template <class... T>
+std::int64_t bytes_of(const Span<T>&... spans) {
+  return (std::int64_t{0} + ... + (static_cast<std::int64_t>(spans.size()) * static_cast<std::int64_t>(sizeof(T))));
+}
+
 }  // namespace throng

@@ -16,6 +16,9 @@ struct KernelStat {
   double median_ms = 0;  // over the most recent samples (see KernelTimings)
   double min_ms = 0;
   double max_ms = 0;
+  // Bytes the launches read and write, estimated from the sizes of the
+  // arrays each one passes over (count_bytes); 0 when none are counted.
+  std::int64_t bytes = 0;
 };
 
 class KernelTimings {
@@ -25,6 +28,12 @@ class KernelTimings {
 
   static KernelTimings& global();
   void record(std::string_view name, double ms);
+  // Adds to the bytes moved under `name`: a launch's estimate of what it
+  // reads and writes, each array it passes over counted once at its size
+  // (a floor: neighbour reads through the bins read some rows again).
+  void count_bytes(std::string_view name, std::int64_t bytes);
+  // Bytes counted so far under every name that starts with `prefix`.
+  std::int64_t bytes_under(std::string_view prefix) const;
   // By total time, largest first. Waits for GPU launches still queued (and
   // so may throw the Error of a kernel that failed); table() and json() too.
   std::vector<KernelStat> stats() const;

@@ -72,26 +72,44 @@ void FrameLoop::finish(nlohmann::json& stats) {
 }
 
 nlohmann::json timings_section(std::int64_t steps, const std::vector<std::pair<std::string, double>>& frame_stage_ms) {
-  std::map<std::string, double> sim_stages;
+  struct Stage {
+    double ms = 0;
+    std::int64_t bytes = 0;
+  };
+  std::map<std::string, Stage> sim_stages;
   nlohmann::json kernels = nlohmann::json::array();
   double step_total = 0;
+  std::int64_t step_bytes = 0;
   for (const KernelStat& k : KernelTimings::global().stats()) {
-    kernels.push_back({{"name", k.name}, {"count", k.count}, {"total_ms", k.total_ms}, {"median_ms", k.median_ms}});
+    kernels.push_back({{"name", k.name},
+                       {"count", k.count},
+                       {"total_ms", k.total_ms},
+                       {"median_ms", k.median_ms},
+                       {"bytes", k.bytes}});
     if (k.name == "sim.step") {
       step_total = k.total_ms;
       continue;
     }
     if (k.name.rfind("sim.", 0) != 0) continue;
+    step_bytes += k.bytes;
     const std::size_t dot = k.name.find('.', 4);
     const std::string stage = k.name.substr(4, dot == std::string::npos ? std::string::npos : dot - 4);
-    if (stage == "bin" || stage == "sense" || stage == "steer" || stage == "sense_steer" || stage == "move")
-      sim_stages[stage] += k.total_ms;
+    if (stage == "bin" || stage == "sense" || stage == "steer" || stage == "sense_steer" || stage == "move") {
+      sim_stages[stage].ms += k.total_ms;
+      sim_stages[stage].bytes += k.bytes;
+    }
   }
   const double per = steps > 0 ? 1.0 / static_cast<double>(steps) : 0.0;
   nlohmann::json stages = nlohmann::json::object();
-  for (const auto& [name, ms] : sim_stages) stages["sim." + name] = {{"total_ms", ms}, {"ms_per_step", ms * per}};
+  for (const auto& [name, s] : sim_stages)
+    stages["sim." + name] = {
+        {"total_ms", s.ms}, {"ms_per_step", s.ms * per}, {"bytes_per_step", static_cast<double>(s.bytes) * per}};
   for (const auto& [name, ms] : frame_stage_ms) stages[name] = {{"total_ms", ms}, {"ms_per_step", ms * per}};
-  return {{"step_ms", step_total * per}, {"stages", stages}, {"kernels", kernels}};
+  // bytes: the step's kernels' estimate of the memory they move (core/parallel.h, count_traffic).
+  return {{"step_ms", step_total * per},
+          {"step_bytes", static_cast<double>(step_bytes) * per},
+          {"stages", stages},
+          {"kernels", kernels}};
 }
 
 }  // namespace throng::sim

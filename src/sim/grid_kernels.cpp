@@ -135,6 +135,9 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
       });
   parallel_for("sim.bin.count", n, CountCells{cells, positions, flags, keys, count, slot_of});
   binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
+  count_traffic("sim.bin.clear", keys, count, cursor);
+  count_traffic("sim.bin.count", positions, flags, keys, count, count, slot_of);
+  count_traffic("sim.bin.scan", count, start);
   // Scatter in arbitrary order, then sort each run by agent index (and
   // give a dense grid's occupied slots their keys, for the slot-by-slot
   // launches of the four colours).
@@ -145,6 +148,7 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
         const std::int32_t k = atomic_fetch_add(&cursor[s], 1);
         items[start[s] + k] = static_cast<std::int32_t>(i);
       });
+  count_traffic("sim.bin.scatter", slot_of, cursor, cursor, start, items);
   const bool is_dense = dense();
   parallel_for(
       "sim.bin.sort", slots, THRONG_LAMBDA(Index s) {
@@ -156,6 +160,7 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
           keys[s] = cell_key(cells.dense_x0 + x, cells.dense_y0 + y);
         }
       });
+  count_traffic("sim.bin.sort", keys, count, start, items, items);
 }
 
 // Dense when the box of the occupied cells (every cell of a wrapping axis)
@@ -167,6 +172,7 @@ void AgentGrid::choose_layout(GridView& cells, Span<const glm::vec2> positions, 
     const CellBox none{kCellCoordLimit, kCellCoordLimit, -kCellCoordLimit, -kCellCoordLimit};
     CellBox box =
         parallel_reduce("sim.bin.box", positions.size(), none, CellOfAgent{cells, positions, flags}, Enclose{});
+    count_traffic("sim.bin.box", positions, flags);
     if (wrap_x_ > 0) box.x0 = 0, box.x1 = wrap_x_ - 1;
     if (wrap_y_ > 0) box.y0 = 0, box.y1 = wrap_y_ - 1;
     const std::int64_t nx = std::int64_t{box.x1} - box.x0 + 1, ny = std::int64_t{box.y1} - box.y0 + 1;

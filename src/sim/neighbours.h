@@ -12,36 +12,38 @@
 
 namespace throng::sim {
 
-// Read-only view of the neighbours' state. Models read a neighbour's
-// position through at(j, p): over a periodic area, the image nearest p.
-// `binned_position`, where given, holds the positions of the steering
-// bins' items in item order (binned_position[k] = position[items[k]]): the
-// candidates of a 3 x 3 are then read from a few contiguous runs instead
-// of all over `position`. Only while positions stay as binned (the double
-// buffer's sense stage); empty elsewhere.
+// Read-only view of the neighbours' state, element j of each array being
+// agent j, or, with `ids` given, the steering bins' item j (a copy gathered
+// in item order, element k holding agent ids[k]: the double buffer's sense
+// stage), so that the candidates of a 3 x 3 are a few contiguous runs of
+// every array rather than reads all over the crowd's. Models index
+// neighbours by element and ask id(j) for the agent itself. Models read a
+// neighbour's position through at(j, p): over a periodic area, the image
+// nearest p.
 struct NeighbourArrays {
   Span<const glm::vec2> position;
   Span<const glm::vec2> velocity;
   Span<const float> radius;
   Span<const std::uint8_t> flags;
   Periodic periodic;
-  Span<const glm::vec2> binned_position = {};
+  Span<const std::int32_t> ids = {};  // the agent of each element (the bins' items); empty: element j is agent j
   THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 at(Index j, glm::vec2 p) const { return periodic.near(position[j], p); }
+  THRONG_HOST_DEVICE THRONG_INLINE Index id(Index j) const { return ids.size() > 0 ? Index{ids[j]} : j; }
 };
 
 // The candidate neighbours of a sense stage: for_each_candidate(c) calls
-// c(j, at) for every active agent j that may be a neighbour, in a fixed
-// order, `at` its position as stored. Below: the bins' items (in their
-// order; every binned agent is active), of one run of `count` from
-// `start` or of every run of `cells`; and every agent (the O(N^2)
-// reference).
+// c(j, at) for every active agent that may be a neighbour, in a fixed
+// order, j its element of the neighbour arrays and `at` its position as
+// stored. Below: the bins' items (in their order; every binned agent is
+// active), of one run of `count` from `start` or of every run of `cells`;
+// and every agent (the O(N^2) reference).
 template <class Fn>
 THRONG_HOST_DEVICE inline void for_each_binned_candidate(const GridView& bins, std::int32_t start, std::int32_t count,
                                                          const NeighbourArrays& n, const Fn& fn) {
-  const bool copied = n.binned_position.size() > 0;
+  const bool in_items = n.ids.size() > 0;
   for (std::int32_t k = start; k < start + count; ++k) {
-    const std::int32_t j = bins.items[k];
-    fn(static_cast<Index>(j), copied ? n.binned_position[k] : n.position[j]);
+    const Index j = in_items ? Index{k} : Index{bins.items[k]};
+    fn(j, n.position[j]);
   }
 }
 template <class Fn>
@@ -55,7 +57,8 @@ THRONG_HOST_DEVICE inline void for_each_active_candidate(const NeighbourArrays& 
     if ((n.flags[j] & kAgentActive) != 0) fn(j, n.position[j]);
 }
 
-// Calls fn(j, q) for every candidate j other than `self` whose position q
+// Calls fn(j, q) for every candidate j other than `self` (the agent's own
+// element of the neighbour arrays) whose position q
 // (its image nearest p) lies closer to p than sqrt(range2), in the order
 // for_each_candidate visits them. The candidates are first sifted without
 // a branch into a batch, then the batch is visited: most candidates fail

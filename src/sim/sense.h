@@ -103,10 +103,11 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 
 // ---- collision-free speed -------------------------------------------------------
 
-// The new velocity of agent `self` under the collision-free speed model
-// (collision_free_speed.h). `for_each_candidate` visits every active agent
-// that may be a neighbour (for_each_binned_candidate, or all agents for the
-// reference); those beyond the query radius or `self` are skipped here.
+// The new velocity of the agent under the collision-free speed model
+// (collision_free_speed.h); `self` is its element of the neighbour arrays.
+// `for_each_candidate` visits every active agent that may be a neighbour
+// (for_each_binned_candidate, or all agents for the reference); those
+// beyond the query radius or `self` are skipped here.
 // Walls and circles come from the agent's cell of the world's halo grids
 // (everything within one cell side).
 template <class ForEachCandidate>
@@ -165,7 +166,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     float gap = INFINITY, gap_now = INFINITY;
     for_each_holder([&](Index j) {
       const glm::vec2 q = n.at(j, me.p);
-      if (!all && cfs_waits_for(me, q, slid || (near_wall && j > self))) return;
+      if (!all && cfs_waits_for(me, q, slid || (near_wall && n.id(j) > n.id(self)))) return;
       gap = fminf(
           gap, cfs_gap_ahead(me.p, me.radius, e, q + n.velocity[j] * c.anticipation_time, n.radius[j], c.lane_width));
       gap_now = fminf(gap_now, cfs_gap_ahead(me.p, me.radius, e, q, n.radius[j]));
@@ -198,12 +199,13 @@ struct ForceAgent {
   float pref_speed = 1.3f;
 };
 
-// The total acceleration of agent `self` under the time-to-collision model
-// (ttc.h), clamped to max_acceleration: the goal term, then walls and
-// circles of the agent's obstacle cell (nearest points within the sensing
-// radius), then neighbours within the sensing radius in the order
-// `for_each_candidate` visits them (the 3x3 bins, or all agents for the
-// reference), so the sum is the same for any thread count.
+// The total acceleration of the agent (`self`: its element of the
+// neighbour arrays) under the time-to-collision model (ttc.h), clamped to
+// max_acceleration: the goal term, then walls and circles of the agent's
+// obstacle cell (nearest points within the sensing radius), then
+// neighbours within the sensing radius in the order `for_each_candidate`
+// visits them (the 3x3 bins, or all agents for the reference), so the sum
+// is the same for any thread count.
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 ttc_force(const WorldView& w, Index self, const ForceAgent& me,
                                               const NeighbourArrays& n, const ModelParams& m,

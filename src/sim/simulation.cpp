@@ -53,6 +53,9 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   contact_depth_ = Buffer<float>::zeros(crowd_.count, m);
   moved_before_ = Buffer<std::int32_t>(crowd_.count + 1, m);
   binned_position_ = Buffer<glm::vec2>(crowd_.count, m);
+  binned_velocity_ = Buffer<glm::vec2>(crowd_.count, m);
+  binned_radius_ = Buffer<float>(crowd_.count, m);
+  binned_flags_ = Buffer<std::uint8_t>(crowd_.count, m);
 }
 
 StepContext Simulation::context() const {
@@ -238,11 +241,13 @@ void Simulation::sense_and_steer(const StepContext& ctx) {
     sense_all_pairs(ctx, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else if (scheduler_ == SchedulerKind::DoubleBuffer) {
-    // Neighbours read from the bins' copy in cell order (the positions
-    // stay as binned until the move stage).
+    // Neighbours read from the bins' copy in cell order (the crowd stays
+    // as binned until the move stage).
+    const Index items = ctx.bins.items.size();
     StepContext gathered = ctx;
-    gathered.binned_position = binned_position_.span().subspan(0, ctx.bins.items.size());
-    gather_binned_positions(ctx.bins, crowd_.position.span(), binned_position_.span());
+    gathered.binned = {binned_position_.span().subspan(0, items), binned_velocity_.span().subspan(0, items),
+                       binned_radius_.span().subspan(0, items), binned_flags_.span().subspan(0, items)};
+    gather_binned_state(ctx.bins, a, gathered.binned);
     sense_double_buffer(gathered, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else {

@@ -83,6 +83,17 @@ struct MoveCells {
   ObstacleCell obstacles;
 };
 
+// The state of the steering bins' items gathered in item order (element k
+// is agent bins.items[k]) while positions stay as binned: the double
+// buffer's sense stage reads neighbours from it (NeighbourArrays), a few
+// contiguous runs per agent instead of reads all over the crowd's arrays.
+struct BinnedState {
+  Span<glm::vec2> position;
+  Span<glm::vec2> velocity;
+  Span<float> radius;
+  Span<std::uint8_t> flags;
+};
+
 struct StepContext {
   WorldView world;
   GridView bins;          // side query_radius: steering neighbours
@@ -93,11 +104,9 @@ struct StepContext {
   // How far an agent may be from where it was binned when others read it:
   // 0 for the double buffer, one step's largest move for the four colours.
   float bin_slack = 0.0f;
-  FieldsView fields;  // navigation fields (none: every agent steers at its waypoint)
-  Periodic periodic;  // the world's periodic boundaries (none: periods 0)
-  // The positions of the bins' items in item order while they stay as
-  // binned (the double buffer's sense stage; NeighbourArrays), else empty.
-  Span<const glm::vec2> binned_position;
+  FieldsView fields;   // navigation fields (none: every agent steers at its waypoint)
+  Periodic periodic;   // the world's periodic boundaries (none: periods 0)
+  BinnedState binned;  // the double buffer's sense stage: neighbours in item order; else empty
 };
 
 // Stages (each one or more parallel_for launches named "sim.<stage>...").
@@ -105,7 +114,7 @@ struct StepContext {
 // force, or the collision-free velocity), then candidate positions.
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
 // The positions of the grid's items in item order: out[k] = position[items[k]].
-void gather_binned_positions(const GridView& bins, Span<const glm::vec2> position, Span<glm::vec2> out);
+void gather_binned_state(const GridView& bins, const AgentArrays& a, const BinnedState& out);
 // The naive reference for the sense stage: every agent against every other,
 // O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
@@ -260,7 +269,9 @@ class Simulation {
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
   Buffer<float> contact_depth_;  // per agent: the deepest overlap the last contact pass found
   Buffer<MoveCells> move_cells_;
-  Buffer<glm::vec2> binned_position_;  // the steering bins' items' positions (gather_binned_positions)
+  Buffer<glm::vec2> binned_position_, binned_velocity_;  // the steering bins' items' state (gather_binned_state)
+  Buffer<float> binned_radius_;
+  Buffer<std::uint8_t> binned_flags_;
   Buffer<std::int32_t> moved_before_;  // contact items moved by the last pass, counted (mark_moved_items)
   std::vector<PendingEntry> pending_;  // by entry time, then agent
   ExitChooser exits_;                  // groups choosing the quickest exit

@@ -146,9 +146,13 @@ THRONG_HOST_DEVICE inline bool led_target(const StepContext& ctx, const AgentArr
   return is_gate;
 }
 
-// The agents as the models read their neighbours.
+// The agents as the models read their neighbours: the steering bins'
+// items' copy in item order where the step gathered one (element k is
+// agent bins.items[k]), else the crowd's arrays (element i is agent i).
 THRONG_HOST_DEVICE inline NeighbourArrays neighbours_of(const StepContext& ctx, const AgentArrays& a) {
-  return {a.position, a.velocity, a.radius, a.flags, ctx.periodic, ctx.binned_position};
+  const BinnedState& b = ctx.binned;
+  if (b.position.size() > 0) return {b.position, b.velocity, b.radius, b.flags, ctx.periodic, ctx.bins.items};
+  return {a.position, a.velocity, a.radius, a.flags, ctx.periodic};
 }
 
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
@@ -172,11 +176,12 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_priority(const StepContext& ctx, const
   return avoidance_force(probe.forward, neighbours(p, v, probe.forward, r), m.max_force);
 }
 
-// Sense under the collision-free speed model: the agent's new velocity.
+// Sense under the collision-free speed model: agent i's new velocity
+// (`self`: its element of the neighbour arrays, neighbours_of).
 // `for_each_candidate(fn)` visits the candidate neighbours.
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx, const AgentArrays& a, Index i,
-                                                         const ForEachCandidate& for_each_candidate) {
+                                                         Index self, const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n = neighbours_of(ctx, a);
   const glm::vec2 p = a.position[i];
   glm::vec2 aim;
@@ -187,7 +192,7 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx,
   // How near it is: to its waypoint or goal itself (a field's aim, a gate's
   // point, lie a step ahead wherever the agent is).
   const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f)), length_of(a.goal[i] - p)};
-  return collision_free_velocity(ctx.world, i, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
+  return collision_free_velocity(ctx.world, self, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
 }
 
 // Agent i as the force models see it: heading straight for its goal, or
@@ -201,46 +206,47 @@ THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const A
 
 // Sense under the time-to-collision model: the agent's total acceleration.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i,
+THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
                                               const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n = neighbours_of(ctx, a);
-  return ttc_force(ctx.world, i, force_agent(ctx, a, i), n, ctx.model, for_each_candidate);
+  return ttc_force(ctx.world, self, force_agent(ctx, a, i), n, ctx.model, for_each_candidate);
 }
 
 // Sense under the social force model: the step's mean velocity.
 template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a, Index i,
-                                                       const ForEachCandidate& for_each_candidate) {
+                                                       Index self, const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n = neighbours_of(ctx, a);
-  return social_force_velocity(ctx.world, i, force_agent(ctx, a, i), ctx.dt, n, ctx.model, for_each_candidate);
+  return social_force_velocity(ctx.world, self, force_agent(ctx, a, i), ctx.dt, n, ctx.model, for_each_candidate);
 }
 
 // The sense of the models that sum over every candidate neighbour
 // (collision-free speed, time to collision, social force).
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, const AgentArrays& a, Index i,
+THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
                                                      const ForEachCandidate& for_each_candidate) {
-  if (ctx.model.kind == ModelKind::Ttc) return sense_ttc(ctx, a, i, for_each_candidate);
-  if (ctx.model.kind == ModelKind::SocialForce) return sense_social_force(ctx, a, i, for_each_candidate);
-  return sense_collision_free(ctx, a, i, for_each_candidate);
+  if (ctx.model.kind == ModelKind::Ttc) return sense_ttc(ctx, a, i, self, for_each_candidate);
+  if (ctx.model.kind == ModelKind::SocialForce) return sense_social_force(ctx, a, i, self, for_each_candidate);
+  return sense_collision_free(ctx, a, i, self, for_each_candidate);
 }
 
 // Sense: what the model makes of the agent's surroundings, zero for agents
 // that do not steer. Priority: the avoidance force (zero when nothing is
 // sensed); collision-free speed: the new velocity; time to collision: the
-// total acceleration; social force: the step's mean velocity. Neighbours come from the 3x3 bins around (cx, cy), the
-// agent's cell.
-THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, std::int32_t cx,
-                                                 std::int32_t cy) {
+// total acceleration; social force: the step's mean velocity. Neighbours
+// come from the 3x3 bins around (cx, cy), the agent's cell; `self` is
+// agent i's element of the neighbour arrays (neighbours_of).
+THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
+                                                 std::int32_t cx, std::int32_t cy) {
   if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
   const NeighbourArrays n = neighbours_of(ctx, a);
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
     auto candidates = [&](const auto& fn) { for_each_binned_candidate(ctx.bins, cells, n, fn); };
-    return sense_candidates(ctx, a, i, candidates);
+    return sense_candidates(ctx, a, i, self, candidates);
   }
   return sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
-    return sense_neighbours(ctx.bins, cx, cy, i, p, v, forward, r, n, ctx.model, ctx.bin_slack);
+    return sense_neighbours(ctx.bins, cx, cy, self, p, v, forward, r, n, ctx.model, ctx.bin_slack);
   });
 }
 
@@ -320,7 +326,8 @@ struct Sense {
   THRONG_HOST_DEVICE void operator()(Index k) const {
     const Index i = ctx.bins.items[k];
     const glm::vec2 p = a.position[i];
-    sensed[i] = sense_binned(ctx, a, i, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
+    const Index self = ctx.binned.position.size() > 0 ? k : i;  // (neighbours_of)
+    sensed[i] = sense_binned(ctx, a, i, self, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
   }
 };
 
@@ -338,7 +345,7 @@ struct SenseAllPairs {
     const NeighbourArrays n = neighbours_of(ctx, a);
     if (ctx.model.kind != ModelKind::Priority) {
       auto candidates = [&](const auto& fn) { for_each_active_candidate(n, fn); };
-      sensed[i] = sense_candidates(ctx, a, i, candidates);
+      sensed[i] = sense_candidates(ctx, a, i, i, candidates);
       return;
     }
     const ModelParams m = ctx.model;
@@ -413,7 +420,7 @@ struct SenseSteerColour {
     for (std::int32_t k = 0; k < n; ++k) {
       const Index i = ctx.bins.items[b + k];
       glm::vec2 np, nv;
-      steer_agent(ctx, a, i, sense_binned(ctx, a, i, cx, cy), np, nv);
+      steer_agent(ctx, a, i, sense_binned(ctx, a, i, i, cx, cy), np, nv);
       a.position[i] = np;
       a.velocity[i] = nv;
     }
@@ -521,25 +528,43 @@ constexpr Index kSlotGrain = 256;
 
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
   parallel_for("sim.sense", ctx.bins.items.size(), Sense{ctx, a, sensed}, kAgentGrain);
+  count_traffic("sim.sense", ctx.bins.items, ctx.bins.start, ctx.bins.count, ctx.binned.position, ctx.binned.velocity,
+                ctx.binned.radius, ctx.binned.flags, a.position, a.velocity, a.radius, a.flags, a.goal, a.pref_speed,
+                a.waypoint_cursor, sensed);
 }
 
-void gather_binned_positions(const GridView& bins, Span<const glm::vec2> position, Span<glm::vec2> out) {
+void gather_binned_state(const GridView& bins, const AgentArrays& a, const BinnedState& out) {
   const Span<const std::int32_t> items = bins.items;
+  const BinnedState b = out;
   parallel_for(
-      "sim.sense.gather", items.size(), THRONG_LAMBDA(Index k) { out[k] = position[items[k]]; }, kAgentGrain);
+      "sim.sense.gather", items.size(),
+      THRONG_LAMBDA(Index k) {
+        const Index i = items[k];
+        b.position[k] = a.position[i];
+        b.velocity[k] = a.velocity[i];
+        b.radius[k] = a.radius[i];
+        b.flags[k] = a.flags[i];
+      },
+      kAgentGrain);
+  count_traffic("sim.sense.gather", items, a.position, a.velocity, a.radius, a.flags, b.position, b.velocity, b.radius,
+                b.flags);
 }
 
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
   parallel_for("sim.sense.all_pairs", a.position.size(), SenseAllPairs{ctx, a, sensed}, 16);
+  count_traffic("sim.sense.all_pairs", a.position, a.velocity, a.radius, a.flags, a.goal, a.pref_speed,
+                a.waypoint_cursor, sensed);
 }
 
 void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> sensed,
                          Span<glm::vec2> out_position) {
   parallel_for("sim.steer", a.position.size(), Steer{ctx, a, sensed, out_position}, kAgentGrain);
+  count_traffic("sim.steer", sensed, a.position, a.velocity, a.flags, a.pref_speed, out_position);
 }
 
 void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells) {
   parallel_for("sim.move.cells", anchor.size(), FindMoveCells{ctx, anchor, cells}, kAgentGrain);
+  count_traffic("sim.move.cells", anchor, cells);
 }
 
 void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
@@ -547,11 +572,16 @@ void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<c
                             Span<float> depth, Span<const std::int32_t> moved_before) {
   parallel_for("sim.move.contacts", a.position.size(),
                ContactsDoubleBuffer{ctx, a, anchor, in, cells, out, depth, moved_before}, kAgentGrain);
+  count_traffic("sim.move.contacts", ctx.contact_bins.items, anchor, cells, in, out, depth, a.radius, a.flags,
+                moved_before);
 }
 
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a) {
   for (int c = 0; c < 4; ++c)
     parallel_for("sim.sense_steer.colour", ctx.bins.capacity(), SenseSteerColour{ctx, a, c}, kSlotGrain);
+  // (the four launches together pass over every slot and agent once)
+  count_traffic("sim.sense_steer.colour", ctx.bins.keys, ctx.bins.start, ctx.bins.count, ctx.bins.items, a.position,
+                a.position, a.velocity, a.velocity, a.radius, a.flags, a.goal, a.pref_speed, a.waypoint_cursor);
 }
 
 void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
@@ -559,9 +589,12 @@ void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<con
   for (int c = 0; c < 4; ++c)
     parallel_for("sim.move.contacts.colour", ctx.contact_bins.capacity(),
                  ContactsColour{ctx, a, anchor, cells, depth, c}, kSlotGrain);
+  count_traffic("sim.move.contacts.colour", ctx.contact_bins.keys, ctx.contact_bins.start, ctx.contact_bins.count,
+                ctx.contact_bins.items, anchor, cells, depth, a.position, a.position, a.radius, a.flags);
 }
 
 float deepest_contact(Span<const float> depth) {
+  count_traffic("sim.move.contacts.deepest", depth);
   return parallel_reduce(
       "sim.move.contacts.deepest", depth.size(), 0.0f, THRONG_LAMBDA(Index i)->float { return depth[i]; },
       THRONG_LAMBDA(float x, float y)->float { return x > y ? x : y; });
@@ -587,17 +620,22 @@ Index mark_moved_items(const GridView& contact_bins, Span<const glm::vec2> in, S
         flags[k] = bits_a[0] != bits_b[0] || bits_a[1] != bits_b[1] ? 1 : 0;
       },
       kAgentGrain);
+  count_traffic("sim.move.contacts.moved", items, in, out, flags);
+  count_traffic("sim.move.contacts.moved_scan", flags, flags);
   return exclusive_scan("sim.move.contacts.moved_scan", Span<const std::int32_t>(flags), flags);
 }
 
 void finalize_step(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
                    Span<const MoveCells> cells, Span<const glm::vec2> moved) {
   parallel_for("sim.move.finalize", a.position.size(), Finalize{ctx, a, anchor, cells, moved});
+  count_traffic("sim.move.finalize", anchor, cells, moved, a.position, a.velocity, a.heading, a.flags, a.flags,
+                a.radius, a.goal, a.path_start, a.waypoint_cursor);
 }
 
 void copy_positions(Span<const glm::vec2> from, Span<glm::vec2> to) {
   parallel_for(
       "sim.move.copy", from.size(), THRONG_LAMBDA(Index i) { to[i] = from[i]; });
+  count_traffic("sim.move.copy", from, to);
 }
 
 void entry_clearance(const GridView& bins, const Periodic& periodic, Span<const glm::vec2> position,
@@ -616,6 +654,7 @@ void entry_clearance(const GridView& bins, const Periodic& periodic, Span<const 
 }
 
 Index count_flag(Span<const std::uint8_t> flags, std::uint8_t bit) {
+  count_traffic("sim.count", flags);
   return parallel_reduce(
       "sim.count", flags.size(), Index{0}, THRONG_LAMBDA(Index i)->Index { return (flags[i] & bit) != 0 ? 1 : 0; },
       THRONG_LAMBDA(Index x, Index y)->Index { return x + y; });

@@ -166,6 +166,11 @@ TEST_F(RunCommand, WritesValidTrajectoriesAndStatsAndPrintsASummary) {
   for (const char* stage : {"sim.bin", "sim.sense", "sim.steer", "sim.move", "emit.trajectories", "sim.metrics"})
     EXPECT_TRUE(stats["timings"]["stages"].contains(stage)) << stage;
   EXPECT_GT(stats["timings"]["step_ms"].get<double>(), 0.0);
+  // The kernels' estimate of the memory a step moves: every agent's
+  // position is copied once a step (two arrays of 8 bytes), and more.
+  const auto agents = stats["crowd"]["agents"].get<double>();
+  EXPECT_GT(stats["timings"]["step_bytes"].get<double>(), 16.0 * agents);
+  EXPECT_GT(stats["timings"]["stages"]["sim.sense"]["bytes_per_step"].get<double>(), 0.0);
   EXPECT_EQ(stats["scenario"]["source"], "builtin:circle");
 }
 

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/vec2.hpp>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <vector>
 
 #include "core/parallel.h"
 
@@ -49,6 +51,41 @@ TEST(Timing, JsonAndTable) {
   EXPECT_EQ(j[0]["count"], 1);
   EXPECT_DOUBLE_EQ(j[0]["median_ms"].get<double>(), 2.5);
   EXPECT_NE(t.table().find("stage.bin"), std::string::npos);
+}
+
+// Bytes counted beside the launches: summed per description, by prefix,
+// reported in the JSON with a rate in the table, and forgotten on reset.
+TEST(Timing, CountsBytesByDescriptionAndPrefix) {
+  auto& t = KernelTimings::global();
+  t.reset();
+  const std::vector<float> four(4);
+  const std::vector<glm::vec2> three(3);
+  const Span<const float> f(four);
+  const Span<const glm::vec2> v(three);
+  EXPECT_EQ(bytes_of(f, v, v), 4 * 4 + 2 * 3 * 8);
+  EXPECT_EQ(bytes_of(), 0);
+  count_traffic("sim.a", f, v);  // 16 + 24
+  count_traffic("sim.a", f);     // + 16
+  t.count_bytes("sim.b.c", 100);
+  t.count_bytes("other", 7);
+  t.record("sim.a", 0.5);
+  EXPECT_EQ(t.bytes_under("sim.a"), 56);
+  EXPECT_EQ(t.bytes_under("sim."), 156);
+  EXPECT_EQ(t.bytes_under(""), 163);
+  EXPECT_EQ(t.bytes_under("nothing"), 0);
+  const auto j = nlohmann::json::parse(t.json());
+  bool found = false;
+  for (const auto& row : j)
+    if (row["name"] == "sim.a") {
+      found = true;
+      EXPECT_EQ(row["bytes"].get<std::int64_t>(), 56);
+      EXPECT_EQ(row["count"].get<std::int64_t>(), 1);  // bytes alone count no launch
+    }
+  EXPECT_TRUE(found);
+  EXPECT_NE(t.table().find("GB/s"), std::string::npos);
+  EXPECT_NE(t.table().find("0.00"), std::string::npos);  // 56 bytes in 0.5 ms
+  t.reset();
+  EXPECT_EQ(t.bytes_under(""), 0);
 }
 
 TEST(Timing, RingKeepsBoundedSamples) {

@@ -91,24 +91,55 @@ TEST(Sense, NeighbourSiftTakesTheImageAcrossTheSeam) {
   expect_same_as_plain_filter(c, periodic, 4.0f);
 }
 
-// The bins' candidates read from the copy in cell order are the crowd's
-// active agents of the 3 x 3 cells, in item order, at their positions.
-TEST(Sense, BinnedCandidatesFromTheCopyInCellOrderAreTheCrowdsOwn) {
-  const Crowd c(2000, 40.0f, 4);
+// The bins' candidates read from the copy in item order are the crowd's
+// active agents of the 3 x 3 cells, in item order, with their positions,
+// velocities, radii and flags: element j of the copy is agent id(j).
+TEST(Sense, BinnedCandidatesFromTheCopyInItemOrderAreTheCrowdsOwn) {
+  Crowd c(2000, 40.0f, 4);
+  for (std::size_t i = 0; i < c.position.size(); ++i) {
+    c.velocity[i] = glm::vec2(0.01f * static_cast<float>(i % 97), -0.02f * static_cast<float>(i % 13));
+    c.radius[i] = 0.15f + 0.001f * static_cast<float>(i % 50);
+  }
   AgentGrid bins(4.0f);
   bins.rebuild(Span<const glm::vec2>(c.position), Span<const std::uint8_t>(c.flags));
   const GridView g = bins.view();
-  std::vector<glm::vec2> copy(static_cast<std::size_t>(g.items.size()));
-  gather_binned_positions(g, Span<const glm::vec2>(c.position), Span<glm::vec2>(copy));
+  const std::size_t items = static_cast<std::size_t>(g.items.size());
+  std::vector<glm::vec2> position(items), velocity(items);
+  std::vector<float> radius(items);
+  std::vector<std::uint8_t> flags(items);
+  std::vector<glm::vec2> crowd_position = c.position, crowd_velocity = c.velocity;
+  std::vector<std::uint8_t> crowd_flags = c.flags;
+  AgentArrays a;
+  a.position = Span<glm::vec2>(crowd_position);
+  a.velocity = Span<glm::vec2>(crowd_velocity);
+  a.radius = Span<const float>(c.radius);
+  a.flags = Span<std::uint8_t>(crowd_flags);
+  const BinnedState copy{Span<glm::vec2>(position), Span<glm::vec2>(velocity), Span<float>(radius),
+                         Span<std::uint8_t>(flags)};
+  gather_binned_state(g, a, copy);
   const NeighbourArrays plain = c.arrays(Periodic{});
-  NeighbourArrays copied = plain;
-  copied.binned_position = Span<const glm::vec2>(copy);
+  const NeighbourArrays copied{Span<const glm::vec2>(position),
+                               Span<const glm::vec2>(velocity),
+                               Span<const float>(radius),
+                               Span<const std::uint8_t>(flags),
+                               Periodic{},
+                               g.items};
   for (std::size_t i = 0; i < c.position.size(); i += 11) {
     const glm::vec2 p = c.position[i];
     const Cells3x3 cells = cells_3x3(g, g.cell_x(p.x), g.cell_y(p.y));
     std::vector<Seen> from_copy, from_crowd, expected;
-    for_each_binned_candidate(g, cells, copied, [&](Index j, glm::vec2 at) { from_copy.push_back({j, at}); });
-    for_each_binned_candidate(g, cells, plain, [&](Index j, glm::vec2 at) { from_crowd.push_back({j, at}); });
+    for_each_binned_candidate(g, cells, copied, [&](Index j, glm::vec2 at) {
+      const Index agent = copied.id(j);
+      const auto k = static_cast<std::size_t>(agent);
+      from_copy.push_back({agent, at});
+      EXPECT_EQ(copied.velocity[j], c.velocity[k]);
+      EXPECT_EQ(copied.radius[j], c.radius[k]);
+      EXPECT_EQ(copied.flags[j], c.flags[k]);
+    });
+    for_each_binned_candidate(g, cells, plain, [&](Index j, glm::vec2 at) {
+      EXPECT_EQ(plain.id(j), j);
+      from_crowd.push_back({j, at});
+    });
     for_each_in_cells(g, cells, [&](std::int32_t j) {
       expected.push_back({j, c.position[static_cast<std::size_t>(j)]});
       EXPECT_NE(c.flags[static_cast<std::size_t>(j)] & kAgentActive, 0);

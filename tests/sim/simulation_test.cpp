@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "core/exec.h"
+#include "core/parallel.h"
+#include "core/timing.h"
 #include "sim/metrics.h"
 #include "tests/sim/test_scenarios.h"
 
@@ -437,6 +439,33 @@ TEST(ContactPasses, AgentsWhoseMoveCellsStayedStillAreNotLookedAtAgain) {
   const Buffer<std::int32_t> still(std::span<const std::int32_t>(none), mem);
   EXPECT_TRUE(test::same_bits(pass(anchor, still.span(), nullptr).to_vector(), p0));
   EXPECT_FALSE(test::same_bits(pass(anchor, {}, nullptr).to_vector(), p0));
+}
+
+// The step counts what its kernels move (count_traffic) under the names it
+// times them by, each launch anew: the pass that copies positions moves two
+// arrays of every agent's position, the move cells' pass the anchors and
+// the cells.
+TEST(Simulation, AStepCountsTheMemoryItsKernelsMove) {
+  ScenarioSpec spec = test::open_field(400, {0, 0}, {200, 200}, {5, 0});
+  Simulation sim(spec);
+  sim.step();
+  auto& t = KernelTimings::global();
+  t.reset();
+  sim.step();
+  const std::int64_t n = sim.agent_count();
+  ASSERT_EQ(sim.last_contact_passes(), 1);
+  const auto bytes = [&](const char* name) {
+    for (const KernelStat& k : t.stats())
+      if (k.name == name) return k.bytes;
+    return std::int64_t{-1};
+  };
+  EXPECT_EQ(bytes("sim.move.copy"), 2 * n * 8);
+  EXPECT_EQ(bytes("sim.move.cells"), n * 8 + n * static_cast<std::int64_t>(sizeof(MoveCells)));
+  const std::int64_t one = t.bytes_under("sim.");
+  EXPECT_GT(one, 100 * n);  // hundreds of bytes per agent-step
+  sim.step();
+  EXPECT_EQ(bytes("sim.move.copy"), 4 * n * 8);
+  EXPECT_GT(t.bytes_under("sim."), one + 100 * n);
 }
 
 // The bins against the O(N^2) reference under the priority model: the same
