@@ -167,7 +167,7 @@ void print_memory_moved(const nlohmann::json& timings, Index agents) {
   const double bytes = timings["step_bytes"].get<double>(), ms = timings["step_ms"].get<double>();
   if (bytes > 0 && agents > 0 && ms > 0)
     std::printf("  memory moved per step: %.0f bytes per agent (estimated from the arrays' sizes), %.2f GB/s\n",
-                bytes / static_cast<double>(agents), bytes / (ms * 1e6));
+                bytes / static_cast<double>(agents), gigabytes_per_second(bytes, ms));
 }
 
 void print_summary(const sim::Simulation& sim, const sim::RunResult& r, const nlohmann::json& stats,

@@ -80,10 +80,6 @@ std::vector<KernelStat> KernelTimings::stats() const {
   return out;
 }
 
-static double gigabytes_per_second(const KernelStat& r) {
-  return static_cast<double>(r.bytes) / (r.total_ms * 1e6);  // (bytes / 1e9) / (ms / 1e3)
-}
-
 std::string KernelTimings::table() const {
   const auto rows = stats();
   std::size_t width = 6;
@@ -92,7 +88,9 @@ std::string KernelTimings::table() const {
                               "total ms", "median ms", "min ms", "max ms", "GB/s");
   for (const auto& r : rows) {
     // GB/s: the counted bytes over the time (blank where none are counted).
-    const std::string rate = r.bytes > 0 && r.total_ms > 0 ? fmt::format("{:.2f}", gigabytes_per_second(r)) : "";
+    const std::string rate = r.bytes > 0 && r.total_ms > 0
+                                 ? fmt::format("{:.2f}", gigabytes_per_second(static_cast<double>(r.bytes), r.total_ms))
+                                 : "";
     s += fmt::format("{:<{}}  {:>9}  {:>12.3f}  {:>11.4f}  {:>11.4f}  {:>11.4f}  {:>8}\n", r.name, width, r.count,
                      r.total_ms, r.median_ms, r.min_ms, r.max_ms, rate);
   }

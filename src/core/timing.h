@@ -21,6 +21,9 @@ struct KernelStat {
   std::int64_t bytes = 0;
 };
 
+// The rate of `bytes` moved in `ms` milliseconds, in GB/s (10^9 bytes).
+inline double gigabytes_per_second(double bytes, double ms) { return bytes / (ms * 1e6); }
+
 class KernelTimings {
  public:
   // Samples kept per kernel for the median; count and total stay exact.

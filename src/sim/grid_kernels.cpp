@@ -133,10 +133,10 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
         count[s] = 0;
         cursor[s] = 0;
       });
-  parallel_for("sim.bin.count", n, CountCells{cells, positions, flags, keys, count, slot_of});
-  binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
   count_traffic("sim.bin.clear", keys, count, cursor);
+  parallel_for("sim.bin.count", n, CountCells{cells, positions, flags, keys, count, slot_of});
   count_traffic("sim.bin.count", positions, flags, keys, count, count, slot_of);
+  binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
   count_traffic("sim.bin.scan", count, start);
   // Scatter in arbitrary order, then sort each run by agent index (and
   // give a dense grid's occupied slots their keys, for the slot-by-slot

@@ -154,6 +154,10 @@ THRONG_HOST_DEVICE inline NeighbourArrays neighbours_of(const StepContext& ctx, 
   if (b.position.size() > 0) return {b.position, b.velocity, b.radius, b.flags, ctx.periodic, ctx.bins.items};
   return {a.position, a.velocity, a.radius, a.flags, ctx.periodic};
 }
+// Agent i's element of those arrays, k being its place in the bins' items.
+THRONG_HOST_DEVICE inline Index element_of(const StepContext& ctx, Index k, Index i) {
+  return ctx.binned.position.size() > 0 ? k : i;
+}
 
 THRONG_HOST_DEVICE inline bool is_steering(std::uint8_t flags) {
   return (flags & kAgentActive) != 0 && (flags & (kAgentStopped | kAgentWaiting)) == 0;
@@ -326,8 +330,7 @@ struct Sense {
   THRONG_HOST_DEVICE void operator()(Index k) const {
     const Index i = ctx.bins.items[k];
     const glm::vec2 p = a.position[i];
-    const Index self = ctx.binned.position.size() > 0 ? k : i;  // (neighbours_of)
-    sensed[i] = sense_binned(ctx, a, i, self, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
+    sensed[i] = sense_binned(ctx, a, i, element_of(ctx, k, i), ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
   }
 };
 
