@@ -7,7 +7,8 @@
 // the RVO2 driver of ../shared/peers (rvo_circle.cc, `disk`) times, for the
 // default model and the paper's: sim/disc_step/<model>, and
 // beside it at 10^5 and 10^6 the same step without the shortcuts that
-// change no bit (sim/disc_step/<model>/reference).
+// change no bit (sim/disc_step/<model>/reference), and the same disc with
+// its agents listed in a random order (sim/disc_step/<model>/shuffled).
 // Items are agent-steps, so items/s is agent-steps per second and the
 // median ns is the time of one step. The counter bytes_per_agent_step is
 // the step's kernels' estimate of the memory they move (core/parallel.h,
@@ -17,8 +18,11 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "bench/registry.h"
 #include "core/exec.h"
@@ -58,8 +62,10 @@ sim::Simulation& plaza(Index n, sim::ModelKind model, Variant variant) {
 // N agents on a disc at 16 m^2 each (radius sqrt(16 N / pi)), each walking
 // to its antipode, with RVO2's example body and step: radius 1.5 m,
 // preferred speed 1 m/s, dt 0.25 s, no obstacles, no route planning.
-std::string disc_scenario_text(Index n, sim::ModelKind model) {
+// `spawn`: the group's spawn region; empty for the disc itself.
+std::string disc_scenario_text(Index n, sim::ModelKind model, const std::string& spawn = "") {
   const double radius = std::sqrt(16.0 * static_cast<double>(n) / 3.14159265358979);
+  const std::string where = spawn.empty() ? fmt::format("{{disc: {{center: [0, 0], radius: {:.2f}}}}}", radius) : spawn;
   return fmt::format(R"(name: disc
 seed: 1
 dt: 0.25
@@ -70,20 +76,46 @@ groups:
   - count: {}
     radius: 1.5
     speed: 1.0
-    spawn: {{disc: {{center: [0, 0], radius: {:.2f}}}}}
+    spawn: {}
     goal: {{mirror: [0, 0]}}
     on_arrival: stop
 )",
-                     sim::to_string(model), n, radius);
+                     sim::to_string(model), n, where);
 }
 
-// `reference`: the step without its shortcuts (hashed bins, every contact
-// pass; sim::SimulationOptions): the same bits, at what they cost before
-// the shortcuts.
-std::unique_ptr<sim::Simulation> fresh_disc(Index n, sim::ModelKind model, bool reference) {
+// The disc's agents in a random order (spawn: points, the disc's own
+// spawn positions shuffled with a fixed seed): the same crowd, but agent
+// indices say nothing of where agents stand, as after long runs, timed
+// entries or many groups. What a step reads of an agent by its index is
+// then a miss; the sim/disc_step/<model>/shuffled rows time that.
+std::string shuffled_disc_text(Index n, sim::ModelKind model) {
+  std::vector<glm::vec2> p =
+      io::build_simulation(io::parse_scenario(disc_scenario_text(n, model), "disc"), {})->positions();
+  std::mt19937 rng(1);
+  for (std::size_t k = p.size(); k > 1; --k) std::swap(p[k - 1], p[rng() % k]);  // Fisher-Yates
+  std::string points = "{points: [";
+  for (std::size_t k = 0; k < p.size(); ++k) points += fmt::format("{}[{}, {}]", k > 0 ? ", " : "", p[k].x, p[k].y);
+  return disc_scenario_text(n, model, points + "]}");
+}
+
+// The disc as it is; the step without its shortcuts (Reference: hashed
+// bins, every contact pass; sim::SimulationOptions), the same bits at what
+// they cost before the shortcuts; its agents in a random order (Shuffled,
+// shuffled_disc_text).
+enum class DiscKind { Plain, Reference, Shuffled };
+std::unique_ptr<sim::Simulation> fresh_disc(Index n, sim::ModelKind model, DiscKind kind) {
+  static std::map<std::pair<Index, sim::ModelKind>, std::string> shuffled;  // (made once: 10^6 points take seconds)
   sim::SimulationOptions options;
-  options.dense_bins = options.skip_idle_contact_passes = !reference;
-  auto sim = io::build_simulation(io::parse_scenario(disc_scenario_text(n, model), "disc"), options);
+  options.dense_bins = options.skip_idle_contact_passes = kind != DiscKind::Reference;
+  std::string text;
+  if (kind == DiscKind::Shuffled) {
+    std::string& t = shuffled[{n, model}];
+    if (t.empty()) t = shuffled_disc_text(n, model);
+    text = t;
+  } else {
+    text = disc_scenario_text(n, model);
+  }
+  auto sim = io::build_simulation(io::parse_scenario(text, "disc"), options);
   sim->run(4);  // 1 s: past the first steps from rest
   return sim;
 }
@@ -96,10 +128,10 @@ std::unique_ptr<sim::Simulation> fresh_disc(Index n, sim::ModelKind model, bool 
 // after about 70 s), a large one only on its first steps: per-agent costs
 // of different sizes would compare different crowds.
 constexpr double kDiscTimedUntil = 10.0;  // s of simulated time
-sim::Simulation& disc(Index n, sim::ModelKind model, bool reference) {
-  static std::map<std::tuple<Index, sim::ModelKind, bool, Backend>, std::unique_ptr<sim::Simulation>> cache;
-  auto& slot = cache[{n, model, reference, current_backend()}];
-  if (!slot || slot->time() >= kDiscTimedUntil) slot = fresh_disc(n, model, reference);
+sim::Simulation& disc(Index n, sim::ModelKind model, DiscKind kind) {
+  static std::map<std::tuple<Index, sim::ModelKind, DiscKind, Backend>, std::unique_ptr<sim::Simulation>> cache;
+  auto& slot = cache[{n, model, kind, current_backend()}];
+  if (!slot || slot->time() >= kDiscTimedUntil) slot = fresh_disc(n, model, kind);
   return *slot;
 }
 
@@ -120,15 +152,15 @@ class TimedBytes {
   std::int64_t counted_ = 0, from_ = now();
 };
 
-Body disc_step(sim::ModelKind model, bool reference) {
-  return [model, reference](benchmark::State& state, Index n) {
-    sim::Simulation* sim = &disc(n, model, reference);
+Body disc_step(sim::ModelKind model, DiscKind kind) {
+  return [model, kind](benchmark::State& state, Index n) {
+    sim::Simulation* sim = &disc(n, model, kind);
     TimedBytes bytes;
     for (auto _ : state) {
       if (sim->time() >= kDiscTimedUntil) {
         state.PauseTiming();
         bytes.pause();
-        sim = &disc(n, model, reference);
+        sim = &disc(n, model, kind);
         bytes.resume();
         state.ResumeTiming();
       }
@@ -160,8 +192,9 @@ void register_sim(const Options& options) {
   }
   for (const sim::ModelKind model : {sim::ModelKind::CollisionFreeSpeed, sim::ModelKind::Priority}) {
     const std::string prefix = std::string("sim/disc_step/") + sim::to_string(model);
-    add(options, {prefix, sizes, disc_step(model, false), true});
-    add(options, {prefix + "/reference", {100000, 1000000}, disc_step(model, true), true});
+    add(options, {prefix, sizes, disc_step(model, DiscKind::Plain), true});
+    add(options, {prefix + "/reference", {100000, 1000000}, disc_step(model, DiscKind::Reference), true});
+    add(options, {prefix + "/shuffled", {10000, 100000, 1000000}, disc_step(model, DiscKind::Shuffled), true});
   }
 }
 

@@ -56,6 +56,10 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   binned_velocity_ = Buffer<glm::vec2>(crowd_.count, m);
   binned_radius_ = Buffer<float>(crowd_.count, m);
   binned_flags_ = Buffer<std::uint8_t>(crowd_.count, m);
+  if (spec_.model.kind != ModelKind::Priority) {
+    aim_ = Buffer<AgentAim>::zeros(crowd_.count, m);
+    binned_aim_ = Buffer<AgentAim>::zeros(crowd_.count, m);
+  }
 }
 
 StepContext Simulation::context() const {
@@ -246,8 +250,9 @@ void Simulation::sense_and_steer(const StepContext& ctx) {
     const Index items = ctx.bins.items.size();
     StepContext gathered = ctx;
     gathered.binned = {binned_position_.span().subspan(0, items), binned_velocity_.span().subspan(0, items),
-                       binned_radius_.span().subspan(0, items), binned_flags_.span().subspan(0, items)};
-    gather_binned_state(ctx.bins, a, gathered.binned);
+                       binned_radius_.span().subspan(0, items), binned_flags_.span().subspan(0, items),
+                       binned_aim_.span().subspan(0, binned_aim_.size() > 0 ? items : 0)};
+    gather_binned_state(ctx, a, aim_.span(), gathered.binned);
     sense_double_buffer(gathered, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else {

@@ -83,6 +83,17 @@ struct MoveCells {
   ObstacleCell obstacles;
 };
 
+// Where an agent heads this step under the models that sum over their
+// neighbours (collision-free speed, time to collision, social force): the
+// unit direction e0 its model aims it at (zero at its aim), how far its
+// waypoint or goal is (m) and its preferred speed (m/s). Found from the
+// agent's route (goal, waypoints, gates, navigation fields) by agent_aim.
+struct AgentAim {
+  glm::vec2 e0{0.0f};
+  float distance = 0.0f;
+  float pref_speed = 0.0f;
+};
+
 // The state of the steering bins' items gathered in item order (element k
 // is agent bins.items[k]) while positions stay as binned: the double
 // buffer's sense stage reads neighbours from it (NeighbourArrays), a few
@@ -92,6 +103,7 @@ struct BinnedState {
   Span<glm::vec2> velocity;
   Span<float> radius;
   Span<std::uint8_t> flags;
+  Span<AgentAim> aim;  // empty under the priority model (it does not use them)
 };
 
 struct StepContext {
@@ -113,8 +125,11 @@ struct StepContext {
 // Double buffer: what the model senses for every binned (active) agent (a
 // force, or the collision-free velocity), then candidate positions.
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
-// The positions of the grid's items in item order: out[k] = position[items[k]].
-void gather_binned_state(const GridView& bins, const AgentArrays& a, const BinnedState& out);
+// The steering bins' items' state in item order: out.position[k] =
+// a.position[ctx.bins.items[k]], and so on. out.aim, when not empty: each
+// agent's aim (AgentAim), found first in agent order into `aims` (the reads
+// of its route then run through the crowd's arrays in order), then copied.
+void gather_binned_state(const StepContext& ctx, const AgentArrays& a, Span<AgentAim> aims, const BinnedState& out);
 // The naive reference for the sense stage: every agent against every other,
 // O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
@@ -272,6 +287,7 @@ class Simulation {
   Buffer<glm::vec2> binned_position_, binned_velocity_;  // the steering bins' items' state (gather_binned_state)
   Buffer<float> binned_radius_;
   Buffer<std::uint8_t> binned_flags_;
+  Buffer<AgentAim> aim_, binned_aim_;  // each agent's aim, in agent order and in the bins' item order
   Buffer<std::int32_t> moved_before_;  // contact items moved by the last pass, counted (mark_moved_items)
   std::vector<PendingEntry> pending_;  // by entry time, then agent
   ExitChooser exits_;                  // groups choosing the quickest exit

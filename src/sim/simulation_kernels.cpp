@@ -180,6 +180,26 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_priority(const StepContext& ctx, const
   return avoidance_force(probe.forward, neighbours(p, v, probe.forward, r), m.max_force);
 }
 
+// Where agent i heads (AgentAim). The collision-free speed model: its
+// field's or gate's aim, else its goal, or a point of its leg past a plain
+// waypoint (waypoint_aim); the force models: the field's or gate's aim, else
+// the goal itself. The distance is to its waypoint or goal itself (a
+// field's aim, a gate's point, lie a step ahead wherever the agent is).
+THRONG_HOST_DEVICE inline AgentAim agent_aim(const StepContext& ctx, const AgentArrays& a, Index i) {
+  const glm::vec2 p = a.position[i];
+  glm::vec2 aim = a.goal[i];
+  if (!led_target(ctx, a, i, aim) && ctx.model.kind == ModelKind::CollisionFreeSpeed) {
+    const bool to_point = a.waypoint_cursor[i] == a.waypoint_goal[i] || waits_at_waypoint(a, i);
+    if (!to_point) aim = waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
+  }
+  return {normalize_or(aim - p, glm::vec2(0.0f)), length_of(a.goal[i] - p), a.pref_speed[i]};
+}
+// Agent i's aim as sense reads it: from the copy in item order where the
+// step gathered one (`self`: its element), else found here.
+THRONG_HOST_DEVICE inline AgentAim aim_of(const StepContext& ctx, const AgentArrays& a, Index i, Index self) {
+  return ctx.binned.aim.size() > 0 ? ctx.binned.aim[self] : agent_aim(ctx, a, i);
+}
+
 // Sense under the collision-free speed model: agent i's new velocity
 // (`self`: its element of the neighbour arrays, neighbours_of).
 // `for_each_candidate(fn)` visits the candidate neighbours.
@@ -187,25 +207,17 @@ template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx, const AgentArrays& a, Index i,
                                                          Index self, const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n = neighbours_of(ctx, a);
-  const glm::vec2 p = a.position[i];
-  glm::vec2 aim;
-  if (!led_target(ctx, a, i, aim)) {
-    const bool to_point = a.waypoint_cursor[i] == a.waypoint_goal[i] || waits_at_waypoint(a, i);
-    aim = to_point ? a.goal[i] : waypoint_aim(ctx.world, p, a.path_start[i], a.goal[i]);
-  }
-  // How near it is: to its waypoint or goal itself (a field's aim, a gate's
-  // point, lie a step ahead wherever the agent is).
-  const CfsAgent me{p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f)), length_of(a.goal[i] - p)};
-  return collision_free_velocity(ctx.world, self, me, a.pref_speed[i], ctx.dt, n, ctx.model, for_each_candidate);
+  const AgentAim aim = aim_of(ctx, a, i, self);
+  const CfsAgent me{n.position[self], n.velocity[self], n.radius[self], aim.e0, aim.distance};
+  return collision_free_velocity(ctx.world, self, me, aim.pref_speed, ctx.dt, n, ctx.model, for_each_candidate);
 }
 
 // Agent i as the force models see it: heading straight for its goal, or
 // where its navigation field leads.
-THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const AgentArrays& a, Index i) {
-  const glm::vec2 p = a.position[i];
-  glm::vec2 aim = a.goal[i];
-  led_target(ctx, a, i, aim);
-  return {p, a.velocity[i], a.radius[i], normalize_or(aim - p, glm::vec2(0.0f)), a.pref_speed[i]};
+THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const AgentArrays& a, Index i, Index self) {
+  const NeighbourArrays n = neighbours_of(ctx, a);
+  const AgentAim aim = aim_of(ctx, a, i, self);
+  return {n.position[self], n.velocity[self], n.radius[self], aim.e0, aim.pref_speed};
 }
 
 // Sense under the time-to-collision model: the agent's total acceleration.
@@ -213,7 +225,7 @@ template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
                                               const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n = neighbours_of(ctx, a);
-  return ttc_force(ctx.world, self, force_agent(ctx, a, i), n, ctx.model, for_each_candidate);
+  return ttc_force(ctx.world, self, force_agent(ctx, a, i, self), n, ctx.model, for_each_candidate);
 }
 
 // Sense under the social force model: the step's mean velocity.
@@ -221,7 +233,7 @@ template <class ForEachCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a, Index i,
                                                        Index self, const ForEachCandidate& for_each_candidate) {
   const NeighbourArrays n = neighbours_of(ctx, a);
-  return social_force_velocity(ctx.world, self, force_agent(ctx, a, i), ctx.dt, n, ctx.model, for_each_candidate);
+  return social_force_velocity(ctx.world, self, force_agent(ctx, a, i, self), ctx.dt, n, ctx.model, for_each_candidate);
 }
 
 // The sense of the models that sum over every candidate neighbour
@@ -242,8 +254,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, con
 // agent i's element of the neighbour arrays (neighbours_of).
 THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
                                                  std::int32_t cx, std::int32_t cy) {
-  if (!is_steering(a.flags[i])) return glm::vec2(0.0f);
   const NeighbourArrays n = neighbours_of(ctx, a);
+  if (!is_steering(n.flags[self])) return glm::vec2(0.0f);
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
     auto candidates = [&](const auto& fn) { for_each_binned_candidate(ctx.bins, cells, n, fn); };
@@ -328,9 +340,9 @@ struct Sense {
   AgentArrays a;
   Span<glm::vec2> sensed;
   THRONG_HOST_DEVICE void operator()(Index k) const {
-    const Index i = ctx.bins.items[k];
-    const glm::vec2 p = a.position[i];
-    sensed[i] = sense_binned(ctx, a, i, element_of(ctx, k, i), ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
+    const Index i = ctx.bins.items[k], self = element_of(ctx, k, i);
+    const glm::vec2 p = neighbours_of(ctx, a).position[self];
+    sensed[i] = sense_binned(ctx, a, i, self, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
   }
 };
 
@@ -532,13 +544,25 @@ constexpr Index kSlotGrain = 256;
 void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {
   parallel_for("sim.sense", ctx.bins.items.size(), Sense{ctx, a, sensed}, kAgentGrain);
   count_traffic("sim.sense", ctx.bins.items, ctx.bins.start, ctx.bins.count, ctx.binned.position, ctx.binned.velocity,
-                ctx.binned.radius, ctx.binned.flags, a.position, a.velocity, a.radius, a.flags, a.goal, a.pref_speed,
-                a.waypoint_cursor, sensed);
+                ctx.binned.radius, ctx.binned.flags, ctx.binned.aim, sensed);
+  // The priority model reads the agent's own state from the crowd's arrays.
+  if (ctx.binned.aim.size() == 0) count_traffic("sim.sense", a.position, a.velocity, a.radius, a.heading);
 }
 
-void gather_binned_state(const GridView& bins, const AgentArrays& a, const BinnedState& out) {
-  const Span<const std::int32_t> items = bins.items;
+void gather_binned_state(const StepContext& ctx, const AgentArrays& a, Span<AgentAim> aims, const BinnedState& out) {
+  const Span<const std::int32_t> items = ctx.bins.items;
   const BinnedState b = out;
+  const bool aimed = b.aim.size() > 0;
+  if (aimed) {
+    const StepContext c = ctx;
+    parallel_for(
+        "sim.sense.aims", a.position.size(),
+        THRONG_LAMBDA(Index i) {
+          if (is_steering(a.flags[i])) aims[i] = agent_aim(c, a, i);
+        },
+        kAgentGrain);
+    count_traffic("sim.sense.aims", a.flags, a.position, a.goal, a.pref_speed, a.waypoint_cursor, aims);
+  }
   parallel_for(
       "sim.sense.gather", items.size(),
       THRONG_LAMBDA(Index k) {
@@ -547,10 +571,12 @@ void gather_binned_state(const GridView& bins, const AgentArrays& a, const Binne
         b.velocity[k] = a.velocity[i];
         b.radius[k] = a.radius[i];
         b.flags[k] = a.flags[i];
+        if (aimed) b.aim[k] = aims[i];
       },
       kAgentGrain);
   count_traffic("sim.sense.gather", items, a.position, a.velocity, a.radius, a.flags, b.position, b.velocity, b.radius,
                 b.flags);
+  if (aimed) count_traffic("sim.sense.gather", aims, b.aim);
 }
 
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {

@@ -116,7 +116,9 @@ TEST(Sense, BinnedCandidatesFromTheCopyInItemOrderAreTheCrowdsOwn) {
   a.flags = Span<std::uint8_t>(crowd_flags);
   const BinnedState copy{Span<glm::vec2>(position), Span<glm::vec2>(velocity), Span<float>(radius),
                          Span<std::uint8_t>(flags)};
-  gather_binned_state(g, a, copy);
+  StepContext ctx;
+  ctx.bins = g;
+  gather_binned_state(ctx, a, {}, copy);  // (no aims: the copy's aim is empty)
   const NeighbourArrays plain = c.arrays(Periodic{});
   const NeighbourArrays copied{Span<const glm::vec2>(position),
                                Span<const glm::vec2>(velocity),
