@@ -115,7 +115,7 @@ TEST(Sense, BinnedCandidatesFromTheCopyInItemOrderAreTheCrowdsOwn) {
   a.radius = Span<const float>(c.radius);
   a.flags = Span<std::uint8_t>(crowd_flags);
   const BinnedState copy{Span<glm::vec2>(position), Span<glm::vec2>(velocity), Span<float>(radius),
-                         Span<std::uint8_t>(flags)};
+                         Span<std::uint8_t>(flags), Span<AgentAim>()};
   StepContext ctx;
   ctx.bins = g;
   gather_binned_state(ctx, a, {}, copy);  // (no aims: the copy's aim is empty)
