@@ -28,7 +28,9 @@
 #include "core/exec.h"
 #include "core/timing.h"
 #include "io/scenario_yaml.h"
+#include "sim/crowd.h"
 #include "sim/simulation.h"
+#include "sim/world.h"
 
 namespace throng::bench {
 
@@ -89,8 +91,8 @@ groups:
 // entries or many groups. What a step reads of an agent by its index is
 // then a miss; the sim/disc_step/<model>/shuffled rows time that.
 std::string shuffled_disc_text(Index n, sim::ModelKind model) {
-  std::vector<glm::vec2> p =
-      io::build_simulation(io::parse_scenario(disc_scenario_text(n, model), "disc"), {})->positions();
+  const sim::ScenarioSpec spec = io::parse_scenario(disc_scenario_text(n, model), "disc").spec;
+  std::vector<glm::vec2> p = sim::spawn_crowd(spec, sim::World::build(spec.world, spec.model.query_radius())).position;
   std::mt19937 rng(1);
   for (std::size_t k = p.size(); k > 1; --k) std::swap(p[k - 1], p[rng() % k]);  // Fisher-Yates
   std::string points = "{points: [";

@@ -204,46 +204,48 @@ THRONG_HOST_DEVICE inline AgentAim aim_of(const StepContext& ctx, const AgentArr
 // (`self`: its element of the neighbour arrays, neighbours_of).
 // `for_each_candidate(fn)` visits the candidate neighbours.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx, const AgentArrays& a, Index i,
-                                                         Index self, const ForEachCandidate& for_each_candidate) {
-  const NeighbourArrays n = neighbours_of(ctx, a);
+THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx, const AgentArrays& a,
+                                                         const NeighbourArrays& n, Index i, Index self,
+                                                         const ForEachCandidate& for_each_candidate) {
   const AgentAim aim = aim_of(ctx, a, i, self);
   const CfsAgent me{n.position[self], n.velocity[self], n.radius[self], aim.e0, aim.distance};
   return collision_free_velocity(ctx.world, self, me, aim.pref_speed, ctx.dt, n, ctx.model, for_each_candidate);
 }
 
 // Agent i as the force models see it: heading straight for its goal, or
-// where its navigation field leads.
-THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const AgentArrays& a, Index i, Index self) {
-  const NeighbourArrays n = neighbours_of(ctx, a);
+// where its navigation field leads (`n`: neighbours_of).
+THRONG_HOST_DEVICE inline ForceAgent force_agent(const StepContext& ctx, const AgentArrays& a, const NeighbourArrays& n,
+                                                 Index i, Index self) {
   const AgentAim aim = aim_of(ctx, a, i, self);
   return {n.position[self], n.velocity[self], n.radius[self], aim.e0, aim.pref_speed};
 }
 
 // Sense under the time-to-collision model: the agent's total acceleration.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
-                                              const ForEachCandidate& for_each_candidate) {
-  const NeighbourArrays n = neighbours_of(ctx, a);
-  return ttc_force(ctx.world, self, force_agent(ctx, a, i, self), n, ctx.model, for_each_candidate);
+THRONG_HOST_DEVICE inline glm::vec2 sense_ttc(const StepContext& ctx, const AgentArrays& a, const NeighbourArrays& n,
+                                              Index i, Index self, const ForEachCandidate& for_each_candidate) {
+  return ttc_force(ctx.world, self, force_agent(ctx, a, n, i, self), n, ctx.model, for_each_candidate);
 }
 
 // Sense under the social force model: the step's mean velocity.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a, Index i,
-                                                       Index self, const ForEachCandidate& for_each_candidate) {
-  const NeighbourArrays n = neighbours_of(ctx, a);
-  return social_force_velocity(ctx.world, self, force_agent(ctx, a, i, self), ctx.dt, n, ctx.model, for_each_candidate);
+THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, const AgentArrays& a,
+                                                       const NeighbourArrays& n, Index i, Index self,
+                                                       const ForEachCandidate& for_each_candidate) {
+  return social_force_velocity(ctx.world, self, force_agent(ctx, a, n, i, self), ctx.dt, n, ctx.model,
+                               for_each_candidate);
 }
 
 // The sense of the models that sum over every candidate neighbour
-// (collision-free speed, time to collision, social force).
+// (collision-free speed, time to collision, social force); `n`:
+// neighbours_of, `self` agent i's element of it.
 template <class ForEachCandidate>
-THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
+THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, const AgentArrays& a,
+                                                     const NeighbourArrays& n, Index i, Index self,
                                                      const ForEachCandidate& for_each_candidate) {
-  if (ctx.model.kind == ModelKind::Ttc) return sense_ttc(ctx, a, i, self, for_each_candidate);
-  if (ctx.model.kind == ModelKind::SocialForce) return sense_social_force(ctx, a, i, self, for_each_candidate);
-  return sense_collision_free(ctx, a, i, self, for_each_candidate);
+  if (ctx.model.kind == ModelKind::Ttc) return sense_ttc(ctx, a, n, i, self, for_each_candidate);
+  if (ctx.model.kind == ModelKind::SocialForce) return sense_social_force(ctx, a, n, i, self, for_each_candidate);
+  return sense_collision_free(ctx, a, n, i, self, for_each_candidate);
 }
 
 // Sense: what the model makes of the agent's surroundings, zero for agents
@@ -251,15 +253,14 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, con
 // sensed); collision-free speed: the new velocity; time to collision: the
 // total acceleration; social force: the step's mean velocity. Neighbours
 // come from the 3x3 bins around (cx, cy), the agent's cell; `self` is
-// agent i's element of the neighbour arrays (neighbours_of).
-THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, Index i, Index self,
-                                                 std::int32_t cx, std::int32_t cy) {
-  const NeighbourArrays n = neighbours_of(ctx, a);
+// agent i's element of the neighbour arrays `n` (neighbours_of).
+THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const AgentArrays& a, const NeighbourArrays& n,
+                                                 Index i, Index self, std::int32_t cx, std::int32_t cy) {
   if (!is_steering(n.flags[self])) return glm::vec2(0.0f);
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
     auto candidates = [&](const auto& fn) { for_each_binned_candidate(ctx.bins, cells, n, fn); };
-    return sense_candidates(ctx, a, i, self, candidates);
+    return sense_candidates(ctx, a, n, i, self, candidates);
   }
   return sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
     return sense_neighbours(ctx.bins, cx, cy, self, p, v, forward, r, n, ctx.model, ctx.bin_slack);
@@ -341,8 +342,9 @@ struct Sense {
   Span<glm::vec2> sensed;
   THRONG_HOST_DEVICE void operator()(Index k) const {
     const Index i = ctx.bins.items[k], self = element_of(ctx, k, i);
-    const glm::vec2 p = neighbours_of(ctx, a).position[self];
-    sensed[i] = sense_binned(ctx, a, i, self, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
+    const NeighbourArrays n = neighbours_of(ctx, a);
+    const glm::vec2 p = n.position[self];
+    sensed[i] = sense_binned(ctx, a, n, i, self, ctx.bins.cell_x(p.x), ctx.bins.cell_y(p.y));
   }
 };
 
@@ -360,7 +362,7 @@ struct SenseAllPairs {
     const NeighbourArrays n = neighbours_of(ctx, a);
     if (ctx.model.kind != ModelKind::Priority) {
       auto candidates = [&](const auto& fn) { for_each_active_candidate(n, fn); };
-      sensed[i] = sense_candidates(ctx, a, i, i, candidates);
+      sensed[i] = sense_candidates(ctx, a, n, i, i, candidates);
       return;
     }
     const ModelParams m = ctx.model;
@@ -431,11 +433,12 @@ struct SenseSteerColour {
     const std::uint64_t key = ctx.bins.keys[s];
     if (key == kEmptyCell || cell_colour(key) != colour) return;
     const std::int32_t cx = key_cx(key), cy = key_cy(key);
-    const std::int32_t b = ctx.bins.start[s], n = ctx.bins.count[s];
-    for (std::int32_t k = 0; k < n; ++k) {
+    const std::int32_t b = ctx.bins.start[s], count = ctx.bins.count[s];
+    const NeighbourArrays n = neighbours_of(ctx, a);
+    for (std::int32_t k = 0; k < count; ++k) {
       const Index i = ctx.bins.items[b + k];
       glm::vec2 np, nv;
-      steer_agent(ctx, a, i, sense_binned(ctx, a, i, i, cx, cy), np, nv);
+      steer_agent(ctx, a, i, sense_binned(ctx, a, n, i, i, cx, cy), np, nv);
       a.position[i] = np;
       a.velocity[i] = nv;
     }
@@ -546,7 +549,7 @@ void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm:
   count_traffic("sim.sense", ctx.bins.items, ctx.bins.start, ctx.bins.count, ctx.binned.position, ctx.binned.velocity,
                 ctx.binned.radius, ctx.binned.flags, ctx.binned.aim, sensed);
   // The priority model reads the agent's own state from the crowd's arrays.
-  if (ctx.binned.aim.size() == 0) count_traffic("sim.sense", a.position, a.velocity, a.radius, a.heading);
+  if (ctx.model.kind == ModelKind::Priority) count_traffic("sim.sense", a.position, a.velocity, a.radius, a.heading);
 }
 
 void gather_binned_state(const StepContext& ctx, const AgentArrays& a, Span<AgentAim> aims, const BinnedState& out) {
