@@ -52,8 +52,14 @@ Backend resolve_backend(BackendChoice choice) {
 }
 
 int hardware_threads() {
-  const unsigned n = std::thread::hardware_concurrency();
-  return n == 0 ? 1 : static_cast<int>(n);
+  // Asked once: glibc's hardware_concurrency() opens and reads
+  // /sys/devices/system/cpu/online on every call, and current_threads()
+  // asks at every launch (a 20-agent step spent most of its time there).
+  static const int threads = [] {
+    const unsigned n = std::thread::hardware_concurrency();
+    return n == 0 ? 1 : static_cast<int>(n);
+  }();
+  return threads;
 }
 
 void configure_execution(Backend backend, int threads) {

@@ -57,10 +57,11 @@ inline double route_length(const Walker& w) {
 // Runs to arrival under `model`; every agent must arrive within `slowest` x
 // its unhindered time (its route at 1.3 m/s, less the arrival radius; 1.5
 // is the aim) and no pair may overlap by more than `deepest_allowed` (1 cm
-// is the aim) at any step.
-inline void expect_encounter_resolves(ModelKind model, const std::string& what, const std::vector<Walker>& walkers,
-                                      const WorldSpec& world = {}, double slowest = 1.5,
-                                      float deepest_allowed = 0.01f) {
+// is the aim) at any step. Returns the slowest arrival over the unhindered
+// time (+inf when someone never arrived).
+inline double expect_encounter_resolves(ModelKind model, const std::string& what, const std::vector<Walker>& walkers,
+                                        const WorldSpec& world = {}, double slowest = 1.5,
+                                        float deepest_allowed = 0.01f) {
   SCOPED_TRACE(what);
   Simulation sim(encounter(walkers, world, model));
   float deepest = 0.0f;
@@ -70,7 +71,10 @@ inline void expect_encounter_resolves(ModelKind model, const std::string& what, 
     deepest =
         std::max(deepest, measure_overlaps(c.position.span(), c.radius.span(), c.flags.span(), 0.0f, 1.0f).max_depth);
   }
-  ASSERT_TRUE(sim.all_arrived()) << "after " << sim.time() << " s";
+  if (!sim.all_arrived()) {
+    ADD_FAILURE() << "not everyone arrived after " << sim.time() << " s";
+    return INFINITY;
+  }
   const std::vector<float> times = sim.arrival_times();
   double worst = 0;
   for (std::size_t i = 0; i < walkers.size(); ++i)
@@ -79,6 +83,7 @@ inline void expect_encounter_resolves(ModelKind model, const std::string& what, 
               what.c_str(), worst, deepest);
   EXPECT_LE(worst, slowest);
   EXPECT_LE(deepest, deepest_allowed);
+  return worst;
 }
 
 // Two walkers head-on on one line, 10 m apart.
@@ -109,15 +114,29 @@ inline std::vector<Walker> circle_of_twenty(float turn = 0.0f) {
 inline WorldSpec l_corridor();
 inline std::vector<Walker> blind_corner_pair();
 
-// The circle of twenty under `model` at four turns of the ring (0-5.4
-// degrees; it repeats every 18), each held to `slowest` and `deepest`.
-inline void expect_circle_resolves(ModelKind model, double slowest, float deepest = 0.01f) {
-  for (int k = 0; k < 4; ++k) {
-    const float degrees = 1.8f * static_cast<float>(k);
+// The circle of twenty under `model` laid out at `turns` turns of the ring
+// `step` degrees apart (it repeats every 18 degrees), each held to `slowest`
+// and `deepest`. Returns the slowest arrival of each layout (over the
+// unhindered time), in turn order.
+inline std::vector<double> expect_circle_resolves(ModelKind model, double slowest, float deepest = 0.01f, int turns = 4,
+                                                  float step = 1.8f) {
+  std::vector<double> worst;
+  for (int k = 0; k < turns; ++k) {
+    const float degrees = step * static_cast<float>(k);
     char what[48];
-    std::snprintf(what, sizeof what, "circle of 20 turned %.1f degrees", static_cast<double>(degrees));
-    expect_encounter_resolves(model, what, circle_of_twenty(degrees * kPiF / 180.0f), {}, slowest, deepest);
+    std::snprintf(what, sizeof what, "circle of 20 turned %.2f degrees", static_cast<double>(degrees));
+    worst.push_back(
+        expect_encounter_resolves(model, what, circle_of_twenty(degrees * kPiF / 180.0f), {}, slowest, deepest));
   }
+  return worst;
+}
+
+// The circle of twenty at `turns` layouts spread evenly over the ring's
+// whole period (18 degrees / turns apart): whether a model's outcome hangs
+// on rounding shows in the spread of these.
+inline std::vector<double> expect_circle_resolves_round_the_ring(ModelKind model, int turns, double slowest,
+                                                                 float deepest = 0.01f) {
+  return expect_circle_resolves(model, slowest, deepest, turns, 18.0f / static_cast<float>(turns));
 }
 
 // The five standard encounters under `model`: head-on, crossing, four ways

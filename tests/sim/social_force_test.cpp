@@ -175,5 +175,11 @@ TEST(SocialForce, EncountersResolve) {
   encounters::expect_standard_encounters_resolve(ModelKind::SocialForce, 1.5);
 }
 
+// The circle's outcome hangs on rounding (encounters.h): laid out at 20
+// turns over the ring's whole period every layout holds the 1.5x aim.
+TEST(SocialForce, CircleOfTwentyResolvesRoundTheRing) {
+  encounters::expect_circle_resolves_round_the_ring(ModelKind::SocialForce, 20, 1.5);
+}
+
 }  // namespace
 }  // namespace throng::sim
