@@ -154,7 +154,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     for (int k = 0; k < held; ++k) fn(static_cast<Index>(holders[k]));
   };
   const glm::vec2 e =
-      cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), dt, c.turn_time);
+      cfs_turn(normalize_or(me.v, glm::vec2(0.0f)), normalize_or(sum, glm::vec2(0.0f)), e0, dt, c.turn_time);
   if (length2(e) == 0.0f) return e;  // forces in balance: stand this step
   const bool slid = e0.x != me.e0.x || e0.y != me.e0.y;
   const float top =
