@@ -113,7 +113,7 @@ TEST(CollisionFreeSpeed, WallsSlideTheGoalDirectionAndTurnsTakeTime) {
   // Walking away from the goal, wanted straight back to it: the blend's
   // turn at 150 degrees, atan2(a / 2, 1 - a - a cos 30) = 23.79 degrees at
   // a = 1/3, to the right.
-  const float turn = 23.79f * 3.14159265f / 180.0f;
+  const float turn = 23.79f * kPiF / 180.0f;
   const glm::vec2 back = cfs_turn({1.0f, 0.0f}, {-1.0f, 0.0f}, {-1.0f, 0.0f}, 0.1f, 0.3f);
   EXPECT_NEAR(back.x, std::cos(turn), 1e-4f);
   EXPECT_NEAR(back.y, -std::sin(turn), 1e-4f);
@@ -126,10 +126,10 @@ TEST(CollisionFreeSpeed, WallsSlideTheGoalDirectionAndTurnsTakeTime) {
   // Either side of 150 degrees (the blend below, the fixed turn above) the
   // step turns within half a degree of the same angle.
   auto turned = [](float degrees) {
-    const float w = degrees * 3.14159265f / 180.0f;
+    const float w = degrees * kPiF / 180.0f;
     const glm::vec2 wanted(std::cos(w), std::sin(w));
     const glm::vec2 walked = cfs_turn({1.0f, 0.0f}, wanted, wanted, 0.1f, 0.3f);
-    return std::atan2(walked.y, walked.x) * 180.0f / 3.14159265f;
+    return std::atan2(walked.y, walked.x) * 180.0f / kPiF;
   };
   EXPECT_NEAR(turned(149.9f), turned(150.1f), 0.5f);
   EXPECT_GT(turned(179.0f), 23.0f);  // the blend alone: 1 degree
