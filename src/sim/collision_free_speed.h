@@ -72,26 +72,24 @@ struct CfsAgent {
   float aim_distance = INFINITY;
 };
 
-// R_ij + A_ij of neighbour j at q with velocity w and radius rj; `parked`:
-// j stands at its goal for good.
-THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj,
-                                                              bool parked, const CollisionFreeSpeedParams& m) {
-  const glm::vec2 d = q - i.p;
-  const float dist = length_of(d);
-  if (dist <= 1e-6f) return glm::vec2(0.0f);  // coincident: the contact passes separate them
-  const float l = i.radius + rj;
-  const glm::vec2 u = d * (1.0f / dist);
-  glm::vec2 f = u * (-m.neighbour_strength * expf((l - dist) / m.neighbour_range));
-  // Anticipation: only neighbours ahead, closing in, soon, near our line,
-  // and walking towards us against or across our way (or parked for good).
-  // A slower walker ahead in the same direction is followed at the time
-  // gap, not dodged: dodging every slower neighbour spreads a queue
-  // sideways and chokes a door.
+// A_ij of neighbour j at offset d = q - p (dist = |d| > 0, u = d / dist,
+// velocity w, l = r_i + r_j; `parked`: j stands at its goal for good),
+// added to f when it applies. Only neighbours ahead along both the goal
+// direction and the walked one (one the agent walks away from will not be
+// met: anticipated, a walker beside it walking its way pushed it away from
+// its goal for seconds), closing in, soon, near the agent's line, and
+// walking towards it against or across its way (or parked for good). A
+// slower walker ahead in the same direction is followed at the time gap,
+// not dodged: dodging every slower neighbour spreads a queue sideways and
+// chokes a door.
+THRONG_HOST_DEVICE THRONG_INLINE void cfs_add_anticipation(const CfsAgent& i, glm::vec2 d, float dist, glm::vec2 u,
+                                                           glm::vec2 w, float l, bool parked,
+                                                           const CollisionFreeSpeedParams& m, glm::vec2& f) {
   const float ahead = dot2(d, i.e0);
   const float closing = -dot2(w - i.v, u);
   const bool towards = parked | (-dot2(w, u) > kCfsOncoming);
-  // One branch on the four cheap tests (evaluated without short cuts).
-  if ((m.avoid_strength > 0.0f) & towards & (ahead > 0.0f) & (closing > 1e-3f)) {
+  // One branch on the five cheap tests (evaluated without short cuts).
+  if ((m.avoid_strength > 0.0f) & towards & (ahead > 0.0f) & (dot2(d, i.v) >= 0.0f) & (closing > 1e-3f)) {
     // Past the cheap tests (most neighbours stop there): j's speed and heading.
     const float speed = length_of(w), along = dot2(w, i.e0);
     const bool against = parked || along < kCfsAgainst * speed;
@@ -106,7 +104,54 @@ THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 cfs_neighbour_push(const CfsAgent& i,
       f += (lateral > 0.01f ? -left : (lateral < -0.01f ? left : -left)) * strength;
     }
   }
+}
+
+// R_ij + A_ij of neighbour j at q with velocity w and radius rj; `parked`:
+// j stands at its goal for good.
+THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 cfs_neighbour_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj,
+                                                              bool parked, const CollisionFreeSpeedParams& m) {
+  const glm::vec2 d = q - i.p;
+  const float dist = length_of(d);
+  if (dist <= 1e-6f) return glm::vec2(0.0f);  // coincident: the contact passes separate them
+  const float l = i.radius + rj;
+  const glm::vec2 u = d * (1.0f / dist);
+  glm::vec2 f = u * (-m.neighbour_strength * expf((l - dist) / m.neighbour_range));
+  cfs_add_anticipation(i, d, dist, u, w, l, parked, m, f);
   return f;
+}
+
+// The far look (this engine's addition). The bins' query radius reaches
+// 0.5 avoid_time max_speed past contact, so two walkers closing at twice
+// the walking speed first see each other about a second before avoid_time
+// would have them dodge; in the circle of twenty the walkers from across
+// the ring came into sight only 2 m from its middle, where ring neighbours
+// already stood shoulder to shoulder, and the crowd jammed there. An agent
+// walking at least kCfsFarSpeed of its preferred speed with at most
+// kCfsFarCrowd neighbours within the query radius (people walking freely
+// look further ahead; in a crowd those next to them fill their view) also
+// anticipates neighbours out to cfs_far_reach: A_ij alone, from
+// cfs_far_push. In crowds it changes nothing (the laboratory doors, the
+// dense counterflow) and costs nothing.
+inline constexpr float kCfsFarSpeed = 0.5f;
+inline constexpr int kCfsFarCrowd = 12;
+// m: 2 max_radius + avoid_time max_speed, at most twice the query radius
+// (so the 5 x 5 cells round an agent's hold it).
+THRONG_HOST_DEVICE inline float cfs_far_reach(const ModelParams& m) {
+  return 2.0f * m.max_radius() + m.cfs.avoid_time * m.max_speed;
+}
+THRONG_HOST_DEVICE inline bool cfs_looks_far(const CfsAgent& i, float v0, int nearby,
+                                             const CollisionFreeSpeedParams& m) {
+  return m.avoid_strength > 0.0f && nearby <= kCfsFarCrowd && length2(i.v) >= (kCfsFarSpeed * v0) * (kCfsFarSpeed * v0);
+}
+// A_ij of a neighbour beyond the query radius; true when it applies (f
+// then holds it).
+THRONG_HOST_DEVICE inline bool cfs_far_push(const CfsAgent& i, glm::vec2 q, glm::vec2 w, float rj, bool parked,
+                                            const CollisionFreeSpeedParams& m, glm::vec2& f) {
+  const glm::vec2 d = q - i.p;
+  const float dist = length_of(d);
+  f = glm::vec2(0.0f);
+  cfs_add_anticipation(i, d, dist, d * (1.0f / dist), w, i.radius + rj, parked, m, f);
+  return f.x != 0.0f || f.y != 0.0f;
 }
 
 // W_iw of a wall point q (the nearest point of a segment or circle).

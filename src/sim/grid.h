@@ -152,13 +152,17 @@ struct GridView {
 // keeping when the same neighbourhood is visited several times in a step
 // (the contact passes): the table lookups and their cache misses are paid
 // once.
-struct Cells3x3 {
-  std::int32_t start[9];
-  std::int32_t count[9];
+template <int kCells>
+struct CellRuns {
+  std::int32_t start[kCells];
+  std::int32_t count[kCells];
   std::int32_t runs = 0;
 };
+using Cells3x3 = CellRuns<9>;
+using Cells5x5 = CellRuns<25>;  // (kept_cells below)
 // Appends the run of n items from b, joined to the last run when it follows it.
-THRONG_HOST_DEVICE inline void add_run(Cells3x3& c, std::int32_t b, std::int32_t n) {
+template <int kCells>
+THRONG_HOST_DEVICE inline void add_run(CellRuns<kCells>& c, std::int32_t b, std::int32_t n) {
   if (c.runs > 0 && c.start[c.runs - 1] + c.count[c.runs - 1] == b) {
     c.count[c.runs - 1] += n;
   } else {
@@ -212,9 +216,42 @@ THRONG_HOST_DEVICE inline bool within_reach(const CellBounds& c, glm::vec2 p, fl
   const float ny = p.y < c.lo.y ? c.lo.y : (p.y > c.hi.y ? c.hi.y : p.y);
   return !((nx - p.x) * (nx - p.x) + (ny - p.y) * (ny - p.y) >= reach2);
 }
+// The item runs of the cells up to `ring` cells from (cx, cy) (2: the
+// 5 x 5) that keep(cell bounds) accepts, row-major as cells_3x3; keep must
+// accept a contiguous stretch of each row (a test of distance or of a
+// half-plane, or both). Along a wrapping axis of fewer than 2 ring + 2
+// cells the cells stay within one of (cx, cy), so that none is visited
+// twice. `slack` widens the bounds (cell_bounds).
+template <class Keep>
+THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, std::int32_t ring,
+                                              float slack, const Keep& keep) {
+  Cells5x5 c;
+  if (g.items.size() == 0) return c;
+  const std::int32_t rx = g.wrap_x > 0 && g.wrap_x < 2 * ring + 2 ? 1 : ring;
+  const std::int32_t ry = g.wrap_y > 0 && g.wrap_y < 2 * ring + 2 ? 1 : ring;
+  const bool dense_row = g.dense_nx > 0 && g.wrap_x == 0 && g.wrap_y == 0;
+  for (std::int32_t y = cy - ry; y <= cy + ry; ++y) {
+    std::int32_t lo = cx - rx, hi = cx + rx;
+    while (lo <= hi && !keep(cell_bounds(g, lo, y, slack))) ++lo;
+    while (hi >= lo && !keep(cell_bounds(g, hi, y, slack))) --hi;
+    if (lo > hi) continue;
+    if (!dense_row) {
+      for (std::int32_t x = lo; x <= hi; ++x)
+        if (const Index s = g.find(x, y); s >= 0) add_run(c, g.start[s], g.count[s]);
+      continue;
+    }
+    const Index a = g.dense_slot(lo > g.dense_x0 ? lo : g.dense_x0, y);
+    const Index b = g.dense_slot(hi < g.dense_x0 + g.dense_nx - 1 ? hi : g.dense_x0 + g.dense_nx - 1, y);
+    if (a < 0 || b < 0 || a > b) continue;
+    const std::int32_t first = g.start[a], n = g.start[b] + g.count[b] - first;
+    if (n > 0) add_run(c, first, n);
+  }
+  return c;
+}
+
 // Calls fn(item) for every item of those cells, in order.
-template <class Fn>
-THRONG_HOST_DEVICE inline void for_each_in_cells(const GridView& g, const Cells3x3& c, Fn&& fn) {
+template <int kCells, class Fn>
+THRONG_HOST_DEVICE inline void for_each_in_cells(const GridView& g, const CellRuns<kCells>& c, Fn&& fn) {
   for (int k = 0; k < c.runs; ++k)
     for (std::int32_t m = 0; m < c.count[k]; ++m) fn(g.items[c.start[k] + m]);
 }

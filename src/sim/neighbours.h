@@ -46,8 +46,8 @@ THRONG_HOST_DEVICE inline void for_each_binned_candidate(const GridView& bins, s
     fn(j, n.position[j]);
   }
 }
-template <class Fn>
-THRONG_HOST_DEVICE inline void for_each_binned_candidate(const GridView& bins, const Cells3x3& cells,
+template <int kCells, class Fn>
+THRONG_HOST_DEVICE inline void for_each_binned_candidate(const GridView& bins, const CellRuns<kCells>& cells,
                                                          const NeighbourArrays& n, const Fn& fn) {
   for (int r = 0; r < cells.runs; ++r) for_each_binned_candidate(bins, cells.start[r], cells.count[r], n, fn);
 }

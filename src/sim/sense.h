@@ -103,18 +103,40 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 
 // ---- collision-free speed -------------------------------------------------------
 
+// The far look of the collision-free speed model (cfs_looks_far): A_ij of
+// every neighbour beyond the query radius and within cfs_far_reach added to
+// `sum`, in the order for_each_far_candidate(e0, reach2, fn) visits them
+// (given the agent's goal direction and the reach squared, to leave out
+// cells wholly behind or beyond), fn(at, velocity, radius, flags) taking
+// each neighbour's state as stored (the agent itself lies within the query
+// radius: skipped).
+template <class ForEachFarCandidate>
+THRONG_HOST_DEVICE inline void add_far_anticipation(const CfsAgent& me, const Periodic& periodic, const ModelParams& m,
+                                                    const ForEachFarCandidate& for_each_far_candidate, glm::vec2& sum) {
+  const float query2 = m.query_radius() * m.query_radius(), reach = cfs_far_reach(m);
+  for_each_far_candidate(me.e0, reach * reach, [&](glm::vec2 at, glm::vec2 w, float r, std::uint8_t flags) {
+    const glm::vec2 q = periodic.near(at, me.p);
+    const float d2 = length2(q - me.p);
+    glm::vec2 f;
+    if (d2 >= query2 && d2 < reach * reach && cfs_far_push(me, q, w, r, (flags & kAgentStopped) != 0, m.cfs, f))
+      sum += f;
+  });
+}
+
 // The new velocity of the agent under the collision-free speed model
 // (collision_free_speed.h); `self` is its element of the neighbour arrays.
 // `for_each_candidate` visits every active agent that may be a neighbour
 // (for_each_binned_candidate, or all agents for the reference); those
-// beyond the query radius or `self` are skipped here.
+// beyond the query radius or `self` are skipped here; the far look's
+// candidates come from `for_each_far_candidate` (add_far_anticipation).
 // Walls and circles come from the agent's cell of the world's halo grids
 // (everything within one cell side).
-template <class ForEachCandidate>
+template <class ForEachCandidate, class ForEachFarCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, Index self, const CfsAgent& me,
                                                             float v0, float dt, const NeighbourArrays& n,
                                                             const ModelParams& m,
-                                                            const ForEachCandidate& for_each_candidate) {
+                                                            const ForEachCandidate& for_each_candidate,
+                                                            const ForEachFarCandidate& for_each_far_candidate) {
   const CollisionFreeSpeedParams& c = m.cfs;
   const float query2 = m.query_radius() * m.query_radius();
   // Walls first: they may slide e0 along them before the pushes are summed.
@@ -140,14 +162,16 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
   const float hold =
       me.radius + m.max_radius() + v0 * fmaxf(c.time_gap, dt) + m.max_speed * c.anticipation_time + 1e-3f;
   std::int32_t holders[kCfsHolders];
-  int held = 0;
+  int held = 0, nearby = 0;
   for_each_neighbour(for_each_candidate, self, n, me.p, query2, [&](Index j, glm::vec2 q) {
     sum += cfs_neighbour_push(me, q, n.velocity[j], n.radius[j], (n.flags[j] & kAgentStopped) != 0, c);
+    ++nearby;
     // Kept without a branch on the distance: written in any case, counted
     // when within `hold` (the next neighbour overwrites one not counted).
     if (held < kCfsHolders) holders[held] = static_cast<std::int32_t>(j);
     held += length2(q - me.p) < hold * hold ? 1 : 0;
   });
+  if (cfs_looks_far(me, v0, nearby, c)) add_far_anticipation(me, n.periodic, m, for_each_far_candidate, sum);
   auto for_each_holder = [&](const auto& fn) {
     if (held > kCfsHolders)
       return for_each_neighbour(for_each_candidate, self, n, me.p, query2, [&](Index j, glm::vec2) { fn(j); });

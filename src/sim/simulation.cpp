@@ -256,7 +256,17 @@ void Simulation::sense_and_steer(const StepContext& ctx) {
     sense_double_buffer(gathered, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else {
-    sense_steer_four_colour(ctx, a);
+    StepContext coloured = ctx;
+    if (spec_.model.kind == ModelKind::CollisionFreeSpeed) {
+      const Index items = ctx.bins.items.size();
+      coloured.far_state = {binned_position_.span().subspan(0, items),
+                            binned_velocity_.span().subspan(0, items),
+                            binned_radius_.span().subspan(0, items),
+                            binned_flags_.span().subspan(0, items),
+                            {}};
+      gather_binned_state(ctx, a, {}, coloured.far_state);
+    }
+    sense_steer_four_colour(coloured, a);
   }
 }
 

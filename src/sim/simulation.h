@@ -116,6 +116,11 @@ struct StepContext {
   // How far an agent may be from where it was binned when others read it:
   // 0 for the double buffer, one step's largest move for the four colours.
   float bin_slack = 0.0f;
+  // Under the four colours, the state of the bins' items as binned (element
+  // k: item k), which the collision-free speed model's far look reads
+  // (add_far_anticipation): its cells, two away, move in the same launch.
+  // Empty elsewhere: the far look reads the neighbours the model reads.
+  BinnedState far_state;
   FieldsView fields;   // navigation fields (none: every agent steers at its waypoint)
   Periodic periodic;   // the world's periodic boundaries (none: periods 0)
   BinnedState binned;  // the double buffer's sense stage: neighbours in item order; else empty

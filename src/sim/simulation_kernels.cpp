@@ -202,14 +202,17 @@ THRONG_HOST_DEVICE inline AgentAim aim_of(const StepContext& ctx, const AgentArr
 
 // Sense under the collision-free speed model: agent i's new velocity
 // (`self`: its element of the neighbour arrays, neighbours_of).
-// `for_each_candidate(fn)` visits the candidate neighbours.
-template <class ForEachCandidate>
+// `for_each_candidate(fn)` visits the candidate neighbours,
+// `for_each_far_candidate(e0, reach2, fn)` those of the far look.
+template <class ForEachCandidate, class ForEachFarCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_collision_free(const StepContext& ctx, const AgentArrays& a,
                                                          const NeighbourArrays& n, Index i, Index self,
-                                                         const ForEachCandidate& for_each_candidate) {
+                                                         const ForEachCandidate& for_each_candidate,
+                                                         const ForEachFarCandidate& for_each_far_candidate) {
   const AgentAim aim = aim_of(ctx, a, i, self);
   const CfsAgent me{n.position[self], n.velocity[self], n.radius[self], aim.e0, aim.distance};
-  return collision_free_velocity(ctx.world, self, me, aim.pref_speed, ctx.dt, n, ctx.model, for_each_candidate);
+  return collision_free_velocity(ctx.world, self, me, aim.pref_speed, ctx.dt, n, ctx.model, for_each_candidate,
+                                 for_each_far_candidate);
 }
 
 // Agent i as the force models see it: heading straight for its goal, or
@@ -239,13 +242,14 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_social_force(const StepContext& ctx, c
 // The sense of the models that sum over every candidate neighbour
 // (collision-free speed, time to collision, social force); `n`:
 // neighbours_of, `self` agent i's element of it.
-template <class ForEachCandidate>
+template <class ForEachCandidate, class ForEachFarCandidate>
 THRONG_HOST_DEVICE inline glm::vec2 sense_candidates(const StepContext& ctx, const AgentArrays& a,
                                                      const NeighbourArrays& n, Index i, Index self,
-                                                     const ForEachCandidate& for_each_candidate) {
+                                                     const ForEachCandidate& for_each_candidate,
+                                                     const ForEachFarCandidate& for_each_far_candidate) {
   if (ctx.model.kind == ModelKind::Ttc) return sense_ttc(ctx, a, n, i, self, for_each_candidate);
   if (ctx.model.kind == ModelKind::SocialForce) return sense_social_force(ctx, a, n, i, self, for_each_candidate);
-  return sense_collision_free(ctx, a, n, i, self, for_each_candidate);
+  return sense_collision_free(ctx, a, n, i, self, for_each_candidate, for_each_far_candidate);
 }
 
 // Sense: what the model makes of the agent's surroundings, zero for agents
@@ -260,7 +264,24 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
   if (ctx.model.kind != ModelKind::Priority) {
     const Cells3x3 cells = cells_3x3(ctx.bins, cx, cy);
     auto candidates = [&](const auto& fn) { for_each_binned_candidate(ctx.bins, cells, n, fn); };
-    return sense_candidates(ctx, a, n, i, self, candidates);
+    // The far look's cells: the 5 x 5 round the agent's, those touching the
+    // reach and the half-plane ahead of it (along e0); read as binned under
+    // the four colours (StepContext::far_state).
+    auto far = [&](glm::vec2 e0, float reach2, const auto& fn) {
+      const glm::vec2 p = n.position[self];
+      auto keep = [&](const CellBounds& c) {
+        const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
+        return within_reach(c, p, reach2) && dot2(front - p, e0) > 0.0f;
+      };
+      const BinnedState& b = ctx.far_state;
+      const NeighbourArrays from =
+          b.position.size() == 0 ? n : NeighbourArrays{b.position, b.velocity,   b.radius,
+                                                       b.flags,    ctx.periodic, ctx.bins.items};
+      for_each_binned_candidate(
+          ctx.bins, kept_cells(ctx.bins, cx, cy, 2, ctx.bin_slack, keep), from,
+          [&](Index j, glm::vec2 at) { fn(at, from.velocity[j], from.radius[j], from.flags[j]); });
+    };
+    return sense_candidates(ctx, a, n, i, self, candidates, far);
   }
   return sense_priority(ctx, a, i, [&](glm::vec2 p, glm::vec2 v, glm::vec2 forward, float r) {
     return sense_neighbours(ctx.bins, cx, cy, self, p, v, forward, r, n, ctx.model, ctx.bin_slack);
@@ -362,7 +383,10 @@ struct SenseAllPairs {
     const NeighbourArrays n = neighbours_of(ctx, a);
     if (ctx.model.kind != ModelKind::Priority) {
       auto candidates = [&](const auto& fn) { for_each_active_candidate(n, fn); };
-      sensed[i] = sense_candidates(ctx, a, n, i, i, candidates);
+      auto far = [&](glm::vec2, float, const auto& fn) {
+        for_each_active_candidate(n, [&](Index j, glm::vec2 at) { fn(at, n.velocity[j], n.radius[j], n.flags[j]); });
+      };
+      sensed[i] = sense_candidates(ctx, a, n, i, i, candidates, far);
       return;
     }
     const ModelParams m = ctx.model;

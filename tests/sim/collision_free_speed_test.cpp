@@ -93,6 +93,82 @@ TEST(CollisionFreeSpeed, CrossersArePassedBehindWhereTheyWillBe) {
   EXPECT_GT(cfs_neighbour_push(me, d, {-1.3f, 0.0f}, 0.2f, false, kParams).y, 0.0f);
 }
 
+// A neighbour ahead along the goal direction but behind the direction the
+// agent walks, walking its way and so crossing its goal direction, is not
+// anticipated; the same neighbour ahead of the walk is.
+TEST(CollisionFreeSpeed, ANeighbourBehindTheWalkedDirectionIsNotAnticipated) {
+  // Walking south-south-west, goal to the west; the neighbour north-west of us,
+  // a third of a metre behind along our walk, walking south-west as well.
+  const glm::vec2 walk = glm::normalize(glm::vec2(-0.4f, -0.9f)) * 1.3f;  // 66 degrees off the goal
+  const CfsAgent me{{0.0f, 0.0f}, walk, 0.2f, {-1.0f, 0.0f}};
+  const glm::vec2 d(-0.25f, 0.55f), w = walk * 1.1f;  // closing in slowly from behind
+  ASSERT_GT(dot2(d, me.e0), 0.0f);
+  ASSERT_LT(dot2(d, me.v), 0.0f);
+  const float dist = length_of(d);
+  const glm::vec2 repulsion =
+      d * (-kParams.neighbour_strength * std::exp((0.4f - dist) / kParams.neighbour_range) / dist);
+  const glm::vec2 f = cfs_neighbour_push(me, d, w, 0.2f, false, kParams);
+  EXPECT_NEAR(f.x, repulsion.x, 1e-4f);
+  EXPECT_NEAR(f.y, repulsion.y, 1e-4f);
+  // Walking west instead, the same neighbour is ahead of the walk too and
+  // crosses it: anticipated (a push beyond the repulsion).
+  const CfsAgent west{{0.0f, 0.0f}, {-1.3f, 0.0f}, 0.2f, {-1.0f, 0.0f}};
+  const glm::vec2 crossing = cfs_neighbour_push(west, d, {0.0f, -1.3f}, 0.2f, false, kParams);
+  EXPECT_GT(length_of(crossing - repulsion), 0.1f);
+}
+
+// The far look: an oncoming walker beyond the query radius and within
+// cfs_far_reach pushes a freely walking agent to the right, by A_ij alone;
+// not one walking slowly or among more than kCfsFarCrowd neighbours; and
+// the binned search's 5 x 5 cells find what all pairs find.
+TEST(CollisionFreeSpeed, FreeWalkersAnticipateOncomingWalkersBeyondTheQueryRadius) {
+  ModelParams m;  // the default model
+  m.max_speed = 1.5f;
+  const float query = m.query_radius(), reach = cfs_far_reach(m);
+  ASSERT_LT(query + 1.0f, reach);
+  ASSERT_LE(reach, 2.0f * query);
+  const float at = query + 0.5f;  // beyond the query radius
+  const CfsAgent me{{0.0f, 0.0f}, {1.3f, 0.0f}, 0.2f, {1.0f, 0.0f}};
+  glm::vec2 f;
+  ASSERT_TRUE(cfs_far_push(me, {at, 0.0f}, {-1.3f, 0.0f}, 0.2f, false, m.cfs, f));
+  const float tau = (at - 0.4f) / 2.6f;
+  EXPECT_NEAR(f.y, -m.cfs.avoid_strength * (1.0f - tau / m.cfs.avoid_time), 1e-4f);
+  EXPECT_EQ(f.x, 0.0f);
+  EXPECT_FALSE(cfs_far_push(me, {at, 0.0f}, {1.0f, 0.0f}, 0.2f, false, m.cfs, f));  // walking our way
+  EXPECT_TRUE(cfs_looks_far(me, 1.3f, kCfsFarCrowd, m.cfs));
+  EXPECT_FALSE(cfs_looks_far(me, 1.3f, kCfsFarCrowd + 1, m.cfs));
+  EXPECT_FALSE(cfs_looks_far({{0.0f, 0.0f}, {0.6f, 0.0f}, 0.2f, {1.0f, 0.0f}}, 1.3f, 0, m.cfs));
+  // Through the whole sense: the oncoming walker at `at` turns us right,
+  // from all pairs and from the bins alike.
+  const std::vector<glm::vec2> p{{0.0f, 0.0f}, {at, 0.0f}}, v{{1.3f, 0.0f}, {-1.3f, 0.0f}};
+  const std::vector<float> r{0.2f, 0.2f};
+  const std::vector<std::uint8_t> flags(2, kAgentActive);
+  const NeighbourArrays n{Span<const glm::vec2>(p), Span<const glm::vec2>(v), Span<const float>(r),
+                          Span<const std::uint8_t>(flags), Periodic{}};
+  const World world = World::build(WorldSpec{}, query);
+  auto all = [&](const auto& fn) { for_each_active_candidate(n, fn); };
+  auto far_all = [&](glm::vec2, float, const auto& fn) {
+    for_each_active_candidate(n, [&](Index j, glm::vec2 q) { fn(q, n.velocity[j], n.radius[j], n.flags[j]); });
+  };
+  auto none = [&](glm::vec2, float, const auto&) {};
+  const glm::vec2 looked = collision_free_velocity(world.view(), 0, me, 1.3f, 0.1f, n, m, all, far_all);
+  const glm::vec2 blind = collision_free_velocity(world.view(), 0, me, 1.3f, 0.1f, n, m, all, none);
+  EXPECT_LT(looked.y, -1e-3f);
+  EXPECT_EQ(blind.y, 0.0f);
+  AgentGrid bins(query);
+  bins.rebuild(Span<const glm::vec2>(p), Span<const std::uint8_t>(flags));
+  const GridView g = bins.view();
+  auto far_binned = [&](glm::vec2 e0, float reach2, const auto& fn) {
+    auto keep = [&](const CellBounds& c) {
+      const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
+      return within_reach(c, p[0], reach2) && dot2(front - p[0], e0) > 0.0f;
+    };
+    for_each_binned_candidate(g, kept_cells(g, g.cell_x(0.0f), g.cell_y(0.0f), 2, 0.0f, keep), n,
+                              [&](Index j, glm::vec2 q) { fn(q, n.velocity[j], n.radius[j], n.flags[j]); });
+  };
+  EXPECT_EQ(collision_free_velocity(world.view(), 0, me, 1.3f, 0.1f, n, m, all, far_binned), looked);
+}
+
 TEST(CollisionFreeSpeed, WallsSlideTheGoalDirectionAndTurnsTakeTime) {
   const glm::vec2 wall_normal(-1.0f, 0.0f);  // a wall east of the agent
   const glm::vec2 slid = cfs_slide_along_wall(glm::normalize(glm::vec2(1.0f, -1.0f)), wall_normal);
@@ -237,8 +313,11 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
     for (const glm::vec2 q : p) near += glm::length(q) < hold ? 1 : 0;
     EXPECT_EQ(near - 1 > kCfsHolders, l.overflows) << near - 1 << " neighbours within " << hold << " m";
     auto all = [&](const auto& fn) { for_each_active_candidate(n, fn); };
+    auto far = [&](glm::vec2, float, const auto& fn) {
+      for_each_active_candidate(n, [&](Index j, glm::vec2 q) { fn(q, n.velocity[j], n.radius[j], n.flags[j]); });
+    };
     const CfsAgent me{p[0], v[0], r[0], {1.0f, 0.0f}};
-    const glm::vec2 got = collision_free_velocity(world.view(), 0, me, v0, dt, n, m, all);
+    const glm::vec2 got = collision_free_velocity(world.view(), 0, me, v0, dt, n, m, all, far);
     const float speed = glm::length(got);
     ASSERT_GT(speed, kCfsBlockedSpeed);  // walking: no fallback, so the direction is known
     const glm::vec2 e = got / speed;
@@ -277,38 +356,35 @@ TEST(CollisionFreeSpeed, FourWaysMeetingInTheMiddleResolve) {
 }
 
 // All twenty meet in the middle at once and queue round it, laid out at
-// four turns of the ring as for the other models: 1.42, 1.37, 1.59, 1.43x
-// measured (at ten turns, 0-16.2 degrees, 1.29-1.59x, nine within the
-// 1.5x aim; 1.31-1.74x before walkers yielded to one abreast, and the
-// priority model 1.64x at radius 8 m).
+// four turns of the ring as for the other models: 1.48, 1.30, 1.30, 1.24x
+// measured (1.42, 1.37, 1.59, 1.43x before the far look and the rule on
+// neighbours behind the walked direction; the priority model 1.64x at
+// radius 8 m).
 TEST(CollisionFreeSpeed, TwentyOnACircleReachTheirAntipodes) {
-  encounters::expect_circle_resolves(ModelKind::CollisionFreeSpeed, 1.65);
+  encounters::expect_circle_resolves(ModelKind::CollisionFreeSpeed, 1.5);
 }
 
-// The same circle at 40 turns over the ring's whole period: the slowest
-// arrival of most layouts lies within the 1.5x aim, some beyond (the crush
-// in the middle throws a walker back, or two walkers abreast each wait for
-// the other to cross; docs/simulation.md). Measured: median 1.44x, worst
-// 1.62x, 9 of 40 beyond 1.5x. Held to bounds with room for rounding
-// (another instruction set rounds differently, and the outcome hangs on
-// it), so that a change which widens the tail fails.
-constexpr double kCircleWorst = 2.0, kCircleMedian = 1.47;
-constexpr int kCircleBeyond = 14;
+// The same circle at 40 turns over the ring's whole period, every layout
+// within the 1.5x aim. Measured: median 1.33x, worst 1.499x (6.3 degrees;
+// an arrival one step later would be 1.507x); before the far look and the
+// rule on neighbours behind the walked direction median 1.43x, worst
+// 1.62x, 9 beyond. Finer spacings still find layouts beyond it
+// (scripts/circle_of_twenty.py: 1 of 200 at 1.64x, 3 of 199, 5 of 201;
+// docs/simulation.md). Results are the same bits on every instruction set
+// (no fused multiply-adds), so the bound does not hang on rounding.
+constexpr double kCircleMedian = 1.40;
 TEST(CollisionFreeSpeed, TwentyOnACircleRoundTheRing) {
-  std::vector<double> worst =
-      encounters::expect_circle_resolves_round_the_ring(ModelKind::CollisionFreeSpeed, 40, kCircleWorst);
+  std::vector<double> worst = encounters::expect_circle_resolves_round_the_ring(ModelKind::CollisionFreeSpeed, 40, 1.5);
   std::sort(worst.begin(), worst.end());
-  const auto beyond = std::count_if(worst.begin(), worst.end(), [](double w) { return w > 1.5; });
-  std::printf("  collision_free_speed, circle of 20 at 40 turns: median %.2fx, worst %.2fx, %d beyond 1.5x\n",
-              worst[worst.size() / 2], worst.back(), static_cast<int>(beyond));
+  std::printf("  collision_free_speed, circle of 20 at 40 turns: median %.2fx, worst %.3fx\n", worst[worst.size() / 2],
+              worst.back());
   EXPECT_LE(worst[worst.size() / 2], kCircleMedian);
-  EXPECT_LE(beyond, kCircleBeyond);
 }
 
 // The L corridor of encounters.h: the walkers meet at the corner without
 // seeing each other.
 TEST(CollisionFreeSpeed, BlindCornerPairPasses) {
-  // 1.45x measured.
+  // 1.46x measured.
   expect_encounter_resolves("blind corner", encounters::blind_corner_pair(), encounters::l_corridor());
 }
 

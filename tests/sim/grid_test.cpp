@@ -205,6 +205,64 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
   }
 }
 
+// kept_cells against the cells one by one: the items of every cell within
+// two of the agent's whose bounds `keep` accepts (a disc of reach and the
+// half-plane ahead), row by row, in the same order; and every item within
+// the reach and ahead among them. Dense and hashed grids, and a periodic
+// area too short for five cells along x (the cells there stay within one).
+void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p, const Periodic& periodic) {
+  const GridView v = g.view();
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> turn(0.0f, 6.2831853f);
+  for (int q = 0; q < 400; ++q) {
+    const std::size_t i = rng() % p.size();
+    const float a = turn(rng), reach = 6.0f;
+    const glm::vec2 e0(std::cos(a), std::sin(a)), at = p[i];
+    auto keep = [&](const CellBounds& c) {
+      const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
+      return within_reach(c, at, reach * reach) && dot2(front - at, e0) > 0.0f;
+    };
+    const std::int32_t cx = v.cell_x(at.x), cy = v.cell_y(at.y);
+    const std::int32_t rx = v.wrap_x > 0 && v.wrap_x < 6 ? 1 : 2;
+    std::vector<std::int32_t> expected, got;
+    for (std::int32_t dy = -2; dy <= 2; ++dy)
+      for (std::int32_t dx = -rx; dx <= rx; ++dx) {
+        const Index s = v.find(cx + dx, cy + dy);
+        if (s < 0 || !keep(cell_bounds(v, cx + dx, cy + dy, 0.0f))) continue;
+        for (std::int32_t k = 0; k < v.count[s]; ++k) expected.push_back(v.items[v.start[s] + k]);
+      }
+    for_each_in_cells(v, kept_cells(v, cx, cy, 2, 0.0f, keep), [&](std::int32_t j) { got.push_back(j); });
+    ASSERT_EQ(expected, got) << "around agent " << i;
+    const std::set<std::int32_t> kept(got.begin(), got.end());
+    for (std::size_t j = 0; j < p.size(); ++j) {
+      const glm::vec2 d = periodic.near(p[j], at) - at;
+      if (rx == 2 && length2(d) < reach * reach && dot2(d, e0) > 0.0f) {
+        EXPECT_TRUE(kept.count(static_cast<std::int32_t>(j))) << "agent " << i << " misses " << j;
+      }
+    }
+  }
+}
+
+TEST(Bins, KeptCellsOfTheFiveByFiveAreThoseAcceptedCellByCell) {
+  const std::vector<glm::vec2> p = random_points(3000, 60.0f, 7);
+  const std::vector<std::uint8_t> flags(p.size(), kAgentActive);
+  for (const bool dense : {true, false}) {
+    SCOPED_TRACE(dense ? "dense" : "hashed");
+    AgentGrid g(4.0f);
+    g.rebuild(p, flags, dense);
+    ASSERT_EQ(g.dense(), dense);
+    kept_cells_match_cell_by_cell(g, p, Periodic{});
+  }
+  SCOPED_TRACE("periodic, 4 cells along x");
+  const Periodic periodic{{0.0f, 0.0f}, {16.0f, 0.0f}};
+  std::vector<glm::vec2> wrapped = p;
+  for (glm::vec2& q : wrapped) q.x = std::fmod(q.x, 16.0f);
+  AgentGrid g(4.0f, periodic);
+  g.rebuild(wrapped, flags);
+  ASSERT_EQ(g.view().wrap_x, 4);
+  kept_cells_match_cell_by_cell(g, wrapped, periodic);
+}
+
 // A cell that within_reach leaves out holds no item within the reach, also
 // for items moved up to the slack since they were binned; around random
 // points some of the 3x3 cells are left out.

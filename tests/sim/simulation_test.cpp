@@ -113,10 +113,11 @@ void expect_acceptance(const RunRecord& r, Index agents, const char* what) {
 
 // Both schedulers run the same model; their order of updates differs, so
 // trajectories differ, but the crowd-level outcome must agree: means of the
-// arrival times within 10%, collisions (pairs in contact, per sample)
-// within a factor of two, and where `same_distribution`, the arrival-time
-// distributions close (two-sample KS statistic below 0.15).
-void expect_schedulers_agree(const RunRecord& a, const RunRecord& b, bool same_distribution) {
+// arrival times within `mean_share` of the larger, collisions (pairs in
+// contact, per sample) within a factor of two, and where
+// `same_distribution`, the arrival-time distributions close (two-sample KS
+// statistic below 0.15).
+void expect_schedulers_agree(const RunRecord& a, const RunRecord& b, double mean_share, bool same_distribution) {
   const double ma = mean(a.arrival_times), mb = mean(b.arrival_times);
   const double ks = ks_statistic(a.arrival_times, b.arrival_times);
   const double ca = static_cast<double>(a.touching_samples) / static_cast<double>(std::max<Index>(1, a.samples));
@@ -125,7 +126,7 @@ void expect_schedulers_agree(const RunRecord& a, const RunRecord& b, bool same_d
               mb, ks, static_cast<long long>(a.steps), static_cast<long long>(b.steps));
   std::printf("  pairs in contact per sample %.2f / %.2f; deepest overlap %.3f / %.3f m\n", ca, cb, a.max_overlap_depth,
               b.max_overlap_depth);
-  EXPECT_LT(std::fabs(ma - mb), 0.1 * std::max(ma, mb));
+  EXPECT_LT(std::fabs(ma - mb), mean_share * std::max(ma, mb));
   if (same_distribution) {
     EXPECT_LT(ks, 0.15);
   }
@@ -251,19 +252,24 @@ TEST(Contacts, ExtraPassesRunWhileAPairIsDeeperThanTheTolerance) {
 }
 
 // Both schedulers on the same scenario (the circle with 400 agents, 200
-// under the sanitizers: a dense jam in a few hundred steps; three seeds,
-// arrival times pooled): the statistics agree. Under the priority model
-// the whole distribution; under the collision-free speed model (the
-// default) the means only: the double buffer clears the circle's jam a
-// few per cent later than the four colours (400 agents: mean arrival
-// 158.2 s against 154.8 s, KS 0.144; 200: 78.4 s against 74.0 s, KS 0.41,
-// the arrivals bunched within seconds of each other).
+// under the sanitizers: a dense jam in a few hundred steps; arrival times
+// of several seeds pooled): the statistics agree. Under the priority model
+// (three seeds) the whole distribution, means within 10%. Under the
+// collision-free speed model (the default) the means only, and not within
+// 10%: in its jam the double buffer, where everyone moves on the last
+// step's positions, is systematically slower than the four colours. Over
+// seeds 1-30 through `throng run circle --agents 400` the per-seed means
+// averaged 167.9 s (sd 9.7) against 153.7 s (sd 10.3), 9% apart (200
+// agents: 6%); three seeds pooled came out 1-18% apart, so the test pools
+// ten (seeds 1-10: 167.4 s against 151.5 s, 9.5%) and allows 15%.
 TEST(Schedulers, ArrivalTimesAndCollisionsAgreeStatistically) {
   for (const ModelKind model : {ModelKind::Priority, ModelKind::CollisionFreeSpeed}) {
     SCOPED_TRACE(to_string(model));
+    const bool priority = model == ModelKind::Priority;
     const Index agents = test::sanitized() ? 200 : 400;
+    const std::uint64_t seeds = priority || test::sanitized() ? 3 : 10;
     RunRecord db, fc;
-    for (std::uint64_t seed : {1, 2, 3}) {
+    for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
       ScenarioSpec spec = test::builtin("circle", agents);
       spec.model.kind = model;
       spec.seed = seed;
@@ -279,7 +285,7 @@ TEST(Schedulers, ArrivalTimesAndCollisionsAgreeStatistically) {
         pooled->samples += r.samples;
       }
     }
-    expect_schedulers_agree(db, fc, model == ModelKind::Priority);
+    expect_schedulers_agree(db, fc, priority ? 0.1 : 0.15, priority);
   }
 }
 
