@@ -216,19 +216,25 @@ THRONG_HOST_DEVICE inline bool within_reach(const CellBounds& c, glm::vec2 p, fl
   const float ny = p.y < c.lo.y ? c.lo.y : (p.y > c.hi.y ? c.hi.y : p.y);
   return !((nx - p.x) * (nx - p.x) + (ny - p.y) * (ny - p.y) >= reach2);
 }
-// The item runs of the cells up to `ring` cells from (cx, cy) (2: the
-// 5 x 5) that keep(cell bounds) accepts, row-major as cells_3x3; keep must
-// accept a contiguous stretch of each row (a test of distance or of a
-// half-plane, or both). Along a wrapping axis of fewer than 2 ring + 2
-// cells the cells stay within one of (cx, cy), so that none is visited
-// twice. `slack` widens the bounds (cell_bounds).
+// Whether cell bounds c reach within sqrt(reach2) of p and into the
+// half-plane ahead of it along e0 (its corner furthest along e0 lies ahead).
+THRONG_HOST_DEVICE inline bool cell_ahead_within_reach(const CellBounds& c, glm::vec2 p, glm::vec2 e0, float reach2) {
+  const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
+  return within_reach(c, p, reach2) && (front.x - p.x) * e0.x + (front.y - p.y) * e0.y > 0.0f;
+}
+// The item runs of the 5 x 5 cells round (cx, cy) that keep(cell bounds)
+// accepts, row-major as cells_3x3; keep must accept a contiguous stretch of
+// each row (a test of distance or of a half-plane, or both). Along a
+// wrapping axis of fewer than 6 cells the cells stay within one of
+// (cx, cy), so that none is visited twice. `slack` widens the bounds
+// (cell_bounds).
 template <class Keep>
-THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, std::int32_t ring,
-                                              float slack, const Keep& keep) {
+THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, float slack,
+                                              const Keep& keep) {
   Cells5x5 c;
   if (g.items.size() == 0) return c;
-  const std::int32_t rx = g.wrap_x > 0 && g.wrap_x < 2 * ring + 2 ? 1 : ring;
-  const std::int32_t ry = g.wrap_y > 0 && g.wrap_y < 2 * ring + 2 ? 1 : ring;
+  const std::int32_t rx = g.wrap_x > 0 && g.wrap_x < 6 ? 1 : 2;
+  const std::int32_t ry = g.wrap_y > 0 && g.wrap_y < 6 ? 1 : 2;
   const bool dense_row = g.dense_nx > 0 && g.wrap_x == 0 && g.wrap_y == 0;
   for (std::int32_t y = cy - ry; y <= cy + ry; ++y) {
     std::int32_t lo = cx - rx, hi = cx + rx;

@@ -269,16 +269,13 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
     // the four colours (StepContext::far_state).
     auto far = [&](glm::vec2 e0, float reach2, const auto& fn) {
       const glm::vec2 p = n.position[self];
-      auto keep = [&](const CellBounds& c) {
-        const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
-        return within_reach(c, p, reach2) && dot2(front - p, e0) > 0.0f;
-      };
+      auto keep = [&](const CellBounds& c) { return cell_ahead_within_reach(c, p, e0, reach2); };
       const BinnedState& b = ctx.far_state;
       const NeighbourArrays from =
           b.position.size() == 0 ? n : NeighbourArrays{b.position, b.velocity,   b.radius,
                                                        b.flags,    ctx.periodic, ctx.bins.items};
       for_each_binned_candidate(
-          ctx.bins, kept_cells(ctx.bins, cx, cy, 2, ctx.bin_slack, keep), from,
+          ctx.bins, kept_cells(ctx.bins, cx, cy, ctx.bin_slack, keep), from,
           [&](Index j, glm::vec2 at) { fn(at, from.velocity[j], from.radius[j], from.flags[j]); });
     };
     return sense_candidates(ctx, a, n, i, self, candidates, far);

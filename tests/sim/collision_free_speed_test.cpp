@@ -159,11 +159,8 @@ TEST(CollisionFreeSpeed, FreeWalkersAnticipateOncomingWalkersBeyondTheQueryRadiu
   bins.rebuild(Span<const glm::vec2>(p), Span<const std::uint8_t>(flags));
   const GridView g = bins.view();
   auto far_binned = [&](glm::vec2 e0, float reach2, const auto& fn) {
-    auto keep = [&](const CellBounds& c) {
-      const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
-      return within_reach(c, p[0], reach2) && dot2(front - p[0], e0) > 0.0f;
-    };
-    for_each_binned_candidate(g, kept_cells(g, g.cell_x(0.0f), g.cell_y(0.0f), 2, 0.0f, keep), n,
+    auto keep = [&](const CellBounds& c) { return cell_ahead_within_reach(c, p[0], e0, reach2); };
+    for_each_binned_candidate(g, kept_cells(g, g.cell_x(0.0f), g.cell_y(0.0f), 0.0f, keep), n,
                               [&](Index j, glm::vec2 q) { fn(q, n.velocity[j], n.radius[j], n.flags[j]); });
   };
   EXPECT_EQ(collision_free_velocity(world.view(), 0, me, 1.3f, 0.1f, n, m, all, far_binned), looked);

@@ -231,7 +231,7 @@ void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p
         if (s < 0 || !keep(cell_bounds(v, cx + dx, cy + dy, 0.0f))) continue;
         for (std::int32_t k = 0; k < v.count[s]; ++k) expected.push_back(v.items[v.start[s] + k]);
       }
-    for_each_in_cells(v, kept_cells(v, cx, cy, 2, 0.0f, keep), [&](std::int32_t j) { got.push_back(j); });
+    for_each_in_cells(v, kept_cells(v, cx, cy, 0.0f, keep), [&](std::int32_t j) { got.push_back(j); });
     ASSERT_EQ(expected, got) << "around agent " << i;
     const std::set<std::int32_t> kept(got.begin(), got.end());
     for (std::size_t j = 0; j < p.size(); ++j) {
