@@ -57,17 +57,17 @@ THRONG_HOST_DEVICE inline void for_each_active_candidate(const NeighbourArrays& 
     if ((n.flags[j] & kAgentActive) != 0) fn(j, n.position[j]);
 }
 
-// Calls fn(j, q) for every candidate j other than `self` (the agent's own
-// element of the neighbour arrays) whose position q
-// (its image nearest p) lies closer to p than sqrt(range2), in the order
-// for_each_candidate visits them. The candidates are first sifted without
-// a branch into a batch, then the batch is visited: most candidates fail
-// the test, and a branch on each mispredicts often enough to cost more
-// than the test itself.
+// Calls fn(j, q) for every candidate j whose position q (its image
+// nearest p) keep(j, q) accepts, in the order for_each_candidate visits
+// them. The candidates are first sifted without a branch into a batch
+// (keep is evaluated for every one, so it should be a few comparisons
+// without branches of its own), then the batch is visited: most
+// candidates fail the test, and a branch on each mispredicts often enough
+// to cost more than the test itself.
 inline constexpr int kNeighbourBatch = 32;
-template <class ForEachCandidate, class Fn>
-THRONG_HOST_DEVICE inline void for_each_neighbour(const ForEachCandidate& for_each_candidate, Index self,
-                                                  const NeighbourArrays& n, glm::vec2 p, float range2, const Fn& fn) {
+template <class ForEachCandidate, class Keep, class Fn>
+THRONG_HOST_DEVICE inline void for_each_sifted(const ForEachCandidate& for_each_candidate, const NeighbourArrays& n,
+                                               glm::vec2 p, const Keep& keep, const Fn& fn) {
   std::int32_t batch[kNeighbourBatch];
   glm::vec2 image[kNeighbourBatch];
   int found = 0;
@@ -79,10 +79,21 @@ THRONG_HOST_DEVICE inline void for_each_neighbour(const ForEachCandidate& for_ea
     const glm::vec2 q = n.periodic.near(at, p);
     batch[found] = static_cast<std::int32_t>(j);
     image[found] = q;
-    found += (j != self) & (length2(q - p) < range2) ? 1 : 0;
+    found += keep(j, q) ? 1 : 0;
     if (found == kNeighbourBatch) visit();
   });
   visit();
+}
+
+// Calls fn(j, q) for every candidate j other than `self` (the agent's own
+// element of the neighbour arrays) whose position q (its image nearest p)
+// lies closer to p than sqrt(range2), in the order for_each_candidate
+// visits them (sifted: for_each_sifted).
+template <class ForEachCandidate, class Fn>
+THRONG_HOST_DEVICE inline void for_each_neighbour(const ForEachCandidate& for_each_candidate, Index self,
+                                                  const NeighbourArrays& n, glm::vec2 p, float range2, const Fn& fn) {
+  for_each_sifted(
+      for_each_candidate, n, p, [&](Index j, glm::vec2 q) { return (j != self) & (length2(q - p) < range2); }, fn);
 }
 
 }  // namespace throng::sim

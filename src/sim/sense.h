@@ -105,21 +105,30 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 
 // The far look of the collision-free speed model (cfs_looks_far): A_ij of
 // every neighbour beyond the query radius and within cfs_far_reach added to
-// `sum`, in the order for_each_far_candidate(e0, reach2, fn) visits them
-// (given the agent's goal direction and the reach squared, to leave out
-// cells wholly behind or beyond), fn(at, velocity, radius, flags) taking
-// each neighbour's state as stored (the agent itself lies within the query
-// radius: skipped).
+// `sum`. for_each_far_candidate(e0, reach2, fn) is given the agent's goal
+// direction and the reach squared (to leave out cells wholly behind or
+// beyond) and calls fn(from, candidates) with the neighbour arrays to read
+// and the candidates in them (a for_each_candidate, neighbours.h), in the
+// order their pushes are summed. The agent itself lies within the query
+// radius. The candidates are sifted first (for_each_sifted) by the tests
+// of the push that need only the position: within the band, ahead along
+// e0 and along the walk, the same expressions cfs_add_anticipation tests,
+// so the sift drops only candidates that push nothing.
 template <class ForEachFarCandidate>
-THRONG_HOST_DEVICE inline void add_far_anticipation(const CfsAgent& me, const Periodic& periodic, const ModelParams& m,
+THRONG_HOST_DEVICE inline void add_far_anticipation(const CfsAgent& me, const ModelParams& m,
                                                     const ForEachFarCandidate& for_each_far_candidate, glm::vec2& sum) {
   const float query2 = m.query_radius() * m.query_radius(), reach = cfs_far_reach(m);
-  for_each_far_candidate(me.e0, reach * reach, [&](glm::vec2 at, glm::vec2 w, float r, std::uint8_t flags) {
-    const glm::vec2 q = periodic.near(at, me.p);
-    const float d2 = length2(q - me.p);
-    glm::vec2 f;
-    if (d2 >= query2 && d2 < reach * reach && cfs_far_push(me, q, w, r, (flags & kAgentStopped) != 0, m.cfs, f))
-      sum += f;
+  for_each_far_candidate(me.e0, reach * reach, [&](const NeighbourArrays& from, const auto& candidates) {
+    auto maybe_pushes = [&](Index, glm::vec2 q) {
+      const glm::vec2 d = q - me.p;
+      const float d2 = length2(d);
+      return (d2 >= query2) & (d2 < reach * reach) & (dot2(d, me.e0) > 0.0f) & (dot2(d, me.v) >= 0.0f);
+    };
+    for_each_sifted(candidates, from, me.p, maybe_pushes, [&](Index j, glm::vec2 q) {
+      glm::vec2 f;
+      if (cfs_far_push(me, q, from.velocity[j], from.radius[j], (from.flags[j] & kAgentStopped) != 0, m.cfs, f))
+        sum += f;
+    });
   });
 }
 
@@ -171,7 +180,7 @@ THRONG_HOST_DEVICE inline glm::vec2 collision_free_velocity(const WorldView& w, 
     if (held < kCfsHolders) holders[held] = static_cast<std::int32_t>(j);
     held += length2(q - me.p) < hold * hold ? 1 : 0;
   });
-  if (cfs_looks_far(me, v0, nearby, c)) add_far_anticipation(me, n.periodic, m, for_each_far_candidate, sum);
+  if (cfs_looks_far(me, v0, nearby, c)) add_far_anticipation(me, m, for_each_far_candidate, sum);
   auto for_each_holder = [&](const auto& fn) {
     if (held > kCfsHolders)
       return for_each_neighbour(for_each_candidate, self, n, me.p, query2, [&](Index j, glm::vec2) { fn(j); });

@@ -274,9 +274,8 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
       const NeighbourArrays from =
           b.position.size() == 0 ? n : NeighbourArrays{b.position, b.velocity,   b.radius,
                                                        b.flags,    ctx.periodic, ctx.bins.items};
-      for_each_binned_candidate(
-          ctx.bins, kept_cells(ctx.bins, cx, cy, ctx.bin_slack, keep), from,
-          [&](Index j, glm::vec2 at) { fn(at, from.velocity[j], from.radius[j], from.flags[j]); });
+      const Cells5x5 far_cells = kept_cells(ctx.bins, cx, cy, ctx.bin_slack, keep);
+      fn(from, [&](const auto& c) { for_each_binned_candidate(ctx.bins, far_cells, from, c); });
     };
     return sense_candidates(ctx, a, n, i, self, candidates, far);
   }
@@ -380,9 +379,7 @@ struct SenseAllPairs {
     const NeighbourArrays n = neighbours_of(ctx, a);
     if (ctx.model.kind != ModelKind::Priority) {
       auto candidates = [&](const auto& fn) { for_each_active_candidate(n, fn); };
-      auto far = [&](glm::vec2, float, const auto& fn) {
-        for_each_active_candidate(n, [&](Index j, glm::vec2 at) { fn(at, n.velocity[j], n.radius[j], n.flags[j]); });
-      };
+      auto far = [&](glm::vec2, float, const auto& fn) { fn(n, candidates); };
       sensed[i] = sense_candidates(ctx, a, n, i, i, candidates, far);
       return;
     }

@@ -147,9 +147,7 @@ TEST(CollisionFreeSpeed, FreeWalkersAnticipateOncomingWalkersBeyondTheQueryRadiu
                           Span<const std::uint8_t>(flags), Periodic{}};
   const World world = World::build(WorldSpec{}, query);
   auto all = [&](const auto& fn) { for_each_active_candidate(n, fn); };
-  auto far_all = [&](glm::vec2, float, const auto& fn) {
-    for_each_active_candidate(n, [&](Index j, glm::vec2 q) { fn(q, n.velocity[j], n.radius[j], n.flags[j]); });
-  };
+  auto far_all = [&](glm::vec2, float, const auto& fn) { fn(n, all); };
   auto none = [&](glm::vec2, float, const auto&) {};
   const glm::vec2 looked = collision_free_velocity(world.view(), 0, me, 1.3f, 0.1f, n, m, all, far_all);
   const glm::vec2 blind = collision_free_velocity(world.view(), 0, me, 1.3f, 0.1f, n, m, all, none);
@@ -160,8 +158,8 @@ TEST(CollisionFreeSpeed, FreeWalkersAnticipateOncomingWalkersBeyondTheQueryRadiu
   const GridView g = bins.view();
   auto far_binned = [&](glm::vec2 e0, float reach2, const auto& fn) {
     auto keep = [&](const CellBounds& c) { return cell_ahead_within_reach(c, p[0], e0, reach2); };
-    for_each_binned_candidate(g, kept_cells(g, g.cell_x(0.0f), g.cell_y(0.0f), 0.0f, keep), n,
-                              [&](Index j, glm::vec2 q) { fn(q, n.velocity[j], n.radius[j], n.flags[j]); });
+    const Cells5x5 cells = kept_cells(g, g.cell_x(0.0f), g.cell_y(0.0f), 0.0f, keep);
+    fn(n, [&](const auto& c) { for_each_binned_candidate(g, cells, n, c); });
   };
   EXPECT_EQ(collision_free_velocity(world.view(), 0, me, 1.3f, 0.1f, n, m, all, far_binned), looked);
 }
@@ -310,9 +308,7 @@ TEST(CollisionFreeSpeed, SpeedHoldsForEveryNeighbourWhetherFewOrManyAreNear) {
     for (const glm::vec2 q : p) near += glm::length(q) < hold ? 1 : 0;
     EXPECT_EQ(near - 1 > kCfsHolders, l.overflows) << near - 1 << " neighbours within " << hold << " m";
     auto all = [&](const auto& fn) { for_each_active_candidate(n, fn); };
-    auto far = [&](glm::vec2, float, const auto& fn) {
-      for_each_active_candidate(n, [&](Index j, glm::vec2 q) { fn(q, n.velocity[j], n.radius[j], n.flags[j]); });
-    };
+    auto far = [&](glm::vec2, float, const auto& fn) { fn(n, all); };
     const CfsAgent me{p[0], v[0], r[0], {1.0f, 0.0f}};
     const glm::vec2 got = collision_free_velocity(world.view(), 0, me, v0, dt, n, m, all, far);
     const float speed = glm::length(got);

@@ -1,10 +1,11 @@
 // The sense stage's neighbour sift (for_each_neighbour, sim/neighbours.h): the
 // same neighbours, at the same images, in the same order as a plain filter
 // that branches on each candidate; every model's sum relies on that order
-// for its bits.
+// for its bits. The same for the far look's sift (add_far_anticipation).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <string>
@@ -157,6 +158,46 @@ TEST(Sense, NeighbourSiftOfNoCandidatesVisitsNothing) {
   int visits = 0;
   for_each_neighbour([](const auto&) {}, 0, n, c.position[0], 100.0f, [&](Index, glm::vec2) { ++visits; });
   EXPECT_EQ(visits, 0);
+}
+
+// The far look's sift (add_far_anticipation) keeps only candidates whose
+// position passes the far push's own tests, so its sum is, bit for bit,
+// the sum of cfs_far_push over every candidate in the band, in order.
+TEST(Sense, FarLookSiftSumsWhatEveryCandidatePushes) {
+  const ModelParams m;
+  const float query2 = m.query_radius() * m.query_radius(), reach = cfs_far_reach(m);
+  Crowd c(3000, 6.0f * reach, 5);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (std::size_t i = 0; i < c.position.size(); ++i) {
+    c.velocity[i] = glm::vec2(1.5f * u(rng), 1.5f * u(rng));
+    if (rng() % 7 == 0) c.flags[i] |= kAgentStopped;
+  }
+  const NeighbourArrays n = c.arrays(Periodic{});
+  auto candidates = [&](const auto& fn) {
+    for (Index j : c.order)
+      if ((c.flags[static_cast<std::size_t>(j)] & kAgentActive) != 0) fn(j, c.position[static_cast<std::size_t>(j)]);
+  };
+  auto far = [&](glm::vec2, float, const auto& fn) { fn(n, candidates); };
+  int pushed = 0;
+  for (std::size_t i = 0; i < c.position.size(); i += 5) {
+    const float angle = 3.14159265f * u(rng);
+    const CfsAgent me{c.position[i], c.velocity[i], c.radius[i], {std::cos(angle), std::sin(angle)}};
+    glm::vec2 plain(0.25f, -0.5f), sifted = plain;
+    candidates([&](Index j, glm::vec2 q) {
+      const auto k = static_cast<std::size_t>(j);
+      const float d2 = length2(q - me.p);
+      glm::vec2 f;
+      if (d2 >= query2 && d2 < reach * reach &&
+          cfs_far_push(me, q, c.velocity[k], c.radius[k], (c.flags[k] & kAgentStopped) != 0, m.cfs, f)) {
+        plain += f;
+        ++pushed;
+      }
+    });
+    add_far_anticipation(me, m, far, sifted);
+    EXPECT_EQ(plain, sifted) << "agent " << i;
+  }
+  EXPECT_GT(pushed, 100);  // the sums are not all of nothing
 }
 
 }  // namespace
