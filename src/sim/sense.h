@@ -121,8 +121,8 @@ THRONG_HOST_DEVICE inline void add_far_anticipation(const CfsAgent& me, const Mo
   for_each_far_candidate(me.e0, reach * reach, [&](const NeighbourArrays& from, const auto& candidates) {
     auto maybe_pushes = [&](Index, glm::vec2 q) {
       const glm::vec2 d = q - me.p;
-      const float d2 = length2(d);
-      return (d2 >= query2) & (d2 < reach * reach) & (dot2(d, me.e0) > 0.0f) & (dot2(d, me.v) >= 0.0f);
+      const float d2 = length2(d), ahead = dot2(d, me.e0), along_walk = dot2(d, me.v);
+      return (d2 >= query2) & (d2 < reach * reach) & (ahead > 0.0f) & (along_walk >= 0.0f);
     };
     for_each_sifted(candidates, from, me.p, maybe_pushes, [&](Index j, glm::vec2 q) {
       glm::vec2 f;
