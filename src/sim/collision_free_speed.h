@@ -82,14 +82,21 @@ struct CfsAgent {
 // slower walker ahead in the same direction is followed at the time gap,
 // not dodged: dodging every slower neighbour spreads a queue sideways and
 // chokes a door.
+// The tests of A_ij that need only the offset d from the agent to the
+// neighbour: ahead along e0 and not behind the walked direction (the far
+// look sifts its candidates by them, add_far_anticipation in sense.h).
+THRONG_HOST_DEVICE THRONG_INLINE bool cfs_ahead_of(const CfsAgent& i, glm::vec2 d) {
+  const float ahead = dot2(d, i.e0), along_walk = dot2(d, i.v);
+  return (ahead > 0.0f) & (along_walk >= 0.0f);
+}
 THRONG_HOST_DEVICE THRONG_INLINE void cfs_add_anticipation(const CfsAgent& i, glm::vec2 d, float dist, glm::vec2 u,
                                                            glm::vec2 w, float l, bool parked,
                                                            const CollisionFreeSpeedParams& m, glm::vec2& f) {
-  const float ahead = dot2(d, i.e0);
+  const bool ahead = cfs_ahead_of(i, d);
   const float closing = -dot2(w - i.v, u);
   const bool towards = parked | (-dot2(w, u) > kCfsOncoming);
   // One branch on the five cheap tests (evaluated without short cuts).
-  if ((m.avoid_strength > 0.0f) & towards & (ahead > 0.0f) & (dot2(d, i.v) >= 0.0f) & (closing > 1e-3f)) {
+  if ((m.avoid_strength > 0.0f) & towards & ahead & (closing > 1e-3f)) {
     // Past the cheap tests (most neighbours stop there): j's speed and heading.
     const float speed = length_of(w), along = dot2(w, i.e0);
     const bool against = parked || along < kCfsAgainst * speed;

@@ -111,9 +111,9 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 // and the candidates in them (a for_each_candidate, neighbours.h), in the
 // order their pushes are summed. The agent itself lies within the query
 // radius. The candidates are sifted first (for_each_sifted) by the tests
-// of the push that need only the position: within the band, ahead along
-// e0 and along the walk, the same expressions cfs_add_anticipation tests,
-// so the sift drops only candidates that push nothing.
+// of the push that need only the position: within the band and
+// cfs_ahead_of, which cfs_add_anticipation tests too, so the sift drops
+// only candidates that push nothing.
 template <class ForEachFarCandidate>
 THRONG_HOST_DEVICE inline void add_far_anticipation(const CfsAgent& me, const ModelParams& m,
                                                     const ForEachFarCandidate& for_each_far_candidate, glm::vec2& sum) {
@@ -121,8 +121,9 @@ THRONG_HOST_DEVICE inline void add_far_anticipation(const CfsAgent& me, const Mo
   for_each_far_candidate(me.e0, reach * reach, [&](const NeighbourArrays& from, const auto& candidates) {
     auto maybe_pushes = [&](Index, glm::vec2 q) {
       const glm::vec2 d = q - me.p;
-      const float d2 = length2(d), ahead = dot2(d, me.e0), along_walk = dot2(d, me.v);
-      return (d2 >= query2) & (d2 < reach * reach) & (ahead > 0.0f) & (along_walk >= 0.0f);
+      const float d2 = length2(d);
+      const bool ahead = cfs_ahead_of(me, d);
+      return (d2 >= query2) & (d2 < reach * reach) & ahead;
     };
     for_each_sifted(candidates, from, me.p, maybe_pushes, [&](Index j, glm::vec2 q) {
       glm::vec2 f;

@@ -41,6 +41,12 @@ struct Crowd {
     std::iota(order.begin(), order.end(), Index{0});
     std::shuffle(order.begin(), order.end(), rng);
   }
+  // fn(j, position) for every active agent, in `order`.
+  template <class Fn>
+  void visit_active(const Fn& fn) const {
+    for (Index j : order)
+      if ((flags[static_cast<std::size_t>(j)] & kAgentActive) != 0) fn(j, position[static_cast<std::size_t>(j)]);
+  }
   NeighbourArrays arrays(const Periodic& periodic) const {
     return {Span<const glm::vec2>(position), Span<const glm::vec2>(velocity), Span<const float>(radius),
             Span<const std::uint8_t>(flags), periodic};
@@ -58,10 +64,7 @@ void expect_same_seen(const std::vector<Seen>& expected, const std::vector<Seen>
 
 void expect_same_as_plain_filter(const Crowd& c, const Periodic& periodic, float range) {
   const NeighbourArrays n = c.arrays(periodic);
-  auto candidates = [&](const auto& fn) {
-    for (Index j : c.order)
-      if ((c.flags[static_cast<std::size_t>(j)] & kAgentActive) != 0) fn(j, c.position[static_cast<std::size_t>(j)]);
-  };
+  auto candidates = [&](const auto& fn) { c.visit_active(fn); };
   std::size_t most = 0;
   for (Index self = 0; self < static_cast<Index>(c.position.size()); self += 7) {
     const glm::vec2 p = c.position[static_cast<std::size_t>(self)];
@@ -174,10 +177,7 @@ TEST(Sense, FarLookSiftSumsWhatEveryCandidatePushes) {
     if (rng() % 7 == 0) c.flags[i] |= kAgentStopped;
   }
   const NeighbourArrays n = c.arrays(Periodic{});
-  auto candidates = [&](const auto& fn) {
-    for (Index j : c.order)
-      if ((c.flags[static_cast<std::size_t>(j)] & kAgentActive) != 0) fn(j, c.position[static_cast<std::size_t>(j)]);
-  };
+  auto candidates = [&](const auto& fn) { c.visit_active(fn); };
   auto far = [&](glm::vec2, float, const auto& fn) { fn(n, candidates); };
   int pushed = 0;
   for (std::size_t i = 0; i < c.position.size(); i += 5) {
