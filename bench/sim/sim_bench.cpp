@@ -108,7 +108,8 @@ enum class DiscKind { Plain, Reference, Shuffled };
 std::unique_ptr<sim::Simulation> fresh_disc(Index n, sim::ModelKind model, DiscKind kind) {
   static std::map<std::pair<Index, sim::ModelKind>, std::string> shuffled;  // (made once: 10^6 points take seconds)
   sim::SimulationOptions options;
-  options.dense_bins = options.skip_idle_contact_passes = kind != DiscKind::Reference;
+  options.dense_bins = options.skip_idle_contact_passes = options.skip_far_cells_walking_along =
+      kind != DiscKind::Reference;
   std::string text;
   if (kind == DiscKind::Shuffled) {
     std::string& t = shuffled[{n, model}];

@@ -162,6 +162,38 @@ THRONG_HOST_DEVICE inline bool cfs_far_push(const CfsAgent& i, glm::vec2 q, glm:
   return f.x != 0.0f || f.y != 0.0f;
 }
 
+// The far look passes over a whole cell none of whose agents it could
+// anticipate (the same sums: such a cell adds nothing). The push needs a
+// neighbour parked, or coming (faster than kCfsOncoming) and walking at
+// least 60 degrees off the agent's e0 (`against`). CellHeadings holds
+// whether any agent of a cell is parked and the box of the unit walking
+// directions of those faster than kCfsHeadingSpeed (slower ones cannot be
+// coming); a cell with nobody parked whose box lies kCfsHeadingMargin
+// inside cos 60 of e0 is passed over. In a stream, where everybody walks
+// one way, that is nearly every cell.
+inline constexpr float kCfsHeadingSpeed = 0.8f * kCfsOncoming;  // m/s
+inline constexpr float kCfsHeadingMargin = 0.01f;               // of the cosine: room for rounding
+struct CellHeadings {
+  glm::vec2 lo{INFINITY}, hi{-INFINITY};
+  std::int32_t parked = 0;
+};
+THRONG_HOST_DEVICE inline void add_heading(CellHeadings& h, glm::vec2 w, bool parked) {
+  h.parked |= parked ? 1 : 0;
+  const float w2 = length2(w);
+  if (!(w2 >= kCfsHeadingSpeed * kCfsHeadingSpeed)) return;
+  const glm::vec2 u = w * (1.0f / sqrtf(w2));
+  h.lo = {u.x < h.lo.x ? u.x : h.lo.x, u.y < h.lo.y ? u.y : h.lo.y};
+  h.hi = {u.x > h.hi.x ? u.x : h.hi.x, u.y > h.hi.y ? u.y : h.hi.y};
+}
+// True when no agent of the cell can be anticipated by one with goal
+// direction e0 (the least of e0 . u over the box is at one of its corners).
+THRONG_HOST_DEVICE inline bool cfs_cell_walks_along(const CellHeadings& h, glm::vec2 e0) {
+  if (h.parked != 0) return false;
+  if (h.lo.x > h.hi.x) return true;  // nobody fast enough to be coming
+  const float least = (e0.x >= 0.0f ? h.lo.x : h.hi.x) * e0.x + (e0.y >= 0.0f ? h.lo.y : h.hi.y) * e0.y;
+  return least >= kCfsAgainst + kCfsHeadingMargin;
+}
+
 // W_iw of a wall point q (the nearest point of a segment or circle).
 // A centre on the wall itself gets no push: the move stage's projection
 // puts it back on its side.

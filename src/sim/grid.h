@@ -224,13 +224,14 @@ THRONG_HOST_DEVICE inline bool cell_ahead_within_reach(const CellBounds& c, glm:
 }
 // The item runs of the 5 x 5 cells round (cx, cy) that keep(cell bounds)
 // accepts, row-major as cells_3x3; keep must accept a contiguous stretch of
-// each row (a test of distance or of a half-plane, or both). Along a
+// each row (a test of distance or of a half-plane, or both). Of those,
+// keep_slot(slot) may leave out any (a test of what the cell holds). Along a
 // wrapping axis of fewer than 6 cells the cells stay within one of
 // (cx, cy), so that none is visited twice. `slack` widens the bounds
 // (cell_bounds).
-template <class Keep>
+template <class Keep, class KeepSlot>
 THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, float slack,
-                                              const Keep& keep) {
+                                              const Keep& keep, const KeepSlot& keep_slot) {
   Cells5x5 c;
   if (g.items.size() == 0) return c;
   const std::int32_t rx = g.wrap_x > 0 && g.wrap_x < 6 ? 1 : 2;
@@ -243,16 +244,23 @@ THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx
     if (lo > hi) continue;
     if (!dense_row) {
       for (std::int32_t x = lo; x <= hi; ++x)
-        if (const Index s = g.find(x, y); s >= 0) add_run(c, g.start[s], g.count[s]);
+        if (const Index s = g.find(x, y); s >= 0 && keep_slot(s)) add_run(c, g.start[s], g.count[s]);
       continue;
     }
+    // A dense row's slots follow each other, and so do their items: the
+    // runs of neighbouring kept slots join into one.
     const Index a = g.dense_slot(lo > g.dense_x0 ? lo : g.dense_x0, y);
     const Index b = g.dense_slot(hi < g.dense_x0 + g.dense_nx - 1 ? hi : g.dense_x0 + g.dense_nx - 1, y);
     if (a < 0 || b < 0 || a > b) continue;
-    const std::int32_t first = g.start[a], n = g.start[b] + g.count[b] - first;
-    if (n > 0) add_run(c, first, n);
+    for (Index s = a; s <= b; ++s)
+      if (g.count[s] > 0 && keep_slot(s)) add_run(c, g.start[s], g.count[s]);
   }
   return c;
+}
+template <class Keep>
+THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, float slack,
+                                              const Keep& keep) {
+  return kept_cells(g, cx, cy, slack, keep, [](Index) { return true; });
 }
 
 // Calls fn(item) for every item of those cells, in order.

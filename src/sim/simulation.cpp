@@ -24,7 +24,8 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
       scheduler_(spec.scheduler),
       neighbours_(options.neighbours),
       dense_bins_(options.dense_bins),
-      skip_idle_contact_passes_(options.skip_idle_contact_passes) {
+      skip_idle_contact_passes_(options.skip_idle_contact_passes),
+      skip_far_cells_walking_along_(options.skip_far_cells_walking_along) {
   spec_.model.validate();
   world_ = World::build(spec_.world, spec_.model.query_radius(), options.limits, current_memory());
   const CrowdHost host = spawn_crowd(spec_, world_, options.limits, options.planner);
@@ -237,6 +238,16 @@ bool Simulation::admit_entries() {
   return !entered.empty();
 }
 
+// The far look's summary of the steering bins' cells (collision-free speed
+// model only; its buffer grows with the bins' slots); none otherwise.
+Span<const CellHeadings> Simulation::far_headings(const GridView& bins, const BinnedState& state) {
+  if (spec_.model.kind != ModelKind::CollisionFreeSpeed || !skip_far_cells_walking_along_) return {};
+  if (cell_headings_.size() < bins.capacity()) cell_headings_ = Buffer<CellHeadings>(bins.capacity(), current_memory());
+  const Span<CellHeadings> out = cell_headings_.span().subspan(0, bins.capacity());
+  summarise_cell_headings(bins, state, out);
+  return out;
+}
+
 void Simulation::sense_and_steer(const StepContext& ctx) {
   const AgentArrays a = arrays_of(crowd_);
   if (neighbours_ == NeighbourSearch::AllPairs) {
@@ -253,6 +264,7 @@ void Simulation::sense_and_steer(const StepContext& ctx) {
                        binned_radius_.span().subspan(0, items), binned_flags_.span().subspan(0, items),
                        binned_aim_.span().subspan(0, binned_aim_.size() > 0 ? items : 0)};
     gather_binned_state(ctx, a, aim_.span(), gathered.binned);
+    gathered.far_headings = far_headings(ctx.bins, gathered.binned);
     sense_double_buffer(gathered, a, sensed_.span());
     steer_double_buffer(ctx, a, sensed_.span(), candidate_.span());
   } else {
@@ -265,6 +277,7 @@ void Simulation::sense_and_steer(const StepContext& ctx) {
                             binned_flags_.span().subspan(0, items),
                             {}};
       gather_binned_state(ctx, a, {}, coloured.far_state);
+      coloured.far_headings = far_headings(ctx.bins, coloured.far_state);
     }
     sense_steer_four_colour(coloured, a);
   }

@@ -40,6 +40,7 @@
 #include <memory>
 #include <vector>
 
+#include "sim/collision_free_speed.h"
 #include "sim/crowd.h"
 #include "sim/exit_choice.h"
 #include "sim/replanning.h"
@@ -121,6 +122,11 @@ struct StepContext {
   // (add_far_anticipation): its cells, two away, move in the same launch.
   // Empty elsewhere: the far look reads the neighbours the model reads.
   BinnedState far_state;
+  // The collision-free speed model's far look: element s, how the agents
+  // of the steering bins' slot s walk (summarise_cell_headings), from the
+  // state the far look reads; it passes over cells that add nothing
+  // (cfs_cell_walks_along). Empty: every cell is looked at.
+  Span<const CellHeadings> far_headings;
   FieldsView fields;   // navigation fields (none: every agent steers at its waypoint)
   Periodic periodic;   // the world's periodic boundaries (none: periods 0)
   BinnedState binned;  // the double buffer's sense stage: neighbours in item order; else empty
@@ -135,6 +141,9 @@ void sense_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<glm:
 // agent's aim (AgentAim), found first in agent order into `aims` (the reads
 // of its route then run through the crowd's arrays in order), then copied.
 void gather_binned_state(const StepContext& ctx, const AgentArrays& a, Span<AgentAim> aims, const BinnedState& out);
+// out[s]: the walking directions and parked agents of the steering bins'
+// slot s (CellHeadings), from `state`, the bins' items' state in item order.
+void summarise_cell_headings(const GridView& bins, const BinnedState& state, Span<CellHeadings> out);
 // The naive reference for the sense stage: every agent against every other,
 // O(N^2); the same forces as sense_double_buffer (up to ties in urgency).
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed);
@@ -213,13 +222,15 @@ struct SimulationOptions {
   // (the simulation keeps the builder). Null: none.
   std::shared_ptr<const FieldBuilder> fields;
   NeighbourSearch neighbours = NeighbourSearch::Bins;
-  // The reference forms of two shortcuts that change no result (tests
+  // The reference forms of three shortcuts that change no result (tests
   // compare them bit for bit): bins hashed even where a dense box of cells
-  // fits (AgentGrid), and every contact pass run even after one that moved
+  // fits (AgentGrid), every contact pass run even after one that moved
   // nobody, every agent looking at its neighbours in every pass (the double
-  // buffer's passes; contacts_double_buffer).
+  // buffer's passes; contacts_double_buffer), and the collision-free speed
+  // model's far look through every cell in reach (StepContext::far_headings).
   bool dense_bins = true;
   bool skip_idle_contact_passes = true;
+  bool skip_far_cells_walking_along = true;
 };
 
 class Simulation {
@@ -272,6 +283,7 @@ class Simulation {
   // planning: quickest: every field built again at the crowd's density.
   void reweigh_fields();
   void sense_and_steer(const StepContext& ctx);
+  Span<const CellHeadings> far_headings(const GridView& bins, const BinnedState& state);
   void move(const StepContext& ctx);
   StepContext context() const;
 
@@ -282,7 +294,7 @@ class Simulation {
   AgentGrid contact_bins_;
   SchedulerKind scheduler_ = SchedulerKind::DoubleBuffer;
   NeighbourSearch neighbours_ = NeighbourSearch::Bins;
-  bool dense_bins_ = true, skip_idle_contact_passes_ = true;
+  bool dense_bins_ = true, skip_idle_contact_passes_ = true, skip_far_cells_walking_along_ = true;
   float max_radius_ = 0.0f;
   std::int64_t steps_done_ = 0;
   std::int32_t contact_passes_ = 0;
@@ -292,11 +304,12 @@ class Simulation {
   Buffer<glm::vec2> binned_position_, binned_velocity_;  // the steering bins' items' state (gather_binned_state)
   Buffer<float> binned_radius_;
   Buffer<std::uint8_t> binned_flags_;
-  Buffer<AgentAim> aim_, binned_aim_;  // each agent's aim, in agent order and in the bins' item order
-  Buffer<std::int32_t> moved_before_;  // contact items moved by the last pass, counted (mark_moved_items)
-  std::vector<PendingEntry> pending_;  // by entry time, then agent
-  ExitChooser exits_;                  // groups choosing the quickest exit
-  Replanner replan_;                   // planned routes, planned again for agents pushed off them
+  Buffer<CellHeadings> cell_headings_;  // per slot of the steering bins (summarise_cell_headings)
+  Buffer<AgentAim> aim_, binned_aim_;   // each agent's aim, in agent order and in the bins' item order
+  Buffer<std::int32_t> moved_before_;   // contact items moved by the last pass, counted (mark_moved_items)
+  std::vector<PendingEntry> pending_;   // by entry time, then agent
+  ExitChooser exits_;                   // groups choosing the quickest exit
+  Replanner replan_;                    // planned routes, planned again for agents pushed off them
   NavigationFields fields_;
   // planning: quickest: the builder and each field's target and radius.
   std::shared_ptr<const FieldBuilder> quickest_builder_;

@@ -267,14 +267,18 @@ THRONG_HOST_DEVICE inline glm::vec2 sense_binned(const StepContext& ctx, const A
     // The far look's cells: the 5 x 5 round the agent's, those touching the
     // reach and the half-plane ahead of it (along e0); read as binned under
     // the four colours (StepContext::far_state).
+    // Cells none of whose agents the far push could anticipate are passed
+    // over (StepContext::far_headings).
     auto far = [&](glm::vec2 e0, float reach2, const auto& fn) {
       const glm::vec2 p = n.position[self];
       auto keep = [&](const CellBounds& c) { return cell_ahead_within_reach(c, p, e0, reach2); };
+      const Span<const CellHeadings> headings = ctx.far_headings;
+      auto keep_slot = [&](Index s) { return headings.size() == 0 || !cfs_cell_walks_along(headings[s], e0); };
       const BinnedState& b = ctx.far_state;
       const NeighbourArrays from =
           b.position.size() == 0 ? n : NeighbourArrays{b.position, b.velocity,   b.radius,
                                                        b.flags,    ctx.periodic, ctx.bins.items};
-      const Cells5x5 far_cells = kept_cells(ctx.bins, cx, cy, ctx.bin_slack, keep);
+      const Cells5x5 far_cells = kept_cells(ctx.bins, cx, cy, ctx.bin_slack, keep, keep_slot);
       fn(from, [&](const auto& c) { for_each_binned_candidate(ctx.bins, far_cells, from, c); });
     };
     return sense_candidates(ctx, a, n, i, self, candidates, far);
@@ -598,6 +602,21 @@ void gather_binned_state(const StepContext& ctx, const AgentArrays& a, Span<Agen
   count_traffic("sim.sense.gather", items, a.position, a.velocity, a.radius, a.flags, b.position, b.velocity, b.radius,
                 b.flags);
   if (aimed) count_traffic("sim.sense.gather", aims, b.aim);
+}
+
+void summarise_cell_headings(const GridView& bins, const BinnedState& state, Span<CellHeadings> out) {
+  const Span<const glm::vec2> velocity = state.velocity;
+  const Span<const std::uint8_t> flags = state.flags;
+  parallel_for(
+      "sim.sense.headings", bins.capacity(),
+      THRONG_LAMBDA(Index s) {
+        CellHeadings h;
+        const std::int32_t b = bins.start[s], n = bins.count[s];
+        for (std::int32_t k = b; k < b + n; ++k) add_heading(h, velocity[k], (flags[k] & kAgentStopped) != 0);
+        out[s] = h;
+      },
+      kSlotGrain);
+  count_traffic("sim.sense.headings", bins.start, bins.count, velocity, flags, out);
 }
 
 void sense_all_pairs(const StepContext& ctx, const AgentArrays& a, Span<glm::vec2> sensed) {

@@ -208,12 +208,14 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
 // kept_cells against the cells one by one: the items of every cell within
 // two of the agent's whose bounds `keep` accepts (a disc of reach and the
 // half-plane ahead), row by row, in the same order; and every item within
-// the reach and ahead among them. Dense and hashed grids, and a periodic
+// the reach and ahead among them; and the same with some slots left out
+// by keep_slot. Dense and hashed grids, and a periodic
 // area too short for five cells along x (the cells there stay within one).
 void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p, const Periodic& periodic) {
   const GridView v = g.view();
   std::mt19937 rng(6);
   std::uniform_real_distribution<float> turn(0.0f, 6.2831853f);
+  std::size_t all_items = 0, slot_items = 0;
   for (int q = 0; q < 400; ++q) {
     const std::size_t i = rng() % p.size();
     const float a = turn(rng), reach = 6.0f;
@@ -224,15 +226,25 @@ void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p
     };
     const std::int32_t cx = v.cell_x(at.x), cy = v.cell_y(at.y);
     const std::int32_t rx = v.wrap_x > 0 && v.wrap_x < 6 ? 1 : 2;
-    std::vector<std::int32_t> expected, got;
+    // Some slots left out by what they hold (here: every third), so the
+    // runs of a row break anywhere.
+    const std::uint32_t salt = rng();
+    auto keep_slot = [&](Index s) { return (static_cast<std::uint32_t>(s) + salt) % 3 != 0; };
+    std::vector<std::int32_t> expected, got, expected_slots, got_slots;
     for (std::int32_t dy = -2; dy <= 2; ++dy)
       for (std::int32_t dx = -rx; dx <= rx; ++dx) {
         const Index s = v.find(cx + dx, cy + dy);
         if (s < 0 || !keep(cell_bounds(v, cx + dx, cy + dy, 0.0f))) continue;
         for (std::int32_t k = 0; k < v.count[s]; ++k) expected.push_back(v.items[v.start[s] + k]);
+        if (keep_slot(s))
+          for (std::int32_t k = 0; k < v.count[s]; ++k) expected_slots.push_back(v.items[v.start[s] + k]);
       }
     for_each_in_cells(v, kept_cells(v, cx, cy, 0.0f, keep), [&](std::int32_t j) { got.push_back(j); });
+    for_each_in_cells(v, kept_cells(v, cx, cy, 0.0f, keep, keep_slot), [&](std::int32_t j) { got_slots.push_back(j); });
     ASSERT_EQ(expected, got) << "around agent " << i;
+    ASSERT_EQ(expected_slots, got_slots) << "around agent " << i;
+    all_items += got.size();
+    slot_items += got_slots.size();
     const std::set<std::int32_t> kept(got.begin(), got.end());
     for (std::size_t j = 0; j < p.size(); ++j) {
       const glm::vec2 d = periodic.near(p[j], at) - at;
@@ -241,6 +253,7 @@ void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p
       }
     }
   }
+  EXPECT_LT(slot_items, all_items);  // keep_slot left some out
 }
 
 TEST(Bins, KeptCellsOfTheFiveByFiveAreThoseAcceptedCellByCell) {

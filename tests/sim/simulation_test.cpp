@@ -363,17 +363,21 @@ TEST(Determinism, FourColourIsBitwiseTheSameForOneTwoAndFourThreads) {
   }
 }
 
-// Two shortcuts that must change no bit, against their reference forms:
-// dense bins (a box of cells indexed directly) against hashed ones, and
-// the double buffer's contact passes ending at the first that moved nobody
+// Three shortcuts that must change no bit, against their reference forms:
+// dense bins (a box of cells indexed directly) against hashed ones; the
+// double buffer's contact passes ending at the first that moved nobody
 // and passing over agents whose move cells the pass before left still
-// against every pass run by every agent. The bottleneck's bins are dense and its jam needs
+// against every pass run by every agent; and the collision-free speed
+// model's far look passing over cells whose agents all walk the agent's
+// way against looking through every cell. The bottleneck's bins are dense and its jam needs
 // every pass; the circle's contact bins are hashed (a ring 100 m across in
-// cells of 1 m) and most of its steps move nobody in their second pass.
-TEST(Determinism, DenseBinsAndSkippedIdleContactPassesChangeNoBit) {
+// cells of 1 m) and most of its steps move nobody in their second pass;
+// the bottleneck's crowd streams to its door.
+TEST(Determinism, DenseBinsSkippedIdleContactPassesAndFarCellsChangeNoBit) {
   SimulationOptions reference;
   reference.dense_bins = false;
   reference.skip_idle_contact_passes = false;
+  reference.skip_far_cells_walking_along = false;
   for_each_model_and_scene(
       {{"bottleneck", 300, 300}, {"circle", 300, 300}}, [&](const ScenarioSpec& spec, std::int64_t steps) {
         for (const SchedulerKind scheduler : {SchedulerKind::DoubleBuffer, SchedulerKind::FourColour})
