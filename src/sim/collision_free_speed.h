@@ -139,7 +139,8 @@ THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 cfs_neighbour_push(const CfsAgent& i,
 // anticipates neighbours out to cfs_far_reach: A_ij alone, from
 // cfs_far_push. In crowds few agents qualify (the laboratory doors and the
 // dense counterflow moved little); among free walkers it visits the
-// candidates of up to 15 more cells (docs/simulation.md, Performance).
+// candidates of up to 15 more cells, less those whose agents all walk its
+// way (cfs_cell_walks_along below; docs/simulation.md, Performance).
 inline constexpr float kCfsFarSpeed = 0.5f;
 inline constexpr int kCfsFarCrowd = 12;
 // m: 2 max_radius + avoid_time max_speed, at most twice the query radius
