@@ -139,8 +139,9 @@ THRONG_HOST_DEVICE THRONG_INLINE glm::vec2 cfs_neighbour_push(const CfsAgent& i,
 // anticipates neighbours out to cfs_far_reach: A_ij alone, from
 // cfs_far_push. In crowds few agents qualify (the laboratory doors and the
 // dense counterflow moved little); among free walkers it visits the
-// candidates of up to 15 more cells, less those whose agents all walk its
-// way (cfs_cell_walks_along below; docs/simulation.md, Performance).
+// candidates of up to 15 more cells, less those none of whose agents it
+// could anticipate (cfs_cell_walks_along below; docs/simulation.md,
+// Performance).
 inline constexpr float kCfsFarSpeed = 0.5f;
 inline constexpr int kCfsFarCrowd = 12;
 // m: 2 max_radius + avoid_time max_speed, at most twice the query radius
@@ -165,23 +166,26 @@ THRONG_HOST_DEVICE inline bool cfs_far_push(const CfsAgent& i, glm::vec2 q, glm:
 
 // The far look passes over a whole cell none of whose agents it could
 // anticipate (the same sums: such a cell adds nothing). The push needs a
-// neighbour parked, or coming (faster than kCfsOncoming) and walking at
-// least 60 degrees off the agent's e0 (`against`). CellHeadings holds
-// whether any agent of a cell is parked and the box of the unit walking
-// directions of those faster than kCfsHeadingSpeed (slower ones cannot be
-// coming); a cell with nobody parked whose box lies kCfsHeadingMargin
-// inside cos 60 of e0 is passed over. In a stream, where everybody walks
-// one way, that is nearly every cell.
+// neighbour parked, or one closing in on the agent at more than
+// kCfsOncoming (-w . u) and walking more than 60 degrees off the agent's e0
+// (`against`). CellHeadings holds whether a cell must be looked at
+// whatever e0 (somebody parked, or a velocity not finite) and the box of
+// the unit walking directions of its agents faster than kCfsHeadingSpeed
+// (slower ones cannot close in fast enough); any other cell whose box lies
+// kCfsHeadingMargin inside cos 60 of e0 is passed over. In a stream, where
+// everybody walks one way, that is nearly every cell; so is a cell where
+// nobody walks faster than kCfsHeadingSpeed (and nobody is parked).
 inline constexpr float kCfsHeadingSpeed = 0.8f * kCfsOncoming;  // m/s
 inline constexpr float kCfsHeadingMargin = 0.01f;               // of the cosine: room for rounding
 struct CellHeadings {
   glm::vec2 lo{INFINITY}, hi{-INFINITY};
-  std::int32_t parked = 0;
+  std::int32_t look = 0;  // 1: looked at for any e0
 };
 THRONG_HOST_DEVICE inline void add_heading(CellHeadings& h, glm::vec2 w, bool parked) {
-  h.parked |= parked ? 1 : 0;
   const float w2 = length2(w);
-  if (!(w2 >= kCfsHeadingSpeed * kCfsHeadingSpeed)) return;
+  // (An infinite component would leave a NaN direction out of the box.)
+  h.look |= parked || !(w2 < INFINITY) ? 1 : 0;
+  if (!(w2 >= kCfsHeadingSpeed * kCfsHeadingSpeed) || h.look != 0) return;
   const glm::vec2 u = w * (1.0f / sqrtf(w2));
   h.lo = {u.x < h.lo.x ? u.x : h.lo.x, u.y < h.lo.y ? u.y : h.lo.y};
   h.hi = {u.x > h.hi.x ? u.x : h.hi.x, u.y > h.hi.y ? u.y : h.hi.y};
@@ -189,7 +193,7 @@ THRONG_HOST_DEVICE inline void add_heading(CellHeadings& h, glm::vec2 w, bool pa
 // True when no agent of the cell can be anticipated by one with goal
 // direction e0 (the least of e0 . u over the box is at one of its corners).
 THRONG_HOST_DEVICE inline bool cfs_cell_walks_along(const CellHeadings& h, glm::vec2 e0) {
-  if (h.parked != 0) return false;
+  if (h.look != 0) return false;
   if (h.lo.x > h.hi.x) return true;  // nobody fast enough to be coming
   const float least = (e0.x >= 0.0f ? h.lo.x : h.hi.x) * e0.x + (e0.y >= 0.0f ? h.lo.y : h.hi.y) * e0.y;
   return least >= kCfsAgainst + kCfsHeadingMargin;

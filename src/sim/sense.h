@@ -106,10 +106,12 @@ THRONG_HOST_DEVICE inline void for_each_wall_point(const WorldView& w, glm::vec2
 // The far look of the collision-free speed model (cfs_looks_far): A_ij of
 // every neighbour beyond the query radius and within cfs_far_reach added to
 // `sum`. for_each_far_candidate(e0, reach2, fn) is given the agent's goal
-// direction and the reach squared (to leave out cells wholly behind or
-// beyond) and calls fn(from, candidates) with the neighbour arrays to read
-// and the candidates in them (a for_each_candidate, neighbours.h), in the
-// order their pushes are summed. The agent itself lies within the query
+// direction (me.e0, the one the push tests) and the reach squared (to
+// leave out cells wholly behind or beyond, and those whose agents push
+// nothing for that e0: cfs_cell_walks_along) and calls fn(from,
+// candidates) with the neighbour arrays to read and the candidates in them
+// (a for_each_candidate, neighbours.h), in the order their pushes are
+// summed. The agent itself lies within the query
 // radius. The candidates are sifted first (for_each_sifted) by the tests
 // of the push that need only the position: within the band and
 // cfs_ahead_of, which cfs_add_anticipation tests too, so the sift drops

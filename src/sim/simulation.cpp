@@ -61,6 +61,8 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
     aim_ = Buffer<AgentAim>::zeros(crowd_.count, m);
     binned_aim_ = Buffer<AgentAim>::zeros(crowd_.count, m);
   }
+  // (the steering bins' slots: at most their hash table's capacity)
+  if (summarises_far_cells()) cell_headings_ = Buffer<CellHeadings>(grid_capacity_for(crowd_.count), m);
 }
 
 StepContext Simulation::context() const {
@@ -241,11 +243,17 @@ bool Simulation::admit_entries() {
 // The far look's summary of the steering bins' cells (collision-free speed
 // model only; its buffer grows with the bins' slots); none otherwise.
 Span<const CellHeadings> Simulation::far_headings(const GridView& bins, const BinnedState& state) {
-  if (spec_.model.kind != ModelKind::CollisionFreeSpeed || !skip_far_cells_walking_along_) return {};
+  if (!summarises_far_cells()) return {};
   if (cell_headings_.size() < bins.capacity()) cell_headings_ = Buffer<CellHeadings>(bins.capacity(), current_memory());
   const Span<CellHeadings> out = cell_headings_.span().subspan(0, bins.capacity());
   summarise_cell_headings(bins, state, out);
+  far_cells_summarised_ = bins.capacity();
   return out;
+}
+// (Without anticipation the far look never runs.)
+bool Simulation::summarises_far_cells() const {
+  return spec_.model.kind == ModelKind::CollisionFreeSpeed && spec_.model.cfs.avoid_strength > 0.0f &&
+         skip_far_cells_walking_along_;
 }
 
 void Simulation::sense_and_steer(const StepContext& ctx) {

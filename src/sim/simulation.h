@@ -260,6 +260,9 @@ class Simulation {
   // passes a jam needed; under the double buffer fewer when a pass moved
   // nobody (the passes left would have changed nothing).
   std::int32_t last_contact_passes() const { return contact_passes_; }
+  // Steering bins' slots the far look's summary covered in the last step
+  // that made one (StepContext::far_headings); 0 when none was made.
+  Index far_cells_summarised() const { return far_cells_summarised_; }
   double time() const { return static_cast<double>(steps_done_) * spec_.dt; }
   Index agent_count() const { return crowd_.count; }
 
@@ -284,6 +287,7 @@ class Simulation {
   void reweigh_fields();
   void sense_and_steer(const StepContext& ctx);
   Span<const CellHeadings> far_headings(const GridView& bins, const BinnedState& state);
+  bool summarises_far_cells() const;
   void move(const StepContext& ctx);
   StepContext context() const;
 
@@ -298,6 +302,7 @@ class Simulation {
   float max_radius_ = 0.0f;
   std::int64_t steps_done_ = 0;
   std::int32_t contact_passes_ = 0;
+  Index far_cells_summarised_ = 0;
   Buffer<glm::vec2> anchor_, candidate_, scratch_, sensed_;
   Buffer<float> contact_depth_;  // per agent: the deepest overlap the last contact pass found
   Buffer<MoveCells> move_cells_;

@@ -205,9 +205,10 @@ TEST(CollisionFreeSpeed, FarLookPassesOverOnlyCellsWhoseAgentsNobodyAnticipates)
   }
   EXPECT_GT(passed, 500);
   EXPECT_GT(kept, 500);
-  // Where a push can come from, the cell is kept: somebody parked, or a
-  // walker 70 degrees off e0; walkers within 50 degrees, or too slow to be
-  // coming whichever way they walk, are passed over.
+  // Where a push can come from, the cell is kept: somebody parked, a
+  // walker 70 degrees off e0, or one of infinite speed; walkers within 50
+  // degrees, or too slow to be coming whichever way they walk, are passed
+  // over.
   const glm::vec2 e0(1.0f, 0.0f);
   CellHeadings h;
   EXPECT_TRUE(cfs_cell_walks_along(h, e0));  // nobody
@@ -215,11 +216,16 @@ TEST(CollisionFreeSpeed, FarLookPassesOverOnlyCellsWhoseAgentsNobodyAnticipates)
   add_heading(h, direction(-0.87f), false);
   add_heading(h, 0.03f * direction(3.0f), false);
   EXPECT_TRUE(cfs_cell_walks_along(h, e0));
-  CellHeadings with_parked = h, with_crosser = h;
+  CellHeadings with_parked = h, with_crosser = h, with_infinite = h;
   add_heading(with_parked, glm::vec2(0.0f), true);
   add_heading(with_crosser, direction(1.22f), false);
+  add_heading(with_infinite, glm::vec2(-INFINITY, 0.0f), false);
   EXPECT_FALSE(cfs_cell_walks_along(with_parked, e0));
   EXPECT_FALSE(cfs_cell_walks_along(with_crosser, e0));
+  EXPECT_FALSE(cfs_cell_walks_along(with_infinite, e0));  // (it would push: coming, against)
+  glm::vec2 f;
+  EXPECT_TRUE(
+      cfs_far_push({{0.0f, 0.0f}, {1.0f, 0.0f}, 0.2f, e0}, {9.0f, 0.0f}, {-INFINITY, 0.0f}, 0.2f, false, m.cfs, f));
   EXPECT_FALSE(cfs_cell_walks_along(h, -e0));
 }
 
@@ -227,7 +233,7 @@ TEST(CollisionFreeSpeed, FarLookPassesOverOnlyCellsWhoseAgentsNobodyAnticipates)
 // walkers and a parked agent among it, each agent's velocity the same bit for bit with
 // the far look passing over cells (summarise_cell_headings) as without,
 // from far fewer candidates.
-TEST(CollisionFreeSpeed, FarLookPassingOverCellsGivesTheSameVelocities) {
+void expect_same_velocities_passing_over_cells(bool dense) {
   const ModelParams m;
   const float query = m.query_radius();
   std::mt19937 rng(12);
@@ -245,7 +251,8 @@ TEST(CollisionFreeSpeed, FarLookPassingOverCellsGivesTheSameVelocities) {
   std::vector<std::uint8_t> flags(p.size(), kAgentActive);
   flags[700] |= kAgentStopped;
   AgentGrid bins(query);
-  bins.rebuild(Span<const glm::vec2>(p), Span<const std::uint8_t>(flags));
+  bins.rebuild(Span<const glm::vec2>(p), Span<const std::uint8_t>(flags), dense);
+  ASSERT_EQ(bins.dense(), dense);
   const GridView g = bins.view();
   const auto items = static_cast<std::size_t>(g.items.size());
   std::vector<glm::vec2> bp(items), bv(items);
@@ -272,32 +279,40 @@ TEST(CollisionFreeSpeed, FarLookPassingOverCellsGivesTheSameVelocities) {
                           g.items};
   const World world = World::build(WorldSpec{}, query);
   long visited_all = 0, visited_kept = 0;
-  int turned = 0;
+  int looked_far = 0;
   for (Index k = 0; k < static_cast<Index>(items); k += 3) {
     const glm::vec2 at = bp[static_cast<std::size_t>(k)];
     const std::int32_t cx = g.cell_x(at.x), cy = g.cell_y(at.y);
     auto near = [&](const auto& fn) { for_each_binned_candidate(g, cells_3x3(g, cx, cy), n, fn); };
-    auto far_through = [&](bool skip, long& visited) {
-      return [&, skip](glm::vec2 e0, float reach2, const auto& fn) {
+    auto far_through = [&](bool skip, long* visited) {
+      return [&, skip, visited](glm::vec2 e0, float reach2, const auto& fn) {
         auto keep = [&](const CellBounds& c) { return cell_ahead_within_reach(c, at, e0, reach2); };
         auto keep_slot = [&](Index s) {
           return !skip || !cfs_cell_walks_along(headings[static_cast<std::size_t>(s)], e0);
         };
         const Cells5x5 cells = kept_cells(g, cx, cy, 0.0f, keep, keep_slot);
-        for (int run = 0; run < cells.runs; ++run) visited += cells.count[run];
+        for (int run = 0; run < cells.runs; ++run) *visited += cells.count[run];
         fn(n, [&](const auto& c) { for_each_binned_candidate(g, cells, n, c); });
       };
     };
     const CfsAgent me{at, bv[static_cast<std::size_t>(k)], 0.25f, {1.0f, 0.0f}};
     const glm::vec2 all =
-        collision_free_velocity(world.view(), k, me, 1.3f, 0.25f, n, m, near, far_through(false, visited_all));
+        collision_free_velocity(world.view(), k, me, 1.3f, 0.25f, n, m, near, far_through(false, &visited_all));
     const glm::vec2 kept =
-        collision_free_velocity(world.view(), k, me, 1.3f, 0.25f, n, m, near, far_through(true, visited_kept));
+        collision_free_velocity(world.view(), k, me, 1.3f, 0.25f, n, m, near, far_through(true, &visited_kept));
     EXPECT_EQ(all, kept) << "agent " << g.items[k];
-    turned += std::fabs(all.y) > 0.05f ? 1 : 0;
+    auto blind = [](glm::vec2, float, const auto&) {};
+    looked_far += all != collision_free_velocity(world.view(), k, me, 1.3f, 0.25f, n, m, near, blind) ? 1 : 0;
   }
-  EXPECT_GT(turned, 10);  // the oncoming walkers are anticipated
+  EXPECT_GT(looked_far, 10);  // the far look changed some velocities
   EXPECT_LT(visited_kept * 3, visited_all);
+}
+
+TEST(CollisionFreeSpeed, FarLookPassingOverCellsGivesTheSameVelocities) {
+  for (const bool dense : {true, false}) {
+    SCOPED_TRACE(dense ? "dense bins" : "hashed bins");
+    expect_same_velocities_passing_over_cells(dense);
+  }
 }
 
 TEST(CollisionFreeSpeed, WallsSlideTheGoalDirectionAndTurnsTakeTime) {

@@ -393,6 +393,10 @@ TEST(Determinism, DenseBinsSkippedIdleContactPassesAndFarCellsChangeNoBit) {
   EXPECT_FALSE(full.bins().dense());
   EXPECT_EQ(sim.last_contact_passes(), 1);
   EXPECT_EQ(full.last_contact_passes(), spec.model.contact_iterations);
+  // (the circle's default model is the collision-free speed model)
+  ASSERT_EQ(spec.model.kind, ModelKind::CollisionFreeSpeed);
+  EXPECT_GT(sim.far_cells_summarised(), 0);
+  EXPECT_EQ(full.far_cells_summarised(), 0);
 }
 
 // The contact passes' other shortcut at the kernel: past the first pass an
