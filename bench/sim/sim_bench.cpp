@@ -101,7 +101,8 @@ std::string shuffled_disc_text(Index n, sim::ModelKind model) {
 }
 
 // The disc as it is; the step without its shortcuts (Reference: hashed
-// bins, every contact pass; sim::SimulationOptions), the same bits at what
+// bins counted with atomics, every contact pass, the far look through every
+// cell; sim::SimulationOptions), the same bits at what
 // they cost before the shortcuts; its agents in a random order (Shuffled,
 // shuffled_disc_text).
 enum class DiscKind { Plain, Reference, Shuffled };
@@ -110,6 +111,7 @@ std::unique_ptr<sim::Simulation> fresh_disc(Index n, sim::ModelKind model, DiscK
   sim::SimulationOptions options;
   options.dense_bins = options.skip_idle_contact_passes = options.skip_far_cells_walking_along =
       kind != DiscKind::Reference;
+  if (kind == DiscKind::Reference) options.bin_counting = sim::BinCounting::Atomic;
   std::string text;
   if (kind == DiscKind::Shuffled) {
     std::string& t = shuffled[{n, model}];

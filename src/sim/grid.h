@@ -321,6 +321,15 @@ class StaticGrid {
   Buffer<std::int32_t> start_, count_, items_;
 };
 
+// How AgentGrid::rebuild counts agents into their cells on the CPU. By
+// slot range: each task owns a range of slots and passes over every agent
+// in index order, counting (then placing) those whose cell is in its range:
+// no atomic, and each cell's run comes out in index order with no sort.
+// Atomic: a locked add per agent, placement in any order, then each run
+// sorted; what the device does (the CPU's reference for it). Both give the
+// same bins.
+enum class BinCounting : std::uint8_t { BySlotRange, Atomic };
+
 // Agents binned by position, rebuilt each step (kernels in grid_kernels.cpp).
 class AgentGrid {
  public:
@@ -335,6 +344,8 @@ class AgentGrid {
   // has at most as many cells as the hash table would have slots, unless
   // `allow_dense` is false (tests compare both).
   void rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, bool allow_dense = true);
+  // The CPU's way of counting (the device always counts with atomics).
+  void set_counting(BinCounting counting) { counting_ = counting; }
   bool dense() const { return dense_nx_ > 0; }
   // The table's slots in use: a dense grid's box of cells, else the whole table.
   Index slots() const { return dense() ? Index{dense_nx_} * dense_ny_ : keys_.size(); }
@@ -351,6 +362,9 @@ class AgentGrid {
  private:
   void choose_layout(GridView& cells, Span<const glm::vec2> positions, Span<const std::uint8_t> flags,
                      bool allow_dense);
+  // Fills count, start and items from slot_of by slot range (BinCounting);
+  // returns the agents binned.
+  Index place_by_slot_range(Index slots);
 
   float asked_ = 1.0f, cell_size_ = 1.0f, cell_size_y_ = 1.0f;
   Periodic periodic_;
@@ -358,6 +372,7 @@ class AgentGrid {
   std::uint64_t mask_ = 0;
   std::int32_t dense_x0_ = 0, dense_y0_ = 0, dense_nx_ = 0, dense_ny_ = 0;  // as GridView's
   Index binned_ = 0;
+  BinCounting counting_ = BinCounting::BySlotRange;
   Buffer<std::uint64_t> keys_;
   Buffer<std::int32_t> start_, count_, cursor_, items_, slot_of_agent_;
 };

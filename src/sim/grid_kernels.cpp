@@ -65,8 +65,9 @@ struct Enclose {
 };
 
 // The slot of each active agent's cell (-1 for inactive agents), its count
-// raised. A dense grid's slot is the cell's index in the box, no hashing; a
-// hashed grid finds or claims the cell's slot by probing.
+// raised unless `count` is empty. A dense grid's slot is the cell's index in
+// the box, no hashing; a hashed grid finds or claims the cell's slot by
+// probing.
 struct CountCells {
   GridView cells;
   Span<const glm::vec2> positions;
@@ -82,7 +83,7 @@ struct CountCells {
     cells.wrap(cx, cy);
     const Index s = cells.dense_nx > 0 ? cells.dense_slot(cx, cy) : claim(cells.key_of(cx, cy));
     slot_of[i] = static_cast<std::int32_t>(s);
-    atomic_fetch_add(&count[s], 1);
+    if (!count.empty()) atomic_fetch_add(&count[s], 1);
   }
   THRONG_HOST_DEVICE Index claim(std::uint64_t key) const {
     std::uint64_t s = home_slot(key, cells.mask);
@@ -134,29 +135,41 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
         cursor[s] = 0;
       });
   count_traffic("sim.bin.clear", keys, count, cursor);
-  parallel_for("sim.bin.count", n, CountCells{cells, positions, flags, keys, count, slot_of});
-  count_traffic("sim.bin.count", positions, flags, keys, count, count, slot_of);
-  binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
-  count_traffic("sim.bin.scan", count, start);
-  // Scatter in arbitrary order, then sort each run by agent index (and
-  // give a dense grid's occupied slots their keys, for the slot-by-slot
-  // launches of the four colours).
-  parallel_for(
-      "sim.bin.scatter", n, THRONG_LAMBDA(Index i) {
-        const std::int32_t s = slot_of[i];
-        if (s < 0) return;
-        const std::int32_t k = atomic_fetch_add(&cursor[s], 1);
-        items[start[s] + k] = static_cast<std::int32_t>(i);
-      });
-  count_traffic("sim.bin.scatter", slot_of, cursor, cursor, start, items);
+  // On the CPU, count and place by slot range (BinCounting): no atomic
+  // but the hashed grid's claims, and runs in index order as placed.
+  const bool by_range = counting_ == BinCounting::BySlotRange && current_backend() == Backend::Cpu;
+  if (by_range) {
+    parallel_for("sim.bin.slot", n, CountCells{cells, positions, flags, keys, {}, slot_of});
+    count_traffic("sim.bin.slot", positions, flags, keys, slot_of);
+    binned_ = place_by_slot_range(slots);
+  } else {
+    parallel_for("sim.bin.count", n, CountCells{cells, positions, flags, keys, count, slot_of});
+    count_traffic("sim.bin.count", positions, flags, keys, count, count, slot_of);
+    binned_ = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
+    count_traffic("sim.bin.scan", count, start);
+    // Scatter in arbitrary order; the next pass sorts each run by agent index.
+    parallel_for(
+        "sim.bin.scatter", n, THRONG_LAMBDA(Index i) {
+          const std::int32_t s = slot_of[i];
+          if (s < 0) return;
+          const std::int32_t k = atomic_fetch_add(&cursor[s], 1);
+          items[start[s] + k] = static_cast<std::int32_t>(i);
+        });
+    count_traffic("sim.bin.scatter", slot_of, cursor, cursor, start, items);
+  }
+  // Sort the atomic path's runs by agent index, and give a dense grid's
+  // occupied slots their keys, for the slot-by-slot launches of the four
+  // colours.
   const bool is_dense = dense();
+  if (by_range && !is_dense) return;
   parallel_for(
       "sim.bin.sort", slots, THRONG_LAMBDA(Index s) {
         const std::int32_t c = count[s];
-        if (c > 1) sort_run(items.data() + start[s], c);
+        if (c > 1 && !by_range) sort_run(items.data() + start[s], c);
         if (is_dense && c > 0) {
-          const auto x = static_cast<std::int32_t>(s % cells.dense_nx),
-                     y = static_cast<std::int32_t>(s / cells.dense_nx);
+          // Slots number fewer than 2^32 (twice the agents at most): a 32-bit division.
+          const auto s32 = static_cast<std::uint32_t>(s), nx = static_cast<std::uint32_t>(cells.dense_nx);
+          const auto x = static_cast<std::int32_t>(s32 % nx), y = static_cast<std::int32_t>(s32 / nx);
           keys[s] = cell_key(cells.dense_x0 + x, cells.dense_y0 + y);
         }
       });

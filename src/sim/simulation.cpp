@@ -45,6 +45,8 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   bins_ = AgentGrid(spec_.model.query_radius(), world_.periodic());
   for (const GroupSpec& g : spec_.groups) max_radius_ = std::max(max_radius_, g.radius);
   contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()), world_.periodic());
+  bins_.set_counting(options.bin_counting);
+  contact_bins_.set_counting(options.bin_counting);
   const Memory m = current_memory();
   anchor_ = Buffer<glm::vec2>(crowd_.count, m);
   candidate_ = Buffer<glm::vec2>(crowd_.count, m);

@@ -222,13 +222,15 @@ struct SimulationOptions {
   // (the simulation keeps the builder). Null: none.
   std::shared_ptr<const FieldBuilder> fields;
   NeighbourSearch neighbours = NeighbourSearch::Bins;
-  // The reference forms of three shortcuts that change no result (tests
+  // The reference forms of four shortcuts that change no result (tests
   // compare them bit for bit): bins hashed even where a dense box of cells
-  // fits (AgentGrid), every contact pass run even after one that moved
-  // nobody, every agent looking at its neighbours in every pass (the double
-  // buffer's passes; contacts_double_buffer), and the collision-free speed
-  // model's far look through every cell in reach (StepContext::far_headings).
+  // fits (AgentGrid), and counted with atomics then sorted (BinCounting),
+  // every contact pass run even after one that moved nobody, every agent
+  // looking at its neighbours in every pass (the double buffer's passes;
+  // contacts_double_buffer), and the collision-free speed model's far look
+  // through every cell in reach (StepContext::far_headings).
   bool dense_bins = true;
+  BinCounting bin_counting = BinCounting::BySlotRange;
   bool skip_idle_contact_passes = true;
   bool skip_far_cells_walking_along = true;
 };

@@ -45,7 +45,8 @@ Binned read_back(const AgentGrid& g) {
 
 TEST(CountingSort, EveryActiveAgentOnceInItsCellInIndexOrder) {
   const float cell = 4.0f;
-  std::vector<glm::vec2> p = random_points(20000, 150.0f, 1);
+  // Enough agents for four tasks by slot range on four threads.
+  std::vector<glm::vec2> p = random_points(33000, 150.0f, 1);
   // Crowded cells and cell borders too.
   for (int k = 0; k < 500; ++k) p.push_back({1.0f, 1.0f});
   for (int k = 0; k < 50; ++k) p.push_back({4.0f * static_cast<float>(k % 7), -8.0f});
@@ -62,32 +63,35 @@ TEST(CountingSort, EveryActiveAgentOnceInItsCellInIndexOrder) {
   }
   // The box of occupied cells (76 x 76) fits the table: dense unless
   // hashing is asked for; both layouts hold the same runs.
-  for (const bool dense : {true, false})
-    for (int threads : {1, 2, 4}) {
-      SCOPED_TRACE(dense ? "dense" : "hashed");
-      ScopedExecution exec(Backend::Cpu, threads);
-      AgentGrid g(cell);
-      g.rebuild(p, flags, dense);
-      EXPECT_EQ(g.dense(), dense);
-      const Binned got = read_back(g);
-      EXPECT_EQ(got.binned, active) << threads;
-      EXPECT_EQ(got.cells, want) << threads << " threads";
-      EXPECT_EQ(g.occupied_cells(), static_cast<Index>(want.size()));
-      // find() reaches every cell; an empty cell is not found, in the box or out of it.
-      const GridView v = g.view();
-      for (const auto& [c, items] : want) {
-        const Index s = v.find(c.first, c.second);
-        ASSERT_GE(s, 0);
-        EXPECT_EQ(v.count[s], static_cast<std::int32_t>(items.size()));
+  for (const BinCounting counting : {BinCounting::BySlotRange, BinCounting::Atomic})
+    for (const bool dense : {true, false})
+      for (int threads : {1, 2, 4}) {
+        SCOPED_TRACE(dense ? "dense" : "hashed");
+        SCOPED_TRACE(counting == BinCounting::Atomic ? "atomic" : "by slot range");
+        ScopedExecution exec(Backend::Cpu, threads);
+        AgentGrid g(cell);
+        g.set_counting(counting);
+        g.rebuild(p, flags, dense);
+        EXPECT_EQ(g.dense(), dense);
+        const Binned got = read_back(g);
+        EXPECT_EQ(got.binned, active) << threads;
+        EXPECT_EQ(got.cells, want) << threads << " threads";
+        EXPECT_EQ(g.occupied_cells(), static_cast<Index>(want.size()));
+        // find() reaches every cell; an empty cell is not found, in the box or out of it.
+        const GridView v = g.view();
+        for (const auto& [c, items] : want) {
+          const Index s = v.find(c.first, c.second);
+          ASSERT_GE(s, 0);
+          EXPECT_EQ(v.count[s], static_cast<std::int32_t>(items.size()));
+        }
+        EXPECT_EQ(v.find(100000, 100000), -1);
+        EXPECT_EQ(v.find(-100000, 3), -1);
+        for (std::int32_t x = -40; x <= 40; ++x)
+          for (std::int32_t y = -40; y <= 40; ++y)
+            if (!want.count({x, y})) {
+              ASSERT_EQ(v.find(x, y), -1) << x << ", " << y;
+            }
       }
-      EXPECT_EQ(v.find(100000, 100000), -1);
-      EXPECT_EQ(v.find(-100000, 3), -1);
-      for (std::int32_t x = -40; x <= 40; ++x)
-        for (std::int32_t y = -40; y <= 40; ++y)
-          if (!want.count({x, y})) {
-            ASSERT_EQ(v.find(x, y), -1) << x << ", " << y;
-          }
-    }
 }
 
 // Over a periodic area the dense box spans each wrapping period, and a

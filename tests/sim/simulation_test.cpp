@@ -363,8 +363,9 @@ TEST(Determinism, FourColourIsBitwiseTheSameForOneTwoAndFourThreads) {
   }
 }
 
-// Three shortcuts that must change no bit, against their reference forms:
-// dense bins (a box of cells indexed directly) against hashed ones; the
+// Four shortcuts that must change no bit, against their reference forms:
+// dense bins (a box of cells indexed directly) against hashed ones, and
+// bins counted by slot range against atomics and a sort; the
 // double buffer's contact passes ending at the first that moved nobody
 // and passing over agents whose move cells the pass before left still
 // against every pass run by every agent; and the collision-free speed
@@ -373,9 +374,10 @@ TEST(Determinism, FourColourIsBitwiseTheSameForOneTwoAndFourThreads) {
 // every pass; the circle's contact bins are hashed (a ring 100 m across in
 // cells of 1 m) and most of its steps move nobody in their second pass;
 // the bottleneck's crowd streams to its door.
-TEST(Determinism, DenseBinsSkippedIdleContactPassesAndFarCellsChangeNoBit) {
+TEST(Determinism, StepShortcutsChangeNoBit) {
   SimulationOptions reference;
   reference.dense_bins = false;
+  reference.bin_counting = BinCounting::Atomic;
   reference.skip_idle_contact_passes = false;
   reference.skip_far_cells_walking_along = false;
   for_each_model_and_scene(
