@@ -4,9 +4,6 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "core/exec.h"
-#include "core/parallel.h"
-#include "core/reduce.h"
 #include "sim/grid.h"
 
 namespace throng::sim {
@@ -114,42 +111,6 @@ GridView AgentGrid::view() const {
   // Only the first binned_ items are agents (inactive ones are not binned).
   v.items = items_.span().subspan(0, binned_);
   return v;
-}
-
-// A few tasks, each over every agent: reading slot_of again per task costs
-// less than a locked add per agent, but not for small crowds.
-Index AgentGrid::place_by_slot_range(Index slots) {
-  const Index n = slot_of_agent_.size();
-  const Index tasks = std::max<Index>(1, std::min<Index>({n / 8192, current_threads(), slots}));
-  const Span<const std::int32_t> slot_of = slot_of_agent_.span();
-  const Span<std::int32_t> count = count_.span().subspan(0, slots), start = start_.span().subspan(0, slots),
-                           cursor = cursor_.span().subspan(0, slots), items = items_.span();
-  // Task t's slots: [first(t), first(t + 1)). An agent not binned has slot -1.
-  const auto first = [&](Index t) { return slots * t / tasks; };
-  const auto in = [](std::int32_t s, Index lo, Index hi) {
-    return static_cast<std::uint64_t>(s - lo) < static_cast<std::uint64_t>(hi - lo);
-  };
-  host_parallel_for("sim.bin.count", tasks, [&](Index t) {
-    const Index lo = first(t), hi = first(t + 1);
-    for (Index i = 0; i < n; ++i)
-      if (in(slot_of[i], lo, hi)) ++count[slot_of[i]];
-  });
-  const Index binned = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
-  host_parallel_for("sim.bin.place", tasks, [&](Index t) {
-    const Index lo = first(t), hi = first(t + 1);
-    for (Index i = 0; i < n; ++i) {
-      const std::int32_t s = slot_of[i];
-      if (in(s, lo, hi)) items[start[s] + cursor[s]++] = static_cast<std::int32_t>(i);
-    }
-  });
-  for (Index t = 0; t < tasks; ++t) {  // every task reads every agent's slot
-    count_traffic("sim.bin.count", slot_of);
-    count_traffic("sim.bin.place", slot_of);
-  }
-  count_traffic("sim.bin.count", count, count);
-  count_traffic("sim.bin.scan", count, start);
-  count_traffic("sim.bin.place", start, cursor, cursor, items);
-  return binned;
 }
 
 Index AgentGrid::occupied_cells() const {

@@ -7,9 +7,11 @@
 // with the extent of the scene (a 10 km scene with a few agents costs a few
 // cells). Two builders share one view type:
 //   - StaticGrid: built once on the host from (cell, item) pairs (obstacles);
-//   - AgentGrid: rebuilt every step by a counting sort through parallel_for
-//     (histogram with atomics -> exclusive_scan -> scatter -> sort inside each
-//     cell by agent index, so the order inside a bin is deterministic).
+//   - AgentGrid: rebuilt every step by a counting sort (each agent's slot ->
+//     histogram -> exclusive_scan -> scatter), each cell's run in agent index
+//     order so the order inside a bin is deterministic: on the CPU by slot
+//     range, with no atomics; on the device with atomics, then a sort inside
+//     each cell (BinCounting).
 #pragma once
 
 #include <cmath>

@@ -1,4 +1,7 @@
 // Per-step agent binning: the counting sort of the perception layer.
+#include <algorithm>
+
+#include "core/exec.h"
 #include "core/parallel.h"
 #include "core/reduce.h"
 #include "sim/atomics.h"
@@ -167,13 +170,54 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
         const std::int32_t c = count[s];
         if (c > 1 && !by_range) sort_run(items.data() + start[s], c);
         if (is_dense && c > 0) {
-          // Slots number fewer than 2^32 (twice the agents at most): a 32-bit division.
+          // Slots are numbered in 32 bits (slot_of): a 32-bit division.
           const auto s32 = static_cast<std::uint32_t>(s), nx = static_cast<std::uint32_t>(cells.dense_nx);
           const auto x = static_cast<std::int32_t>(s32 % nx), y = static_cast<std::int32_t>(s32 / nx);
           keys[s] = cell_key(cells.dense_x0 + x, cells.dense_y0 + y);
         }
       });
-  count_traffic("sim.bin.sort", keys, count, start, items, items);
+  if (by_range)
+    count_traffic("sim.bin.sort", keys, count);
+  else
+    count_traffic("sim.bin.sort", keys, count, start, items, items);
+}
+
+// A few tasks, each over every agent: reading slot_of again per task costs
+// less than a locked add per agent, but not for small crowds. Host code
+// (host_parallel_for) kept in this file so that exclusive_scan and its
+// kernels are compiled by nvcc, with their CUDA branch, in CUDA builds.
+Index AgentGrid::place_by_slot_range(Index slots) {
+  const Index n = slot_of_agent_.size();
+  const Index tasks = std::max<Index>(1, std::min<Index>({n / 8192, current_threads(), slots}));
+  const Span<const std::int32_t> slot_of = slot_of_agent_.span();
+  const Span<std::int32_t> count = count_.span().subspan(0, slots), start = start_.span().subspan(0, slots),
+                           cursor = cursor_.span().subspan(0, slots), items = items_.span();
+  // Task t's slots: [first(t), first(t + 1)). An agent not binned has slot -1.
+  const auto first = [&](Index t) { return slots * t / tasks; };
+  const auto in = [](std::int32_t s, Index lo, Index hi) {
+    return static_cast<std::uint64_t>(s - lo) < static_cast<std::uint64_t>(hi - lo);
+  };
+  host_parallel_for("sim.bin.count", tasks, [&](Index t) {
+    const Index lo = first(t), hi = first(t + 1);
+    for (Index i = 0; i < n; ++i)
+      if (in(slot_of[i], lo, hi)) ++count[slot_of[i]];
+  });
+  const Index binned = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
+  host_parallel_for("sim.bin.place", tasks, [&](Index t) {
+    const Index lo = first(t), hi = first(t + 1);
+    for (Index i = 0; i < n; ++i) {
+      const std::int32_t s = slot_of[i];
+      if (in(s, lo, hi)) items[start[s] + cursor[s]++] = static_cast<std::int32_t>(i);
+    }
+  });
+  for (Index t = 0; t < tasks; ++t) {  // every task reads every agent's slot
+    count_traffic("sim.bin.count", slot_of);
+    count_traffic("sim.bin.place", slot_of);
+  }
+  count_traffic("sim.bin.count", count, count);
+  count_traffic("sim.bin.scan", count, start);
+  count_traffic("sim.bin.place", start, cursor, cursor, items);
+  return binned;
 }
 
 // Dense when the box of the occupied cells (every cell of a wrapping axis)
