@@ -222,7 +222,7 @@ THRONG_HOST_DEVICE inline bool within_reach(const CellBounds& c, glm::vec2 p, fl
 // half-plane ahead of it along e0 (its corner furthest along e0 lies ahead).
 THRONG_HOST_DEVICE inline bool cell_ahead_within_reach(const CellBounds& c, glm::vec2 p, glm::vec2 e0, float reach2) {
   const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
-  return within_reach(c, p, reach2) && (front.x - p.x) * e0.x + (front.y - p.y) * e0.y > 0.0f;
+  return within_reach(c, p, reach2) & ((front.x - p.x) * e0.x + (front.y - p.y) * e0.y > 0.0f);
 }
 // The item runs of the 5 x 5 cells round (cx, cy) that keep(cell bounds)
 // accepts, row-major as cells_3x3; keep must accept a contiguous stretch of
@@ -240,9 +240,14 @@ THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx
   const std::int32_t ry = g.wrap_y > 0 && g.wrap_y < 6 ? 1 : 2;
   const bool dense_row = g.dense_nx > 0 && g.wrap_x == 0 && g.wrap_y == 0;
   for (std::int32_t y = cy - ry; y <= cy + ry; ++y) {
-    std::int32_t lo = cx - rx, hi = cx + rx;
-    while (lo <= hi && !keep(cell_bounds(g, lo, y, slack))) ++lo;
-    while (hi >= lo && !keep(cell_bounds(g, hi, y, slack))) --hi;
+    // The row's stretch: every cell tested, the first and last kept picked
+    // without a branch (a scan in from either end mispredicts its exits).
+    std::int32_t lo = cx + rx + 1, hi = cx - rx - 1;
+    for (std::int32_t x = cx - rx; x <= cx + rx; ++x) {
+      const bool kept = keep(cell_bounds(g, x, y, slack));
+      lo = kept & (lo > cx + rx) ? x : lo;
+      hi = kept ? x : hi;
+    }
     if (lo > hi) continue;
     if (!dense_row) {
       for (std::int32_t x = lo; x <= hi; ++x)
