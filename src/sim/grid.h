@@ -224,20 +224,22 @@ THRONG_HOST_DEVICE inline bool cell_ahead_within_reach(const CellBounds& c, glm:
   const glm::vec2 front(e0.x >= 0.0f ? c.hi.x : c.lo.x, e0.y >= 0.0f ? c.hi.y : c.lo.y);
   return within_reach(c, p, reach2) & ((front.x - p.x) * e0.x + (front.y - p.y) * e0.y > 0.0f);
 }
-// The item runs of the 5 x 5 cells round (cx, cy) that keep(cell bounds)
-// accepts, row-major as cells_3x3; keep must accept a contiguous stretch of
-// each row (a test of distance or of a half-plane, or both). Of those,
-// keep_slot(slot) may leave out any (a test of what the cell holds). Along a
-// wrapping axis of fewer than 6 cells the cells stay within one of
+// The item runs of the cells within kRadius of (cx, cy) along each axis
+// (kept_cells: the 5 x 5) that keep(cell bounds) accepts, row-major as
+// cells_3x3; keep must accept a contiguous stretch of each row (a test of
+// distance or of a half-plane, or both). Of those, keep_slot(slot) may
+// leave out any (a test of what the cell holds). Along a wrapping axis of
+// fewer than 2 kRadius + 2 cells the cells stay within kRadius - 1 of
 // (cx, cy), so that none is visited twice. `slack` widens the bounds
 // (cell_bounds).
-template <class Keep, class KeepSlot>
-THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, float slack,
-                                              const Keep& keep, const KeepSlot& keep_slot) {
-  Cells5x5 c;
+template <int kRadius, class Keep, class KeepSlot>
+THRONG_HOST_DEVICE inline CellRuns<(2 * kRadius + 1) * (2 * kRadius + 1)> kept_cells_within(
+    const GridView& g, std::int32_t cx, std::int32_t cy, float slack, const Keep& keep, const KeepSlot& keep_slot) {
+  CellRuns<(2 * kRadius + 1) * (2 * kRadius + 1)> c;
   if (g.items.size() == 0) return c;
-  const std::int32_t rx = g.wrap_x > 0 && g.wrap_x < 6 ? 1 : 2;
-  const std::int32_t ry = g.wrap_y > 0 && g.wrap_y < 6 ? 1 : 2;
+  constexpr std::int32_t kShort = 2 * kRadius + 2;  // a wrapping axis of fewer cells keeps one cell less each way
+  const std::int32_t rx = g.wrap_x > 0 && g.wrap_x < kShort ? kRadius - 1 : kRadius;
+  const std::int32_t ry = g.wrap_y > 0 && g.wrap_y < kShort ? kRadius - 1 : kRadius;
   const bool dense_row = g.dense_nx > 0 && g.wrap_x == 0 && g.wrap_y == 0;
   for (std::int32_t y = cy - ry; y <= cy + ry; ++y) {
     // The row's stretch: every cell tested, the first and last kept picked
@@ -263,6 +265,11 @@ THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx
       if (g.count[s] > 0 && keep_slot(s)) add_run(c, g.start[s], g.count[s]);
   }
   return c;
+}
+template <class Keep, class KeepSlot>
+THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, float slack,
+                                              const Keep& keep, const KeepSlot& keep_slot) {
+  return kept_cells_within<2>(g, cx, cy, slack, keep, keep_slot);
 }
 template <class Keep>
 THRONG_HOST_DEVICE inline Cells5x5 kept_cells(const GridView& g, std::int32_t cx, std::int32_t cy, float slack,

@@ -58,6 +58,14 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
   const float query = m.query_radius();
   const float query2 = query * query;
   auto candidates = [&](const auto& fn) {
+    if (bins.wrap_x == 0 && bins.wrap_y == 0) {
+      // The same cells picked without a branch per cell (kept_cells_within);
+      // a dense grid's kept cells of a row make one run.
+      auto keep = [&](const CellBounds& c) { return cell_ahead_within_reach(c, p, forward, query2); };
+      for_each_binned_candidate(bins, kept_cells_within<1>(bins, cx, cy, slack, keep, [](Index) { return true; }), n,
+                                fn);
+      return;
+    }
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
         const CellBounds cell = cell_bounds(bins, cx + dx, cy + dy, slack);

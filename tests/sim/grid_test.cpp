@@ -213,7 +213,7 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
 // two of the agent's whose bounds `keep` accepts (a disc of reach and the
 // half-plane ahead), row by row, in the same order; and every item within
 // the reach and ahead among them; and the same with some slots left out
-// by keep_slot. Dense and hashed grids, and a periodic
+// by keep_slot; and the same of the 3 x 3. Dense and hashed grids, and a periodic
 // area too short for five cells along x (the cells there stay within one).
 void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p, const Periodic& periodic) {
   const GridView v = g.view();
@@ -247,6 +247,19 @@ void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p
     for_each_in_cells(v, kept_cells(v, cx, cy, 0.0f, keep, keep_slot), [&](std::int32_t j) { got_slots.push_back(j); });
     ASSERT_EQ(expected, got) << "around agent " << i;
     ASSERT_EQ(expected_slots, got_slots) << "around agent " << i;
+    // The 3 x 3 (kept_cells_within<1>), as the priority model's sense picks
+    // its cells.
+    std::vector<std::int32_t> expected_3x3, got_3x3;
+    const std::int32_t rx1 = v.wrap_x > 0 && v.wrap_x < 4 ? 0 : 1;
+    for (std::int32_t dy = -1; dy <= 1; ++dy)
+      for (std::int32_t dx = -rx1; dx <= rx1; ++dx) {
+        const Index s = v.find(cx + dx, cy + dy);
+        if (s < 0 || !keep(cell_bounds(v, cx + dx, cy + dy, 0.0f))) continue;
+        for (std::int32_t k = 0; k < v.count[s]; ++k) expected_3x3.push_back(v.items[v.start[s] + k]);
+      }
+    for_each_in_cells(v, kept_cells_within<1>(v, cx, cy, 0.0f, keep, [](Index) { return true; }),
+                      [&](std::int32_t j) { got_3x3.push_back(j); });
+    ASSERT_EQ(expected_3x3, got_3x3) << "around agent " << i;
     all_items += got.size();
     slot_items += got_slots.size();
     const std::set<std::int32_t> kept(got.begin(), got.end());
