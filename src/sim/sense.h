@@ -66,6 +66,8 @@ THRONG_HOST_DEVICE inline Threat sense_neighbours(const GridView& bins, std::int
                                 fn);
       return;
     }
+    // Where an axis wraps, cell by cell (kept_cells_within would keep one
+    // cell less each way along an axis of fewer than 4).
     for (std::int32_t dy = -1; dy <= 1; ++dy)
       for (std::int32_t dx = -1; dx <= 1; ++dx) {
         const CellBounds cell = cell_bounds(bins, cx + dx, cy + dy, slack);
