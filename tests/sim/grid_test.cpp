@@ -213,8 +213,9 @@ TEST(Bins, ThreeByThreeFindsEveryNeighbourWithinOneCellSide) {
 // two of the agent's whose bounds `keep` accepts (a disc of reach and the
 // half-plane ahead), row by row, in the same order; and every item within
 // the reach and ahead among them; and the same with some slots left out
-// by keep_slot; and the same of the 3 x 3. Dense and hashed grids, and a periodic
-// area too short for five cells along x (the cells there stay within one).
+// by keep_slot; and the same of the 3 x 3. Dense and hashed grids, and a
+// periodic area too short for five cells along x (the cells there stay
+// within one).
 void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p, const Periodic& periodic) {
   const GridView v = g.view();
   std::mt19937 rng(6);
@@ -234,32 +235,34 @@ void kept_cells_match_cell_by_cell(AgentGrid& g, const std::vector<glm::vec2>& p
     // runs of a row break anywhere.
     const std::uint32_t salt = rng();
     auto keep_slot = [&](Index s) { return (static_cast<std::uint32_t>(s) + salt) % 3 != 0; };
-    std::vector<std::int32_t> expected, got, expected_slots, got_slots;
-    for (std::int32_t dy = -2; dy <= 2; ++dy)
-      for (std::int32_t dx = -rx; dx <= rx; ++dx) {
-        const Index s = v.find(cx + dx, cy + dy);
-        if (s < 0 || !keep(cell_bounds(v, cx + dx, cy + dy, 0.0f))) continue;
-        for (std::int32_t k = 0; k < v.count[s]; ++k) expected.push_back(v.items[v.start[s] + k]);
-        if (keep_slot(s))
-          for (std::int32_t k = 0; k < v.count[s]; ++k) expected_slots.push_back(v.items[v.start[s] + k]);
-      }
-    for_each_in_cells(v, kept_cells(v, cx, cy, 0.0f, keep), [&](std::int32_t j) { got.push_back(j); });
-    for_each_in_cells(v, kept_cells(v, cx, cy, 0.0f, keep, keep_slot), [&](std::int32_t j) { got_slots.push_back(j); });
-    ASSERT_EQ(expected, got) << "around agent " << i;
-    ASSERT_EQ(expected_slots, got_slots) << "around agent " << i;
+    auto every_slot = [](Index) { return true; };
+    // The items of the cells within r rows and r columns (r - 1 along an
+    // axis that wraps in fewer than 2 r + 2 cells) that keep and
+    // slot_kept accept, tested one by one.
+    auto cell_by_cell = [&](std::int32_t r, const auto& slot_kept) {
+      std::vector<std::int32_t> items;
+      const std::int32_t rc = v.wrap_x > 0 && v.wrap_x < 2 * r + 2 ? r - 1 : r;
+      for (std::int32_t dy = -r; dy <= r; ++dy)
+        for (std::int32_t dx = -rc; dx <= rc; ++dx) {
+          const Index s = v.find(cx + dx, cy + dy);
+          if (s < 0 || !keep(cell_bounds(v, cx + dx, cy + dy, 0.0f)) || !slot_kept(s)) continue;
+          for (std::int32_t k = 0; k < v.count[s]; ++k) items.push_back(v.items[v.start[s] + k]);
+        }
+      return items;
+    };
+    auto items_of = [&](const auto& runs) {
+      std::vector<std::int32_t> items;
+      for_each_in_cells(v, runs, [&](std::int32_t j) { items.push_back(j); });
+      return items;
+    };
+    const std::vector<std::int32_t> got = items_of(kept_cells(v, cx, cy, 0.0f, keep));
+    const std::vector<std::int32_t> got_slots = items_of(kept_cells(v, cx, cy, 0.0f, keep, keep_slot));
+    ASSERT_EQ(cell_by_cell(2, every_slot), got) << "around agent " << i;
+    ASSERT_EQ(cell_by_cell(2, keep_slot), got_slots) << "around agent " << i;
     // The 3 x 3 (kept_cells_within<1>), as the priority model's sense picks
     // its cells.
-    std::vector<std::int32_t> expected_3x3, got_3x3;
-    const std::int32_t rx1 = v.wrap_x > 0 && v.wrap_x < 4 ? 0 : 1;
-    for (std::int32_t dy = -1; dy <= 1; ++dy)
-      for (std::int32_t dx = -rx1; dx <= rx1; ++dx) {
-        const Index s = v.find(cx + dx, cy + dy);
-        if (s < 0 || !keep(cell_bounds(v, cx + dx, cy + dy, 0.0f))) continue;
-        for (std::int32_t k = 0; k < v.count[s]; ++k) expected_3x3.push_back(v.items[v.start[s] + k]);
-      }
-    for_each_in_cells(v, kept_cells_within<1>(v, cx, cy, 0.0f, keep, [](Index) { return true; }),
-                      [&](std::int32_t j) { got_3x3.push_back(j); });
-    ASSERT_EQ(expected_3x3, got_3x3) << "around agent " << i;
+    ASSERT_EQ(cell_by_cell(1, every_slot), items_of(kept_cells_within<1>(v, cx, cy, 0.0f, keep, every_slot)))
+        << "around agent " << i;
     all_items += got.size();
     slot_items += got_slots.size();
     const std::set<std::int32_t> kept(got.begin(), got.end());
