@@ -29,8 +29,9 @@ struct OverlapOf {
   Span<const std::uint8_t> flags;
   float tolerance;
   Periodic periodic;
-  THRONG_HOST_DEVICE OverlapAcc operator()(Index i) const {
+  THRONG_HOST_DEVICE OverlapAcc operator()(Index k) const {
     OverlapAcc acc{0, 0, 0.0f, INFINITY};
+    const Index i = bins.items[k];
     if ((flags[i] & kAgentActive) == 0) return acc;
     for_each_in_3x3(bins, p[i], [&](std::int32_t j) {
       if (j <= i || (flags[j] & kAgentActive) == 0) return;  // each pair once
@@ -84,9 +85,13 @@ OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float>
                               float tolerance, float reach, const Periodic& periodic) {
   AgentGrid grid(reach, periodic);
   grid.rebuild(positions, flags);
+  // Agents in cell order (the grid's items): one after another they read
+  // the same cells, whatever order the crowd lists them in. Counts, the
+  // largest and the smallest do not depend on the order.
+  const GridView bins = grid.view();
   const OverlapAcc acc =
-      parallel_reduce("sim.metrics.overlaps", positions.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
-                      OverlapOf{grid.view(), positions, radii, flags, tolerance, periodic}, CombineOverlap{});
+      parallel_reduce("sim.metrics.overlaps", bins.items.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
+                      OverlapOf{bins, positions, radii, flags, tolerance, periodic}, CombineOverlap{});
   return {acc.touching, acc.pairs, acc.max_depth, acc.min_separation};
 }
 
@@ -228,16 +233,19 @@ DensityHistogram density_histogram(Span<const glm::vec2> positions, Span<const s
   grid.rebuild(positions, flags);
   const GridView g = grid.view();
   const float inv_area = 1.0f / (g.cell_size * g.cell_size_y);
+  // Every agent of a cell sees the cell's density: each slot adds its count
+  // to its density's bin at once (empty slots count 0), with no lookup per
+  // agent.
   const Histogram h = parallel_reduce(
-      "sim.metrics.density", positions.size(), Histogram{},
-      THRONG_LAMBDA(Index i)->Histogram {
+      "sim.metrics.density", g.capacity(), Histogram{},
+      THRONG_LAMBDA(Index s)->Histogram {
         Histogram one{};
-        if ((flags[i] & kAgentActive) == 0) return one;
-        const Index s = g.find(g.cell_x(positions[i].x), g.cell_y(positions[i].y));
-        const float density = static_cast<float>(g.count[s]) * inv_area;
+        const std::int32_t agents = g.count[s];
+        if (agents == 0) return one;
+        const float density = static_cast<float>(agents) * inv_area;
         int b = static_cast<int>(density / bin_width);
         b = b < kDensityBins - 1 ? b : kDensityBins - 1;
-        one.bins[b] = 1;
+        one.bins[b] = agents;
         return one;
       },
       CombineHistogram{});
