@@ -321,7 +321,7 @@ void Simulation::move(const StepContext& ctx) {
     run_passes([&](bool want_depth) {
       contacts_double_buffer(ctx, a, anchor, cells, in, out, depth, moved_before);
       std::swap(in, out);
-      const float deepest = want_depth ? deepest_contact(depth) : 0.0f;
+      const float deepest = want_depth ? deepest_contact(depth, a.flags) : 0.0f;
       if (!skip_idle_contact_passes_) return ContactPass{deepest, true};
       const Index moved = mark_moved_items(ctx.contact_bins, out, in, moved_before_.span());
       moved_before = moved_before_.span();
@@ -331,7 +331,7 @@ void Simulation::move(const StepContext& ctx) {
   } else {  // in place: whether a pass moved anybody is not kept
     run_passes([&](bool want_depth) {
       contacts_four_colour(ctx, a, anchor, cells, depth);
-      return ContactPass{want_depth ? deepest_contact(depth) : 0.0f, true};
+      return ContactPass{want_depth ? deepest_contact(depth, a.flags) : 0.0f, true};
     });
     finalize_step(ctx, a, anchor, cells, a.position);
   }

@@ -153,7 +153,8 @@ void steer_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<cons
 // the start of the step).
 void move_cells(const StepContext& ctx, Span<const glm::vec2> anchor, Span<MoveCells> cells);
 // Contact passes write, per agent, the deepest overlap the pass found
-// before pushing (`depth`, m; 0 for inactive agents).
+// before pushing (`depth`, m; the double buffer writes 0 for inactive
+// agents, the four colours leave their entries as they were).
 // Double buffer: one contact pass from `in` to `out`. `moved_before`, from
 // mark_moved_items on the pass before (empty for the first pass): an agent
 // none of whose move cells holds an agent that pass moved gets its input
@@ -168,8 +169,11 @@ void contacts_double_buffer(const StepContext& ctx, const AgentArrays& a, Span<c
 void sense_steer_four_colour(const StepContext& ctx, const AgentArrays& a);
 void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<const glm::vec2> anchor,
                           Span<const MoveCells> cells, Span<float> depth);
-// The deepest of the per-agent overlaps a contact pass wrote.
-float deepest_contact(Span<const float> depth);
+// The deepest of the per-agent overlaps a contact pass wrote, over the
+// agents active now. The four-colour pass writes only the binned (active)
+// agents' entries: an agent that left the crowd keeps its last depth, which
+// must not count in later steps.
+float deepest_contact(Span<const float> depth, Span<const std::uint8_t> flags);
 // The agents a double-buffer pass from `in` to `out` moved (bit for bit:
 // -0 differs from 0), counted along the contact bins' items:
 // moved_before[k] = how many of items[0, k) moved, for k up to the item

@@ -662,10 +662,11 @@ void contacts_four_colour(const StepContext& ctx, const AgentArrays& a, Span<con
                 ctx.contact_bins.items, anchor, cells, depth, a.position, a.position, a.radius, a.flags);
 }
 
-float deepest_contact(Span<const float> depth) {
-  count_traffic("sim.move.contacts.deepest", depth);
+float deepest_contact(Span<const float> depth, Span<const std::uint8_t> flags) {
+  count_traffic("sim.move.contacts.deepest", depth, flags);
   return parallel_reduce(
-      "sim.move.contacts.deepest", depth.size(), 0.0f, THRONG_LAMBDA(Index i)->float { return depth[i]; },
+      "sim.move.contacts.deepest", depth.size(), 0.0f,
+      THRONG_LAMBDA(Index i)->float { return (flags[i] & kAgentActive) != 0 ? depth[i] : 0.0f; },
       THRONG_LAMBDA(float x, float y)->float { return x > y ? x : y; });
 }
 

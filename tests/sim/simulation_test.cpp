@@ -457,6 +457,40 @@ TEST(ContactPasses, AgentsWhoseMoveCellsStayedStillAreNotLookedAtAgain) {
   EXPECT_FALSE(test::same_bits(pass(anchor, {}, nullptr).to_vector(), p0));
 }
 
+// The deepest contact counts the agents active now. The four-colour pass
+// visits only binned (active) agents, so an agent that left the crowd keeps
+// the depth of its last pass: here a stale 5 m. An overlapping pair and
+// that agent: the deepest is the pair's overlap.
+TEST(ContactPasses, TheDeepestContactIsAmongTheActiveAgentsOnly) {
+  const World world = World::build(WorldSpec{}, 1.0f);
+  const std::vector<glm::vec2> start = {{0.0f, 0.0f}, {0.3f, 0.05f}, {20.0f, 0.0f}};
+  const Index n = static_cast<Index>(start.size());
+  const Memory mem = current_memory();
+  const Buffer<glm::vec2> anchor(std::span<const glm::vec2>(start), mem);
+  Buffer<glm::vec2> position(std::span<const glm::vec2>(start), mem);
+  const std::vector<float> radii(start.size(), 0.25f);
+  const Buffer<float> radius(std::span<const float>(radii), mem);
+  const std::vector<std::uint8_t> state = {kAgentActive, kAgentActive, 0};
+  Buffer<std::uint8_t> flags(std::span<const std::uint8_t>(state), mem);
+  AgentGrid bins(1.0f);
+  bins.rebuild(anchor.span(), flags.span());
+  StepContext ctx;
+  ctx.world = world.view();
+  ctx.contact_bins = bins.view();
+  AgentArrays a;
+  a.position = position.span();
+  a.radius = radius.span();
+  a.flags = flags.span();
+  Buffer<MoveCells> cells(n, mem);
+  move_cells(ctx, anchor.span(), cells.span());
+  const std::vector<float> stale = {0.0f, 0.0f, 5.0f};
+  Buffer<float> depth(std::span<const float>(stale), mem);
+  contacts_four_colour(ctx, a, anchor.span(), cells.span(), depth.span());
+  EXPECT_FLOAT_EQ(depth.to_vector()[2], 5.0f);  // not visited
+  const float overlap = 0.5f - glm::length(start[1] - start[0]);
+  EXPECT_NEAR(deepest_contact(depth.span(), flags.span()), overlap, 1e-6f);
+}
+
 // The step counts what its kernels move (count_traffic) under the names it
 // times them by, each launch anew: the pass that copies positions moves two
 // arrays of every agent's position, the move cells' pass the anchors and
