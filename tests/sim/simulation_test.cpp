@@ -408,28 +408,46 @@ TEST(Determinism, StepShortcutsChangeNoBit) {
 // after gives with it what it gives without, bit for bit, and a count
 // claiming nobody moved leaves even overlapping pairs where they are (so
 // the count is what decides).
+// Agents of radius 0.25 m at `start` (flags: `state`) in an open world,
+// binned in contact cells of 1 m, with their move cells: what the move
+// stage's passes read, their anchors and positions both `start`.
+struct ContactScene {
+  World world = World::build(WorldSpec{}, 1.0f);
+  Memory mem = current_memory();
+  Buffer<glm::vec2> anchor, position;
+  Buffer<float> radius;
+  Buffer<std::uint8_t> flags;
+  AgentGrid bins{1.0f};
+  StepContext ctx;
+  AgentArrays a;
+  Buffer<MoveCells> cells;
+  ContactScene(const std::vector<glm::vec2>& start, const std::vector<std::uint8_t>& state)
+      : anchor(std::span<const glm::vec2>(start), mem),
+        position(std::span<const glm::vec2>(start), mem),
+        radius(std::span<const float>(std::vector<float>(start.size(), 0.25f)), mem),
+        flags(std::span<const std::uint8_t>(state), mem),
+        cells(static_cast<Index>(start.size()), mem) {
+    bins.rebuild(anchor.span(), flags.span());
+    ctx.world = world.view();
+    ctx.contact_bins = bins.view();
+    a.position = position.span();  // sets the agent count
+    a.radius = radius.span();
+    a.flags = flags.span();
+    move_cells(ctx, anchor.span(), cells.span());
+  }
+  ContactScene(const ContactScene&) = delete;  // ctx and a point into the scene
+  ContactScene& operator=(const ContactScene&) = delete;
+};
+
 TEST(ContactPasses, AgentsWhoseMoveCellsStayedStillAreNotLookedAtAgain) {
-  const World world = World::build(WorldSpec{}, 1.0f);
   const std::vector<glm::vec2> start = {{0.0f, 0.0f}, {0.3f, 0.05f}, {20.0f, 0.0f}, {20.35f, 0.0f}, {40.0f, 0.0f}};
   const Index n = static_cast<Index>(start.size());
-  const Memory mem = current_memory();
-  const Buffer<glm::vec2> anchor(std::span<const glm::vec2>(start), mem);
-  const std::vector<float> radii(start.size(), 0.25f);
-  const std::vector<std::uint8_t> active(start.size(), kAgentActive);
-  const Buffer<float> radius(std::span<const float>(radii), mem);
-  Buffer<std::uint8_t> flags(std::span<const std::uint8_t>(active), mem);
-  AgentGrid bins(1.0f);
-  bins.rebuild(anchor.span(), flags.span());
-  StepContext ctx;
-  ctx.world = world.view();
-  ctx.contact_bins = bins.view();
-  Buffer<glm::vec2> position(std::span<const glm::vec2>(start), mem);  // (a pass reads only its input)
-  AgentArrays a;
-  a.position = position.span();  // sets the agent count
-  a.radius = radius.span();
-  a.flags = flags.span();
-  Buffer<MoveCells> cells(n, mem);
-  move_cells(ctx, anchor.span(), cells.span());
+  const ContactScene scene(start, std::vector<std::uint8_t>(start.size(), kAgentActive));
+  const Memory mem = scene.mem;
+  const Buffer<glm::vec2>& anchor = scene.anchor;  // (a pass reads only its input)
+  const StepContext& ctx = scene.ctx;
+  const AgentArrays& a = scene.a;
+  const Buffer<MoveCells>& cells = scene.cells;
   auto pass = [&](const Buffer<glm::vec2>& in, Span<const std::int32_t> moved_before, std::vector<float>* depths) {
     Buffer<glm::vec2> out(n, mem);
     Buffer<float> depth = Buffer<float>::zeros(n, mem);
@@ -462,33 +480,14 @@ TEST(ContactPasses, AgentsWhoseMoveCellsStayedStillAreNotLookedAtAgain) {
 // the depth of its last pass: here a stale 5 m. An overlapping pair and
 // that agent: the deepest is the pair's overlap.
 TEST(ContactPasses, TheDeepestContactIsAmongTheActiveAgentsOnly) {
-  const World world = World::build(WorldSpec{}, 1.0f);
   const std::vector<glm::vec2> start = {{0.0f, 0.0f}, {0.3f, 0.05f}, {20.0f, 0.0f}};
-  const Index n = static_cast<Index>(start.size());
-  const Memory mem = current_memory();
-  const Buffer<glm::vec2> anchor(std::span<const glm::vec2>(start), mem);
-  Buffer<glm::vec2> position(std::span<const glm::vec2>(start), mem);
-  const std::vector<float> radii(start.size(), 0.25f);
-  const Buffer<float> radius(std::span<const float>(radii), mem);
-  const std::vector<std::uint8_t> state = {kAgentActive, kAgentActive, 0};
-  Buffer<std::uint8_t> flags(std::span<const std::uint8_t>(state), mem);
-  AgentGrid bins(1.0f);
-  bins.rebuild(anchor.span(), flags.span());
-  StepContext ctx;
-  ctx.world = world.view();
-  ctx.contact_bins = bins.view();
-  AgentArrays a;
-  a.position = position.span();
-  a.radius = radius.span();
-  a.flags = flags.span();
-  Buffer<MoveCells> cells(n, mem);
-  move_cells(ctx, anchor.span(), cells.span());
+  ContactScene scene(start, {kAgentActive, kAgentActive, 0});  // (the four colours move scene.position)
   const std::vector<float> stale = {0.0f, 0.0f, 5.0f};
-  Buffer<float> depth(std::span<const float>(stale), mem);
-  contacts_four_colour(ctx, a, anchor.span(), cells.span(), depth.span());
+  Buffer<float> depth(std::span<const float>(stale), scene.mem);
+  contacts_four_colour(scene.ctx, scene.a, scene.anchor.span(), scene.cells.span(), depth.span());
   EXPECT_FLOAT_EQ(depth.to_vector()[2], 5.0f);  // not visited
   const float overlap = 0.5f - glm::length(start[1] - start[0]);
-  EXPECT_NEAR(deepest_contact(depth.span(), flags.span()), overlap, 1e-6f);
+  EXPECT_NEAR(deepest_contact(depth.span(), scene.flags.span()), overlap, 1e-6f);
 }
 
 // The step counts what its kernels move (count_traffic) under the names it
