@@ -26,15 +26,13 @@ struct OverlapOf {
   GridView bins;
   Span<const glm::vec2> p;
   Span<const float> r;
-  Span<const std::uint8_t> flags;
   float tolerance;
   Periodic periodic;
   THRONG_HOST_DEVICE OverlapAcc operator()(Index k) const {
     OverlapAcc acc{0, 0, 0.0f, INFINITY};
-    const Index i = bins.items[k];
-    if ((flags[i] & kAgentActive) == 0) return acc;
+    const Index i = bins.items[k];  // (the grid holds the active agents only)
     for_each_in_3x3(bins, p[i], [&](std::int32_t j) {
-      if (j <= i || (flags[j] & kAgentActive) == 0) return;  // each pair once
+      if (j <= i) return;  // each pair once
       const float gap = length_of(p[i] - periodic.near(p[j], p[i])) - r[i] - r[j];
       acc.min_separation = gap < acc.min_separation ? gap : acc.min_separation;
       if (gap < 0.0f) ++acc.touching;
@@ -89,9 +87,8 @@ OverlapStats measure_overlaps(Span<const glm::vec2> positions, Span<const float>
   // the same cells, whatever order the crowd lists them in. Counts, the
   // largest and the smallest do not depend on the order.
   const GridView bins = grid.view();
-  const OverlapAcc acc =
-      parallel_reduce("sim.metrics.overlaps", bins.items.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
-                      OverlapOf{bins, positions, radii, flags, tolerance, periodic}, CombineOverlap{});
+  const OverlapAcc acc = parallel_reduce("sim.metrics.overlaps", bins.items.size(), OverlapAcc{0, 0, 0.0f, INFINITY},
+                                         OverlapOf{bins, positions, radii, tolerance, periodic}, CombineOverlap{});
   return {acc.touching, acc.pairs, acc.max_depth, acc.min_separation};
 }
 

@@ -401,13 +401,6 @@ TEST(Determinism, StepShortcutsChangeNoBit) {
   EXPECT_EQ(full.far_cells_summarised(), 0);
 }
 
-// The contact passes' other shortcut at the kernel: past the first pass an
-// agent none of whose move cells holds an agent the pass before moved keeps
-// its input, unlooked. Two overlapping pairs far apart and a lone agent:
-// the count of moved agents is checked against a plain count, the pass
-// after gives with it what it gives without, bit for bit, and a count
-// claiming nobody moved leaves even overlapping pairs where they are (so
-// the count is what decides).
 // Agents of radius 0.25 m at `start` (flags: `state`) in an open world,
 // binned in contact cells of 1 m, with their move cells: what the move
 // stage's passes read, their anchors and positions both `start`.
@@ -439,6 +432,13 @@ struct ContactScene {
   ContactScene& operator=(const ContactScene&) = delete;
 };
 
+// The contact passes' other shortcut at the kernel: past the first pass an
+// agent none of whose move cells holds an agent the pass before moved keeps
+// its input, unlooked. Two overlapping pairs far apart and a lone agent:
+// the count of moved agents is checked against a plain count, the pass
+// after gives with it what it gives without, bit for bit, and a count
+// claiming nobody moved leaves even overlapping pairs where they are (so
+// the count is what decides).
 TEST(ContactPasses, AgentsWhoseMoveCellsStayedStillAreNotLookedAtAgain) {
   const std::vector<glm::vec2> start = {{0.0f, 0.0f}, {0.3f, 0.05f}, {20.0f, 0.0f}, {20.35f, 0.0f}, {40.0f, 0.0f}};
   const Index n = static_cast<Index>(start.size());
