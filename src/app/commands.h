@@ -29,10 +29,11 @@ void add_global_options(CLI::App& app, GlobalOptions& g);
 
 // Memory per agent for the budget check before set-up (core/memory_budget.h):
 // growth of the resident set per agent measured with the built-in plaza
-// between 10^4 and 10^5 agents (simulation 0.58 KB; locomotion with the
-// 22-joint default character 0.68 KB, also per character of `throng
-// animate`), rounded up.
-constexpr double kSimBytesPerAgent = 640;
+// between 10^4 and 10^5 agents (simulation 0.58 KB, plus up to 0.32 KB for a
+// sparse crowd's dense contact bins, kDenseCellsPerItem: 0.76 KB measured
+// on the plaza; locomotion with the 22-joint default character 0.68 KB, also
+// per character of `throng animate`), rounded up.
+constexpr double kSimBytesPerAgent = 960;
 constexpr double kLocomotionBytesPerAgent = 768;
 
 // Range checks whose errors read "--agents: must be at least 1, got 0"

@@ -1,9 +1,11 @@
 #include <algorithm>
+#include <limits>
 
 #include <cmath>
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "sim/agent_grid.h"
 #include "sim/grid.h"
 
 namespace throng::sim {
@@ -14,7 +16,8 @@ Index grid_capacity_for(Index n) {
   return c;
 }
 
-StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std::int32_t>> pairs, Memory memory)
+StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std::int32_t>> pairs, Memory memory,
+                       bool allow_dense)
     : cell_size_(cell_size) {
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
@@ -23,9 +26,20 @@ StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std
   occupied_ = cells;
   const Index cap = grid_capacity_for(cells);
   mask_ = static_cast<std::uint64_t>(cap - 1);
-  host_keys_.assign(static_cast<std::size_t>(cap), kEmptyCell);
-  host_start_.assign(static_cast<std::size_t>(cap), 0);
-  host_count_.assign(static_cast<std::size_t>(cap), 0);
+  if (allow_dense) choose_dense_box(pairs, std::max<Index>(cap, kDenseCellsPerItem * cells));
+  const bool dense = dense_nx_ > 0;
+  // A dense grid's items run slot by slot (row by row), as AgentGrid's.
+  const auto slot_of = [&](std::uint64_t key) {
+    return static_cast<std::uint64_t>(std::int64_t{key_cy(key)} - dense_y0_) * static_cast<std::uint64_t>(dense_nx_) +
+           static_cast<std::uint64_t>(key_cx(key) - dense_x0_);
+  };
+  if (dense)
+    std::stable_sort(pairs.begin(), pairs.end(),
+                     [&](const auto& a, const auto& b) { return slot_of(a.first) < slot_of(b.first); });
+  const auto slots = static_cast<std::size_t>(dense ? Index{dense_nx_} * dense_ny_ : cap);
+  host_keys_.assign(slots, kEmptyCell);
+  host_start_.assign(slots, 0);
+  host_count_.assign(slots, 0);
   host_items_.resize(pairs.size());
   for (std::size_t i = 0; i < pairs.size();) {
     std::size_t j = i;
@@ -33,23 +47,43 @@ StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std
       host_items_[j] = pairs[j].second;
       ++j;
     }
-    std::uint64_t s = home_slot(pairs[i].first, mask_);
-    while (host_keys_[s] != kEmptyCell) s = (s + 1) & mask_;
+    std::uint64_t s = dense ? slot_of(pairs[i].first) : home_slot(pairs[i].first, mask_);
+    while (!dense && host_keys_[s] != kEmptyCell) s = (s + 1) & mask_;
     host_keys_[s] = pairs[i].first;
     host_start_[s] = static_cast<std::int32_t>(i);
     host_count_[s] = static_cast<std::int32_t>(j - i);
     i = j;
   }
+  // Every dense slot's start set, an empty one's where its items would be (GridView).
+  for (std::size_t s = 1; dense && s < slots; ++s)
+    if (host_count_[s] == 0) host_start_[s] = host_start_[s - 1] + host_count_[s - 1];
   keys_ = Buffer<std::uint64_t>(std::span<const std::uint64_t>(host_keys_), memory);
   start_ = Buffer<std::int32_t>(std::span<const std::int32_t>(host_start_), memory);
   count_ = Buffer<std::int32_t>(std::span<const std::int32_t>(host_count_), memory);
   items_ = Buffer<std::int32_t>(std::span<const std::int32_t>(host_items_), memory);
 }
 
+// Dense when the box of the occupied cells has at most `most` cells.
+void StaticGrid::choose_dense_box(const std::vector<std::pair<std::uint64_t, std::int32_t>>& pairs, Index most) {
+  if (pairs.empty()) return;
+  std::int32_t x0 = kCellCoordLimit, y0 = kCellCoordLimit, x1 = -kCellCoordLimit, y1 = -kCellCoordLimit;
+  for (const auto& [key, item] : pairs) {
+    x0 = std::min(x0, key_cx(key)), x1 = std::max(x1, key_cx(key));
+    y0 = std::min(y0, key_cy(key)), y1 = std::max(y1, key_cy(key));
+  }
+  const std::int64_t nx = std::int64_t{x1} - x0 + 1, ny = std::int64_t{y1} - y0 + 1;
+  // (Slots are numbered in 32 bits, as AgentGrid's.)
+  if (nx * ny > std::min<std::int64_t>(most, std::numeric_limits<std::int32_t>::max())) return;
+  dense_x0_ = x0, dense_y0_ = y0;
+  dense_nx_ = static_cast<std::int32_t>(nx), dense_ny_ = static_cast<std::int32_t>(ny);
+}
+
 GridView StaticGrid::view() const {
   GridView v;
   v.cell_size = v.cell_size_y = cell_size_;
   v.mask = mask_;
+  v.dense_x0 = dense_x0_, v.dense_y0 = dense_y0_;
+  v.dense_nx = dense_nx_, v.dense_ny = dense_ny_;
   v.keys = keys_.span();
   v.start = start_.span();
   v.count = count_.span();
@@ -61,6 +95,8 @@ GridView StaticGrid::host_view() const {
   GridView v;
   v.cell_size = v.cell_size_y = cell_size_;
   v.mask = mask_;
+  v.dense_x0 = dense_x0_, v.dense_y0 = dense_y0_;
+  v.dense_nx = dense_nx_, v.dense_ny = dense_ny_;
   v.keys = Span<const std::uint64_t>(host_keys_.data(), static_cast<Index>(host_keys_.size()));
   v.start = Span<const std::int32_t>(host_start_.data(), static_cast<Index>(host_start_.size()));
   v.count = Span<const std::int32_t>(host_count_.data(), static_cast<Index>(host_count_.size()));

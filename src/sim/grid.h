@@ -1,17 +1,16 @@
 // Sparse uniform grids: cell (cx, cy) -> a run of item indices.
 //
-// Cells live in a table of about twice as many slots as items: an
-// open-addressing hash table of the occupied cells keyed by the packed cell
-// coordinates, or, for agents whose box of occupied cells fits the table,
-// that box densely (GridView below). Memory grows with the items, never
-// with the extent of the scene (a 10 km scene with a few agents costs a few
-// cells). Two builders share one view type:
+// Cells live in an open-addressing hash table of about twice as many slots
+// as items, keyed by the packed cell coordinates, or, where the box of the
+// occupied cells is small enough, in that box densely (GridView below).
+// Memory grows with the items, never with the extent of the scene (a 10 km
+// scene with a few agents costs a few cells). Two builders, one view type:
 //   - StaticGrid: built once on the host from (cell, item) pairs (obstacles);
-//   - AgentGrid: rebuilt every step by a counting sort (each agent's slot ->
-//     histogram -> exclusive_scan -> scatter), each cell's run in agent index
-//     order so the order inside a bin is deterministic: on the CPU by slot
-//     range, with no atomics; on the device with atomics, then a sort inside
-//     each cell (BinCounting).
+//   - AgentGrid (agent_grid.h): rebuilt every step by a counting sort (each
+//     agent's slot -> histogram -> exclusive_scan -> scatter), each cell's
+//     run in agent index order so the order inside a bin is deterministic:
+//     on the CPU by slot range, with no atomics; on the device with
+//     atomics, then a sort inside each cell (BinCounting).
 #pragma once
 
 #include <cmath>
@@ -83,8 +82,7 @@ THRONG_HOST_DEVICE inline std::uint64_t home_slot(std::uint64_t key, std::uint64
 // A dense grid (dense_nx > 0) has no hashing: its slots are the cells of the
 // box of dense_nx x dense_ny cells from (dense_x0, dense_y0), row by row, so
 // a lookup is an index computation and the neighbouring cells of a row are
-// neighbouring slots. AgentGrid builds one whenever the box of the occupied
-// cells fits the table it would have hashed into (memory stays the same).
+// neighbouring slots (AgentGrid::rebuild and StaticGrid say when).
 //
 // Over a periodic area (core/periodic.h) the cells of a wrapping axis tile the
 // period exactly, `wrap_x` (or `wrap_y`) of them, an even number so that the
@@ -313,12 +311,18 @@ THRONG_HOST_DEVICE inline void for_each_in_cell(const GridView& g, glm::vec2 p, 
 
 // Smallest power of two >= 2 * n (load factor <= 1/2), at least 16.
 Index grid_capacity_for(Index n);
+// The largest dense box, in cells per agent (the simulation's AgentGrids) or
+// per occupied cell (StaticGrid), 20 bytes each (docs/simulation.md, bins).
+inline constexpr Index kDenseCellsPerItem = 16;
 
-// Host-built grid from (cell key, item) pairs; uploaded to `memory`.
+// Host-built grid from (cell key, item) pairs; uploaded to `memory`. Dense
+// as AgentGrid's (per occupied cell) unless `allow_dense` is false.
 class StaticGrid {
  public:
   StaticGrid() = default;
-  StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std::int32_t>> pairs, Memory memory);
+  StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std::int32_t>> pairs, Memory memory,
+             bool allow_dense = true);
+  bool dense() const { return dense_nx_ > 0; }
   GridView view() const;
   // The same tables in host memory (spawning and validation run on the host).
   GridView host_view() const;
@@ -328,67 +332,14 @@ class StaticGrid {
  private:
   float cell_size_ = 1.0f;
   std::uint64_t mask_ = 0;
+  std::int32_t dense_x0_ = 0, dense_y0_ = 0, dense_nx_ = 0, dense_ny_ = 0;  // as GridView's
   Index occupied_ = 0;
   std::vector<std::uint64_t> host_keys_;
   std::vector<std::int32_t> host_start_, host_count_, host_items_;
   Buffer<std::uint64_t> keys_;
   Buffer<std::int32_t> start_, count_, items_;
-};
 
-// How AgentGrid::rebuild counts agents into their cells on the CPU. By
-// slot range: each task owns a range of slots and passes over every agent
-// in index order, counting (then placing) those whose cell is in its range:
-// no atomic, and each cell's run comes out in index order with no sort.
-// Atomic: a locked add per agent, placement in any order, then each run
-// sorted; what the device does (the CPU's reference for it). Both give the
-// same bins.
-enum class BinCounting : std::uint8_t { BySlotRange, Atomic };
-
-// Agents binned by position, rebuilt each step (kernels in grid_kernels.cpp).
-class AgentGrid {
- public:
-  AgentGrid() = default;
-  explicit AgentGrid(float cell_size) : asked_(cell_size), cell_size_(cell_size), cell_size_y_(cell_size) {}
-  // Over a periodic area: cells at least cell_size wide, tiling each
-  // wrapping period in an even number of them (at least four: throws
-  // Error when the period is shorter than four cell sides).
-  AgentGrid(float cell_size, const Periodic& periodic);
-  // Bins every agent whose flags[i] has bit 0 (active) set, by positions[i].
-  // Spans in current_memory(). Dense when the box of the occupied cells
-  // has at most as many cells as the hash table would have slots, unless
-  // `allow_dense` is false (tests compare both).
-  void rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t> flags, bool allow_dense = true);
-  // The CPU's way of counting (the device always counts with atomics).
-  void set_counting(BinCounting counting) { counting_ = counting; }
-  bool dense() const { return dense_nx_ > 0; }
-  // The table's slots in use: a dense grid's box of cells, else the whole table.
-  Index slots() const { return dense() ? Index{dense_nx_} * dense_ny_ : keys_.size(); }
-  GridView view() const;
-  // The side asked for; the view's cells are at least as wide (wider along
-  // a periodic axis, to tile its period).
-  float cell_size() const { return asked_; }
-  const Periodic& periodic() const { return periodic_; }
-  Index binned_agents() const { return binned_; }
-  Index occupied_cells() const;  // counts on the host (for tests and stats)
-  // Memory held by the tables, bytes.
-  std::size_t bytes() const;
-
- private:
-  void choose_layout(GridView& cells, Span<const glm::vec2> positions, Span<const std::uint8_t> flags,
-                     bool allow_dense);
-  // Fills count, start and items from slot_of by slot range (BinCounting);
-  // returns the agents binned.
-  Index place_by_slot_range(Index slots);
-
-  float asked_ = 1.0f, cell_size_ = 1.0f, cell_size_y_ = 1.0f;
-  Periodic periodic_;
-  std::int32_t wrap_x_ = 0, wrap_y_ = 0;
-  std::uint64_t mask_ = 0;
-  std::int32_t dense_x0_ = 0, dense_y0_ = 0, dense_nx_ = 0, dense_ny_ = 0;  // as GridView's
-  Index binned_ = 0;
-  BinCounting counting_ = BinCounting::BySlotRange;
-  Buffer<std::uint64_t> keys_;
-  Buffer<std::int32_t> start_, count_, cursor_, items_, slot_of_agent_;
+  void choose_dense_box(const std::vector<std::pair<std::uint64_t, std::int32_t>>& pairs, Index most);
 };
 
 }  // namespace throng::sim

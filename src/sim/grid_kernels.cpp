@@ -1,11 +1,12 @@
 // Per-step agent binning: the counting sort of the perception layer.
 #include <algorithm>
+#include <limits>
 
 #include "core/exec.h"
 #include "core/parallel.h"
 #include "core/reduce.h"
+#include "sim/agent_grid.h"
 #include "sim/atomics.h"
-#include "sim/grid.h"
 
 namespace throng::sim {
 
@@ -67,6 +68,14 @@ struct Enclose {
   }
 };
 
+// The key of a dense grid's slot s. Slots are numbered in 32 bits
+// (slot_of): a 32-bit division.
+THRONG_HOST_DEVICE inline std::uint64_t dense_slot_key(const GridView& cells, Index s) {
+  const auto s32 = static_cast<std::uint32_t>(s), nx = static_cast<std::uint32_t>(cells.dense_nx);
+  const auto x = static_cast<std::int32_t>(s32 % nx), y = static_cast<std::int32_t>(s32 / nx);
+  return cell_key(cells.dense_x0 + x, cells.dense_y0 + y);
+}
+
 // The slot of each active agent's cell (-1 for inactive agents), its count
 // raised unless `count` is empty. A dense grid's slot is the cell's index in
 // the box, no hashing; a hashed grid finds or claims the cell's slot by
@@ -104,17 +113,12 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
   const Index n = positions.size();
   const Index cap = grid_capacity_for(n);
   const Memory m = current_memory();
-  if (keys_.size() != cap || keys_.memory() != m) {
-    keys_ = Buffer<std::uint64_t>(cap, m);
-    start_ = Buffer<std::int32_t>(cap, m);
-    count_ = Buffer<std::int32_t>(cap, m);
-    cursor_ = Buffer<std::int32_t>(cap, m);
-  }
   if (items_.size() != n || items_.memory() != m) {
     items_ = Buffer<std::int32_t>(n, m);
     slot_of_agent_ = Buffer<std::int32_t>(n, m);
   }
   mask_ = static_cast<std::uint64_t>(cap - 1);
+  table_ = cap;
   GridView cells;  // the cell geometry only (its tables are being built)
   cells.cell_size = cell_size_;
   cells.cell_size_y = cell_size_y_;
@@ -124,6 +128,14 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
   cells.mask = mask_;
   choose_layout(cells, positions, flags, allow_dense);
   const Index slots = this->slots();
+  // The tables grow to the largest layout asked for (a hashed table, or a
+  // dense box within the limit) and stay.
+  if (keys_.size() < slots || keys_.memory() != m) {
+    keys_ = Buffer<std::uint64_t>(slots, m);
+    start_ = Buffer<std::int32_t>(slots, m);
+    count_ = Buffer<std::int32_t>(slots, m);
+    cursor_ = Buffer<std::int32_t>(slots, m);
+  }
   auto keys = keys_.span().subspan(0, slots);
   auto start = start_.span().subspan(0, slots);
   auto count = count_.span().subspan(0, slots);
@@ -131,16 +143,21 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
   auto items = items_.span();
   auto slot_of = slot_of_agent_.span();
 
+  // On the CPU, count and place by slot range (BinCounting): no atomic
+  // but the hashed grid's claims, and runs in index order as placed. Its
+  // cursors are reset where counted (a sparse box has far more cells than
+  // agents).
+  const bool by_range = counting_ == BinCounting::BySlotRange && current_backend() == Backend::Cpu;
   parallel_for(
       "sim.bin.clear", slots, THRONG_LAMBDA(Index s) {
         keys[s] = kEmptyCell;
         count[s] = 0;
-        cursor[s] = 0;
+        if (!by_range) cursor[s] = 0;
       });
-  count_traffic("sim.bin.clear", keys, count, cursor);
-  // On the CPU, count and place by slot range (BinCounting): no atomic
-  // but the hashed grid's claims, and runs in index order as placed.
-  const bool by_range = counting_ == BinCounting::BySlotRange && current_backend() == Backend::Cpu;
+  if (by_range)
+    count_traffic("sim.bin.clear", keys, count);
+  else
+    count_traffic("sim.bin.clear", keys, count, cursor);
   if (by_range) {
     parallel_for("sim.bin.slot", n, CountCells{cells, positions, flags, keys, {}, slot_of});
     count_traffic("sim.bin.slot", positions, flags, keys, slot_of);
@@ -160,26 +177,18 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
         });
     count_traffic("sim.bin.scatter", slot_of, cursor, cursor, start, items);
   }
+  if (by_range) return;
   // Sort the atomic path's runs by agent index, and give a dense grid's
   // occupied slots their keys, for the slot-by-slot launches of the four
   // colours.
   const bool is_dense = dense();
-  if (by_range && !is_dense) return;
   parallel_for(
       "sim.bin.sort", slots, THRONG_LAMBDA(Index s) {
         const std::int32_t c = count[s];
-        if (c > 1 && !by_range) sort_run(items.data() + start[s], c);
-        if (is_dense && c > 0) {
-          // Slots are numbered in 32 bits (slot_of): a 32-bit division.
-          const auto s32 = static_cast<std::uint32_t>(s), nx = static_cast<std::uint32_t>(cells.dense_nx);
-          const auto x = static_cast<std::int32_t>(s32 % nx), y = static_cast<std::int32_t>(s32 / nx);
-          keys[s] = cell_key(cells.dense_x0 + x, cells.dense_y0 + y);
-        }
+        if (c > 1) sort_run(items.data() + start[s], c);
+        if (is_dense && c > 0) keys[s] = dense_slot_key(cells, s);
       });
-  if (by_range)
-    count_traffic("sim.bin.sort", keys, count);
-  else
-    count_traffic("sim.bin.sort", keys, count, start, items, items);
+  count_traffic("sim.bin.sort", keys, count, start, items, items);
 }
 
 // A few tasks, each over every agent: reading slot_of again per task costs
@@ -197,10 +206,21 @@ Index AgentGrid::place_by_slot_range(Index slots) {
   const auto in = [](std::int32_t s, Index lo, Index hi) {
     return static_cast<std::uint64_t>(s - lo) < static_cast<std::uint64_t>(hi - lo);
   };
+  // A dense grid's occupied slots get their keys here (the hashed grid's
+  // were claimed while finding the slots), for the slot-by-slot launches of
+  // the four colours: a pass over every slot of a sparse box cost more.
+  const bool is_dense = dense();
+  GridView box;
+  box.dense_x0 = dense_x0_, box.dense_y0 = dense_y0_, box.dense_nx = dense_nx_;
+  const Span<std::uint64_t> keys = keys_.span();
   host_parallel_for("sim.bin.count", tasks, [&](Index t) {
     const Index lo = first(t), hi = first(t + 1);
-    for (Index i = 0; i < n; ++i)
-      if (in(slot_of[i], lo, hi)) ++count[slot_of[i]];
+    for (Index i = 0; i < n; ++i) {
+      const std::int32_t s = slot_of[i];
+      if (!in(s, lo, hi) || count[s]++ > 0) continue;
+      cursor[s] = 0;
+      if (is_dense) keys[s] = dense_slot_key(box, s);
+    }
   });
   const Index binned = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
   host_parallel_for("sim.bin.place", tasks, [&](Index t) {
@@ -221,7 +241,8 @@ Index AgentGrid::place_by_slot_range(Index slots) {
 }
 
 // Dense when the box of the occupied cells (every cell of a wrapping axis)
-// has no more cells than the table has slots; records the box in `cells`.
+// has no more cells than the hash table would have slots, or than the dense
+// box limit per agent; records the box in `cells`.
 void AgentGrid::choose_layout(GridView& cells, Span<const glm::vec2> positions, Span<const std::uint8_t> flags,
                               bool allow_dense) {
   dense_nx_ = dense_ny_ = 0;
@@ -233,7 +254,10 @@ void AgentGrid::choose_layout(GridView& cells, Span<const glm::vec2> positions, 
     if (wrap_x_ > 0) box.x0 = 0, box.x1 = wrap_x_ - 1;
     if (wrap_y_ > 0) box.y0 = 0, box.y1 = wrap_y_ - 1;
     const std::int64_t nx = std::int64_t{box.x1} - box.x0 + 1, ny = std::int64_t{box.y1} - box.y0 + 1;
-    if (box.x0 <= box.x1 && box.y0 <= box.y1 && nx * ny <= keys_.size()) {
+    // (Slots are numbered in 32 bits: slot_of.)
+    const Index most = std::min<Index>(std::max<Index>(table_, dense_box_limit_ * positions.size()),
+                                       std::numeric_limits<std::int32_t>::max());
+    if (box.x0 <= box.x1 && box.y0 <= box.y1 && nx * ny <= most) {
       dense_x0_ = box.x0, dense_y0_ = box.y0;
       dense_nx_ = static_cast<std::int32_t>(nx), dense_ny_ = static_cast<std::int32_t>(ny);
     }

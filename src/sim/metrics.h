@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/span.h"
+#include "sim/agent_grid.h"
 #include "sim/geometry.h"
 #include "sim/world.h"
 

@@ -47,6 +47,8 @@ Simulation::Simulation(const ScenarioSpec& spec, const SimulationOptions& option
   contact_bins_ = AgentGrid(std::min(4.0f * max_radius_, spec_.model.query_radius()), world_.periodic());
   bins_.set_counting(options.bin_counting);
   contact_bins_.set_counting(options.bin_counting);
+  bins_.set_dense_box_limit(kDenseCellsPerItem);
+  contact_bins_.set_dense_box_limit(kDenseCellsPerItem);
   const Memory m = current_memory();
   anchor_ = Buffer<glm::vec2>(crowd_.count, m);
   candidate_ = Buffer<glm::vec2>(crowd_.count, m);

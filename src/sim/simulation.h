@@ -40,6 +40,7 @@
 #include <memory>
 #include <vector>
 
+#include "sim/agent_grid.h"
 #include "sim/collision_free_speed.h"
 #include "sim/crowd.h"
 #include "sim/exit_choice.h"

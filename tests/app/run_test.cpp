@@ -645,7 +645,7 @@ TEST_F(RunCommand, RequestsBeyondTheMemoryBudgetAreRefusedUpFront) {
       << o.out;
   o = run({"run", "plaza", "--agents", "2000000", "--max-memory", "500M", "--out", dir_.string()});
   EXPECT_EQ(o.code, 1) << o.out;
-  EXPECT_NE(o.out.find("--agents: about 1.19 GiB for 2000000 agents exceeds the memory budget of 500 MiB"),
+  EXPECT_NE(o.out.find("--agents: about 1.79 GiB for 2000000 agents exceeds the memory budget of 500 MiB"),
             std::string::npos)
       << o.out;
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(60)) << "the refusal came after the work";

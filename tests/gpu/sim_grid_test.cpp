@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "sim/crowd.h"
-#include "sim/grid.h"
+#include "sim/agent_grid.h"
 #include "tests/gpu/gpu_test.h"
 
 namespace throng::sim {

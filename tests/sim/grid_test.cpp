@@ -10,6 +10,7 @@
 #include <set>
 
 #include "core/exec.h"
+#include "sim/agent_grid.h"
 #include "sim/crowd.h"
 #include "sim/world.h"
 
@@ -131,6 +132,64 @@ TEST(CountingSort, ASparseCrowdIsHashed) {
   g.rebuild(p, flags);
   EXPECT_TRUE(g.dense());  // 4 x 3 cells fit the table's 16 slots
   EXPECT_EQ(read_back(g).cells.size(), 3u);
+}
+
+// With the simulation's dense box limit, a sparse crowd whose box of cells
+// outgrows the hash table but holds at most kDenseCellsPerItem cells per
+// agent is dense; a sparser one is hashed again, in the first slots of the
+// grown tables. Each rebuild holds
+// the runs a hashed grid holds, and the tables stay within the bound.
+TEST(CountingSort, ABoxOfUpToSixteenCellsPerAgentIsDense) {
+  const Index n = 64;  // a hash table of 128 slots; dense up to 1024 cells
+  const std::vector<std::uint8_t> flags(n, kAgentActive);
+  AgentGrid g(1.0f), reference(1.0f), table_only(1.0f);
+  g.set_dense_box_limit(kDenseCellsPerItem);
+  for (const float extent : {14.9f, 20.0f, 14.9f}) {  // boxes of 30 x 30 cells, then 40 x 40
+    std::vector<glm::vec2> p = random_points(n, extent, 11);
+    p[0] = {-extent, -extent}, p[1] = {extent, extent};
+    g.rebuild(p, flags);
+    reference.rebuild(p, flags, false);
+    table_only.rebuild(p, flags);  // no dense box limit: the hash table's 128 slots
+    SCOPED_TRACE(extent);
+    EXPECT_EQ(g.dense(), extent < 16.0f);
+    EXPECT_FALSE(table_only.dense());
+    EXPECT_EQ(read_back(g).cells, read_back(reference).cells);
+    EXPECT_LE(g.slots(), std::max<Index>(128, kDenseCellsPerItem * n));
+  }
+}
+
+// A static grid (the world's walls, circles, polygons) is dense over a
+// box of up to kDenseCellsPerItem cells per occupied cell, and finds the
+// same runs as the hashed table, in the box and out of it.
+TEST(StaticGrids, DenseAndHashedFindTheSameItems) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::int32_t> coord(-20, 20), item(0, 99);
+  std::vector<std::pair<std::uint64_t, std::int32_t>> pairs;
+  for (int k = 0; k < 300; ++k) pairs.push_back({cell_key(coord(rng), coord(rng)), item(rng)});
+  const StaticGrid dense(2.0f, pairs, Memory::Host), hashed(2.0f, pairs, Memory::Host, false);
+  ASSERT_TRUE(dense.dense());
+  ASSERT_FALSE(hashed.dense());
+  const GridView d = dense.view(), h = hashed.view();
+  for (std::int32_t x = -25; x <= 25; ++x)
+    for (std::int32_t y = -25; y <= 25; ++y) {
+      const Index a = d.find(x, y), b = h.find(x, y);
+      ASSERT_EQ(a < 0, b < 0) << x << ", " << y;
+      if (a < 0) continue;
+      ASSERT_EQ(d.count[a], h.count[b]);
+      for (std::int32_t m = 0; m < d.count[a]; ++m) EXPECT_EQ(d.items[d.start[a] + m], h.items[h.start[b] + m]);
+    }
+  // The 3 x 3 runs too (a dense row is one run: every slot's start is set).
+  for (std::int32_t x = -22; x <= 22; x += 3)
+    for (std::int32_t y = -22; y <= 22; y += 5) {
+      std::vector<std::int32_t> from_dense, from_hashed;
+      for_each_in_cells(d, cells_3x3(d, x, y), [&](std::int32_t k) { from_dense.push_back(k); });
+      for_each_in_cells(h, cells_3x3(h, x, y), [&](std::int32_t k) { from_hashed.push_back(k); });
+      EXPECT_EQ(from_dense, from_hashed) << x << ", " << y;
+    }
+  // Two cells far apart: a box of 10^6 cells for 2 occupied is hashed.
+  const StaticGrid sparse(2.0f, {{cell_key(0, 0), 1}, {cell_key(999, 999), 2}}, Memory::Host);
+  EXPECT_FALSE(sparse.dense());
+  EXPECT_GE(sparse.view().find(999, 999), 0);
 }
 
 TEST(CountingSort, RebuildAfterMovingAndWithNoAgents) {
