@@ -26,7 +26,7 @@ StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std
   occupied_ = cells;
   const Index cap = grid_capacity_for(cells);
   mask_ = static_cast<std::uint64_t>(cap - 1);
-  if (allow_dense) choose_dense_box(pairs, std::max<Index>(cap, kDenseCellsPerItem * cells));
+  if (allow_dense) choose_dense_box(pairs, 2 * cap);
   const bool dense = dense_nx_ > 0;
   // A dense grid's items run slot by slot (row by row), as AgentGrid's.
   const auto slot_of = [&](std::uint64_t key) {

@@ -311,12 +311,14 @@ THRONG_HOST_DEVICE inline void for_each_in_cell(const GridView& g, glm::vec2 p, 
 
 // Smallest power of two >= 2 * n (load factor <= 1/2), at least 16.
 Index grid_capacity_for(Index n);
-// The largest dense box, in cells per agent (the simulation's AgentGrids) or
-// per occupied cell (StaticGrid), 20 bytes each (docs/simulation.md, bins).
+// The largest dense box of the simulation's AgentGrids, in cells per agent,
+// 20 bytes each (docs/simulation.md, the bins).
 inline constexpr Index kDenseCellsPerItem = 16;
 
 // Host-built grid from (cell key, item) pairs; uploaded to `memory`. Dense
-// as AgentGrid's (per occupied cell) unless `allow_dense` is false.
+// when the box of its cells has at most twice as many cells as its hash
+// table would have slots (at most twice the memory), unless `allow_dense`
+// is false.
 class StaticGrid {
  public:
   StaticGrid() = default;

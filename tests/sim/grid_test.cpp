@@ -159,8 +159,8 @@ TEST(CountingSort, ABoxOfUpToSixteenCellsPerAgentIsDense) {
 }
 
 // A static grid (the world's walls, circles, polygons) is dense over a
-// box of up to kDenseCellsPerItem cells per occupied cell, and finds the
-// same runs as the hashed table, in the box and out of it.
+// box of up to twice its hash table's slots, and finds the same runs as
+// the hashed table, in the box and out of it.
 TEST(StaticGrids, DenseAndHashedFindTheSameItems) {
   std::mt19937 rng(5);
   std::uniform_int_distribution<std::int32_t> coord(-20, 20), item(0, 99);
