@@ -57,8 +57,9 @@ class AgentGrid {
   void choose_layout(GridView& cells, Span<const glm::vec2> positions, Span<const std::uint8_t> flags,
                      bool allow_dense);
   // Fills count, start and items (and a dense grid's keys) from slot_of by
-  // slot range (BinCounting); returns the agents binned.
-  Index place_by_slot_range(Index slots);
+  // slot range (BinCounting), `cells` the layout choose_layout recorded;
+  // returns the agents binned.
+  Index place_by_slot_range(const GridView& cells, Index slots);
 
   float asked_ = 1.0f, cell_size_ = 1.0f, cell_size_y_ = 1.0f;
   Periodic periodic_;

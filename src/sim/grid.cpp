@@ -29,9 +29,9 @@ StaticGrid::StaticGrid(float cell_size, std::vector<std::pair<std::uint64_t, std
   if (allow_dense) choose_dense_box(pairs, 2 * cap);
   const bool dense = dense_nx_ > 0;
   // A dense grid's items run slot by slot (row by row), as AgentGrid's.
+  const GridView box = geometry();
   const auto slot_of = [&](std::uint64_t key) {
-    return static_cast<std::uint64_t>(std::int64_t{key_cy(key)} - dense_y0_) * static_cast<std::uint64_t>(dense_nx_) +
-           static_cast<std::uint64_t>(key_cx(key) - dense_x0_);
+    return static_cast<std::uint64_t>(box.dense_slot(key_cx(key), key_cy(key)));
   };
   if (dense)
     std::stable_sort(pairs.begin(), pairs.end(),
@@ -78,12 +78,17 @@ void StaticGrid::choose_dense_box(const std::vector<std::pair<std::uint64_t, std
   dense_nx_ = static_cast<std::int32_t>(nx), dense_ny_ = static_cast<std::int32_t>(ny);
 }
 
-GridView StaticGrid::view() const {
+GridView StaticGrid::geometry() const {
   GridView v;
   v.cell_size = v.cell_size_y = cell_size_;
   v.mask = mask_;
   v.dense_x0 = dense_x0_, v.dense_y0 = dense_y0_;
   v.dense_nx = dense_nx_, v.dense_ny = dense_ny_;
+  return v;
+}
+
+GridView StaticGrid::view() const {
+  GridView v = geometry();
   v.keys = keys_.span();
   v.start = start_.span();
   v.count = count_.span();
@@ -92,11 +97,7 @@ GridView StaticGrid::view() const {
 }
 
 GridView StaticGrid::host_view() const {
-  GridView v;
-  v.cell_size = v.cell_size_y = cell_size_;
-  v.mask = mask_;
-  v.dense_x0 = dense_x0_, v.dense_y0 = dense_y0_;
-  v.dense_nx = dense_nx_, v.dense_ny = dense_ny_;
+  GridView v = geometry();
   v.keys = Span<const std::uint64_t>(host_keys_.data(), static_cast<Index>(host_keys_.size()));
   v.start = Span<const std::int32_t>(host_start_.data(), static_cast<Index>(host_start_.size()));
   v.count = Span<const std::int32_t>(host_count_.data(), static_cast<Index>(host_count_.size()));

@@ -342,6 +342,7 @@ class StaticGrid {
   Buffer<std::int32_t> start_, count_, items_;
 
   void choose_dense_box(const std::vector<std::pair<std::uint64_t, std::int32_t>>& pairs, Index most);
+  GridView geometry() const;  // the cells and layout, no tables
 };
 
 }  // namespace throng::sim

@@ -161,7 +161,7 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
   if (by_range) {
     parallel_for("sim.bin.slot", n, CountCells{cells, positions, flags, keys, {}, slot_of});
     count_traffic("sim.bin.slot", positions, flags, keys, slot_of);
-    binned_ = place_by_slot_range(slots);
+    binned_ = place_by_slot_range(cells, slots);
   } else {
     parallel_for("sim.bin.count", n, CountCells{cells, positions, flags, keys, count, slot_of});
     count_traffic("sim.bin.count", positions, flags, keys, count, count, slot_of);
@@ -195,7 +195,7 @@ void AgentGrid::rebuild(Span<const glm::vec2> positions, Span<const std::uint8_t
 // less than a locked add per agent, but not for small crowds. Host code
 // (host_parallel_for) kept in this file so that exclusive_scan and its
 // kernels are compiled by nvcc, with their CUDA branch, in CUDA builds.
-Index AgentGrid::place_by_slot_range(Index slots) {
+Index AgentGrid::place_by_slot_range(const GridView& cells, Index slots) {
   const Index n = slot_of_agent_.size();
   const Index tasks = std::max<Index>(1, std::min<Index>({n / 8192, current_threads(), slots}));
   const Span<const std::int32_t> slot_of = slot_of_agent_.span();
@@ -210,8 +210,6 @@ Index AgentGrid::place_by_slot_range(Index slots) {
   // were claimed while finding the slots), for the slot-by-slot launches of
   // the four colours: a pass over every slot of a sparse box cost more.
   const bool is_dense = dense();
-  GridView box;
-  box.dense_x0 = dense_x0_, box.dense_y0 = dense_y0_, box.dense_nx = dense_nx_;
   const Span<std::uint64_t> keys = keys_.span();
   host_parallel_for("sim.bin.count", tasks, [&](Index t) {
     const Index lo = first(t), hi = first(t + 1);
@@ -219,7 +217,7 @@ Index AgentGrid::place_by_slot_range(Index slots) {
       const std::int32_t s = slot_of[i];
       if (!in(s, lo, hi) || count[s]++ > 0) continue;
       cursor[s] = 0;
-      if (is_dense) keys[s] = dense_slot_key(box, s);
+      if (is_dense) keys[s] = dense_slot_key(cells, s);
     }
   });
   const Index binned = exclusive_scan("sim.bin.scan", Span<const std::int32_t>(count), start);
